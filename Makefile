@@ -1,0 +1,42 @@
+# siloflow: the two commands a newcomer needs are `make run` and `make test`.
+# Both install what is missing first (Debian packages, then the Python package) and are idempotent.
+
+PYTHON   ?= python3
+CONFIG   ?= config/config.yaml
+CORES    ?= 2
+SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
+APT_PACKAGES := liggghts openmpi-bin
+
+.PHONY: install install-system install-python run test test-unit test-integration dry-run clean-help
+
+install: install-system install-python
+
+# Debian packages: only when the engine or MPI launcher is missing.
+install-system:
+	@if ! command -v liggghts >/dev/null 2>&1 || ! command -v mpirun >/dev/null 2>&1; then \
+		echo "Installing $(APT_PACKAGES) with apt-get"; \
+		$(SUDO) apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PACKAGES); \
+	else \
+		echo "LIGGGHTS: $$(command -v liggghts), MPI: $$(command -v mpirun)"; \
+	fi
+
+# pip is a no-op when everything is already satisfied.
+install-python:
+	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+
+run: install
+	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete
+	@$(PYTHON) -m engines.summary --configfile $(CONFIG)
+
+test: install
+	$(PYTHON) -m pytest tests
+
+test-unit: install
+	$(PYTHON) -m pytest tests/unit
+
+test-integration: install
+	$(PYTHON) -m pytest tests/integration
+
+dry-run: install
+	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)

@@ -1,0 +1,23 @@
+# siloflow: DEM calibration, validation and blending of pellets in silos.
+# Thin entry point: validate the config, include one rule file per stage, declare the final targets.
+
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/silo.smk"
+
+
+rule all:
+    input:
+        silo_flat_targets(),
+    default_target: True
+
+
+onsuccess:
+    print_result_locations()

@@ -1,0 +1,704 @@
+"""Silo discharge: bulk density, discharged mass, mass flow rate, Beverloo, clump volume.
+
+Pure functions on numpy arrays; no file I/O (readers and writers live at the edges).
+All quantities are SI: lengths in m, masses in kg, times in s, densities in kg/m3.
+
+Coordinates follow the project convention: x across the silo width (x = 0 on the
+axis), y front-to-back depth (0 <= y <= T), z up with z = 0 at the outlet plane
+(the silo floor).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "BulkDensity",
+    "DischargeHistory",
+    "FlowRateFit",
+    "beverloo_mass_flow_rate",
+    "column_surface_heights",
+    "filling_bulk_density",
+    "mass_in_silo",
+    "discharged_mass_history",
+    "steady_flow_rate",
+    "volumetric_flow_rate",
+    "clump_volume",
+    "equivalent_diameter",
+]
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True)
+class BulkDensity:
+    """Filling bulk density of the settled fill.
+
+    Attributes
+    ----------
+    density : float
+        Bulk density [kg/m3].
+    measured_height : float
+        Measurement height z_m above the floor [m]; the control volume is W * T * z_m.
+    mass : float
+        Mass of the clumps whose centre lies in the control volume [kg].
+    volume : float
+        Control volume W * T * z_m [m3].
+    """
+
+    density: float
+    measured_height: float
+    mass: float
+    volume: float
+
+
+@dataclass(frozen=True)
+class DischargeHistory:
+    """Discharged mass against time since the outlet opened.
+
+    Attributes
+    ----------
+    time : numpy.ndarray
+        Time since the outlet opened, ``times - times[0]`` [s].
+    discharged_mass : numpy.ndarray
+        Mass that has left the silo, ``masses_in_silo[0] - masses_in_silo`` [kg].
+    """
+
+    time: np.ndarray
+    discharged_mass: np.ndarray
+
+
+@dataclass(frozen=True)
+class FlowRateFit:
+    """Ordinary least-squares fit of discharged mass over the steady window.
+
+    Attributes
+    ----------
+    mass_flow_rate : float
+        Fitted slope d(discharged mass)/dt [kg/s].
+    standard_error : float
+        Standard error of the slope [kg/s].
+    t_start, t_end : float
+        Steady window used for the fit [s].
+    n_points : int
+        Number of samples inside the window.
+    intercept : float
+        Fitted discharged mass at t = 0 [kg]; the fitted line is
+        ``intercept + mass_flow_rate * t``.
+    """
+
+    mass_flow_rate: float
+    standard_error: float
+    t_start: float
+    t_end: float
+    n_points: int
+    intercept: float
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _positive(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def _non_negative(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value) or value < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return value
+
+
+def _finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
+    array = np.asarray(values, dtype=float)
+    if ndim is not None and array.ndim != ndim:
+        raise ValueError(f"{name} must be a {ndim}-D array, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must contain only finite numbers")
+    return array
+
+
+def _per_particle(name: str, values, n: int) -> np.ndarray:
+    """Broadcast a scalar or length-n array (e.g. masses, radii) to length n."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim == 0:
+        array = np.full(n, float(array))
+    if array.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or np.any(array < 0.0):
+        raise ValueError(f"{name} must contain finite numbers >= 0")
+    return array
+
+
+# --------------------------------------------------------------------------- Beverloo
+
+
+def beverloo_mass_flow_rate(
+    bulk_density: float,
+    outlet_width: float,
+    outlet_length: float,
+    particle_diameter: float,
+    discharge_coefficient: float = 0.58,
+    shape_coefficient: float = 1.5,
+    gravity: float = 9.81,
+) -> float:
+    """Beverloo mass flow rate through a slot outlet.
+
+    ``W = C * rho_b * sqrt(g) * L * (B0 - k d)**1.5``
+
+    Parameters
+    ----------
+    bulk_density : float
+        Bulk density rho_b of the flowing material [kg/m3].
+    outlet_width : float
+        Slot width B0, across the silo width [m].
+    outlet_length : float
+        Slot length L, here the full silo depth T [m].
+    particle_diameter : float
+        Particle (equivalent) diameter d [m].
+    discharge_coefficient : float, optional
+        Beverloo coefficient C [-] (default 0.58).
+    shape_coefficient : float, optional
+        Empty-annulus coefficient k [-] (default 1.5).
+    gravity : float, optional
+        Gravitational acceleration g [m/s2] (default 9.81).
+
+    Returns
+    -------
+    float
+        Mass flow rate [kg/s].
+
+    Raises
+    ------
+    ValueError
+        If an argument is not a finite positive number (k may be 0), or if the
+        effective outlet width ``B0 - k d`` is not positive.
+    """
+    bulk_density = _positive("bulk_density", bulk_density)
+    outlet_width = _positive("outlet_width", outlet_width)
+    outlet_length = _positive("outlet_length", outlet_length)
+    particle_diameter = _positive("particle_diameter", particle_diameter)
+    discharge_coefficient = _positive("discharge_coefficient", discharge_coefficient)
+    shape_coefficient = _non_negative("shape_coefficient", shape_coefficient)
+    gravity = _positive("gravity", gravity)
+
+    effective_width = outlet_width - shape_coefficient * particle_diameter
+    if effective_width <= 0.0:
+        raise ValueError(
+            f"outlet too small for particles: B0 - k d = {effective_width:.6g} m "
+            f"(outlet_width B0 = {outlet_width:.6g} m, k = {shape_coefficient:.6g}, d = {particle_diameter:.6g} m)"
+        )
+    return (
+        discharge_coefficient
+        * bulk_density
+        * math.sqrt(gravity)
+        * outlet_length
+        * effective_width**1.5
+    )
+
+
+def volumetric_flow_rate(mass_flow_rate: float, bulk_density: float) -> float:
+    """Volumetric flow rate of bulk material.
+
+    Parameters
+    ----------
+    mass_flow_rate : float
+        Mass flow rate [kg/s].
+    bulk_density : float
+        Bulk density [kg/m3].
+
+    Returns
+    -------
+    float
+        Volumetric flow rate ``mass_flow_rate / bulk_density`` [m3/s].
+    """
+    mass_flow_rate = float(mass_flow_rate)
+    if not math.isfinite(mass_flow_rate):
+        raise ValueError(f"mass_flow_rate must be finite, got {mass_flow_rate!r}")
+    bulk_density = _positive("bulk_density", bulk_density)
+    return mass_flow_rate / bulk_density
+
+
+# --------------------------------------------------------------------------- fill
+
+
+def column_surface_heights(x, z, radius, width: float, n_columns: int) -> np.ndarray:
+    """Free-surface height of the fill in vertical columns across the width.
+
+    The width ``[-W/2, W/2]`` is split into ``n_columns`` equal columns; each
+    particle belongs to the column containing its centre (a centre exactly on
+    ``+W/2`` belongs to the last column). Particles whose centre lies outside the
+    width are ignored.
+
+    Parameters
+    ----------
+    x, z : array_like, shape (n,)
+        Particle centre coordinates [m].
+    radius : float or array_like, shape (n,)
+        Particle radius, added to z to get the particle top [m].
+    width : float
+        Silo width W [m].
+    n_columns : int
+        Number of columns (>= 1).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_columns,)
+        Highest particle top ``z + radius`` per column [m]; NaN for an empty column.
+    """
+    x = _finite_array("x", x)
+    z = _finite_array("z", z)
+    if x.shape != z.shape:
+        raise ValueError(f"x and z must have the same shape, got {x.shape} and {z.shape}")
+    radius = _per_particle("radius", radius, x.size)
+    width = _positive("width", width)
+    if isinstance(n_columns, bool) or int(n_columns) != n_columns or n_columns < 1:
+        raise ValueError(f"n_columns must be an integer >= 1, got {n_columns!r}")
+    n_columns = int(n_columns)
+
+    half_width = 0.5 * width
+    inside = (x >= -half_width) & (x <= half_width)
+    column_index = np.floor((x[inside] + half_width) / width * n_columns).astype(np.intp)
+    # x == +W/2 would fall into a column past the end.
+    column_index = np.minimum(column_index, n_columns - 1)
+
+    heights = np.full(n_columns, -np.inf)
+    np.maximum.at(heights, column_index, z[inside] + radius[inside])
+    heights[np.isneginf(heights)] = np.nan
+    return heights
+
+
+def filling_bulk_density(
+    clump_position,
+    clump_mass,
+    width: float,
+    depth: float,
+    surface_margin: float,
+    n_columns: int | None = None,
+    radius=None,
+) -> BulkDensity:
+    """Bulk density of the settled fill, excluding the heap on top.
+
+    A centrally filled silo has a heap (a free surface at the angle of repose)
+    on top of the fill, so ``total mass / (W T H)`` depends on how H is chosen.
+    Instead the density is measured in a control volume that the fill covers
+    completely: the box ``[-W/2, W/2] x [0, T] x [0, z_m)`` with
+
+        ``z_m = min(column surface heights) - surface_margin``,
+
+    i.e. a margin below the lowest point of the free surface (found per column
+    by :func:`column_surface_heights`, normally at a side wall). The density is
+    the mass of the clumps whose centre lies in ``0 <= z < z_m`` divided by
+    ``W * T * z_m``. Counting whole clumps by their centre makes an error of at
+    most one layer of clumps at ``z = z_m``, which averages out for a random
+    packing and vanishes when ``z_m`` falls between layers of a lattice. The margin
+    should be at least a particle diameter so that the loose top layer and the
+    roughness of the surface are excluded. Wall effects (lower packing density
+    next to the walls) are part of the measured bulk density, as in the
+    experiment (mass of a known filled volume).
+
+    Parameters
+    ----------
+    clump_position : array_like, shape (n, 3)
+        Clump centre (centre of mass) positions [m].
+    clump_mass : float or array_like, shape (n,)
+        Clump masses [kg].
+    width : float
+        Silo width W [m].
+    depth : float
+        Silo depth T (front to back) [m].
+    surface_margin : float
+        Distance below the lowest surface height where the control volume ends [m].
+    n_columns : int, optional
+        Number of columns used to find the lowest surface height. Default: 10.
+        Each column must contain particles (a column should be a few particle
+        diameters wide).
+    radius : float or array_like, shape (n,), optional
+        Clump bounding radius added to z for the surface height [m]. Default 0
+        (surface through the clump centres; then the margin must cover it).
+
+    Returns
+    -------
+    BulkDensity
+        Density [kg/m3], measured height z_m [m], mass [kg], volume [m3].
+
+    Raises
+    ------
+    ValueError
+        If inputs are malformed, a column is empty (the fill does not cover the
+        floor: fewer columns are needed), or ``z_m <= 0`` (margin too large).
+    """
+    positions = _finite_array("clump_position", clump_position, ndim=2)
+    if positions.shape[1] != 3 or positions.shape[0] == 0:
+        raise ValueError(f"clump_position must have shape (n, 3) with n >= 1, got {positions.shape}")
+    n_clumps = positions.shape[0]
+    masses = _per_particle("clump_mass", clump_mass, n_clumps)
+    width = _positive("width", width)
+    depth = _positive("depth", depth)
+    surface_margin = _non_negative("surface_margin", surface_margin)
+    if n_columns is None:
+        n_columns = 10
+    if radius is None:
+        radius = 0.0
+
+    heights = column_surface_heights(positions[:, 0], positions[:, 2], radius, width, n_columns)
+    if np.any(np.isnan(heights)):
+        empty = np.flatnonzero(np.isnan(heights)).tolist()
+        raise ValueError(
+            f"n_columns = {n_columns}: columns {empty} contain no clumps; the fill does not "
+            "cover the floor or the columns are too narrow"
+        )
+    measured_height = float(np.min(heights)) - surface_margin
+    if measured_height <= 0.0:
+        raise ValueError(
+            f"surface_margin = {surface_margin:.6g} m leaves no control volume: lowest surface "
+            f"height {float(np.min(heights)):.6g} m, measurement height {measured_height:.6g} m"
+        )
+
+    z = positions[:, 2]
+    in_control_volume = (z >= 0.0) & (z < measured_height)
+    mass = float(np.sum(masses[in_control_volume]))
+    volume = width * depth * measured_height
+    return BulkDensity(
+        density=mass / volume, measured_height=measured_height, mass=mass, volume=volume
+    )
+
+
+# --------------------------------------------------------------------------- discharge
+
+
+def mass_in_silo(clump_z, clump_mass, outlet_plane: float = 0.0) -> float:
+    """Mass of the clumps still in the silo.
+
+    Parameters
+    ----------
+    clump_z : array_like, shape (n,)
+        Clump centre heights [m].
+    clump_mass : float or array_like, shape (n,)
+        Clump masses [kg].
+    outlet_plane : float, optional
+        Height of the outlet plane [m] (default 0, the silo floor).
+
+    Returns
+    -------
+    float
+        Total mass of the clumps with centre at or above the outlet plane [kg].
+    """
+    clump_z = _finite_array("clump_z", clump_z)
+    masses = _per_particle("clump_mass", clump_mass, clump_z.size)
+    outlet_plane = float(outlet_plane)
+    if not math.isfinite(outlet_plane):
+        raise ValueError(f"outlet_plane must be finite, got {outlet_plane!r}")
+    return float(np.sum(masses[clump_z >= outlet_plane]))
+
+
+def discharged_mass_history(times, masses_in_silo) -> DischargeHistory:
+    """Discharged mass against time since the outlet opened.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Simulation times of the frames, strictly increasing; ``times[0]`` is the
+        moment the outlet opened [s].
+    masses_in_silo : array_like, shape (n,)
+        Mass in the silo at each time, e.g. from :func:`mass_in_silo` [kg].
+
+    Returns
+    -------
+    DischargeHistory
+        ``time = times - times[0]`` [s], ``discharged_mass = masses_in_silo[0] - masses_in_silo`` [kg].
+    """
+    times = _finite_array("times", times)
+    masses = _finite_array("masses_in_silo", masses_in_silo)
+    if times.size == 0:
+        raise ValueError("times must contain at least one sample")
+    if times.shape != masses.shape:
+        raise ValueError(
+            f"times and masses_in_silo must have equal lengths, got {times.size} and {masses.size}"
+        )
+    if np.any(np.diff(times) <= 0.0):
+        raise ValueError("times must be strictly increasing")
+    return DischargeHistory(time=times - times[0], discharged_mass=masses[0] - masses)
+
+
+def steady_flow_rate(
+    time,
+    discharged_mass,
+    window: tuple[float, float] | None = None,
+    fraction_window: tuple[float, float] = (0.2, 0.8),
+) -> FlowRateFit:
+    """Steady mass flow rate: least-squares slope of discharged mass over time.
+
+    Batch discharge has a start-up transient (the flow accelerates after the
+    outlet opens) and an end phase (when the free surface reaches the outlet
+    the rate drops). Between them the rate of a silo is nearly constant
+    (independent of fill height, which is what Beverloo describes), so the
+    slope is fitted only over a steady window:
+
+    * ``window=(t0, t1)``: the samples with ``t0 <= t <= t1``;
+    * otherwise an automatic window, from the first time the discharged mass
+      reaches ``fraction_window[0]`` of its final value to the first time it
+      reaches ``fraction_window[1]`` of it. Using fractions of the discharged mass
+      (not of the time) places the window inside the steady phase whatever the
+      duration of the run.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Time since the outlet opened, strictly increasing [s].
+    discharged_mass : array_like, shape (n,)
+        Discharged mass [kg].
+    window : tuple of float, optional
+        Explicit fit window ``(t0, t1)`` [s].
+    fraction_window : tuple of float, optional
+        Fractions of the final discharged mass bounding the automatic window,
+        ``0 <= f0 < f1 <= 1`` (default ``(0.2, 0.8)``).
+
+    Returns
+    -------
+    FlowRateFit
+        Slope [kg/s], its standard error [kg/s], the window [s], the number of
+        samples, and the intercept [kg].
+
+    Raises
+    ------
+    ValueError
+        On malformed input, or if fewer than 3 samples lie in the window (the
+        standard error needs n - 2 >= 1 degrees of freedom).
+    """
+    time = _finite_array("time", time)
+    mass = _finite_array("discharged_mass", discharged_mass)
+    if time.shape != mass.shape:
+        raise ValueError(
+            f"time and discharged_mass must have equal lengths, got {time.size} and {mass.size}"
+        )
+    if time.size == 0:
+        raise ValueError("time must contain at least one sample")
+    if np.any(np.diff(time) <= 0.0):
+        raise ValueError("time must be strictly increasing")
+
+    if window is not None:
+        if len(window) != 2:
+            raise ValueError(f"window must be (t0, t1), got {window!r}")
+        t_start, t_end = float(window[0]), float(window[1])
+        if not (math.isfinite(t_start) and math.isfinite(t_end)) or t_end <= t_start:
+            raise ValueError(f"window must be finite with t0 < t1, got {window!r}")
+        window_description = f"window = ({t_start:.6g}, {t_end:.6g}) s"
+    else:
+        if len(fraction_window) != 2:
+            raise ValueError(f"fraction_window must be (f0, f1), got {fraction_window!r}")
+        f_low, f_high = float(fraction_window[0]), float(fraction_window[1])
+        if not (0.0 <= f_low < f_high <= 1.0):
+            raise ValueError(f"fraction_window must satisfy 0 <= f0 < f1 <= 1, got {fraction_window!r}")
+        final_mass = float(mass[-1])
+        if final_mass <= 0.0:
+            raise ValueError(
+                f"fraction_window: final discharged mass is {final_mass:.6g} kg; nothing was discharged"
+            )
+        # argmax on a boolean array gives the first True; the final sample always qualifies.
+        t_start = float(time[np.argmax(mass >= f_low * final_mass)])
+        t_end = float(time[np.argmax(mass >= f_high * final_mass)])
+        window_description = (
+            f"fraction_window = ({f_low:.6g}, {f_high:.6g}) -> window ({t_start:.6g}, {t_end:.6g}) s"
+        )
+
+    in_window = (time >= t_start) & (time <= t_end)
+    n_points = int(np.count_nonzero(in_window))
+    if n_points < 3:
+        raise ValueError(f"{window_description} holds {n_points} samples; at least 3 are needed")
+
+    t_fit = time[in_window]
+    m_fit = mass[in_window]
+    # Centre the data before forming sums so the slope is exact for linear data.
+    t_mean = t_fit.mean()
+    m_mean = m_fit.mean()
+    dt = t_fit - t_mean
+    sxx = float(np.dot(dt, dt))
+    slope = float(np.dot(dt, m_fit - m_mean)) / sxx
+    intercept = float(m_mean - slope * t_mean)
+    residuals = m_fit - (intercept + slope * t_fit)
+    residual_variance = float(np.dot(residuals, residuals)) / (n_points - 2)
+    standard_error = math.sqrt(residual_variance / sxx)
+    return FlowRateFit(
+        mass_flow_rate=slope,
+        standard_error=standard_error,
+        t_start=t_start,
+        t_end=t_end,
+        n_points=n_points,
+        intercept=intercept,
+    )
+
+
+# --------------------------------------------------------------------------- clump volume
+
+
+def _sphere_volume(radius: float) -> float:
+    return 4.0 / 3.0 * math.pi * radius**3
+
+
+def _two_sphere_union_volume(r1: float, r2: float, distance: float) -> float:
+    """Exact volume of the union of two spheres [m3].
+
+    The overlap (lens) of spheres of radii r1, r2 at centre distance d, with
+    ``|r1 - r2| < d < r1 + r2``, is
+    ``V_lens = pi (r1 + r2 - d)^2 (d^2 + 2 d (r1 + r2) - 3 (r1 - r2)^2) / (12 d)``,
+    which for equal radii r reduces to ``pi (4 r + d)(2 r - d)^2 / 12``.
+    """
+    separate = _sphere_volume(r1) + _sphere_volume(r2)
+    if distance >= r1 + r2:
+        return separate
+    if distance <= abs(r1 - r2):
+        # One sphere lies inside the other.
+        return _sphere_volume(max(r1, r2))
+    lens = (
+        math.pi
+        * (r1 + r2 - distance) ** 2
+        * (distance**2 + 2.0 * distance * (r1 + r2) - 3.0 * (r1 - r2) ** 2)
+        / (12.0 * distance)
+    )
+    return separate - lens
+
+
+def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution: int) -> float:
+    """Volume of a union of spheres: exact chord lengths in z, midpoint rule in (x, y).
+
+    The bounding box in x and y is divided into ``resolution x resolution`` cells.
+    Along the vertical line through each cell centre the union of the spheres is
+    a union of intervals whose total length is computed exactly (sort by lower
+    end, sweep). Integrating that length over (x, y) with the midpoint rule
+    gives the volume. The integrand is continuous (it vanishes like a square
+    root at the silhouette), so the error falls like ``resolution**-2``; at the
+    default resolution of 400 it is ~1e-5 relative, well below 1e-3. Deterministic.
+    """
+    lower = (centres[:, :2] - radii[:, None]).min(axis=0)
+    upper = (centres[:, :2] + radii[:, None]).max(axis=0)
+    step = (upper - lower) / resolution
+    x_cells = lower[0] + (np.arange(resolution) + 0.5) * step[0]
+    y_cells = lower[1] + (np.arange(resolution) + 0.5) * step[1]
+
+    # Chunk over x rows so memory stays bounded (~ a few million values) for many spheres.
+    n_spheres = radii.size
+    rows_per_chunk = max(1, int(2_000_000 // (resolution * n_spheres)))
+    total_length = 0.0
+    for row_start in range(0, resolution, rows_per_chunk):
+        xs, ys = np.meshgrid(x_cells[row_start : row_start + rows_per_chunk], y_cells, indexing="ij")
+        xs = xs.ravel()[:, None]
+        ys = ys.ravel()[:, None]
+        rho_squared = (xs - centres[None, :, 0]) ** 2 + (ys - centres[None, :, 1]) ** 2
+        half_chord_squared = radii[None, :] ** 2 - rho_squared
+        hits = half_chord_squared > 0.0
+        half_chord = np.sqrt(np.where(hits, half_chord_squared, 0.0))
+        low = np.where(hits, centres[None, :, 2] - half_chord, np.inf)
+        high = np.where(hits, centres[None, :, 2] + half_chord, np.inf)
+
+        order = np.argsort(low, axis=1)
+        low = np.take_along_axis(low, order, axis=1)
+        high = np.take_along_axis(high, order, axis=1)
+        hits = np.take_along_axis(hits, order, axis=1)
+
+        reach = np.full(xs.shape[0], -np.inf)  # highest z covered so far on each line
+        length = np.zeros(xs.shape[0])
+        for k in range(n_spheres):
+            valid = hits[:, k]
+            # Misses carry infinite ends (sorted last); zero them so no inf - inf occurs.
+            high_k = np.where(valid, high[:, k], 0.0)
+            start = np.where(valid, np.maximum(low[:, k], reach), 0.0)
+            length += np.maximum(high_k - start, 0.0)
+            reach = np.where(valid, np.maximum(reach, high_k), reach)
+        total_length += float(length.sum())
+    return total_length * float(step[0] * step[1])
+
+
+def clump_volume(
+    sphere_positions,
+    sphere_radii,
+    resolution: int = 400,
+    method: str = "auto",
+) -> float:
+    """Volume of a multisphere clump (union of possibly overlapping spheres).
+
+    Parameters
+    ----------
+    sphere_positions : array_like, shape (k, 3)
+        Sphere centres [m].
+    sphere_radii : array_like, shape (k,)
+        Sphere radii [m], > 0.
+    resolution : int, optional
+        Grid cells per horizontal axis for the numerical path (>= 10).
+    method : {"auto", "grid"}, optional
+        ``"auto"`` uses the closed forms where they apply; ``"grid"`` forces the
+        numerical integration (used to test it against the closed forms).
+
+    Returns
+    -------
+    float
+        Clump volume [m3].
+
+    Notes
+    -----
+    * One sphere: ``4/3 pi r^3``.
+    * Two spheres: the sphere volumes minus the exact lens volume
+      (``pi (4 r + d)(2 r - d)^2 / 12`` for equal radii at distance d; the
+      general unequal-radii formula otherwise).
+    * Pairwise disjoint spheres: the sum of their volumes.
+    * Otherwise numerical integration: on a regular ``resolution x resolution``
+      grid over the bounding box in (x, y), the length of the union along each
+      vertical line through a cell centre is computed exactly and the lengths
+      are summed (midpoint rule). The error falls like ``resolution**-2``: the
+      relative error is ~2e-4 at a resolution of 100 and ~1e-5 at the
+      default 400. Deterministic (no random sampling).
+    """
+    centres = _finite_array("sphere_positions", sphere_positions, ndim=2)
+    if centres.shape[1] != 3 or centres.shape[0] == 0:
+        raise ValueError(f"sphere_positions must have shape (k, 3) with k >= 1, got {centres.shape}")
+    radii = _finite_array("sphere_radii", sphere_radii)
+    if radii.shape != (centres.shape[0],):
+        raise ValueError(
+            f"sphere_radii must have shape ({centres.shape[0]},), got {radii.shape}"
+        )
+    if np.any(radii <= 0.0):
+        raise ValueError("sphere_radii must be > 0")
+    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 10:
+        raise ValueError(f"resolution must be an integer >= 10, got {resolution!r}")
+    if method not in ("auto", "grid"):
+        raise ValueError(f"method must be 'auto' or 'grid', got {method!r}")
+
+    if method == "auto":
+        if radii.size == 1:
+            return _sphere_volume(float(radii[0]))
+        if radii.size == 2:
+            distance = float(np.linalg.norm(centres[1] - centres[0]))
+            return _two_sphere_union_volume(float(radii[0]), float(radii[1]), distance)
+        distances = np.linalg.norm(centres[:, None, :] - centres[None, :, :], axis=-1)
+        contact = radii[:, None] + radii[None, :]
+        off_diagonal = ~np.eye(radii.size, dtype=bool)
+        if np.all(distances[off_diagonal] >= contact[off_diagonal]):
+            return float(sum(_sphere_volume(r) for r in radii))
+    return _union_volume_by_columns(centres, radii, int(resolution))
+
+
+def equivalent_diameter(volume):
+    """Diameter of the sphere with the given volume.
+
+    Parameters
+    ----------
+    volume : float or array_like
+        Volume [m3], > 0.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``(6 V / pi)**(1/3)`` [m].
+    """
+    volume_array = np.asarray(volume, dtype=float)
+    if not np.all(np.isfinite(volume_array)) or np.any(volume_array <= 0.0):
+        raise ValueError(f"volume must be finite and > 0, got {volume!r}")
+    diameter = np.cbrt(6.0 * volume_array / math.pi)
+    return float(diameter) if diameter.ndim == 0 else diameter

@@ -1,0 +1,192 @@
+"""Loading and validating siloflow configuration.
+
+The schema in ``workflow/schemas/config.schema.yaml`` is the single source of truth: it declares every key
+with a description and a default. Validation fills the defaults (as Snakemake's ``validate`` does) and
+then checks what a JSON schema cannot express: that names refer to defined materials and particle models,
+and that every material pair a case brings into contact has contact parameters.
+
+Errors are reported as one :class:`ConfigError` naming the offending key, before any simulation starts.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import jsonschema
+import yaml
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+class ConfigError(ValueError):
+    """A configuration value is invalid; the message names the key."""
+
+
+def load_schema(path: Path = SCHEMA_PATH) -> dict:
+    """Read the configuration JSON schema (YAML syntax)."""
+    with open(path, encoding="utf-8") as handle:
+        return yaml.safe_load(handle)
+
+
+def load_config_file(path: str | Path) -> dict:
+    """Read a YAML configuration file into a dict (no validation)."""
+    with open(path, encoding="utf-8") as handle:
+        loaded = yaml.safe_load(handle)
+    if loaded is None:
+        return {}
+    if not isinstance(loaded, dict):
+        raise ConfigError(f"{path}: the top level of a config file must be a mapping, got {type(loaded).__name__}")
+    return loaded
+
+
+def _with_defaults(validator_class):
+    """Extend a jsonschema validator so that ``properties`` fills in declared defaults."""
+    validate_properties = validator_class.VALIDATORS["properties"]
+
+    def set_defaults(validator, properties, instance, schema):
+        if isinstance(instance, dict):
+            for name, subschema in properties.items():
+                if name not in instance and "default" in subschema:
+                    instance[name] = copy.deepcopy(subschema["default"])
+        yield from validate_properties(validator, properties, instance, schema)
+
+    return jsonschema.validators.extend(validator_class, {"properties": set_defaults})
+
+
+_DefaultFillingValidator = _with_defaults(jsonschema.Draft7Validator)
+
+
+def _key_path(path: Iterable[Any]) -> str:
+    parts = []
+    for element in path:
+        if isinstance(element, int):
+            parts.append(f"[{element}]")
+        else:
+            parts.append(("." if parts else "") + str(element))
+    return "".join(parts) or "<top level>"
+
+
+def _describe(error: jsonschema.ValidationError) -> str:
+    key = _key_path(error.absolute_path)
+    value = error.instance
+    message = error.message
+    if error.validator == "additionalProperties":
+        return f"config key '{key}': {message} (check the spelling against the schema)"
+    if error.validator == "type" and isinstance(value, str):
+        try:
+            float(value)
+        except ValueError:
+            pass
+        else:
+            message += f" (YAML reads '{value}' as a string: write the exponent with a sign, e.g. 5.0e+6)"
+    description = error.schema.get("description") if isinstance(error.schema, dict) else None
+    if description is None and len(error.relative_schema_path) > 1:
+        parent = error.parent
+        description = parent.schema.get("description") if parent is not None else None
+    suffix = f" [{description.strip()}]" if description else ""
+    return f"config key '{key}': {message}{suffix}"
+
+
+def _error_depth_key(error: jsonschema.ValidationError):
+    # The deepest error is the most specific one, e.g. the friction value rather than its parent object.
+    return (-len(error.absolute_path), str(list(error.absolute_path)))
+
+
+def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> dict:
+    """Validate a configuration and fill in defaults.
+
+    Parameters
+    ----------
+    config : mapping
+        The raw configuration (as read from YAML or as Snakemake's ``config``).
+    schema : dict, optional
+        The JSON schema; defaults to ``workflow/schemas/config.schema.yaml``.
+
+    Returns
+    -------
+    dict
+        A new dict with every default filled in.
+
+    Raises
+    ------
+    ConfigError
+        One message naming the first offending key.
+    """
+    schema = load_schema() if schema is None else schema
+    filled = copy.deepcopy(dict(config))
+    validator = _DefaultFillingValidator(schema)
+    errors = sorted(validator.iter_errors(filled), key=_error_depth_key)
+    if errors:
+        best = errors[0]
+        # oneOf/anyOf wrap the real reason; report the most relevant inner error.
+        if best.context:
+            best = jsonschema.exceptions.best_match(best.context) or best
+        raise ConfigError(_describe(best))
+    _check_finite(filled, ())
+    _check_references(filled)
+    return filled
+
+
+def _check_finite(node: Any, path: tuple) -> None:
+    if isinstance(node, dict):
+        for key, value in node.items():
+            _check_finite(value, path + (key,))
+    elif isinstance(node, list):
+        for index, value in enumerate(node):
+            _check_finite(value, path + (index,))
+    elif isinstance(node, float) and not math.isfinite(node):
+        raise ConfigError(f"config key '{_key_path(path)}': {node} is not a finite number")
+
+
+def _check_references(config: dict) -> None:
+    materials = config["materials"]
+    models = config["particle_models"]
+    silo = config["silo_flat"]
+
+    def require(name: str, defined: Mapping, key: str, kind: str) -> None:
+        if name not in defined:
+            known = ", ".join(sorted(defined)) or "none"
+            raise ConfigError(f"config key '{key}': unknown {kind} '{name}'; defined: {known}")
+
+    require(silo["particle_model"], models, "silo_flat.particle_model", "particle model")
+    require(silo["particle_material"], materials, "silo_flat.particle_material", "material")
+    for wall, material in silo["wall_materials"].items():
+        require(material, materials, f"silo_flat.wall_materials.{wall}", "material")
+    for index, contact in enumerate(config["contacts"]):
+        for material in contact["materials"]:
+            require(material, materials, f"contacts[{index}].materials", "material")
+
+    seen: dict[frozenset, int] = {}
+    for index, contact in enumerate(config["contacts"]):
+        pair = frozenset(contact["materials"])
+        if pair in seen:
+            raise ConfigError(
+                f"config key 'contacts[{index}]': material pair {sorted(pair)} is already defined "
+                f"in contacts[{seen[pair]}]"
+            )
+        seen[pair] = index
+
+    particle_material = silo["particle_material"]
+    if "density" not in materials[particle_material]:
+        raise ConfigError(
+            f"config key 'materials.{particle_material}.density': the particle material needs a density"
+        )
+    needed = {particle_material, *silo["wall_materials"].values()}
+    for material in sorted(needed):
+        if frozenset((particle_material, material)) not in seen:
+            raise ConfigError(
+                f"config key 'contacts': no contact parameters for the pair "
+                f"[{particle_material}, {material}] used by silo_flat"
+            )
+
+
+def load_config(path: str | Path) -> dict:
+    """Read and validate a configuration file (defaults filled)."""
+    try:
+        return validate_config(load_config_file(path))
+    except ConfigError as error:
+        raise ConfigError(f"{path}: {error}") from None

@@ -1,0 +1,367 @@
+"""LIGGGHTS: rendering decks for siloflow cases, running the engine, reading its log.
+
+Run directory layout (relative paths are what the deck sees, the engine runs inside the run directory)::
+
+    <run>/deck/in.liggghts     the rendered deck
+    <run>/deck/meshes/*.stl    wall meshes
+    <run>/deck/case.json       derived case quantities (time step, clump count, ...)
+    <run>/dumps/               particle dumps (binary legacy VTK)
+    <run>/log.liggghts         the engine log
+    <run>/engine.out           the engine's screen output
+    <run>/run.json             written last, only after every check passed
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from engines.geometry import horizontal_rectangle, write_stl
+from engines.silo import SiloCase
+from engines.templating import render_deck
+
+DECK_NAME = "in.liggghts"
+LOG_NAME = "log.liggghts"
+SCREEN_NAME = "engine.out"
+DUMP_PREFIX = "particles"
+RUN_RECORD = "run.json"
+
+# LIGGGHTS only accepts 5e6 <= E <= 1e9 Pa (SI) unless told otherwise.
+SOFT_LIMIT = 5e6
+HARD_LIMIT = 1e9
+
+
+class EngineNotFound(RuntimeError):
+    """The engine executable is not installed or not on PATH."""
+
+
+class EngineRunError(RuntimeError):
+    """A run failed; the message quotes the relevant log lines and names the run directory."""
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A ``SILOFLOW <event> key=value ...`` line the deck prints at a stage boundary."""
+
+    event: str
+    values: dict
+
+
+_MARKER = re.compile(r"^SILOFLOW (\w+)((?: \w+=\S+)*)\s*$")
+
+
+def parse_markers(log_text: str) -> list[Marker]:
+    """Stage markers in the order the engine printed them (echoed ``print`` commands are skipped)."""
+    markers = []
+    for line in log_text.splitlines():
+        match = _MARKER.match(line.strip())
+        if not match:
+            continue
+        values = {}
+        for item in match.group(2).split():
+            key, _, raw = item.partition("=")
+            try:
+                values[key] = float(raw)
+            except ValueError:
+                values[key] = raw
+        markers.append(Marker(match.group(1), values))
+    return markers
+
+
+def error_lines(log_text: str) -> list[str]:
+    """Lines that report a fatal engine problem (``ERROR``, lost atoms, a crash signal)."""
+    patterns = ("ERROR", "Lost atoms", "Segmentation fault", "received signal", "MPI_ABORT")
+    return [line.rstrip() for line in log_text.splitlines() if any(p in line for p in patterns)]
+
+
+def log_excerpt(log_text: str, lines: int = 15) -> str:
+    """Error lines if there are any, else the last lines of the log, indented for quoting."""
+    selected = error_lines(log_text) or log_text.rstrip().splitlines()[-lines:]
+    return "\n".join("    " + line for line in selected[-lines:])
+
+
+# ---------------------------------------------------------------------------------------------- decks
+
+
+def _flat(matrix) -> list[float]:
+    return [float(value) for row in matrix for value in row]
+
+
+def _common_context(case: SiloCase) -> dict:
+    table = case.materials
+    moduli = table.youngs_modulus
+    particle = case.particle
+    spheres = [[*map(float, position), float(radius)] for position, radius in zip(particle.sphere_positions, particle.sphere_radii)]
+    return {
+        "materials": {
+            "n_types": len(table.names),
+            "youngs_modulus": list(moduli),
+            "poisson_ratio": list(table.poisson_ratio),
+            "restitution": _flat(table.restitution),
+            "sliding_friction": _flat(table.sliding_friction),
+            "rolling_friction": _flat(table.rolling_friction),
+        },
+        "switches": {
+            "soft_particles": min(moduli) < SOFT_LIMIT,
+            "hard_particles": max(moduli) > HARD_LIMIT,
+        },
+        "timestep": case.timestep,
+        "gravity": 9.81,
+        "neighbor_skin": 0.4 * particle.smallest_radius,
+        "particle": {
+            "name": particle.name,
+            "seed": case.seeds[0],
+            "distribution_seed": case.seeds[1],
+            "type": 1,
+            "density": particle.density,
+            "spheres": spheres,
+            "ntry": 1000000,
+        },
+    }
+
+
+def silo_meshes(case: SiloCase) -> dict:
+    """Floor plates left and right of the outlet and the gate that closes it (z = 0, normals up)."""
+    half_width, half_outlet, depth = 0.5 * case.width, 0.5 * case.outlet_width, case.depth
+    return {
+        "floor_left": horizontal_rectangle(-half_width, -half_outlet, 0.0, depth, 0.0),
+        "floor_right": horizontal_rectangle(half_outlet, half_width, 0.0, depth, 0.0),
+        "outlet_gate": horizontal_rectangle(-half_outlet, half_outlet, 0.0, depth, 0.0),
+    }
+
+
+def silo_deck_context(case: SiloCase) -> dict:
+    """The rendering context of ``templates/liggghts/silo_flat.lmp.j2``."""
+    table = case.materials
+    side, bottom, front_back = (
+        table.type_of(case.wall_materials[key]) for key in ("side", "bottom", "front_back")
+    )
+    half_width = 0.5 * case.width
+    context = _common_context(case)
+    dump_every = case.dump_every
+    context.update(
+        {
+            "title": f"siloflow-silo_flat-{case.run_id}",
+            "boundary": ["f", "f", "f"],
+            "domain": {
+                "x": [-half_width, half_width],
+                "y": [0.0, case.depth],
+                "z": [-case.sink_depth, case.domain_top],
+            },
+            "primitive_walls": [
+                {"id": "wall_left", "type": side, "plane": "xplane", "position": -half_width},
+                {"id": "wall_right", "type": side, "plane": "xplane", "position": half_width},
+                {"id": "wall_front", "type": front_back, "plane": "yplane", "position": 0.0},
+                {"id": "wall_back", "type": front_back, "plane": "yplane", "position": case.depth},
+            ],
+            "meshes": [
+                {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom}
+                for name in ("floor_left", "floor_right", "outlet_gate")
+            ],
+            "closed_floor": ["floor_left", "floor_right", "outlet_gate"],
+            "open_floor": ["floor_left", "floor_right"],
+            "gate_mesh": "outlet_gate",
+            "fill": {
+                "seed": case.seeds[2],
+                "zone": list(case.fill.zone),
+                "n_clumps": case.fill.n_clumps,
+                "particle_rate": case.fill.particle_rate,
+                "insert_every": case.fill.insert_every,
+                "insertion_velocity": case.fill.insertion_velocity,
+                "steps": case.fill.fill_steps,
+                # Crowded insertion events may place fewer clumps than asked: allow as many extra events again.
+                "max_extra_insertions": int(np.ceil(case.fill.n_clumps / case.fill.clumps_per_insertion)) + 10,
+            },
+            "settle": {
+                "threshold": case.settle_threshold,
+                "check_steps": case.settle_check_steps,
+                "max_checks": case.settle_max_checks,
+            },
+            "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
+            "discharge": {"steps": case.discharge_steps},
+            "thermo_every": dump_every,
+        }
+    )
+    return context
+
+
+def render_silo_deck(case: SiloCase) -> str:
+    """The LIGGGHTS deck of a flat-bottom silo run."""
+    return render_deck("liggghts/silo_flat.lmp.j2", silo_deck_context(case))
+
+
+def _write_text_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)
+
+
+def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    deck_dir = Path(deck_dir)
+    for name, mesh in silo_meshes(case).items():
+        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
+    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
+    deck_path = deck_dir / DECK_NAME
+    _write_text_atomic(deck_path, render_silo_deck(case))
+    return deck_path
+
+
+# ---------------------------------------------------------------------------------------------- running
+
+
+def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun") -> list[str]:
+    """Command line of one engine run, serial or under MPI (no shell involved)."""
+    if shutil.which(executable) is None:
+        raise EngineNotFound(
+            f"LIGGGHTS executable '{executable}' not found on PATH; install it with `make install` "
+            "(Debian package liggghts) or set engine.executable in the config"
+        )
+    command = [executable, "-in", deck, "-log", LOG_NAME]
+    if mpi_ranks > 1:
+        if shutil.which(mpirun) is None:
+            raise EngineNotFound(f"MPI launcher '{mpirun}' not found; install openmpi-bin or set engine.mpirun")
+        command = [mpirun, "-np", str(mpi_ranks), "--oversubscribe", *command]
+    return command
+
+
+def _mpi_environment() -> dict:
+    environment = dict(os.environ)
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        # Open MPI refuses to run as root unless told; containers and CI run as root.
+        environment.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        environment.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return environment
+
+
+def set_aside_previous_attempt(run_dir: Path) -> Path | None:
+    """Move the output of an unfinished earlier attempt into ``failed_attempts/<UTC time>/``.
+
+    Nothing is deleted: the user may want to inspect a failed run. Returns the new location, if any.
+    """
+    leftovers = [run_dir / name for name in ("dumps", LOG_NAME, SCREEN_NAME) if (run_dir / name).exists()]
+    if not leftovers:
+        return None
+    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+    target = run_dir / "failed_attempts" / stamp
+    attempt = 1
+    while target.exists():
+        attempt += 1
+        target = run_dir / "failed_attempts" / f"{stamp}-{attempt}"
+    target.mkdir(parents=True)
+    for path in leftovers:
+        shutil.move(str(path), str(target / path.name))
+    return target
+
+
+def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun") -> str:
+    """Run the deck ``<run_dir>/deck/in.liggghts`` inside ``run_dir`` and return the log text.
+
+    Raises
+    ------
+    EngineRunError
+        On a non-zero exit or an ERROR line, quoting the relevant log lines; the run directory is left as is.
+    """
+    run_dir = Path(run_dir)
+    command = engine_command(f"deck/{DECK_NAME}", executable, mpi_ranks, mpirun)
+    (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
+    with open(run_dir / SCREEN_NAME, "w", encoding="utf-8") as screen:
+        completed = subprocess.run(
+            command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment(), check=False
+        )
+    log_path = run_dir / LOG_NAME
+    log_text = log_path.read_text(encoding="utf-8", errors="replace") if log_path.exists() else ""
+    screen_text = (run_dir / SCREEN_NAME).read_text(encoding="utf-8", errors="replace")
+    problems = error_lines(log_text) or error_lines(screen_text)
+    if completed.returncode != 0 or problems:
+        raise EngineRunError(
+            f"LIGGGHTS run in {run_dir} failed (exit code {completed.returncode}); "
+            f"log lines:\n{log_excerpt(log_text or screen_text)}\n"
+            f"The run directory is left for inspection: {run_dir}"
+        )
+    return log_text
+
+
+def check_silo_run(case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path) -> dict:
+    """Check that a finished silo run did what the case asked; returns the stage record.
+
+    Raises
+    ------
+    EngineRunError
+        When clumps are missing after filling, the fill did not settle, a stage marker or the dumps
+        are missing.
+    """
+    by_event = {}
+    for marker in markers:
+        by_event.setdefault(marker.event, []).append(marker)
+    for event in ("filled", "settled", "opened", "discharged"):
+        if event not in by_event:
+            raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
+    filled = by_event["filled"][-1].values
+    if int(round(filled["clumps"])) != case.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: only {int(filled['clumps'])} of {case.fill.n_clumps} clumps were inserted; "
+            "widen silo_flat.fill.zone_width_fraction or lower silo_flat.fill.volume_fraction"
+        )
+    settled = by_event["settled"][-1].values
+    if not settled["ke_per_clump"] < case.settle_threshold:
+        raise EngineRunError(
+            f"{run_dir}: the fill did not settle: kinetic energy per clump {settled['ke_per_clump']:.3g} J is above "
+            f"the threshold {case.settle_threshold:.3g} J after the longest settling time; raise "
+            "silo_flat.settle.max_time or the threshold"
+        )
+    if len(dump_files) < 2:
+        raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
+    opened = by_event["opened"][-1].values
+    discharged = by_event["discharged"][-1].values
+    return {
+        "filled": filled,
+        "settled": settled,
+        "opened": opened,
+        "discharged": discharged,
+        "settle_checks": [m.values for m in by_event.get("settle", [])],
+        "open_step": int(round(opened["step"])),
+        "open_time_s": opened["time"],
+        "timestep_s": case.timestep,
+        "n_clumps": case.fill.n_clumps,
+        "n_dumps": len(dump_files),
+    }
+
+
+def write_run_record(run_dir: Path, record: dict) -> Path:
+    """Write ``run.json`` last and atomically: its presence means the run is complete and checked."""
+    path = Path(run_dir) / RUN_RECORD
+    _write_text_atomic(path, json.dumps(record, indent=2, sort_keys=True, default=float))
+    return path
+
+
+def run_silo(
+    case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
+) -> Path:
+    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns its path.
+
+    Output of an earlier unfinished attempt is moved to ``failed_attempts/`` first, so the dumps of this
+    run are never mixed with older ones.
+    """
+    from analysis.dumps import list_dumps
+
+    run_dir = Path(run_dir)
+    deck = run_dir / "deck" / DECK_NAME
+    if not deck.exists():
+        raise FileNotFoundError(f"no deck at {deck}; render it first")
+    (run_dir / RUN_RECORD).unlink(missing_ok=True)
+    set_aside_previous_attempt(run_dir)
+    log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
+    dumps = list_dumps(run_dir / "dumps", DUMP_PREFIX)
+    record = check_silo_run(case, parse_markers(log_text), dumps, run_dir)
+    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX})
+    return write_run_record(run_dir, record)

@@ -1,0 +1,128 @@
+"""Configuration validation: defaults filled, one clear message naming the key for bad input."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+import yaml
+
+from engines.config import SCHEMA_PATH, ConfigError, load_config, validate_config
+
+
+def _schema_properties(node, path=""):
+    """Yield (path, subschema) for every declared property of the schema."""
+    for name, sub in node.get("properties", {}).items():
+        yield f"{path}{name}", sub
+        yield from _schema_properties(sub, f"{path}{name}.")
+
+
+def test_every_schema_key_has_description_and_default():
+    schema = yaml.safe_load(SCHEMA_PATH.read_text())
+    for path, sub in _schema_properties(schema):
+        assert "description" in sub, f"{path} has no description"
+        assert "default" in sub, f"{path} has no default"
+
+
+def test_empty_config_gets_every_default():
+    config = validate_config({})
+    assert config["engine"] == {"executable": "liggghts", "mpi_ranks": 1, "mpirun": "mpirun"}
+    assert config["silo_flat"]["width"] == 0.15
+    assert config["silo_flat"]["settle"]["kinetic_energy_threshold"] == 1e-12
+    assert config["silo_flat"]["beverloo"] == {
+        "discharge_coefficient": 0.58,
+        "shape_coefficient": 1.5,
+        "particle_diameter": None,
+    }
+    assert set(config["particle_models"]) == {"sphere", "sphere2", "sphere4"}
+
+
+def test_validation_does_not_modify_its_input(raw_default_config):
+    before = copy.deepcopy(raw_default_config)
+    validate_config(raw_default_config)
+    assert raw_default_config == before
+
+
+def test_default_and_thesis_configs_are_valid():
+    for name in ("config/config.yaml", "config/thesis.yaml"):
+        config = load_config(SCHEMA_PATH.parents[2] / name)
+        assert config["silo_flat"]["particle_model"] == "sphere2"
+
+
+def _with(raw, path, value):
+    config = copy.deepcopy(raw)
+    node = config
+    for key in path[:-1]:
+        node = node.setdefault(key, {})
+    node[path[-1]] = value
+    return config
+
+
+@pytest.mark.parametrize(
+    "path, value, expected",
+    [
+        (("silo_flat", "width"), "wide", "config key 'silo_flat.width': 'wide' is not of type 'number'"),
+        (("silo_flat", "outlet_width"), -0.04, "config key 'silo_flat.outlet_width': -0.04 is less than or equal to the minimum of 0"),
+        (("engine", "mpi_ranks"), 1.5, "config key 'engine.mpi_ranks': 1.5 is not of type 'integer'"),
+        (("silo_flat", "particle_model"), "sphere3", "config key 'silo_flat.particle_model': unknown particle model 'sphere3'; defined: sphere, sphere2, sphere4"),
+        (("silo_flat", "wall_materials", "side"), "steel", "config key 'silo_flat.wall_materials.side': unknown material 'steel'"),
+        (("silo_flat", "widht"), 0.1, "config key 'silo_flat': Additional properties are not allowed ('widht' was unexpected)"),
+    ],
+)
+def test_bad_values_name_the_key(raw_default_config, path, value, expected):
+    with pytest.raises(ConfigError) as caught:
+        validate_config(_with(raw_default_config, path, value))
+    assert expected in str(caught.value)
+    assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("field", ["sliding_friction", "rolling_friction"])
+@pytest.mark.parametrize("value", [-0.1, 1.5])
+def test_friction_outside_unit_interval_is_rejected(raw_default_config, field, value):
+    config = copy.deepcopy(raw_default_config)
+    config["contacts"][1][field] = value
+    with pytest.raises(ConfigError, match=rf"config key 'contacts\[1\]\.{field}': {value} is"):
+        validate_config(config)
+
+
+def test_restitution_below_engine_limit_is_rejected(raw_default_config):
+    config = copy.deepcopy(raw_default_config)
+    config["contacts"][0]["restitution"] = 1e-4
+    with pytest.raises(ConfigError, match=r"contacts\[0\]\.restitution': 0.0001 is less than or equal to the minimum of 0.05"):
+        validate_config(config)
+
+
+def test_yaml_exponent_without_sign_gets_a_hint(raw_default_config):
+    raw = yaml.safe_load("youngs_modulus: 5.0e6")
+    config = copy.deepcopy(raw_default_config)
+    config["materials"]["hdpe"]["youngs_modulus"] = raw["youngs_modulus"]
+    with pytest.raises(ConfigError, match=r"materials.hdpe.youngs_modulus.*write the exponent with a sign"):
+        validate_config(config)
+
+
+def test_missing_contact_pair_is_named(raw_default_config):
+    config = copy.deepcopy(raw_default_config)
+    config["contacts"] = [c for c in config["contacts"] if set(c["materials"]) != {"hdpe", "perspex"}]
+    with pytest.raises(ConfigError, match=r"no contact parameters for the pair \[hdpe, perspex\]"):
+        validate_config(config)
+
+
+def test_duplicate_contact_pair_is_named(raw_default_config):
+    config = copy.deepcopy(raw_default_config)
+    config["contacts"].append({**config["contacts"][1], "materials": ["aluminium", "hdpe"]})
+    with pytest.raises(ConfigError, match=r"contacts\[3\]': material pair \['aluminium', 'hdpe'\] is already defined in contacts\[1\]"):
+        validate_config(config)
+
+
+def test_injected_material_name_is_rejected(raw_default_config):
+    config = copy.deepcopy(raw_default_config)
+    config["silo_flat"]["particle_material"] = "hdpe\nshell rm -rf /"
+    with pytest.raises(ConfigError, match=r"silo_flat.particle_material"):
+        validate_config(config)
+
+
+def test_file_errors_name_the_file(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text("silo_flat:\n  depth: -1.0\n")
+    with pytest.raises(ConfigError, match=rf"{path}: config key 'silo_flat.depth'"):
+        load_config(path)

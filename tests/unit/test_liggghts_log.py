@@ -1,0 +1,109 @@
+"""Reading the engine log: stage markers, error lines, and the checks of a finished silo run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from engines.liggghts import (
+    EngineNotFound,
+    EngineRunError,
+    check_silo_run,
+    engine_command,
+    error_lines,
+    parse_markers,
+    set_aside_previous_attempt,
+)
+from engines.silo import build_silo_case
+
+LOG = """\
+print "SILOFLOW filled step=$(step) time=$(time) clumps=${n_clumps} ke_per_clump=${ke_per_clump}"
+SILOFLOW filled step=26391 time=0.30456196341661323501 clumps=1395 ke_per_clump=8.89482733543151e-09
+WARNING: Particle insertion: Less insertions than requested (./src/fix_insert.cpp:814)
+SILOFLOW settle step=27258 time=0.31 clumps=1395 ke_per_clump=5.9e-09
+SILOFLOW settled step=34194 time=0.39461148789616412591 clumps=1395 ke_per_clump=5.43629662393841e-11
+SILOFLOW opened step=34194 time=0.39461148789616412591 clumps=1395 ke_per_clump=5.43629662393841e-11
+SILOFLOW discharged step=86186 time=0.99461852067084310924 clumps=355 ke_per_clump=3.1e-07
+"""
+
+
+def test_markers_are_parsed_in_order_and_echoed_print_commands_skipped():
+    markers = parse_markers(LOG)
+    assert [m.event for m in markers] == ["filled", "settle", "settled", "opened", "discharged"]
+    assert markers[0].values == {
+        "step": 26391.0,
+        "time": 0.30456196341661323501,
+        "clumps": 1395.0,
+        "ke_per_clump": 8.89482733543151e-09,
+    }
+
+
+def test_error_lines_find_errors_lost_atoms_and_crashes_but_not_warnings():
+    text = LOG + "ERROR: Lost atoms: original 1596 current 1596 (./src/thermo.cpp:445)\n[vm:1] *** Process received signal ***\n"
+    assert error_lines(text) == [
+        "ERROR: Lost atoms: original 1596 current 1596 (./src/thermo.cpp:445)",
+        "[vm:1] *** Process received signal ***",
+    ]
+    assert error_lines(LOG) == []
+
+
+def _dumps(tmp_path, count):
+    return [tmp_path / f"particles_{i}.vtk" for i in range(count)]
+
+
+def test_a_complete_run_passes_the_checks(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    log = LOG.replace("clumps=1395", f"clumps={case.fill.n_clumps}")
+    record = check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path)
+    assert record["open_step"] == 34194
+    assert record["n_clumps"] == case.fill.n_clumps
+    assert len(record["settle_checks"]) == 1
+
+
+def test_missing_clumps_are_reported(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    with pytest.raises(EngineRunError, match=rf"only 1000 of {case.fill.n_clumps} clumps were inserted"):
+        check_silo_run(case, parse_markers(LOG.replace("clumps=1395", "clumps=1000")), _dumps(tmp_path, 3), tmp_path)
+
+
+def test_an_unsettled_fill_is_reported(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    log = LOG.replace("clumps=1395", f"clumps={case.fill.n_clumps}").replace("5.43629662393841e-11", "3e-9")
+    with pytest.raises(EngineRunError, match="did not settle: kinetic energy per clump 3e-09 J is above the threshold 1e-10 J"):
+        check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path)
+
+
+def test_a_truncated_log_is_reported(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    truncated = "\n".join(LOG.splitlines()[:4])
+    with pytest.raises(EngineRunError, match="no 'settled' stage marker"):
+        check_silo_run(case, parse_markers(truncated), _dumps(tmp_path, 3), tmp_path)
+
+
+def test_missing_dumps_are_reported(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    log = LOG.replace("clumps=1395", f"clumps={case.fill.n_clumps}")
+    with pytest.raises(EngineRunError, match="expected particle dumps of the discharge, found 0"):
+        check_silo_run(case, parse_markers(log), [], tmp_path)
+
+
+def test_engine_command_serial_and_mpi():
+    assert engine_command("deck/in.liggghts", executable="true") == ["true", "-in", "deck/in.liggghts", "-log", "log.liggghts"]
+    assert engine_command("d", executable="true", mpi_ranks=2, mpirun="true")[:4] == ["true", "-np", "2", "--oversubscribe"]
+
+
+def test_missing_executable_is_a_clear_error():
+    with pytest.raises(EngineNotFound, match="'no-such-liggghts' not found"):
+        engine_command("d", executable="no-such-liggghts")
+
+
+def test_an_earlier_attempt_is_moved_aside_not_deleted(tmp_path):
+    (tmp_path / "dumps").mkdir()
+    (tmp_path / "dumps" / "particles_0.vtk").write_text("old")
+    (tmp_path / "log.liggghts").write_text("old log")
+    moved = set_aside_previous_attempt(tmp_path)
+    assert (moved / "dumps" / "particles_0.vtk").read_text() == "old"
+    assert (moved / "log.liggghts").read_text() == "old log"
+    assert not (tmp_path / "dumps").exists()
+    assert set_aside_previous_attempt(tmp_path) is None

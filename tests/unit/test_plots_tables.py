@@ -1,0 +1,110 @@
+"""Unit tests for analysis.plots and analysis.tables (files under tmp_path only)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from analysis.flow import DischargeHistory, discharged_mass_history, steady_flow_rate
+from analysis.plots import plot_discharge
+from analysis.tables import write_discharge_history_csv, write_flow_table, write_json
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _history():
+    time = np.linspace(0.0, 1.0, 101)
+    mass_in_silo = 5.0 - 2.5 * np.clip(time - 0.1, 0.0, 0.7)
+    history = discharged_mass_history(time + 3.0, mass_in_silo)
+    fit = steady_flow_rate(history.time, history.discharged_mass)
+    return history, fit
+
+
+def _only_file(folder, name):
+    assert sorted(p.name for p in folder.iterdir()) == [name], "temporary files left behind"
+
+
+@pytest.mark.parametrize("beverloo_rate", [2.7, None])
+def test_plot_discharge_writes_valid_png(tmp_path, beverloo_rate):
+    history, fit = _history()
+    target = tmp_path / "plots" / "discharge.png"
+    returned = plot_discharge(history, fit, beverloo_rate, target, "flat-bottom silo")
+    assert returned == target
+    data = target.read_bytes()
+    assert len(data) > 0
+    assert data.startswith(PNG_SIGNATURE)
+    _only_file(target.parent, "discharge.png")
+
+
+def test_write_flow_table_round_trip(tmp_path):
+    rows = [
+        {"case": "sphere2", "mass_flow_rate_kg_s": 0.123456789012345, "n_points": 40, "bulk_density": 667.1},
+        {"case": "sphere", "mass_flow_rate_kg_s": 1e-7, "n_points": 3, "bulk_density": np.float64(650.25)},
+    ]
+    target = tmp_path / "metrics" / "flow.csv"
+    write_flow_table(target, rows)
+    table = pd.read_csv(target)
+    assert list(table.columns) == ["case", "mass_flow_rate_kg_s", "n_points", "bulk_density"]
+    expected = pd.DataFrame(rows).astype({"bulk_density": float})
+    pd.testing.assert_frame_equal(table, expected)
+    _only_file(target.parent, "flow.csv")
+
+
+def test_write_flow_table_column_order_from_first_row(tmp_path):
+    rows = [{"b": 1, "a": 2}, {"a": 3, "b": 4, "c": 5}]
+    target = tmp_path / "t.csv"
+    write_flow_table(target, rows)
+    with open(target, newline="") as stream:
+        records = list(csv.DictReader(stream))
+    assert list(records[0].keys()) == ["b", "a", "c"]
+    assert records == [{"b": "1", "a": "2", "c": ""}, {"b": "4", "a": "3", "c": "5"}]
+
+
+def test_write_flow_table_rejects_no_rows(tmp_path):
+    with pytest.raises(ValueError, match="rows"):
+        write_flow_table(tmp_path / "t.csv", [])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_json_sorted_plain_numbers(tmp_path):
+    target = tmp_path / "flow.json"
+    write_json(target, {"zeta": np.float64(1.25), "alpha": np.int64(3), "rates": np.array([0.5, 1.5]), "nan": math.nan})
+    text = target.read_text()
+    assert json.loads(text) == {"alpha": 3, "nan": None, "rates": [0.5, 1.5], "zeta": 1.25}
+    assert text.index('"alpha"') < text.index('"nan"') < text.index('"rates"') < text.index('"zeta"')
+    assert "np.float64" not in text
+    _only_file(tmp_path, "flow.json")
+
+
+def test_write_json_dataclass(tmp_path):
+    _, fit = _history()
+    target = tmp_path / "fit.json"
+    write_json(target, fit)
+    loaded = json.loads(target.read_text())
+    assert loaded["mass_flow_rate"] == fit.mass_flow_rate
+    assert loaded["n_points"] == fit.n_points
+
+
+def test_failed_write_keeps_old_file_and_leaves_no_temp(tmp_path):
+    target = tmp_path / "flow.json"
+    write_json(target, {"a": 1})
+    with pytest.raises(TypeError):
+        write_json(target, {"a": object()})
+    assert json.loads(target.read_text()) == {"a": 1}
+    _only_file(tmp_path, "flow.json")
+
+
+def test_write_discharge_history_csv_round_trip(tmp_path):
+    history = DischargeHistory(time=np.array([0.0, 0.005, 0.01]), discharged_mass=np.array([0.0, 1 / 3, 0.7]))
+    target = tmp_path / "history.csv"
+    write_discharge_history_csv(target, history)
+    table = pd.read_csv(target)
+    assert list(table.columns) == ["time_s", "discharged_mass_kg"]
+    np.testing.assert_array_equal(table["time_s"].to_numpy(), history.time)
+    np.testing.assert_array_equal(table["discharged_mass_kg"].to_numpy(), history.discharged_mass)
+    _only_file(tmp_path, "history.csv")

@@ -1,0 +1,98 @@
+"""The flat-bottom silo case derived from configuration: counts, zones, steps, run ids."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import pytest
+
+from engines.config import validate_config
+from engines.silo import build_silo_case, material_table, run_id, silo_case_for_run
+
+
+def test_clump_count_follows_the_fill_height(tiny_config):
+    case = build_silo_case(tiny_config)
+    silo = tiny_config["silo_flat"]
+    expected = 667.0 * silo["width"] * silo["depth"] * silo["fill_height"] / case.particle.mass
+    assert case.fill.n_clumps == round(expected)
+
+
+def test_sphere2_clump_mass_is_two_spheres_minus_their_lens(tiny_config):
+    # two r = 1.5 mm spheres, centres d = 0.75 mm apart: V = 2 (4/3) pi r^3 - pi (4r + d)(2r - d)^2 / 12
+    r, d = 1.5e-3, 0.75e-3
+    volume = 2 * 4 / 3 * math.pi * r**3 - math.pi * (4 * r + d) * (2 * r - d) ** 2 / 12
+    case = build_silo_case(tiny_config)
+    assert case.particle.volume == pytest.approx(volume, rel=1e-12)
+    assert case.particle.mass == pytest.approx(950.0 * volume, rel=1e-12)
+    assert case.particle.bounding_radius == pytest.approx(r + d / 2, rel=1e-12)
+
+
+def test_insertion_zone_lies_above_the_heap_and_inside_the_walls(tiny_config):
+    case = build_silo_case(tiny_config)
+    x_min, x_max, y_min, y_max, z_min, z_max = case.fill.zone
+    heap_top = case.fill_height + 0.5 * case.width * math.tan(math.radians(40.0))
+    assert z_min > heap_top
+    assert -case.width / 2 < x_min < x_max < case.width / 2
+    assert 0.0 < y_min < y_max < case.depth
+    assert case.domain_top > z_max
+
+
+def test_insertion_events_do_not_overlap(tiny_config):
+    case = build_silo_case(tiny_config)
+    zone_height = case.fill.zone[5] - case.fill.zone[4]
+    travelled = case.fill.insertion_velocity * case.fill.insert_every * case.timestep
+    assert travelled >= zone_height
+    assert case.fill.fill_steps * case.timestep * case.fill.particle_rate >= case.fill.n_clumps
+
+
+def test_material_types_put_the_particle_first():
+    config = validate_config({})
+    table = material_table(config, "hdpe", ["aluminium", "aluminium", "perspex"])
+    assert table.names == ("hdpe", "aluminium", "perspex")
+    assert table.type_of("perspex") == 3
+    assert table.sliding_friction[0] == (0.35, 0.17, 0.2)
+    assert table.sliding_friction[1][2] == 0.0  # aluminium-perspex never touch: neutral value
+
+
+def test_run_id_is_stable_and_changes_with_any_defining_parameter(tiny_config):
+    case = build_silo_case(tiny_config)
+    assert case.run_id == build_silo_case(copy.deepcopy(tiny_config)).run_id
+    assert case.run_id.startswith("sphere2-")
+    changed = copy.deepcopy(tiny_config)
+    changed["contacts"][0]["rolling_friction"] = 0.2
+    assert build_silo_case(changed).run_id != case.run_id
+    # analysis-only settings do not define the simulation
+    analysis_only = copy.deepcopy(tiny_config)
+    analysis_only["silo_flat"]["steady_window"] = [0.1, 0.9]
+    assert build_silo_case(analysis_only).run_id == case.run_id
+
+
+def test_contact_pair_order_does_not_change_the_run_id(tiny_config):
+    swapped = copy.deepcopy(tiny_config)
+    swapped["contacts"][1]["materials"] = list(reversed(swapped["contacts"][1]["materials"]))
+    assert build_silo_case(swapped).run_id == build_silo_case(tiny_config).run_id
+
+
+def test_run_id_hash_by_hand():
+    assert run_id("x", {"a": 1}) == "x-015abd7f5c"
+
+
+def test_unknown_run_is_reported_with_the_defined_ones(tiny_config):
+    with pytest.raises(KeyError, match="defines: sphere2-"):
+        silo_case_for_run(tiny_config, "sphere2-0000000000")
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("outlet_width", 0.2, "outlet_width .* must be smaller than silo_flat.width"),
+        ("depth", 0.002, "depth .* is thinner than one clump"),
+        ("sink_depth", 0.001, "sink_depth .* must exceed one clump size"),
+    ],
+)
+def test_inconsistent_geometry_is_refused(tiny_config, key, value, message):
+    config = copy.deepcopy(tiny_config)
+    config["silo_flat"][key] = value
+    with pytest.raises(ValueError, match=message):
+        build_silo_case(config)

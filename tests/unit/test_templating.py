@@ -1,0 +1,121 @@
+"""Deck rendering: golden files pin the decks; nothing from config can inject an engine command."""
+
+from __future__ import annotations
+
+import copy
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+from engines.config import ConfigError, load_config, validate_config
+from engines.liggghts import render_silo_deck, silo_deck_context, write_silo_inputs
+from engines.silo import build_silo_case
+from engines.templating import (
+    UnsafeDeckValue,
+    check_context,
+    deck_environment,
+    deck_integer,
+    deck_name,
+    deck_number,
+    deck_path,
+    render_deck,
+)
+
+GOLDEN = Path(__file__).resolve().parent.parent / "golden"
+
+
+def _golden_case():
+    return build_silo_case(load_config(GOLDEN / "silo_flat_config.yaml"))
+
+
+def test_silo_deck_matches_golden_file():
+    rendered = render_silo_deck(_golden_case())
+    golden = GOLDEN / "silo_flat.lmp"
+    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
+        golden.write_text(rendered)
+    assert rendered == golden.read_text()
+
+
+def test_every_contact_uses_hertz_with_cdt_rolling_friction():
+    deck = render_silo_deck(_golden_case())
+    contact_lines = [line for line in deck.splitlines() if re.match(r"^(pair_style|fix \S+ all wall/gran)", line)]
+    # pair style, four primitive walls, the closed floor and the re-created open floor
+    assert len(contact_lines) == 7
+    for line in contact_lines:
+        assert "model hertz tangential history rolling_friction cdt" in line, line
+
+
+def test_material_matrices_are_rendered_row_major():
+    deck = render_silo_deck(_golden_case())
+    rolling = next(line for line in deck.splitlines() if "coefficientRollingFriction" in line)
+    # types: 1 hdpe, 2 aluminium, 3 perspex; wall-wall pairs get neutral zeros
+    assert rolling.endswith("peratomtypepair 3 0.1 0.1 0.05 0.1 0.0 0.0 0.05 0.0 0.0")
+
+
+def test_timestep_is_the_configured_fraction_of_the_rayleigh_time():
+    case = _golden_case()
+    deck = render_silo_deck(case)
+    timestep = float(re.search(r"^timestep (\S+)$", deck, re.M).group(1))
+    assert timestep == case.timestep == pytest.approx(0.1 * case.rayleigh_time, rel=1e-15)
+
+
+def test_write_silo_inputs_writes_deck_meshes_and_case(tmp_path):
+    deck = write_silo_inputs(_golden_case(), tmp_path / "deck")
+    assert deck.read_text() == (GOLDEN / "silo_flat.lmp").read_text()
+    for name in ("floor_left", "floor_right", "outlet_gate"):
+        assert (tmp_path / "deck" / "meshes" / f"{name}.stl").stat().st_size > 0
+    assert (tmp_path / "deck" / "case.json").exists()
+    assert not list(tmp_path.rglob("*.partial"))
+
+
+INJECTIONS = ["0.5\nshell rm -rf /", "x & shell touch y", "${danger}", "$(v_x)", "a # comment", "../../etc/passwd", "a b"]
+
+
+@pytest.mark.parametrize("value", INJECTIONS)
+def test_filters_refuse_injected_strings(value):
+    for render in (deck_number, deck_integer, deck_name):
+        with pytest.raises(UnsafeDeckValue):
+            render(value)
+    with pytest.raises(UnsafeDeckValue):
+        deck_path(value)
+
+
+@pytest.mark.parametrize("value", INJECTIONS)
+def test_context_check_refuses_injected_strings_anywhere(value):
+    context = silo_deck_context(_golden_case())
+    poisoned = copy.deepcopy(context)
+    poisoned["settle"]["threshold"] = value
+    with pytest.raises(UnsafeDeckValue, match=r"context\.settle\.threshold"):
+        render_deck("liggghts/silo_flat.lmp.j2", poisoned)
+
+
+def test_injected_config_string_never_reaches_a_deck():
+    raw = load_config(GOLDEN / "silo_flat_config.yaml")
+    raw["silo_flat"]["settle"]["kinetic_energy_threshold"] = "0.5\nshell rm -rf /"
+    with pytest.raises(ConfigError, match="silo_flat.settle.kinetic_energy_threshold"):
+        validate_config(raw)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), True, None, object()])
+def test_number_filter_refuses_non_numbers(value):
+    with pytest.raises(UnsafeDeckValue):
+        deck_number(value)
+
+
+def test_numbers_render_so_the_engine_reads_back_the_same_value():
+    for value in (0.1, 1e-12, 1.1540372226009369e-05, -0.075, 5e6, 3):
+        assert float(deck_number(value)) == value
+    assert deck_integer(11003) == "11003"
+
+
+def test_context_check_accepts_numbers_names_and_relative_paths():
+    check_context({"a": 1, "b": [0.5, "wall_left", "deck/meshes/floor.stl", True]})
+
+
+def test_environment_is_strict_about_undefined_values():
+    environment = deck_environment()
+    assert environment.undefined.__name__ == "StrictUndefined"
+    with pytest.raises(Exception, match="undefined"):
+        environment.from_string("{{ missing|num }}").render()

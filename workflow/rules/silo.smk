@@ -1,0 +1,53 @@
+# Planar flat-bottom silo (batch discharge): deck -> LIGGGHTS run -> flow metrics.
+
+wildcard_constraints:
+    run="[A-Za-z0-9_.-]+",
+
+
+rule silo_deck:
+    output:
+        deck=f"{RESULTS}/silo_flat/{{run}}/deck/in.liggghts",
+        case=f"{RESULTS}/silo_flat/{{run}}/deck/case.json",
+    params:
+        parameters=lambda wildcards: SILO_CASES[wildcards.run].defining_parameters,
+    log:
+        f"{RESULTS}/silo_flat/{{run}}/logs/deck.log",
+    script:
+        "../scripts/silo_deck.py"
+
+
+rule silo_run:
+    input:
+        deck=rules.silo_deck.output.deck,
+        case=rules.silo_deck.output.case,
+    output:
+        record=f"{RESULTS}/silo_flat/{{run}}/run.json",
+    params:
+        engine=config["engine"],
+    resources:
+        tasks=config["engine"]["mpi_ranks"],
+    threads: config["engine"]["mpi_ranks"]
+    log:
+        f"{RESULTS}/silo_flat/{{run}}/logs/run.log",
+    script:
+        "../scripts/silo_run.py"
+
+
+rule silo_metrics:
+    input:
+        record=rules.silo_run.output.record,
+        case=rules.silo_deck.output.case,
+    output:
+        table=f"{RESULTS}/silo_flat/{{run}}/metrics/flow.csv",
+        history=f"{RESULTS}/silo_flat/{{run}}/metrics/discharge.csv",
+        summary=f"{RESULTS}/silo_flat/{{run}}/metrics/flow.json",
+        plot=f"{RESULTS}/silo_flat/{{run}}/plots/discharge.png",
+    params:
+        analysis=lambda wildcards: {
+            "steady_window": config["silo_flat"]["steady_window"],
+            "beverloo": config["silo_flat"]["beverloo"],
+        },
+    log:
+        f"{RESULTS}/silo_flat/{{run}}/logs/metrics.log",
+    script:
+        "../scripts/silo_metrics.py"
