@@ -7,7 +7,7 @@ CORES    ?= 2
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 
-.PHONY: install install-system install-python run test test-unit test-integration dry-run clean-help
+.PHONY: install install-system install-python run test test-unit test-integration dry-run bench
 
 install: install-system install-python
 
@@ -27,7 +27,6 @@ install-python:
 
 run: install
 	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete
-	@$(PYTHON) -m engines.summary --configfile $(CONFIG)
 
 test: install
 	$(PYTHON) -m pytest tests
@@ -40,3 +39,7 @@ test-integration: install
 
 dry-run: install
 	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)
+
+# Speed figures are ratios against a baseline measured in the same run (results/bench/).
+bench: install
+	$(PYTHON) -m tests.bench.bench_dumps results/bench/dumps.csv

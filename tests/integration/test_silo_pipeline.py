@@ -1,0 +1,148 @@
+"""The real pipeline on a tiny flat-bottom silo: Snakemake renders, runs LIGGGHTS and analyses.
+
+About 1,400 two-sphere clumps; the engine run takes well under a minute on one core.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from engines.config import REPO_ROOT
+from engines.liggghts import EngineRunError, run_engine, write_silo_inputs, run_silo
+from engines.silo import build_silo_case
+from tests.conftest import TINY_SILO, require_liggghts
+
+pytestmark = pytest.mark.integration
+
+
+def _snakemake(workdir: Path, *arguments: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "-s", str(REPO_ROOT / "Snakefile"), "--directory", str(workdir), *arguments],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+
+
+@pytest.fixture(scope="module")
+def tiny_pipeline(tmp_path_factory):
+    """Run the whole workflow once on the tiny silo; yields (workdir, run directory)."""
+    require_liggghts()
+    workdir = tmp_path_factory.mktemp("tiny_silo")
+    config_path = workdir / "tiny.yaml"
+    config_path.write_text(yaml.safe_dump({"silo_flat": TINY_SILO}))
+    result = _snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    (run_dir,) = (workdir / "results" / "silo_flat").iterdir()
+    yield workdir, run_dir, result
+
+
+def test_all_clumps_were_inserted_and_settled(tiny_pipeline):
+    _, run_dir, _ = tiny_pipeline
+    record = json.loads((run_dir / "run.json").read_text())
+    case = json.loads((run_dir / "deck" / "case.json").read_text())
+    assert record["filled"]["clumps"] == case["n_clumps"] == record["n_clumps"]
+    assert record["settled"]["ke_per_clump"] < case["settle_threshold_J"]
+    assert record["opened"]["step"] >= record["settled"]["step"]
+
+
+def test_clumps_leave_through_the_outlet(tiny_pipeline):
+    _, run_dir, _ = tiny_pipeline
+    record = json.loads((run_dir / "run.json").read_text())
+    assert record["discharged"]["clumps"] < record["n_clumps"]
+    rows = list(csv.DictReader((run_dir / "metrics" / "discharge.csv").open()))
+    discharged = [float(row["discharged_mass_kg"]) for row in rows]
+    assert discharged[0] == 0.0 and discharged[-1] > 0.0
+    assert all(b >= a - 1e-12 for a, b in zip(discharged, discharged[1:]))
+
+
+def test_flow_rate_lies_within_a_factor_of_two_of_beverloo(tiny_pipeline):
+    _, run_dir, _ = tiny_pipeline
+    (row,) = list(csv.DictReader((run_dir / "metrics" / "flow.csv").open()))
+    ratio = float(row["mass_flow_rate_kg_s"]) / float(row["beverloo_mass_flow_rate_kg_s"])
+    assert 0.5 <= ratio <= 2.0, row
+    assert float(row["beverloo_ratio"]) == pytest.approx(ratio)
+    assert 300.0 < float(row["filling_bulk_density_kg_m3"]) < 800.0
+
+
+def test_outputs_and_logs_are_where_the_workflow_says(tiny_pipeline):
+    _, run_dir, result = tiny_pipeline
+    assert (run_dir / "plots" / "discharge.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (run_dir / "log.liggghts").exists()
+    for log in ("deck.log", "run.log", "metrics.log"):
+        assert (run_dir / "logs" / log).exists()
+    assert f"siloflow result: {run_dir / 'metrics' / 'flow.csv'}" in result.stdout + result.stderr
+    assert list((run_dir / "frames").glob("*.npz")), "parsed dumps are cached"
+
+
+def test_a_second_call_has_nothing_to_do(tiny_pipeline):
+    workdir, _, _ = tiny_pipeline
+    result = _snakemake(workdir, "-n", "--cores", "2", "--configfile", str(workdir / "tiny.yaml"))
+    assert result.returncode == 0
+    assert "Nothing to be done" in result.stdout + result.stderr
+
+
+def test_engine_error_quotes_the_log_and_keeps_the_run_directory(tmp_path):
+    require_liggghts()
+    (tmp_path / "deck").mkdir()
+    (tmp_path / "deck" / "in.liggghts").write_text("units si\nfix nonsense all no_such_style\n")
+    with pytest.raises(EngineRunError) as caught:
+        run_engine(tmp_path)
+    message = str(caught.value)
+    assert "ERROR" in message and "left for inspection" in message
+    assert (tmp_path / "log.liggghts").exists()
+
+
+def test_an_unsettled_fill_fails_without_a_run_record(tmp_path, tiny_config):
+    require_liggghts()
+    tiny_config["silo_flat"]["settle"] = {"kinetic_energy_threshold": 1e-30, "check_interval": 0.01, "max_time": 0.02}
+    case = build_silo_case(tiny_config)
+    write_silo_inputs(case, tmp_path / "deck")
+    with pytest.raises(EngineRunError, match="did not settle"):
+        run_silo(case, tmp_path)
+    assert not (tmp_path / "run.json").exists()
+    assert (tmp_path / "log.liggghts").exists()
+
+
+def test_thesis_config_plans_without_error(tmp_path):
+    result = _snakemake(tmp_path, "-n", "--cores", "2", "--configfile", str(REPO_ROOT / "config" / "thesis.yaml"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert "silo_run" in result.stdout
+
+
+def test_invalid_config_stops_the_workflow_with_the_key_named(tmp_path):
+    config_path = tmp_path / "bad.yaml"
+    config_path.write_text("silo_flat:\n  outlet_width: -0.04\n")
+    result = _snakemake(tmp_path, "-n", "--cores", "1", "--configfile", str(config_path))
+    assert result.returncode != 0
+    assert "config key 'silo_flat.outlet_width': -0.04 is less than or equal to the minimum of 0" in result.stdout + result.stderr
+
+
+def test_two_mpi_ranks_give_the_same_flow_within_noise(tiny_pipeline, tmp_path, tiny_config):
+    """Trajectories differ between rank counts; the steady flow rate must not (beyond noise)."""
+    _, serial_dir, _ = tiny_pipeline
+    case = build_silo_case(tiny_config)
+    assert case.run_id == serial_dir.name
+    write_silo_inputs(case, tmp_path / "deck")
+    run_silo(case, tmp_path, mpi_ranks=2)
+    record = json.loads((tmp_path / "run.json").read_text())
+    assert record["mpi_ranks"] == 2 and record["filled"]["clumps"] == case.fill.n_clumps
+
+    from analysis.dumps import clumps_from_frame, read_frames
+    from analysis.silo import silo_flow_metrics
+
+    frames = [
+        clumps_from_frame(frame)
+        for frame in read_frames(tmp_path / "dumps", record["dump_prefix"], record["timestep_s"])
+        if frame.step >= record["open_step"]
+    ]
+    parallel = silo_flow_metrics(frames, case.width, case.depth, case.outlet_width, case.particle.equivalent_diameter)
+    (serial,) = list(csv.DictReader((serial_dir / "metrics" / "flow.csv").open()))
+    assert parallel.fit.mass_flow_rate == pytest.approx(float(serial["mass_flow_rate_kg_s"]), rel=0.15)
