@@ -1,0 +1,641 @@
+"""Bulk friction from Jenike direct shear force histories, and contact diagnostics.
+
+Pure functions on numpy arrays; no file I/O (readers and writers live at the edges).
+All quantities are SI: forces in N, times in s; friction coefficients are
+dimensionless and angles are in degrees unless a name says ``_rad``.
+
+A Jenike shear simulation records, at sample times ``t``, the horizontal forces
+along the shear direction on the lid ``F_lid(t)``, on the shear ring
+``F_ring(t)`` and on the fixed bottom ring ``F_bottom(t)`` (as magnitudes along
+the shear direction: the caller flips the sign of the reaction), the normal
+force on the lid ``F_N`` and the weight ``W`` of the solids above the shear
+plane. The bulk friction coefficient is
+
+    ``mu = <F_lid + F_ring> / <F_N + W>``
+
+averaged over the steady part of the shear (see :func:`detect_steady_window`),
+and independently from the bottom side ``mu_bottom = <F_bottom> / <F_N + W>``;
+the two must agree (force balance on the sheared sample).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "SteadyWindow",
+    "BulkFriction",
+    "detect_steady_window",
+    "mean_and_standard_error",
+    "bulk_friction",
+    "friction_angle",
+    "friction_coefficient",
+    "mobilised_friction_histogram",
+    "angular_histogram",
+]
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True)
+class SteadyWindow:
+    """Steady (plateau) part of a force history.
+
+    Attributes
+    ----------
+    t_start, t_end : float
+        Times of the first and of the last sample in the window [s].
+    i_start, i_end : int
+        Slice bounds of the window: the samples ``i_start <= i < i_end``.
+    plateau : float
+        Estimated plateau level of the signal the window was detected on
+        (same unit as the signal, normally N).
+    """
+
+    t_start: float
+    t_end: float
+    i_start: int
+    i_end: int
+    plateau: float
+
+
+@dataclass(frozen=True)
+class BulkFriction:
+    """Bulk friction of a sheared sample from the forces of a Jenike cell.
+
+    Attributes
+    ----------
+    coefficient : float
+        ``mu = <F_lid + F_ring> / <F_N + W>`` over the window [-].
+    standard_error : float
+        Standard error of ``coefficient`` (batch means, see
+        :func:`mean_and_standard_error`) [-].
+    bottom_coefficient : float
+        ``mu_bottom = <F_bottom> / <F_N + W>`` over the window [-].
+    bottom_standard_error : float
+        Standard error of ``bottom_coefficient`` [-].
+    angle_deg : float
+        Bulk friction angle ``atan(mu)`` [deg].
+    bottom_angle_deg : float
+        ``atan(mu_bottom)`` [deg].
+    window : SteadyWindow
+        Samples used for the averages.
+    relative_difference : float
+        ``|mu - mu_bottom| / mu`` [-] (0 if both are 0, inf if only ``mu`` is 0).
+    shear_force : float
+        Mean ``F_lid + F_ring`` over the window [N].
+    normal_load : float
+        Mean ``F_N + W`` over the window [N].
+    """
+
+    coefficient: float
+    standard_error: float
+    bottom_coefficient: float
+    bottom_standard_error: float
+    angle_deg: float
+    bottom_angle_deg: float
+    window: SteadyWindow
+    relative_difference: float
+    shear_force: float
+    normal_load: float
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
+    array = np.asarray(values, dtype=float)
+    if ndim is not None and array.ndim != ndim:
+        raise ValueError(f"{name} must be a {ndim}-D array, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must contain only finite numbers")
+    return array
+
+
+def _times(time) -> np.ndarray:
+    time = _finite_array("time", time)
+    if time.size < 2:
+        raise ValueError(f"time must contain at least 2 samples, got {time.size}")
+    if np.any(np.diff(time) <= 0.0):
+        raise ValueError("time must be strictly increasing")
+    return time
+
+
+def _history(name: str, values, n: int) -> np.ndarray:
+    array = _finite_array(name, values)
+    if array.shape != (n,):
+        raise ValueError(f"{name} must have the same length as time ({n}), got shape {array.shape}")
+    return array
+
+
+def _scalar_or_history(name: str, values, n: int) -> np.ndarray:
+    array = np.asarray(values, dtype=float)
+    if array.ndim == 0:
+        array = np.full(n, float(array))
+    if array.shape != (n,):
+        raise ValueError(f"{name} must be a number or have the same length as time ({n}), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must contain only finite numbers")
+    return array
+
+
+def _fraction(name: str, value: float, allow_one: bool = True) -> float:
+    value = float(value)
+    upper_ok = value <= 1.0 if allow_one else value < 1.0
+    if not (math.isfinite(value) and value > 0.0 and upper_ok):
+        bound = "<= 1" if allow_one else "< 1"
+        raise ValueError(f"{name} must be a number > 0 and {bound}, got {value!r}")
+    return value
+
+
+# --------------------------------------------------------------------------- steady window
+
+
+def _default_averaging_samples(n: int) -> int:
+    """About 5 % of ``n`` samples, odd, at least 5."""
+    samples = max(5, int(round(0.05 * n)))
+    return samples if samples % 2 == 1 else samples + 1
+
+
+def _centred_running_mean(values: np.ndarray, samples: int) -> np.ndarray:
+    """Centred running mean over ``samples`` (odd) samples, windows clipped at both ends."""
+    half = samples // 2
+    padded = np.concatenate([np.full(half, np.nan), values, np.full(half, np.nan)])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, samples)
+    return np.nanmean(windows, axis=1)
+
+
+def detect_steady_window(
+    time,
+    signal,
+    start_after: float = 0.0,
+    rel_tolerance: float = 0.05,
+    min_fraction: float = 0.25,
+    averaging_samples: int | None = None,
+) -> SteadyWindow:
+    """Find the steady (plateau) part of a ramp-then-plateau force history.
+
+    The shear force of a Jenike test rises while the sample is mobilised and
+    then fluctuates (possibly with stick-slip) about a steady level. Only the
+    samples with ``time >= start_after`` are analysed; among them:
+
+    1. the plateau ``P`` is the median of the last half of the samples (robust
+       to the fluctuations and to the ramp, which lies in the first half);
+    2. the signal is smoothed with a *centred* running mean of
+       ``averaging_samples`` samples (``w = 2 h + 1``; near both ends of the
+       analysed record the window is clipped to the samples that exist);
+    3. the window starts at the first sample after which the running mean stays
+       within the band ``|mean - P| <= rel_tolerance * |P|`` up to the last
+       sample, and ends at the last sample.
+
+    Precision on a noise-free ramp. Because the running mean is centred it does
+    not lag: on a linear ramp it equals the signal, except at the ``h`` samples
+    either side of the corner at ``t0 = time[k]`` (end of the ramp), where it
+    lies below the plateau by the relative amount ``(h - d)(h - d + 1) / (2 r w)``
+    at sample ``k + d`` (``|d| < h``; ``r`` = ramp length in samples). Hence:
+
+    * if the ramp enters the band at a sample ``j <= k - h`` (a slow ramp), the
+      window starts exactly at ``j``, the first sample of the ramp within
+      ``rel_tolerance`` of the plateau;
+    * otherwise it starts between ``j`` and ``k + h``. For a steep ramp that
+      enters the band less than one sample before ``t0`` (``rel_tolerance * r < 1``)
+      and with ``h (h - 1) / (2 r w) <= rel_tolerance`` (with the defaults
+      ``h = 2, w = 5``: ``r >= 4``), "within one sample of ``t0``" holds in
+      the precise sense ``t0 <= t_start <= t0 + dt``: the window starts at
+      ``time[k]`` or ``time[k + 1]``.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times, strictly increasing [s].
+    signal : array_like, shape (n,)
+        Force history, e.g. ``F_lid + F_ring`` [N].
+    start_after : float, optional
+        Ignore samples before this time [s] (default 0).
+    rel_tolerance : float, optional
+        Half-width of the band about the plateau, relative to ``|P|``
+        (default 0.05, i.e. 5 %).
+    min_fraction : float, optional
+        Smallest accepted window, as a fraction of the analysed samples
+        (default 0.25).
+    averaging_samples : int, optional
+        Odd number of samples ``w`` of the running mean (>= 1; 1 means no
+        smoothing). Default: about 5 % of the analysed samples, odd, at least
+        5 (5 for up to 109 samples; 21 for 400 samples). Raise it for signals
+        with strong stick-slip so that a window spans a few slip events.
+
+    Returns
+    -------
+    SteadyWindow
+        Window times [s], slice bounds and plateau level.
+
+    Raises
+    ------
+    ValueError
+        On malformed input; if the plateau is 0; or (naming ``signal``) if the
+        running mean never settles in the band for at least ``min_fraction``
+        of the analysed samples, e.g. a force that keeps growing.
+    """
+    time = _times(time)
+    signal = _history("signal", signal, time.size)
+    start_after = float(start_after)
+    if not math.isfinite(start_after):
+        raise ValueError(f"start_after must be a finite time, got {start_after!r}")
+    rel_tolerance = float(rel_tolerance)
+    if not (math.isfinite(rel_tolerance) and rel_tolerance > 0.0):
+        raise ValueError(f"rel_tolerance must be a finite number > 0, got {rel_tolerance!r}")
+    min_fraction = _fraction("min_fraction", min_fraction)
+
+    first = int(np.searchsorted(time, start_after, side="left"))
+    analysed = signal[first:]
+    n_analysed = analysed.size
+    if n_analysed < 4:
+        raise ValueError(
+            f"start_after = {start_after:.6g} s leaves {n_analysed} samples of signal; at least 4 are needed"
+        )
+    if averaging_samples is None:
+        averaging_samples = _default_averaging_samples(n_analysed)
+    if (
+        isinstance(averaging_samples, bool)
+        or int(averaging_samples) != averaging_samples
+        or averaging_samples < 1
+        or averaging_samples % 2 == 0
+    ):
+        raise ValueError(f"averaging_samples must be an odd integer >= 1, got {averaging_samples!r}")
+    averaging_samples = int(averaging_samples)
+
+    plateau = float(np.median(analysed[n_analysed // 2 :]))
+    if plateau == 0.0:
+        raise ValueError("signal: the final level (median of the last half) is 0; there is no shear force")
+    running_mean = _centred_running_mean(analysed, averaging_samples)
+    inside = np.abs(running_mean - plateau) <= rel_tolerance * abs(plateau)
+
+    outside = np.flatnonzero(~inside)
+    start = 0 if outside.size == 0 else int(outside[-1]) + 1
+    length = n_analysed - start
+    if length < 2 or length < min_fraction * n_analysed:
+        raise ValueError(
+            f"signal: no steady shear: the force never settles within {100.0 * rel_tolerance:g} % of its "
+            f"final level ({plateau:.6g}) for at least {100.0 * min_fraction:g} % of the samples after "
+            f"start_after = {start_after:.6g} s (settled part: {length} of {n_analysed} samples)"
+        )
+    i_start = first + start
+    return SteadyWindow(
+        t_start=float(time[i_start]),
+        t_end=float(time[-1]),
+        i_start=i_start,
+        i_end=int(time.size),
+        plateau=plateau,
+    )
+
+
+# --------------------------------------------------------------------------- statistics
+
+
+def mean_and_standard_error(values, n_batches: int = 10) -> tuple[float, float]:
+    """Mean of a (possibly autocorrelated) time series and its standard error.
+
+    Successive samples of a shear force are correlated, so the naive error
+    ``s / sqrt(n)`` is too small. The method of batch means is used instead:
+    the series is cut into ``n_batches`` consecutive batches of ``b = n // n_batches``
+    samples (the first ``n - n_batches * b`` samples, the ones nearest the
+    transient, are left out of the batches); if the batches are longer than the
+    correlation time their means are nearly independent, and the standard error
+    is ``std(batch means, ddof=1) / sqrt(n_batches)``. With fewer than
+    ``2 * n_batches`` values (20 by default) the naive error
+    ``std(values, ddof=1) / sqrt(n)`` is returned. The mean is always the mean of
+    all values.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        The series, n >= 2.
+    n_batches : int, optional
+        Number of batches (>= 2, default 10).
+
+    Returns
+    -------
+    tuple of float
+        ``(mean, standard_error)`` in the unit of ``values``.
+    """
+    values = _finite_array("values", values)
+    if values.size < 2:
+        raise ValueError(f"values must contain at least 2 numbers, got {values.size}")
+    if isinstance(n_batches, bool) or int(n_batches) != n_batches or n_batches < 2:
+        raise ValueError(f"n_batches must be an integer >= 2, got {n_batches!r}")
+    n_batches = int(n_batches)
+
+    n = values.size
+    mean = float(np.mean(values))
+    if n < 2 * n_batches:
+        return mean, float(np.std(values, ddof=1)) / math.sqrt(n)
+    batch = n // n_batches
+    batch_means = values[n - n_batches * batch :].reshape(n_batches, batch).mean(axis=1)
+    return mean, float(np.std(batch_means, ddof=1)) / math.sqrt(n_batches)
+
+
+# --------------------------------------------------------------------------- bulk friction
+
+
+def _ratio_and_error(numerator: np.ndarray, denominator: np.ndarray) -> tuple[float, float]:
+    """Ratio of means and its standard error (linearised: residuals ``x - r y``)."""
+    mean_denominator = float(np.mean(denominator))
+    ratio = float(np.mean(numerator)) / mean_denominator
+    _, error = mean_and_standard_error(numerator - ratio * denominator)
+    return ratio, error / mean_denominator
+
+
+def bulk_friction(
+    time,
+    lid_force,
+    ring_force,
+    bottom_force,
+    normal_force,
+    weight_above,
+    window: SteadyWindow | tuple[float, float] | None = None,
+) -> BulkFriction:
+    """Bulk friction coefficient from the forces of a Jenike direct shear test.
+
+    ``mu = <F_lid + F_ring> / <F_N + W>`` and
+    ``mu_bottom = <F_bottom> / <F_N + W>``, with ``<.>`` the mean over the steady
+    window (a ratio of means, so a fluctuating measured normal force is
+    averaged, not divided sample by sample). Standard errors are those of the
+    ratio estimator: the batch-means error (:func:`mean_and_standard_error`) of
+    the residuals ``F_t - mu (F_N + W)`` divided by ``<F_N + W>``; for a
+    constant load this is the error of ``<F_t>`` divided by the load.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times, strictly increasing [s].
+    lid_force, ring_force : array_like, shape (n,)
+        Horizontal forces on the lid and on the shear ring along the shear
+        direction [N].
+    bottom_force : array_like, shape (n,)
+        Horizontal force on the fixed bottom ring (or wall plate), as a
+        magnitude along the shear direction [N].
+    normal_force : float or array_like, shape (n,)
+        Normal force F_N applied to the lid [N].
+    weight_above : float or array_like, shape (n,)
+        Weight W of the solids above the shear plane [N].
+    window : SteadyWindow or tuple of float, optional
+        Averaging window: a :class:`SteadyWindow` (its slice bounds are used)
+        or ``(t0, t1)``, the samples with ``t0 <= t <= t1`` [s]. Default:
+        :func:`detect_steady_window` on ``F_lid + F_ring`` with its defaults.
+
+    Returns
+    -------
+    BulkFriction
+        Coefficients, standard errors, angles [deg], window and the relative
+        difference of the two estimates.
+
+    Raises
+    ------
+    ValueError
+        On malformed input, if ``F_N + W`` is not positive on average over the
+        window, or if the window holds fewer than 2 samples.
+    """
+    time = _times(time)
+    n = time.size
+    lid = _history("lid_force", lid_force, n)
+    ring = _history("ring_force", ring_force, n)
+    bottom = _history("bottom_force", bottom_force, n)
+    normal = _scalar_or_history("normal_force", normal_force, n)
+    weight = _scalar_or_history("weight_above", weight_above, n)
+    shear = lid + ring
+
+    if window is None:
+        window = detect_steady_window(time, shear)
+    elif isinstance(window, SteadyWindow):
+        if not (0 <= window.i_start and window.i_start + 2 <= window.i_end <= n):
+            raise ValueError(
+                f"window: slice [{window.i_start}, {window.i_end}) must hold at least 2 of the {n} samples"
+            )
+    else:
+        if len(window) != 2:
+            raise ValueError(f"window must be a SteadyWindow or (t0, t1), got {window!r}")
+        t0, t1 = float(window[0]), float(window[1])
+        if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
+            raise ValueError(f"window must be finite with t0 < t1, got {window!r}")
+        i_start = int(np.searchsorted(time, t0, side="left"))
+        i_end = int(np.searchsorted(time, t1, side="right"))
+        if i_end - i_start < 2:
+            raise ValueError(f"window ({t0:.6g}, {t1:.6g}) s holds {max(i_end - i_start, 0)} samples; at least 2 are needed")
+        window = SteadyWindow(
+            t_start=float(time[i_start]),
+            t_end=float(time[i_end - 1]),
+            i_start=i_start,
+            i_end=i_end,
+            plateau=float(np.median(shear[i_start:i_end])),
+        )
+
+    part = slice(window.i_start, window.i_end)
+    load = normal[part] + weight[part]
+    normal_load = float(np.mean(load))
+    if normal_load <= 0.0:
+        raise ValueError(
+            f"normal_force: F_N + W must be positive over the window, got a mean of {normal_load:.6g} N"
+        )
+    mu, mu_error = _ratio_and_error(shear[part], load)
+    mu_bottom, mu_bottom_error = _ratio_and_error(bottom[part], load)
+    if mu != 0.0:
+        relative_difference = abs(mu - mu_bottom) / abs(mu)
+    else:
+        relative_difference = 0.0 if mu_bottom == 0.0 else math.inf
+    return BulkFriction(
+        coefficient=mu,
+        standard_error=mu_error,
+        bottom_coefficient=mu_bottom,
+        bottom_standard_error=mu_bottom_error,
+        angle_deg=math.degrees(math.atan(mu)),
+        bottom_angle_deg=math.degrees(math.atan(mu_bottom)),
+        window=window,
+        relative_difference=relative_difference,
+        shear_force=float(np.mean(shear[part])),
+        normal_load=normal_load,
+    )
+
+
+# --------------------------------------------------------------------------- angle <-> coefficient
+
+
+def friction_angle(mu):
+    """Friction angle of a friction coefficient.
+
+    Parameters
+    ----------
+    mu : float or array_like
+        Friction coefficient(s) [-], finite and >= 0.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``degrees(atan(mu))`` [deg].
+    """
+    array = np.asarray(mu, dtype=float)
+    if not np.all(np.isfinite(array)) or np.any(array < 0.0):
+        raise ValueError(f"mu must be finite and >= 0, got {mu!r}")
+    angle = np.degrees(np.arctan(array))
+    return float(angle) if angle.ndim == 0 else angle
+
+
+def friction_coefficient(angle_deg):
+    """Friction coefficient of a friction angle.
+
+    Parameters
+    ----------
+    angle_deg : float or array_like
+        Friction angle(s) [deg], ``0 <= angle < 90``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``tan(radians(angle_deg))`` [-].
+    """
+    array = np.asarray(angle_deg, dtype=float)
+    if not np.all(np.isfinite(array)) or np.any(array < 0.0) or np.any(array >= 90.0):
+        raise ValueError(f"angle_deg must satisfy 0 <= angle_deg < 90, got {angle_deg!r}")
+    coefficient = np.tan(np.radians(array))
+    return float(coefficient) if coefficient.ndim == 0 else coefficient
+
+
+# --------------------------------------------------------------------------- contact diagnostics
+
+
+def _vectors(name: str, values) -> np.ndarray:
+    array = _finite_array(name, values, ndim=None)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (n, 3), got {array.shape}")
+    return array
+
+
+def mobilised_friction_histogram(
+    normal_force_vectors,
+    tangential_force_vectors,
+    bins=20,
+    range: tuple[float, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Histogram of the mobilised friction ``|F_t| / |F_n|`` of contacts.
+
+    The contact force is given already split into its normal and tangential
+    parts, as LIGGGHTS reports them (``compute pair/gran/local`` or
+    ``wall/gran/local`` with ``force_normal`` and ``force_tangential``). A ratio
+    equal to the sliding friction coefficient means a sliding contact.
+    Contacts with ``|F_n| = 0`` (no load, ratio undefined) are left out.
+
+    Parameters
+    ----------
+    normal_force_vectors : array_like, shape (n, 3)
+        Normal contact forces [N].
+    tangential_force_vectors : array_like, shape (n, 3)
+        Tangential contact forces [N].
+    bins : int or array_like, optional
+        Number of equal bins (default 20) or the bin edges (increasing).
+    range : tuple of float, optional
+        ``(low, high)`` for integer ``bins``; default ``(0, max ratio)``
+        (``(0, 1)`` if there is no loaded contact or every ratio is 0).
+        Ratios outside the range are not counted; ``high`` is included in the
+        last bin.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(bin_edges, counts)``: the edges [-] and the integer number of
+        contacts per bin.
+    """
+    normal = _vectors("normal_force_vectors", normal_force_vectors)
+    tangential = _vectors("tangential_force_vectors", tangential_force_vectors)
+    if normal.shape != tangential.shape:
+        raise ValueError(
+            f"normal_force_vectors and tangential_force_vectors must have the same shape, "
+            f"got {normal.shape} and {tangential.shape}"
+        )
+    normal_magnitude = np.linalg.norm(normal, axis=1)
+    loaded = normal_magnitude > 0.0
+    ratio = np.linalg.norm(tangential[loaded], axis=1) / normal_magnitude[loaded]
+
+    if np.ndim(bins) == 0:
+        if isinstance(bins, bool) or int(bins) != bins or bins < 1:
+            raise ValueError(f"bins must be an integer >= 1 or an array of edges, got {bins!r}")
+        if range is None:
+            high = float(ratio.max()) if ratio.size else 0.0
+            range = (0.0, high if high > 0.0 else 1.0)
+        low, high = float(range[0]), float(range[1])
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            raise ValueError(f"range must be finite with low < high, got {range!r}")
+        counts, edges = np.histogram(ratio, bins=int(bins), range=(low, high))
+    else:
+        edges = _finite_array("bins", bins)
+        if edges.size < 2 or np.any(np.diff(edges) <= 0.0):
+            raise ValueError("bins must hold at least 2 strictly increasing edges")
+        counts, edges = np.histogram(ratio, bins=edges)
+    return edges, counts
+
+
+_PLANE_AXES = {"x": (1, 2), "y": (0, 2), "z": (0, 1)}
+
+
+def angular_histogram(vectors, axis: str = "y", bins: int = 36, weights=None) -> tuple[np.ndarray, np.ndarray]:
+    """Histogram of the direction of vectors projected on a coordinate plane.
+
+    Each vector is projected on the plane perpendicular to ``axis`` and the
+    angle of the projection ``(u, v)`` is ``atan2(v, u)`` in ``[0, 2 pi)``, with
+
+    * ``axis="y"``: ``(u, v) = (x, z)``: 0 along +x, pi/2 along +z, i.e.
+      counter-clockwise as seen from the front (looking along +y, x to the
+      right, z up), the usual view of a planar silo or a shear cell;
+    * ``axis="x"``: ``(u, v) = (y, z)``;
+    * ``axis="z"``: ``(u, v) = (x, y)`` (seen from above).
+
+    Vectors whose projection is zero (parallel to ``axis``, or zero) have no
+    direction and are left out. Sector ``i`` holds the angles
+    ``2 pi i / bins <= angle < 2 pi (i + 1) / bins``, so a direction on an edge
+    (e.g. exactly along +z) belongs to the sector that starts there. Used for polar plots of, e.g., particle angular
+    velocity directions or the direction of the mobilised tangential force.
+
+    Parameters
+    ----------
+    vectors : array_like, shape (n, 3)
+        Vectors (any unit).
+    axis : {"x", "y", "z"}, optional
+        Normal of the projection plane (default "y").
+    bins : int, optional
+        Number of equal angular sectors over ``[0, 2 pi]`` (default 36, 10 deg).
+    weights : array_like, shape (n,), optional
+        Weight per vector (e.g. its magnitude); default 1 (counts).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(edges_rad, counts)``: ``bins + 1`` edges from 0 to 2 pi [rad] and the
+        (weighted) counts per sector (integers without weights).
+    """
+    vectors = _vectors("vectors", vectors)
+    if axis not in _PLANE_AXES:
+        raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
+    if isinstance(bins, bool) or int(bins) != bins or bins < 1:
+        raise ValueError(f"bins must be an integer >= 1, got {bins!r}")
+    if weights is not None:
+        weights = _finite_array("weights", weights)
+        if weights.shape != (vectors.shape[0],):
+            raise ValueError(f"weights must have shape ({vectors.shape[0]},), got {weights.shape}")
+
+    first, second = _PLANE_AXES[axis]
+    u = vectors[:, first]
+    v = vectors[:, second]
+    has_direction = (u != 0.0) | (v != 0.0)
+    bins = int(bins)
+    angle = np.mod(np.arctan2(v[has_direction], u[has_direction]), 2.0 * math.pi)
+    # Sector index from the fraction of a full turn: exact for the axis directions
+    # (pi/2 / 2pi = 0.25 exactly), so a direction on an edge starts the next sector.
+    sector = np.minimum(np.floor(angle / (2.0 * math.pi) * bins).astype(np.intp), bins - 1)
+    if weights is None:
+        counts = np.bincount(sector, minlength=bins)
+    else:
+        counts = np.bincount(sector, weights=weights[has_direction], minlength=bins)
+    edges = np.linspace(0.0, 2.0 * math.pi, bins + 1)
+    return edges, counts

@@ -1,0 +1,324 @@
+"""Unit tests for calibration.friction on synthetic force histories with exact answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from calibration.friction import (
+    BulkFriction,
+    SteadyWindow,
+    angular_histogram,
+    bulk_friction,
+    detect_steady_window,
+    friction_angle,
+    friction_coefficient,
+    mean_and_standard_error,
+    mobilised_friction_histogram,
+)
+
+N_SAMPLES = 101  # default running mean: 5 samples (h = 2)
+
+
+def _ramp(ramp_samples: int, plateau: float = 31.2, n: int = N_SAMPLES):
+    """Linear ramp from 0 at sample 0 to the plateau at sample k = ramp_samples, then constant."""
+    time = np.linspace(0.0, 1.0, n)
+    signal = plateau * np.minimum(np.arange(n) / ramp_samples, 1.0)
+    return time, signal
+
+
+# --------------------------------------------------------------------------- steady window
+
+
+@pytest.mark.parametrize(
+    "ramp_samples, expected_offset",
+    [
+        # Steep ramps (rel_tolerance * r < 1, r >= 4): t0 <= t_start <= t0 + dt.
+        # r = 10: the centred mean at k is 6 % low (> 5 %), at k + 1 2 % low -> k + 1.
+        (10, 1),
+        # r = 16: at k 3.75 % low (inside), at k - 1 7.5 % low -> k.
+        (16, 0),
+    ],
+)
+def test_steady_window_starts_within_one_sample_of_ramp_end(ramp_samples, expected_offset):
+    time, signal = _ramp(ramp_samples)
+    window = detect_steady_window(time, signal)
+    k = ramp_samples
+    assert window.i_start == k + expected_offset
+    assert time[k] <= window.t_start <= time[k + 1]
+    assert window.t_start == time[k + expected_offset]
+    assert window.i_end == N_SAMPLES
+    assert window.t_end == time[-1]
+    assert window.plateau == 31.2
+
+
+def test_steady_window_slow_ramp_starts_where_ramp_enters_band():
+    # r = 50: the ramp is within 5 % from sample 48 (4 % low) on; 48 <= k - h, so the start is exactly 48.
+    time, signal = _ramp(50)
+    window = detect_steady_window(time, signal)
+    assert window.i_start == 48
+    assert window.t_start == time[48]
+
+
+def test_steady_window_noisy_plateau():
+    rng = np.random.default_rng(12345)
+    time, signal = _ramp(20, plateau=10.0, n=401)  # default running mean: 21 samples
+    noisy = signal + rng.normal(0.0, 0.1, signal.size)  # 1 % noise
+    window = detect_steady_window(time, noisy)
+    assert 15 <= window.i_start <= 30
+    assert window.plateau == pytest.approx(10.0, abs=0.03)
+    assert window.i_end == 401
+
+
+def test_steady_window_stick_slip_averaged_by_running_mean():
+    # A sawtooth of period 5 samples and +-20 % amplitude on the plateau: every 5-sample mean is the plateau.
+    time, signal = _ramp(10, plateau=10.0)
+    saw = np.tile([-2.0, -1.0, 0.0, 1.0, 2.0], 30)[: N_SAMPLES - 30]
+    signal[30:] += saw
+    window = detect_steady_window(time, signal)
+    assert window.plateau == pytest.approx(10.0)
+    assert window.i_start <= 32
+    with pytest.raises(ValueError, match="signal: no steady shear"):
+        detect_steady_window(time, signal, averaging_samples=1)
+
+
+def test_steady_window_start_after():
+    time, signal = _ramp(10)
+    window = detect_steady_window(time, signal, start_after=0.5)
+    assert window.i_start == 50
+    assert window.t_start == time[50]
+
+
+def test_steady_window_growing_signal_raises():
+    time = np.linspace(0.0, 1.0, 101)
+    with pytest.raises(ValueError, match=r"signal: no steady shear: the force never settles within 5 % of its final level"):
+        detect_steady_window(time, 1.0 + 10.0 * time)
+
+
+def test_steady_window_min_fraction():
+    # Ramp to sample 60: the plateau holds the last 41 of 101 samples (41 %).
+    time, signal = _ramp(60)
+    assert 57 <= detect_steady_window(time, signal).i_start <= 62
+    with pytest.raises(ValueError, match="signal: no steady shear"):
+        detect_steady_window(time, signal, min_fraction=0.5)
+
+
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"rel_tolerance": 0.0}, "rel_tolerance"),
+        ({"min_fraction": 1.5}, "min_fraction"),
+        ({"averaging_samples": 4}, "averaging_samples"),
+        ({"start_after": 0.99}, "start_after"),
+    ],
+)
+def test_steady_window_rejects_bad_arguments(kwargs, name):
+    time, signal = _ramp(10)
+    with pytest.raises(ValueError, match=name):
+        detect_steady_window(time, signal, **kwargs)
+
+
+def test_steady_window_rejects_bad_time_and_zero_signal():
+    time, signal = _ramp(10)
+    with pytest.raises(ValueError, match="time"):
+        detect_steady_window(time[::-1], signal)
+    with pytest.raises(ValueError, match="signal"):
+        detect_steady_window(time, signal[:-1])
+    with pytest.raises(ValueError, match="signal"):
+        detect_steady_window(time, np.zeros_like(time))
+
+
+# --------------------------------------------------------------------------- mean and error
+
+
+def test_mean_and_error_of_constant():
+    assert mean_and_standard_error(np.full(100, 2.5)) == (2.5, 0.0)
+    assert mean_and_standard_error(np.full(7, 2.5)) == (2.5, 0.0)
+
+
+@pytest.mark.parametrize("n", [10, 100, 200])
+def test_mean_and_error_alternating(n):
+    values = 3.0 + np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    mean, error = mean_and_standard_error(values)
+    assert mean == 3.0
+    if n < 20:
+        # Naive error: s = sqrt(n / (n - 1)), error = s / sqrt(n).
+        assert error == pytest.approx(1.0 / math.sqrt(n - 1), rel=1e-14)
+    else:
+        # Batches of even length average to exactly 3: anti-correlation gives error 0.
+        assert error == 0.0
+
+
+def test_mean_and_error_batch_means_by_hand():
+    # 20 values, 10 batches of 2: batch means 0, 1, ..., 9.
+    values = np.repeat(np.arange(10.0), 2)
+    mean, error = mean_and_standard_error(values)
+    assert mean == 4.5
+    assert error == pytest.approx(np.std(np.arange(10.0), ddof=1) / math.sqrt(10), rel=1e-14)
+
+
+def test_mean_and_error_rejects_short_input():
+    with pytest.raises(ValueError, match="values"):
+        mean_and_standard_error([1.0])
+
+
+# --------------------------------------------------------------------------- bulk friction
+
+
+def _histories(n=201, ramp_samples=20):
+    time = np.linspace(0.0, 2.0, n)
+    shape = np.minimum(np.arange(n) / ramp_samples, 1.0)
+    total = 0.6 * 52.0 * shape
+    lid = 0.25 * total
+    ring = total - lid
+    return time, lid, ring, total
+
+
+def test_bulk_friction_exact():
+    time, lid, ring, total = _histories()
+    result = bulk_friction(time, lid, ring, total, 50.0, 2.0)
+    assert isinstance(result, BulkFriction)
+    assert result.coefficient == pytest.approx(0.6, abs=1e-12)
+    assert result.bottom_coefficient == pytest.approx(0.6, abs=1e-12)
+    assert result.angle_deg == pytest.approx(math.degrees(math.atan(0.6)), abs=1e-12)
+    assert result.bottom_angle_deg == pytest.approx(math.degrees(math.atan(0.6)), abs=1e-12)
+    assert result.relative_difference == pytest.approx(0.0, abs=1e-12)
+    assert result.standard_error == pytest.approx(0.0, abs=1e-12)
+    assert result.normal_load == 52.0
+    assert result.shear_force == pytest.approx(31.2, abs=1e-12)
+    assert isinstance(result.window, SteadyWindow)
+    assert result.window.i_end == time.size
+    assert 20 <= result.window.i_start <= 21
+
+
+def test_bulk_friction_array_loads_and_bottom_difference():
+    time, lid, ring, total = _histories()
+    normal = np.full(time.size, 50.0)
+    weight = np.full(time.size, 2.0)
+    result = bulk_friction(time, lid, ring, 0.9 * total, normal, weight)
+    assert result.coefficient == pytest.approx(0.6, abs=1e-12)
+    assert result.bottom_coefficient == pytest.approx(0.54, abs=1e-12)
+    assert result.relative_difference == pytest.approx(0.1, abs=1e-12)
+
+
+def test_bulk_friction_explicit_windows():
+    time, lid, ring, total = _histories()
+    by_times = bulk_friction(time, lid, ring, total, 50.0, 2.0, window=(1.0, 2.0))
+    assert by_times.window.i_start == 100
+    assert by_times.window.i_end == 201
+    assert by_times.coefficient == pytest.approx(0.6, abs=1e-12)
+    # A window including the ramp lowers the mean: the given window is used as is.
+    given = SteadyWindow(t_start=0.0, t_end=0.2, i_start=0, i_end=21, plateau=31.2)
+    ramp = bulk_friction(time, lid, ring, total, 50.0, 2.0, window=given)
+    assert ramp.window is given
+    assert ramp.coefficient == pytest.approx(0.3, abs=1e-12)  # mean of a full linear ramp
+
+
+def test_bulk_friction_standard_error_from_fluctuations():
+    # Plateau alternating 31.2 +- 1 (period 2): batch means are exact, error 0; a block pattern is not.
+    time, lid, ring, total = _histories()
+    fluctuating = total + np.where(np.arange(time.size) % 2 == 0, 1.0, -1.0) * (np.arange(time.size) >= 20)
+    result = bulk_friction(time, fluctuating, np.zeros_like(time), total, 50.0, 2.0, window=(1.0, 1.995))
+    assert result.coefficient == pytest.approx(0.6, abs=1e-12)
+    assert result.standard_error == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    "name, change",
+    [
+        ("lid_force", {"lid_force": np.zeros(5)}),
+        ("bottom_force", {"bottom_force": np.full(201, np.nan)}),
+        ("normal_force", {"normal_force": -2.0}),
+        ("weight_above", {"weight_above": np.zeros(3)}),
+        ("window", {"window": (1.0, 0.5)}),
+    ],
+)
+def test_bulk_friction_rejects_bad_input(name, change):
+    time, lid, ring, total = _histories()
+    arguments = dict(
+        time=time, lid_force=lid, ring_force=ring, bottom_force=total, normal_force=50.0, weight_above=2.0
+    )
+    arguments.update(change)
+    with pytest.raises(ValueError, match=name):
+        bulk_friction(**arguments)
+
+
+def test_friction_angle_and_coefficient():
+    assert friction_angle(1.0) == pytest.approx(45.0, abs=1e-12)
+    assert friction_angle(0.0) == 0.0
+    assert friction_coefficient(45.0) == pytest.approx(1.0, abs=1e-12)
+    angles = friction_angle(np.array([0.2, 0.6]))
+    np.testing.assert_allclose(friction_coefficient(angles), [0.2, 0.6], rtol=1e-14)
+    with pytest.raises(ValueError, match="mu"):
+        friction_angle(-0.1)
+    with pytest.raises(ValueError, match="angle_deg"):
+        friction_coefficient(90.0)
+
+
+# --------------------------------------------------------------------------- diagnostics
+
+
+def test_mobilised_friction_histogram_by_hand():
+    normal = np.array([[0, 0, 2.0], [0, 0, 1.0], [0, 0, 4.0], [0, 0, 1.0], [0, 0, 0.0]])
+    tangential = np.array([[0.2, 0, 0], [0, 0.25, 0], [1.2, 1.6, 0], [0.7, 0, 0], [1.0, 0, 0]])
+    # ratios: 0.1, 0.25, 0.5, 0.7; the unloaded contact is left out
+    edges, counts = mobilised_friction_histogram(normal, tangential, bins=4, range=(0.0, 0.8))
+    np.testing.assert_allclose(edges, [0.0, 0.2, 0.4, 0.6, 0.8])
+    assert counts.tolist() == [1, 1, 1, 1]
+
+    edges, counts = mobilised_friction_histogram(normal, tangential, bins=[0.0, 0.3, 1.0])
+    assert counts.tolist() == [2, 2]
+
+    # default range: (0, max ratio), the maximum in the last bin
+    edges, counts = mobilised_friction_histogram(normal, tangential, bins=7)
+    assert edges[0] == 0.0 and edges[-1] == pytest.approx(0.7)
+    assert counts.sum() == 4 and counts[-1] == 1
+
+
+def test_mobilised_friction_histogram_rejects_mismatch():
+    with pytest.raises(ValueError, match="normal_force_vectors"):
+        mobilised_friction_histogram(np.zeros((3, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="tangential_force_vectors"):
+        mobilised_friction_histogram(np.zeros((3, 3)), np.zeros((3, 2)))
+
+
+def test_angular_histogram_axis_y_by_hand():
+    vectors = np.array(
+        [
+            [1.0, 5.0, 0.0],   # +x: 0 -> sector 0
+            [0.0, 0.0, 2.0],   # +z: pi/2 -> sector 1 (on an edge: the sector starting there)
+            [-1.0, 0.0, 0.0],  # -x: pi -> sector 2
+            [0.0, -3.0, -1.0],  # -z: 3 pi/2 -> sector 3
+            [1.0, 0.0, 1.0],   # pi/4 -> sector 0
+            [0.0, 7.0, 0.0],   # along y: no direction, left out
+        ]
+    )
+    edges, counts = angular_histogram(vectors, axis="y", bins=4)
+    np.testing.assert_allclose(edges, [0.0, math.pi / 2, math.pi, 1.5 * math.pi, 2 * math.pi])
+    assert counts.tolist() == [2, 1, 1, 1]
+
+
+def test_angular_histogram_other_axes_and_weights():
+    vectors = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0]])
+    _, counts_x = angular_histogram(vectors, axis="x", bins=4)  # (y, z): 0, pi/2, 0
+    assert counts_x.tolist() == [2, 1, 0, 0]
+    _, counts_z = angular_histogram(vectors, axis="z", bins=8)  # (x, y): pi/2, none, pi/4
+    assert counts_z.tolist() == [0, 1, 1, 0, 0, 0, 0, 0]
+    edges, weighted = angular_histogram(vectors, axis="x", bins=4, weights=[2.0, 3.0, 0.5])
+    assert weighted.tolist() == [2.5, 3.0, 0.0, 0.0]
+    assert edges.size == 5
+    edges, counts = angular_histogram(vectors)
+    assert edges.size == 37 and counts.size == 36
+
+
+def test_angular_histogram_rejects_bad_arguments():
+    with pytest.raises(ValueError, match="axis"):
+        angular_histogram(np.zeros((2, 3)), axis="w")
+    with pytest.raises(ValueError, match="vectors"):
+        angular_histogram(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="bins"):
+        angular_histogram(np.zeros((2, 3)), bins=0)
+    with pytest.raises(ValueError, match="weights"):
+        angular_histogram(np.zeros((2, 3)), weights=[1.0])

@@ -1,0 +1,251 @@
+"""Unit tests for calibration.inversion on synthetic charts with exact answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from calibration.inversion import (
+    CalibrationCurve,
+    Inversion,
+    UnreachableTarget,
+    curves_from_table,
+    invert_calibration,
+    invert_curve,
+)
+
+PARTICLE = np.linspace(0.0, 1.0, 11)
+
+
+def _deg(mu: float) -> float:
+    return math.degrees(math.atan(mu))
+
+
+def _linear_curve(test="internal", material=None, rolling=0.1, shape="sphere2", offset=0.2, slope=0.5):
+    return CalibrationCurve(
+        shape=shape,
+        test=test,
+        rolling_friction=rolling,
+        particle_friction=PARTICLE,
+        bulk_friction=offset + slope * PARTICLE,
+        wall_material=material,
+    )
+
+
+def _plateau_curve():
+    return CalibrationCurve(
+        shape="sphere2",
+        test="internal",
+        rolling_friction=0.05,
+        particle_friction=[0.0, 0.2, 0.4, 0.6, 0.8, 1.0],
+        bulk_friction=[0.3, 0.4, 0.5, 0.55, 0.55, 0.54],
+    )
+
+
+# --------------------------------------------------------------------------- invert_curve
+
+
+def test_invert_monotone_chart_exact():
+    target = _deg(0.45)
+    inversion = invert_curve(_linear_curve(), target, tolerance_deg=1.0)
+    assert isinstance(inversion, Inversion)
+    assert inversion.particle_friction == pytest.approx(0.5, abs=1e-12)
+
+    # Band edges by hand: linear interpolation in angle between the bracketing chart points.
+    def angle(p):
+        return _deg(0.2 + 0.5 * p)
+
+    low_angle, high_angle = target - 1.0, target + 1.0
+    assert angle(0.4) < low_angle < angle(0.5) < high_angle < angle(0.6)
+    lower = 0.4 + 0.1 * (low_angle - angle(0.4)) / (angle(0.5) - angle(0.4))
+    upper = 0.5 + 0.1 * (high_angle - angle(0.5)) / (angle(0.6) - angle(0.5))
+    assert inversion.lower == pytest.approx(lower, abs=1e-12)
+    assert inversion.upper == pytest.approx(upper, abs=1e-12)
+    assert inversion.band_clipped is False
+    assert inversion.plateau_particle_friction is None
+    assert inversion.reachable_range_deg == pytest.approx((_deg(0.2), _deg(0.7)), abs=1e-12)
+    assert (inversion.shape, inversion.test, inversion.rolling_friction) == ("sphere2", "internal", 0.1)
+    assert inversion.target_angle_deg == target and inversion.tolerance_deg == 1.0
+
+
+def test_invert_reproduces_chart_points():
+    curve = _linear_curve()
+    for p, mu in zip(curve.particle_friction, curve.bulk_friction):
+        assert invert_curve(curve, _deg(mu), 0.0).particle_friction == pytest.approx(p, abs=1e-12)
+
+
+def test_invert_plateau_uses_monotone_part():
+    curve = _plateau_curve()
+    inversion = invert_curve(curve, _deg(0.45), tolerance_deg=1.0)
+    # between p = 0.2 (0.4) and 0.4 (0.5), linear in angle
+    expected = 0.2 + 0.2 * (_deg(0.45) - _deg(0.4)) / (_deg(0.5) - _deg(0.4))
+    assert inversion.particle_friction == pytest.approx(expected, abs=1e-12)
+    assert inversion.plateau_particle_friction == 0.6
+    assert inversion.reachable_range_deg == pytest.approx((_deg(0.3), _deg(0.55)), abs=1e-12)
+
+    # Target reachable, upper band edge beyond the first maximum: clipped to p = 0.6.
+    near_top = invert_curve(curve, _deg(0.55) - 0.5, tolerance_deg=1.0)
+    assert near_top.band_clipped is True
+    assert near_top.upper == 0.6
+    assert near_top.lower < near_top.particle_friction < 0.6
+
+    # Lower band edge below the chart: clipped to p = 0.
+    near_bottom = invert_curve(curve, _deg(0.3) + 0.5, tolerance_deg=1.0)
+    assert near_bottom.band_clipped is True
+    assert near_bottom.lower == 0.0
+
+
+def test_unreachable_target_message_names_range():
+    curve = _plateau_curve()
+    expected = (
+        "internal friction angle 30.0 deg is unreachable for sphere2 with rolling friction 0.05: "
+        "the chart reaches 16.7-28.8 deg (bulk friction stops growing above particle friction 0.6)"
+    )
+    with pytest.raises(UnreachableTarget) as raised:
+        invert_curve(curve, 30.0)
+    assert str(raised.value) == expected
+    assert isinstance(raised.value, ValueError)
+
+    with pytest.raises(UnreachableTarget, match=r"aluminium wall friction angle 5\.0 deg .* reaches 11\.3-35\.0 deg$"):
+        invert_curve(_linear_curve("wall", "aluminium"), 5.0)
+
+
+def test_invert_curve_rejects_bad_arguments():
+    with pytest.raises(ValueError, match="target_angle_deg"):
+        invert_curve(_linear_curve(), float("nan"))
+    with pytest.raises(ValueError, match="tolerance_deg"):
+        invert_curve(_linear_curve(), 25.0, tolerance_deg=-1.0)
+    with pytest.raises(ValueError, match="curve"):
+        invert_curve({"shape": "sphere"}, 25.0)
+
+
+@pytest.mark.parametrize(
+    "change, name",
+    [
+        ({"test": "shear"}, "test"),
+        ({"particle_friction": [0.0, 0.2, 0.1]}, "particle_friction"),
+        ({"bulk_friction": [0.1, 0.2]}, "bulk_friction"),
+        ({"bulk_standard_error": [0.1]}, "bulk_standard_error"),
+        ({"rolling_friction": -0.1}, "rolling_friction"),
+        ({"wall_material": "perspex"}, "wall_material"),
+        ({"shape": ""}, "shape"),
+    ],
+)
+def test_calibration_curve_validation(change, name):
+    arguments = dict(
+        shape="sphere", test="internal", rolling_friction=0.0, particle_friction=[0.0, 0.1, 0.2],
+        bulk_friction=[0.2, 0.3, 0.4],
+    )
+    arguments.update(change)
+    with pytest.raises(ValueError, match=name):
+        CalibrationCurve(**arguments)
+
+
+def test_calibration_curve_normalises_empty_material():
+    curve = CalibrationCurve("sphere", "internal", 0, [0.1], [0.3], wall_material="")
+    assert curve.wall_material is None
+    assert isinstance(curve.particle_friction, np.ndarray)
+    assert curve.rolling_friction == 0.0
+
+
+# --------------------------------------------------------------------------- invert_calibration
+
+
+def _chart_set():
+    return [
+        _linear_curve("internal", None, rolling=0.1),
+        _linear_curve("wall", "aluminium", rolling=0.1, offset=0.05, slope=0.5),
+        _linear_curve("wall", "perspex", rolling=0.1, offset=0.1, slope=0.5),
+        _linear_curve("internal", None, rolling=0.05, offset=0.1),  # other rolling friction
+        _linear_curve("internal", None, rolling=0.1, shape="sphere4", offset=0.3),  # other shape
+    ]
+
+
+def test_invert_calibration_dict():
+    targets = {"internal": _deg(0.45), "aluminium": _deg(0.30), "perspex": _deg(0.35)}
+    result = invert_calibration(_chart_set(), targets, tolerance_deg=1.0, shape="sphere2", rolling_friction=0.1)
+    assert set(result) == {"shape", "rolling_friction", "tolerance_deg", "particle_particle", "particle_wall", "targets_deg"}
+    assert result["shape"] == "sphere2" and result["rolling_friction"] == 0.1 and result["tolerance_deg"] == 1.0
+    assert result["particle_particle"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
+    assert result["particle_wall"]["aluminium"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
+    assert result["particle_wall"]["perspex"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
+    assert set(result["particle_wall"]["perspex"]) == {"sliding_friction", "lower", "upper", "band_clipped"}
+    assert result["targets_deg"] == targets
+    expected_band = invert_curve(_linear_curve(), _deg(0.45), 1.0)
+    assert result["particle_particle"]["lower"] == expected_band.lower
+    assert result["particle_particle"]["upper"] == expected_band.upper
+    # plain types only: safe_dump accepts it and round-trips
+    assert yaml.safe_load(yaml.safe_dump(result)) == result
+
+
+def test_invert_calibration_missing_curve():
+    curves = _chart_set()[:2]
+    with pytest.raises(ValueError, match=r"no wall friction on perspex curve for shape sphere2 with rolling friction 0\.1"):
+        invert_calibration(curves, {"internal": 24.0, "perspex": 11.0}, shape="sphere2", rolling_friction=0.1)
+    with pytest.raises(ValueError, match=r"no internal friction curve for shape sphere with rolling friction 0\.1"):
+        invert_calibration(curves, {"internal": 24.0}, shape="sphere", rolling_friction=0.1)
+
+
+def test_invert_calibration_unreachable_propagates():
+    with pytest.raises(UnreachableTarget, match="perspex wall friction angle 40.0 deg"):
+        invert_calibration(_chart_set(), {"perspex": 40.0}, shape="sphere2", rolling_friction=0.1)
+
+
+# --------------------------------------------------------------------------- curves_from_table
+
+
+def test_curves_from_table_groups_and_sorts():
+    rows = [
+        {"shape": "sphere2", "test": "wall", "wall_material": "perspex", "rolling_friction": "0.1",
+         "particle_friction": "0.5", "bulk_friction": "0.3", "bulk_friction_stderr": "0.01"},
+        {"shape": "sphere2", "test": "internal", "wall_material": "", "rolling_friction": "0.1",
+         "particle_friction": "0.2", "bulk_friction": "0.5", "bulk_friction_stderr": ""},
+        {"shape": "sphere", "test": "internal", "wall_material": float("nan"), "rolling_friction": 0.0,
+         "particle_friction": 0.3, "bulk_friction": 0.45, "bulk_friction_stderr": 0.02},
+        {"shape": "sphere2", "test": "internal", "wall_material": None, "rolling_friction": 0.1,
+         "particle_friction": 0.1, "bulk_friction": 0.4},
+        {"shape": "sphere2", "test": "wall", "wall_material": "aluminium", "rolling_friction": 0.1,
+         "particle_friction": 0.5, "bulk_friction": 0.25, "bulk_friction_stderr": 0.01},
+        {"shape": "sphere2", "test": "wall", "wall_material": "perspex", "rolling_friction": 0.1,
+         "particle_friction": 0.2, "bulk_friction": 0.2, "bulk_friction_stderr": None},
+        {"shape": "sphere2", "test": "internal", "wall_material": "", "rolling_friction": 0.05,
+         "particle_friction": 0.1, "bulk_friction": 0.35},
+        {"shape": "sphere", "test": "internal", "wall_material": "", "rolling_friction": 0.0,
+         "particle_friction": 0.1, "bulk_friction": 0.3, "bulk_friction_stderr": 0.01},
+    ]
+    curves = curves_from_table(rows)
+    keys = [(c.shape, c.test, c.wall_material, c.rolling_friction) for c in curves]
+    assert keys == [
+        ("sphere", "internal", None, 0.0),
+        ("sphere2", "internal", None, 0.05),
+        ("sphere2", "internal", None, 0.1),
+        ("sphere2", "wall", "aluminium", 0.1),
+        ("sphere2", "wall", "perspex", 0.1),
+    ]
+    sphere = curves[0]
+    np.testing.assert_array_equal(sphere.particle_friction, [0.1, 0.3])
+    np.testing.assert_array_equal(sphere.bulk_friction, [0.3, 0.45])
+    np.testing.assert_array_equal(sphere.bulk_standard_error, [0.01, 0.02])
+    internal = curves[2]
+    np.testing.assert_array_equal(internal.particle_friction, [0.1, 0.2])
+    np.testing.assert_array_equal(internal.bulk_friction, [0.4, 0.5])
+    assert internal.bulk_standard_error is None
+    perspex = curves[4]
+    np.testing.assert_array_equal(perspex.particle_friction, [0.2, 0.5])
+    np.testing.assert_array_equal(perspex.bulk_standard_error, [np.nan, 0.01])
+
+
+def test_curves_from_table_errors():
+    row = {"shape": "sphere", "test": "internal", "wall_material": "", "rolling_friction": 0.0,
+           "particle_friction": 0.1, "bulk_friction": 0.3}
+    with pytest.raises(ValueError, match="particle friction 0.1"):
+        curves_from_table([row, dict(row)])
+    with pytest.raises(ValueError, match=r"rows\[0\] lacks the key 'bulk_friction'"):
+        curves_from_table([{k: v for k, v in row.items() if k != "bulk_friction"}])
+    with pytest.raises(ValueError, match=r"rows\[0\]: bulk_friction"):
+        curves_from_table([dict(row, bulk_friction="abc")])
+    with pytest.raises(ValueError, match=r"rows\[0\]: test"):
+        curves_from_table([dict(row, test="shear")])
