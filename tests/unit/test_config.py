@@ -110,7 +110,8 @@ def test_missing_contact_pair_is_named(raw_default_config):
 def test_duplicate_contact_pair_is_named(raw_default_config):
     config = copy.deepcopy(raw_default_config)
     config["contacts"].append({**config["contacts"][1], "materials": ["aluminium", "hdpe"]})
-    with pytest.raises(ConfigError, match=r"contacts\[3\]': material pair \['aluminium', 'hdpe'\] is already defined in contacts\[1\]"):
+    last = len(config["contacts"]) - 1
+    with pytest.raises(ConfigError, match=rf"contacts\[{last}\]': material pair \['aluminium', 'hdpe'\] is already defined in contacts\[1\]"):
         validate_config(config)
 
 
