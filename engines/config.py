@@ -170,6 +170,8 @@ def _check_references(config: dict) -> None:
             )
         seen[pair] = index
 
+    _check_jenike_references(config, require, seen)
+
     particle_material = silo["particle_material"]
     if "density" not in materials[particle_material]:
         raise ConfigError(
@@ -182,6 +184,40 @@ def _check_references(config: dict) -> None:
                 f"config key 'contacts': no contact parameters for the pair "
                 f"[{particle_material}, {material}] used by silo_flat"
             )
+
+
+def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None:
+    materials = config["materials"]
+    jenike = config["jenike"]
+    sweep = jenike["sweep"]
+    particle = jenike["particle_material"]
+    for key in ("particle_material", "ring_material", "lid_material"):
+        require(jenike[key], materials, f"jenike.{key}", "material")
+    if "density" not in materials[particle]:
+        raise ConfigError(f"config key 'materials.{particle}.density': the particle material needs a density")
+    for index, shape in enumerate(sweep["shapes"]):
+        require(shape, config["particle_models"], f"jenike.sweep.shapes[{index}]", "particle model")
+    wall_tests = []
+    for index, test in enumerate(sweep["tests"]):
+        if test != "internal":
+            require(test, materials, f"jenike.sweep.tests[{index}]", "test ('internal' or a wall material)")
+            wall_tests.append(test)
+    for material in sorted({particle, jenike["ring_material"], jenike["lid_material"], *wall_tests}):
+        if frozenset((particle, material)) not in contact_pairs:
+            raise ConfigError(
+                f"config key 'contacts': no contact parameters for the pair [{particle}, {material}] used by jenike"
+            )
+    calibration = config["calibration"]
+    if calibration["shape"] not in sweep["shapes"]:
+        raise ConfigError(
+            f"config key 'calibration.shape': '{calibration['shape']}' is not among jenike.sweep.shapes "
+            f"{sweep['shapes']}"
+        )
+    if calibration["rolling_friction"] not in sweep["rolling_friction"]:
+        raise ConfigError(
+            f"config key 'calibration.rolling_friction': {calibration['rolling_friction']} is not among "
+            f"jenike.sweep.rolling_friction {sweep['rolling_friction']}"
+        )
 
 
 def load_config(path: str | Path) -> dict:

@@ -1,0 +1,43 @@
+"""Expansion of the calibration sweep grid."""
+
+from calibration.sweep import is_chart_point, sweep_points
+from engines.config import validate_config
+
+
+def test_default_sweep_is_shape_x_test_x_sliding_x_rolling():
+    sweep = validate_config({})["jenike"]["sweep"]
+    points = sweep_points(sweep)
+    assert len(points) == 1 * 2 * 3 * 2
+    assert points[0] == {
+        "shape": "sphere2",
+        "test": "internal",
+        "sliding_friction": 0.1,
+        "rolling_friction": 0.0,
+        "restitution": 0.1,
+        "rotation_blocked": False,
+    }
+    assert {p["test"] for p in points} == {"internal", "aluminium"}
+    assert all(is_chart_point(p, sweep["restitution"]) for p in points)
+
+
+def test_sensitivity_and_rotation_blocked_points_are_added_once():
+    sweep = {
+        "shapes": ["sphere", "sphere2"],
+        "tests": ["internal"],
+        "sliding_friction": [0.1, 0.5, 0.3],
+        "rolling_friction": [0.05, 0.2],
+        "restitution": 0.1,
+        "restitution_sensitivity": [0.1, 0.6, 1.0],
+        "rotation_blocked": True,
+        "wall_test_particle_friction": 0.35,
+    }
+    points = sweep_points(sweep)
+    grid = 2 * 1 * 3 * 2
+    # restitution 0.1 duplicates a grid point; 0.6 and 1.0 are new: middle friction 0.3, rolling 0.05
+    sensitivity = [p for p in points if p["restitution"] != 0.1]
+    assert len(sensitivity) == 2 * 2
+    assert {(p["sliding_friction"], p["rolling_friction"]) for p in sensitivity} == {(0.3, 0.05)}
+    blocked = [p for p in points if p["rotation_blocked"]]
+    assert len(blocked) == 2 * 3
+    assert len(points) == grid + 4 + 6
+    assert not any(is_chart_point(p, 0.1) for p in sensitivity + blocked)
