@@ -10,12 +10,14 @@ configfile: "config/config.yaml"
 
 
 include: "workflow/rules/common.smk"
+include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
 
 
 rule all:
     input:
-        silo_flat_targets(),
+        calibration_targets(),
+        silo_flat_targets,
     default_target: True
 
 

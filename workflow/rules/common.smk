@@ -5,8 +5,9 @@ from pathlib import Path
 
 sys.path.insert(0, workflow.basedir)
 
+from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
-from engines.silo import silo_cases
+from engines.silo import silo_case_for_run, silo_cases
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.
@@ -17,23 +18,42 @@ except ConfigError as error:
 RESULTS = "results"
 
 try:
-    SILO_CASES = silo_cases(config)
+    # Geometry and sizing errors surface before anything runs, whatever the parameter source.
+    silo_cases(config)
 except ValueError as error:
     raise WorkflowError(f"Invalid silo_flat configuration: {error}") from None
+
+
+def uses_calibrated_parameters():
+    return config["silo_flat"]["parameters"] == "calibrated"
+
+
+def calibrated_parameters_file(wildcards=None):
+    """The calibration's parameters.yaml when the silo uses it (waits for the checkpoint), else nothing."""
+    if not uses_calibrated_parameters():
+        return []
+    return checkpoints.calibration_parameters.get().output.parameters
+
+
+def silo_config():
+    """The configuration of the silo runs, with calibrated parameters applied when asked for."""
+    if not uses_calibrated_parameters():
+        return config
+    return calibrated_config(config, calibrated_parameters_file())
 
 
 def silo_dir(run_id):
     return f"{RESULTS}/silo_flat/{run_id}"
 
 
-def silo_flat_targets():
+def silo_flat_targets(wildcards=None):
     return [
         path
-        for run_id in SILO_CASES
+        for run_id in silo_cases(silo_config())
         for path in (f"{silo_dir(run_id)}/metrics/flow.csv", f"{silo_dir(run_id)}/plots/discharge.png")
     ]
 
 
 def print_result_locations():
-    for path in silo_flat_targets():
+    for path in [*calibration_targets(), *silo_flat_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")

@@ -5,11 +5,13 @@ wildcard_constraints:
 
 
 rule silo_deck:
+    input:
+        parameters=calibrated_parameters_file,
     output:
         deck=f"{RESULTS}/silo_flat/{{run}}/deck/in.liggghts",
         case=f"{RESULTS}/silo_flat/{{run}}/deck/case.json",
     params:
-        parameters=lambda wildcards: SILO_CASES[wildcards.run].defining_parameters,
+        defining=lambda wildcards: silo_case_for_run(silo_config(), wildcards.run).defining_parameters,
     log:
         f"{RESULTS}/silo_flat/{{run}}/logs/deck.log",
     script:
@@ -20,6 +22,7 @@ rule silo_run:
     input:
         deck=rules.silo_deck.output.deck,
         case=rules.silo_deck.output.case,
+        parameters=calibrated_parameters_file,
     output:
         record=f"{RESULTS}/silo_flat/{{run}}/run.json",
     params:

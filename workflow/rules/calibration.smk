@@ -1,0 +1,119 @@
+# Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
+
+from calibration.sweep import is_chart_point, sweep_points
+from engines.jenike import build_jenike_case
+
+
+def _jenike_points():
+    points = {}
+    for point in sweep_points(config["jenike"]["sweep"]):
+        try:
+            case = build_jenike_case(config, point)
+        except ValueError as error:
+            raise WorkflowError(f"Invalid jenike configuration for sweep point {point}: {error}") from None
+        points[case.run_id] = point
+    return points
+
+
+JENIKE_POINTS = _jenike_points()
+CALIBRATION = f"{RESULTS}/calibration"
+
+
+def jenike_dir(run_id):
+    return f"{CALIBRATION}/runs/{run_id}"
+
+
+def calibration_chart_names():
+    sweep = config["jenike"]["sweep"]
+    return [f"{shape}_{test}" for shape in sweep["shapes"] for test in sweep["tests"]]
+
+
+def calibration_targets():
+    return [
+        f"{CALIBRATION}/bulk_friction.csv",
+        f"{CALIBRATION}/parameters.yaml",
+        *[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
+    ]
+
+
+rule jenike_deck:
+    output:
+        deck=f"{CALIBRATION}/runs/{{point}}/deck/in.liggghts",
+        case=f"{CALIBRATION}/runs/{{point}}/deck/case.json",
+    params:
+        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+    log:
+        f"{CALIBRATION}/runs/{{point}}/logs/deck.log",
+    script:
+        "../scripts/jenike_deck.py"
+
+
+rule jenike_run:
+    input:
+        deck=rules.jenike_deck.output.deck,
+    output:
+        record=f"{CALIBRATION}/runs/{{point}}/run.json",
+    params:
+        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+        engine=config["engine"],
+    resources:
+        tasks=config["engine"]["mpi_ranks"],
+    threads: config["engine"]["mpi_ranks"]
+    log:
+        f"{CALIBRATION}/runs/{{point}}/logs/run.log",
+    script:
+        "../scripts/jenike_run.py"
+
+
+rule jenike_friction:
+    input:
+        record=rules.jenike_run.output.record,
+        case=rules.jenike_deck.output.case,
+    output:
+        summary=f"{CALIBRATION}/runs/{{point}}/metrics/bulk_friction.json",
+        plot=f"{CALIBRATION}/runs/{{point}}/plots/forces.png",
+    params:
+        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+    log:
+        f"{CALIBRATION}/runs/{{point}}/logs/friction.log",
+    script:
+        "../scripts/jenike_friction.py"
+
+
+rule calibration_table:
+    input:
+        summaries=expand(f"{CALIBRATION}/runs/{{point}}/metrics/bulk_friction.json", point=sorted(JENIKE_POINTS)),
+    output:
+        table=f"{CALIBRATION}/bulk_friction.csv",
+    log:
+        f"{CALIBRATION}/logs/table.log",
+    script:
+        "../scripts/calibration_table.py"
+
+
+rule calibration_charts:
+    input:
+        table=rules.calibration_table.output.table,
+    output:
+        charts=[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
+    params:
+        calibration=config["calibration"],
+        base_restitution=config["jenike"]["sweep"]["restitution"],
+    log:
+        f"{CALIBRATION}/logs/charts.log",
+    script:
+        "../scripts/calibration_charts.py"
+
+
+checkpoint calibration_parameters:
+    input:
+        table=rules.calibration_table.output.table,
+    output:
+        parameters=f"{CALIBRATION}/parameters.yaml",
+    params:
+        calibration=config["calibration"],
+        base_restitution=config["jenike"]["sweep"]["restitution"],
+    log:
+        f"{CALIBRATION}/logs/parameters.log",
+    script:
+        "../scripts/calibration_parameters.py"

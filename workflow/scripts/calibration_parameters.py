@@ -1,0 +1,29 @@
+"""Snakemake adapter: invert the calibration chart at the measured bulk friction angles."""
+
+import csv
+
+import yaml
+
+from calibration.inversion import UnreachableTarget, curves_from_table, invert_calibration
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    calibration = snakemake.params.calibration
+    with open(snakemake.input.table, newline="") as handle:
+        rows = [row for row in csv.DictReader(handle)
+                if float(row["restitution"]) == snakemake.params.base_restitution and row["rotation_blocked"] == "False"]
+    curves = curves_from_table(rows)
+    tested = {"internal" if c.test == "internal" else c.wall_material for c in curves}
+    targets = {name: angle for name, angle in calibration["targets_deg"].items() if name in tested}
+    skipped = sorted(set(calibration["targets_deg"]) - set(targets))
+    if skipped:
+        log.warning("no shear test for %s: those targets are not inverted", ", ".join(skipped))
+    try:
+        parameters = invert_calibration(curves, targets, calibration["tolerance_deg"],
+                                        shape=calibration["shape"], rolling_friction=calibration["rolling_friction"])
+    except UnreachableTarget as error:
+        raise SystemExit(f"calibration target unreachable: {error}") from None
+    parameters["not_calibrated"] = skipped
+    with open(snakemake.output.parameters, "w") as handle:
+        yaml.safe_dump(parameters, handle, sort_keys=False)
+    log.info("parameters: %s", parameters)
