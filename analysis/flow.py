@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.checks import finite_array
+
 __all__ = [
     "BulkDensity",
     "DischargeHistory",
@@ -114,15 +116,6 @@ def _non_negative(name: str, value: float) -> float:
     if not math.isfinite(value) or value < 0.0:
         raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     return value
-
-
-def _finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
-    array = np.asarray(values, dtype=float)
-    if ndim is not None and array.ndim != ndim:
-        raise ValueError(f"{name} must be a {ndim}-D array, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must contain only finite numbers")
-    return array
 
 
 def _per_particle(name: str, values, n: int) -> np.ndarray:
@@ -253,8 +246,8 @@ def column_surface_heights(x, z, radius, width: float, n_columns: int) -> np.nda
     numpy.ndarray, shape (n_columns,)
         Highest particle top ``z + radius`` per column [m]; NaN for an empty column.
     """
-    x = _finite_array("x", x)
-    z = _finite_array("z", z)
+    x = finite_array("x", x)
+    z = finite_array("z", z)
     if x.shape != z.shape:
         raise ValueError(f"x and z must have the same shape, got {x.shape} and {z.shape}")
     radius = _per_particle("radius", radius, x.size)
@@ -335,7 +328,7 @@ def filling_bulk_density(
         If inputs are malformed, a column is empty (the fill does not cover the
         floor: fewer columns are needed), or ``z_m <= 0`` (margin too large).
     """
-    positions = _finite_array("clump_position", clump_position, ndim=2)
+    positions = finite_array("clump_position", clump_position, ndim=2)
     if positions.shape[1] != 3 or positions.shape[0] == 0:
         raise ValueError(f"clump_position must have shape (n, 3) with n >= 1, got {positions.shape}")
     n_clumps = positions.shape[0]
@@ -391,7 +384,7 @@ def mass_in_silo(clump_z, clump_mass, outlet_plane: float = 0.0) -> float:
     float
         Total mass of the clumps with centre at or above the outlet plane [kg].
     """
-    clump_z = _finite_array("clump_z", clump_z)
+    clump_z = finite_array("clump_z", clump_z)
     masses = _per_particle("clump_mass", clump_mass, clump_z.size)
     outlet_plane = float(outlet_plane)
     if not math.isfinite(outlet_plane):
@@ -415,8 +408,8 @@ def discharged_mass_history(times, masses_in_silo) -> DischargeHistory:
     DischargeHistory
         ``time = times - times[0]`` [s], ``discharged_mass = masses_in_silo[0] - masses_in_silo`` [kg].
     """
-    times = _finite_array("times", times)
-    masses = _finite_array("masses_in_silo", masses_in_silo)
+    times = finite_array("times", times)
+    masses = finite_array("masses_in_silo", masses_in_silo)
     if times.size == 0:
         raise ValueError("times must contain at least one sample")
     if times.shape != masses.shape:
@@ -473,8 +466,8 @@ def steady_flow_rate(
         On malformed input, or if fewer than 3 samples lie in the window (the
         standard error needs n - 2 >= 1 degrees of freedom).
     """
-    time = _finite_array("time", time)
-    mass = _finite_array("discharged_mass", discharged_mass)
+    time = finite_array("time", time)
+    mass = finite_array("discharged_mass", discharged_mass)
     if time.shape != mass.shape:
         raise ValueError(
             f"time and discharged_mass must have equal lengths, got {time.size} and {mass.size}"
@@ -655,10 +648,10 @@ def clump_volume(
       relative error is ~2e-4 at a resolution of 100 and ~1e-5 at the
       default 400. Deterministic (no random sampling).
     """
-    centres = _finite_array("sphere_positions", sphere_positions, ndim=2)
+    centres = finite_array("sphere_positions", sphere_positions, ndim=2)
     if centres.shape[1] != 3 or centres.shape[0] == 0:
         raise ValueError(f"sphere_positions must have shape (k, 3) with k >= 1, got {centres.shape}")
-    radii = _finite_array("sphere_radii", sphere_radii)
+    radii = finite_array("sphere_radii", sphere_radii)
     if radii.shape != (centres.shape[0],):
         raise ValueError(
             f"sphere_radii must have shape ({centres.shape[0]},), got {radii.shape}"

@@ -25,6 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.checks import finite_array
+
 __all__ = [
     "SteadyWindow",
     "BulkFriction",
@@ -107,17 +109,8 @@ class BulkFriction:
 # --------------------------------------------------------------------------- validation
 
 
-def _finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
-    array = np.asarray(values, dtype=float)
-    if ndim is not None and array.ndim != ndim:
-        raise ValueError(f"{name} must be a {ndim}-D array, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must contain only finite numbers")
-    return array
-
-
 def _times(time) -> np.ndarray:
-    time = _finite_array("time", time)
+    time = finite_array("time", time)
     if time.size < 2:
         raise ValueError(f"time must contain at least 2 samples, got {time.size}")
     if np.any(np.diff(time) <= 0.0):
@@ -126,7 +119,7 @@ def _times(time) -> np.ndarray:
 
 
 def _history(name: str, values, n: int) -> np.ndarray:
-    array = _finite_array(name, values)
+    array = finite_array(name, values)
     if array.shape != (n,):
         raise ValueError(f"{name} must have the same length as time ({n}), got shape {array.shape}")
     return array
@@ -322,7 +315,7 @@ def mean_and_standard_error(values, n_batches: int = 10) -> tuple[float, float]:
     tuple of float
         ``(mean, standard_error)`` in the unit of ``values``.
     """
-    values = _finite_array("values", values)
+    values = finite_array("values", values)
     if values.size < 2:
         raise ValueError(f"values must contain at least 2 numbers, got {values.size}")
     if isinstance(n_batches, bool) or int(n_batches) != n_batches or n_batches < 2:
@@ -507,7 +500,7 @@ def friction_coefficient(angle_deg):
 
 
 def _vectors(name: str, values) -> np.ndarray:
-    array = _finite_array(name, values, ndim=None)
+    array = finite_array(name, values, ndim=None)
     if array.ndim != 2 or array.shape[1] != 3:
         raise ValueError(f"{name} must have shape (n, 3), got {array.shape}")
     return array
@@ -569,7 +562,7 @@ def mobilised_friction_histogram(
             raise ValueError(f"range must be finite with low < high, got {range!r}")
         counts, edges = np.histogram(ratio, bins=int(bins), range=(low, high))
     else:
-        edges = _finite_array("bins", bins)
+        edges = finite_array("bins", bins)
         if edges.size < 2 or np.any(np.diff(edges) <= 0.0):
             raise ValueError("bins must hold at least 2 strictly increasing edges")
         counts, edges = np.histogram(ratio, bins=edges)
@@ -620,7 +613,7 @@ def angular_histogram(vectors, axis: str = "y", bins: int = 36, weights=None) ->
     if isinstance(bins, bool) or int(bins) != bins or bins < 1:
         raise ValueError(f"bins must be an integer >= 1, got {bins!r}")
     if weights is not None:
-        weights = _finite_array("weights", weights)
+        weights = finite_array("weights", weights)
         if weights.shape != (vectors.shape[0],):
             raise ValueError(f"weights must have shape ({vectors.shape[0]},), got {weights.shape}")
 

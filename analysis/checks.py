@@ -1,0 +1,21 @@
+"""Argument checks shared by the analysis and calibration functions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
+    """``values`` as a float array of ``ndim`` dimensions with only finite entries.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument ``name`` when the shape is wrong or a value is NaN or infinite.
+    """
+    array = np.asarray(values, dtype=float)
+    if ndim is not None and array.ndim != ndim:
+        raise ValueError(f"{name} must be a {ndim}-D array, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must contain only finite numbers")
+    return array
