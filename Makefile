@@ -43,3 +43,4 @@ dry-run: install
 # Speed figures are ratios against a baseline measured in the same run (results/bench/).
 bench: install
 	$(PYTHON) -m tests.bench.bench_dumps results/bench/dumps.csv
+	$(PYTHON) -m tests.bench.bench_coarse_graining results/bench/coarse_graining.csv
