@@ -1,0 +1,159 @@
+"""Particle-particle contacts from LIGGGHTS local dumps, and the force-chain geometry built from them.
+
+The silo deck writes ``compute pair/gran/local pos id force`` through ``dump local`` as text::
+
+    ITEM: TIMESTEP
+    22000
+    ITEM: NUMBER OF ENTRIES
+    533
+    ITEM: BOX BOUNDS ff ff ff
+    ...three lines...
+    ITEM: ENTRIES c_contacts[1] ... c_contacts[12]
+    x_i y_i z_i x_j y_j z_j id_i id_j periodic f_x f_y f_z
+
+``f`` is the force on particle i by particle j (N). Parsing is pure (text in, arrays out); reading a file
+is a thin wrapper.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+N_COLUMNS = 12
+
+
+class ContactDumpError(ValueError):
+    """A local dump is truncated or malformed; the message names the file."""
+
+
+@dataclass(frozen=True)
+class ContactFrame:
+    """Pairwise contacts at one time step.
+
+    Attributes
+    ----------
+    step : int
+        Time step.
+    position_i, position_j : numpy.ndarray
+        (n, 3) centres of the two spheres in contact (m).
+    id_i, id_j : numpy.ndarray
+        (n,) sphere ids.
+    force : numpy.ndarray
+        (n, 3) contact force on sphere i by sphere j (N).
+    """
+
+    step: int
+    position_i: np.ndarray
+    position_j: np.ndarray
+    id_i: np.ndarray
+    id_j: np.ndarray
+    force: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.id_i.shape[0])
+
+    @property
+    def branch(self) -> np.ndarray:
+        """Branch vectors x_j - x_i (m)."""
+        return self.position_j - self.position_i
+
+    @property
+    def normal_force(self) -> np.ndarray:
+        """Magnitude of the force component along the branch vector (N); positive in compression."""
+        branch = self.branch
+        length = np.linalg.norm(branch, axis=1)
+        safe = np.where(length > 0, length, 1.0)
+        return -np.einsum("ij,ij->i", self.force, branch) / safe
+
+
+def parse_local_dump(text: str, source: str = "<text>") -> ContactFrame:
+    """Parse one ``dump local`` snapshot of ``pos id force`` contacts.
+
+    Raises
+    ------
+    ContactDumpError
+        Naming ``source`` when a header item is missing, the entry count disagrees with the lines, or a
+        value is not a finite number.
+    """
+    lines = text.splitlines()
+
+    def item(name: str) -> int:
+        for index, line in enumerate(lines):
+            if line.startswith(f"ITEM: {name}"):
+                return index
+        raise ContactDumpError(f"{source}: no 'ITEM: {name}' header (not a LIGGGHTS local dump?)")
+
+    try:
+        step = int(lines[item("TIMESTEP") + 1])
+        count = int(lines[item("NUMBER OF ENTRIES") + 1])
+    except (IndexError, ValueError):
+        raise ContactDumpError(f"{source}: malformed TIMESTEP or NUMBER OF ENTRIES") from None
+    start = item("ENTRIES") + 1
+    rows = [line for line in lines[start:] if line.strip()]
+    if len(rows) != count:
+        raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")
+    if count == 0:
+        values = np.empty((0, N_COLUMNS))
+    else:
+        try:
+            values = np.array([row.split() for row in rows], dtype=float)
+        except ValueError as error:
+            raise ContactDumpError(f"{source}: a contact line is not numeric ({error})") from None
+        if values.ndim != 2 or values.shape[1] != N_COLUMNS:
+            raise ContactDumpError(f"{source}: expected {N_COLUMNS} columns (pos id force) per contact")
+        if not np.all(np.isfinite(values)):
+            raise ContactDumpError(f"{source}: non-finite values in the contacts")
+    return ContactFrame(
+        step=step,
+        position_i=values[:, 0:3],
+        position_j=values[:, 3:6],
+        id_i=values[:, 6].astype(np.int64),
+        id_j=values[:, 7].astype(np.int64),
+        force=values[:, 9:12],
+    )
+
+
+def read_contacts(path: str | Path) -> ContactFrame:
+    """Read a local dump file written by the silo deck."""
+    path = Path(path)
+    return parse_local_dump(path.read_text(encoding="utf-8", errors="replace"), str(path))
+
+
+@dataclass(frozen=True)
+class ForceChainSegments:
+    """Branch vectors of contacts in a slice, for a force-chain picture.
+
+    Attributes
+    ----------
+    start, end : numpy.ndarray
+        (n, 3) sphere centres (m).
+    normal_force : numpy.ndarray
+        (n,) compressive normal force, capped (N).
+    cap : float
+        The cap applied (N).
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    normal_force: np.ndarray
+    cap: float
+
+
+def force_chain_segments(
+    contacts: ContactFrame, slice_centre_y: float, slice_thickness: float, cap: float
+) -> ForceChainSegments:
+    """Contacts whose two centres lie in the slice |y - y_c| <= thickness / 2, normal force capped at ``cap``.
+
+    The study drew branch vectors in a 6 mm slice coloured by normal force capped at 50 particle weights.
+    """
+    if slice_thickness <= 0 or cap <= 0:
+        raise ValueError("slice_thickness and cap must be positive")
+    half = 0.5 * slice_thickness
+    inside = (np.abs(contacts.position_i[:, 1] - slice_centre_y) <= half) & (
+        np.abs(contacts.position_j[:, 1] - slice_centre_y) <= half
+    )
+    force = np.clip(contacts.normal_force[inside], 0.0, cap)
+    return ForceChainSegments(contacts.position_i[inside], contacts.position_j[inside], force, float(cap))

@@ -1,0 +1,167 @@
+"""Real LIGGGHTS runs of a small Jenike cell: the normal force holds, bulk friction responds to particle friction,
+and the lid + shear ring estimate agrees with the bottom-ring estimate.
+
+The cell is scaled down (inner diameter 40 mm, rings 8 + 10 mm, about 650 two-sphere clumps after levelling)
+and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, and two run side by side.
+"""
+
+from __future__ import annotations
+
+import json
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from analysis.dumps import list_dumps, parse_legacy_vtk_polydata
+from calibration.friction import BulkFriction, bulk_friction
+from engines.config import validate_config
+from engines.jenike import LID_TYPE, JenikeCase, ShearSignals, build_jenike_case, shear_signals
+from engines.liggghts import DUMP_PREFIX
+from engines.liggghts_jenike import (
+    PAIR_CONTACT_PREFIX,
+    WALL_CONTACT_PREFIX,
+    read_contact_dump,
+    read_force_history,
+    run_jenike,
+    write_jenike_inputs,
+)
+from tests.conftest import require_liggghts
+
+pytestmark = pytest.mark.integration
+
+SMALL_JENIKE = {
+    "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01},
+    "fill": {"settle_time": 0.1},
+    "consolidation": {"time": 0.05},
+    "shear": {"velocity": 0.03, "displacement": 0.004},
+}
+
+POINT = {"shape": "sphere2", "test": "internal", "rolling_friction": 0.0, "restitution": 0.1, "rotation_blocked": False}
+
+RUNS = {
+    "rigid_0.1": ("rigid", {**POINT, "sliding_friction": 0.1}),
+    "rigid_0.5": ("rigid", {**POINT, "sliding_friction": 0.5}),
+    "servo_0.5": ("servo", {**POINT, "sliding_friction": 0.5}),
+    "wall_0.3": ("rigid", {**POINT, "test": "aluminium", "sliding_friction": 0.3}),
+}
+
+
+@dataclass
+class Run:
+    case: JenikeCase
+    run_dir: Path
+    record: dict
+    history: dict
+    signals: ShearSignals
+    friction: BulkFriction
+
+
+def _run(case: JenikeCase, run_dir: Path) -> Run:
+    write_jenike_inputs(case, run_dir / "deck")
+    record = json.loads(run_jenike(case, run_dir).read_text())
+    history = read_force_history(run_dir / record["forces"])
+    signals = shear_signals(history, record["shear_start_s"], record["shear_end_s"])
+    # A 4 mm shear of a 40 mm cell is too short for a plateau: average over its second half.
+    half = signals.time[0] + 0.5 * (signals.time[-1] - signals.time[0])
+    friction = bulk_friction(
+        signals.time,
+        signals.lid_force,
+        signals.ring_force,
+        signals.bottom_force,
+        signals.normal_force,
+        signals.weight_above,
+        window=(half, signals.time[-1]),
+    )
+    return Run(case, run_dir, record, history, signals, friction)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory) -> dict[str, Run]:
+    require_liggghts()
+    root = tmp_path_factory.mktemp("jenike")
+    cases = {}
+    for name, (lid, point) in RUNS.items():
+        config = validate_config({"jenike": {**SMALL_JENIKE, "lid": lid}})
+        cases[name] = build_jenike_case(config, point)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {name: pool.submit(_run, case, root / case.run_id) for name, case in cases.items()}
+        return {name: future.result() for name, future in futures.items()}
+
+
+def test_runs_fill_level_and_keep_every_clump(runs):
+    for name, run in runs.items():
+        record = run.record
+        assert record["n_clumps_created"] == run.case.fill.n_clumps, name
+        assert 0 < record["n_clumps"] < record["n_clumps_created"], name
+        assert record["stages"]["sheared"]["clumps"] == record["n_clumps"], name
+        assert (run.run_dir / "run.json").exists() and list_dumps(run.run_dir / "dumps", DUMP_PREFIX), name
+
+
+@pytest.mark.parametrize("name", ["rigid_0.1", "rigid_0.5", "wall_0.3"])
+def test_rigid_lid_holds_the_normal_force_during_shear(name, runs):
+    run = runs[name]
+    deviation = run.signals.normal_force / run.case.normal_force - 1.0
+    assert np.abs(deviation).max() <= 0.05
+    assert abs(deviation.mean()) <= 0.01
+
+
+def test_servo_lid_holds_the_normal_force_during_shear(runs):
+    run = runs["servo_0.5"]
+    deviation = run.signals.normal_force / run.case.normal_force - 1.0
+    assert np.mean(np.abs(deviation) <= 0.05) >= 0.95
+    assert abs(deviation.mean()) <= 0.01
+
+
+def test_bulk_friction_grows_with_particle_friction(runs):
+    low, high = runs["rigid_0.1"].friction, runs["rigid_0.5"].friction
+    assert high.coefficient > low.coefficient + 3 * (high.standard_error + low.standard_error)
+    assert high.bottom_coefficient > low.bottom_coefficient
+
+
+@pytest.mark.parametrize("name", list(RUNS))
+def test_lid_and_ring_estimate_agrees_with_the_bottom_estimate(name, runs):
+    friction = runs[name].friction
+    assert friction.coefficient > 0
+    assert friction.relative_difference < 0.10
+
+
+def test_bulk_wall_friction_does_not_exceed_the_particle_wall_friction(runs):
+    friction = runs["wall_0.3"].friction
+    assert 0.0 < friction.bottom_coefficient <= 0.3 * 1.02
+
+
+def test_rigid_lid_moves_with_the_shear_ring(runs):
+    run = runs["rigid_0.5"]
+    dumps = list_dumps(run.run_dir / "dumps", DUMP_PREFIX)
+    shear_start = int(run.record["stages"]["consolidated"]["step"])
+    x = []
+    for path in (dumps[0], dumps[-1]):
+        frame = parse_legacy_vtk_polydata(path.read_bytes(), str(path))
+        x.append(frame["points"][frame["type"] == LID_TYPE, 0].mean())
+    last_step = int(dumps[-1].stem.rsplit("_", 1)[1])
+    expected = run.case.shear_velocity * (last_step - shear_start) * run.case.timestep
+    assert expected > 0.5 * run.case.geometry.shear_displacement
+    assert x[1] - x[0] == pytest.approx(expected, rel=1e-3)
+
+
+def test_contact_dumps_carry_the_plate_load(runs):
+    """The plate contacts of the wall-contact dump add up to the plate's measured vertical force.
+
+    Only normal forces are checked: LIGGGHTS 3.8's ``force_tangential`` (and ``force``) of these computes
+    exceed the applied tangential forces (their sum over the plate contacts is about 20 % above the plate's
+    measured horizontal force, and single weak contacts show |F_t| / |F_n| far above the sliding friction),
+    while the mesh forces balance the lid and ring forces exactly.
+    """
+    run = runs["wall_0.3"]
+    paths = sorted((run.run_dir / "dumps").glob(f"{WALL_CONTACT_PREFIX}_*.txt"))
+    assert paths and sorted((run.run_dir / "dumps").glob(f"{PAIR_CONTACT_PREFIX}_*.txt"))
+    contacts = read_contact_dump(paths[-1])
+    plate = contacts["id1"] == 0  # mesh index 0: the base (plate)
+    assert plate.sum() > 10
+    load = (contacts["fn_z"] + contacts["ft_z"])[plate].sum()
+    row = int(np.searchsorted(run.history["step"], contacts["step"][0]))
+    measured = -run.history["bottom_fz"][row - 1 : row + 1].mean()
+    assert load == pytest.approx(measured, rel=0.02)
