@@ -198,3 +198,41 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
         return _save(figure, path)
     finally:
         plt.close(figure)
+
+
+def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -> Path:
+    """Shear force histories of one shear test with the averaging window and the bulk friction.
+
+    Parameters
+    ----------
+    signals : engines.jenike.ShearSignals or any object with ``time``, ``lid_force``, ``ring_force``,
+        ``bottom_force``, ``normal_force``, ``weight_above``
+        Force histories of the shear stage (s, N).
+    friction : calibration.friction.BulkFriction
+        The bulk friction and its window.
+    path : str or os.PathLike
+        Destination PNG file (written atomically, 150 dpi).
+    title : str
+        Figure title.
+    """
+    time = np.asarray(signals.time, dtype=float)
+    figure, axes = plt.subplots(figsize=(6.4, 4.4))
+    try:
+        axes.plot(time, signals.lid_force + signals.ring_force, label="lid + shear ring", color="tab:blue")
+        axes.plot(time, signals.bottom_force, label="bottom ring / plate", color="tab:orange", alpha=0.8)
+        axes.plot(time, np.broadcast_to(signals.normal_force + signals.weight_above, time.shape),
+                  label="normal force + weight above", color="0.4", linestyle="--")
+        window = friction.window
+        axes.axvspan(window.t_start, window.t_end, color="tab:blue", alpha=0.08, label="averaging window")
+        axes.set_xlabel("time [s]")
+        axes.set_ylabel("force [N]")
+        axes.set_title(title)
+        axes.text(0.02, 0.97,
+                  f"mu_bulk = {friction.coefficient:.3f} +- {friction.standard_error:.3f} "
+                  f"({friction.angle_deg:.1f} deg)\nbottom side: {friction.bottom_coefficient:.3f}",
+                  transform=axes.transAxes, va="top", fontsize=9)
+        axes.legend(loc="lower right", fontsize=8)
+        axes.grid(alpha=0.3)
+        return _save(figure, path)
+    finally:
+        plt.close(figure)

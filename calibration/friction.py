@@ -632,3 +632,38 @@ def angular_histogram(vectors, axis: str = "y", bins: int = 36, weights=None) ->
         counts = np.bincount(sector, weights=weights[has_direction], minlength=bins)
     edges = np.linspace(0.0, 2.0 * math.pi, bins + 1)
     return edges, counts
+
+
+def bulk_friction_of_shear(signals) -> tuple[BulkFriction, str]:
+    """Bulk friction of a shear stage: over the detected steady window, else over its second half.
+
+    A short shear (a few millimetres in a small cell) may end before the shear force reaches a plateau;
+    then the second half of the shear is the best available estimate, and the returned method says so.
+
+    Parameters
+    ----------
+    signals : object with ``time``, ``lid_force``, ``ring_force``, ``bottom_force``, ``normal_force``,
+        ``weight_above``
+        Force histories of the shear stage (s, N), signed as :func:`bulk_friction` expects.
+
+    Returns
+    -------
+    (BulkFriction, str)
+        The estimate and ``"steady"`` or ``"second half"``.
+    """
+    arguments = (
+        signals.time,
+        signals.lid_force,
+        signals.ring_force,
+        signals.bottom_force,
+        signals.normal_force,
+        signals.weight_above,
+    )
+    try:
+        return bulk_friction(*arguments), "steady"
+    except ValueError as error:
+        if "no steady shear" not in str(error):
+            raise
+    time = np.asarray(signals.time, dtype=float)
+    half = time[0] + 0.5 * (time[-1] - time[0])
+    return bulk_friction(*arguments, window=(half, time[-1])), "second half"

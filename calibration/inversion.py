@@ -319,6 +319,7 @@ def invert_calibration(
     *,
     shape: str,
     rolling_friction: float,
+    record_unreachable: bool = False,
 ) -> dict:
     """Particle-scale friction parameters that reproduce measured bulk friction angles.
 
@@ -341,6 +342,10 @@ def invert_calibration(
         Particle shape to calibrate (keyword only).
     rolling_friction : float
         Rolling friction of the curves to use [-] (keyword only).
+    record_unreachable : bool, optional
+        Instead of raising :class:`UnreachableTarget`, leave the target out of the parameters and record
+        its message under ``"unreachable"`` (keyword only; default False). A calibration stage uses this
+        so that one unreachable target does not hide the others.
 
     Returns
     -------
@@ -376,6 +381,7 @@ def invert_calibration(
     result: dict = {"shape": shape, "rolling_friction": rolling_friction, "tolerance_deg": tolerance}
     walls: dict[str, dict] = {}
     targets_deg: dict[str, float] = {}
+    unreachable: dict[str, str] = {}
     for name, angle in targets.items():
         material = _material(name)
         if material is None:
@@ -386,7 +392,13 @@ def invert_calibration(
             curve = _find_curve(curves, "internal", None, shape, rolling_friction)
         else:
             curve = _find_curve(curves, "wall", material, shape, rolling_friction)
-        inversion = invert_curve(curve, angle, tolerance)
+        try:
+            inversion = invert_curve(curve, angle, tolerance)
+        except UnreachableTarget as error:
+            if not record_unreachable:
+                raise
+            unreachable[material] = str(error)
+            continue
         entry = {
             "sliding_friction": inversion.particle_friction,
             "lower": inversion.lower,
@@ -399,6 +411,8 @@ def invert_calibration(
             walls[material] = entry
     result["particle_wall"] = walls
     result["targets_deg"] = targets_deg
+    if record_unreachable:
+        result["unreachable"] = unreachable
     return result
 
 

@@ -35,7 +35,8 @@ def apply_calibrated_parameters(config: dict, parameters: dict, particle_materia
         If the parameters lack the particle-particle result.
     """
     if "particle_particle" not in parameters:
-        raise ValueError("calibrated parameters have no particle_particle entry (was the internal test run?)")
+        reason = parameters.get("unreachable", {}).get("internal", "was the internal test run?")
+        raise ValueError(f"the calibration chose no particle-particle friction: {reason}")
     calibrated = copy.deepcopy(config)
     calibrated["silo_flat"]["particle_model"] = parameters["shape"]
     rolling = float(parameters["rolling_friction"])

@@ -322,3 +322,28 @@ def test_angular_histogram_rejects_bad_arguments():
         angular_histogram(np.zeros((2, 3)), bins=0)
     with pytest.raises(ValueError, match="weights"):
         angular_histogram(np.zeros((2, 3)), weights=[1.0])
+
+
+def test_bulk_friction_of_shear_uses_the_plateau_or_the_second_half():
+    from types import SimpleNamespace
+
+    from calibration.friction import bulk_friction_of_shear
+
+    time = np.linspace(0.0, 1.0, 201)
+    load = 52.0
+    plateau = np.where(time < 0.2, 0.6 * load * time / 0.2, 0.6 * load)
+    signals = SimpleNamespace(time=time, lid_force=0.5 * plateau, ring_force=0.5 * plateau, bottom_force=plateau,
+                              normal_force=50.0, weight_above=2.0)
+    friction, method = bulk_friction_of_shear(signals)
+    assert method == "steady"
+    # the window may open a sample or two before the ramp ends (5 % tolerance band)
+    assert friction.coefficient == pytest.approx(0.6, rel=1e-3)
+    assert friction.window.t_start == pytest.approx(0.2, abs=0.02)
+
+    growing = 10.0 * time  # never settles: the mean of the second half is 10 * 0.75
+    signals = SimpleNamespace(time=time, lid_force=growing, ring_force=0.0 * time, bottom_force=growing,
+                              normal_force=50.0, weight_above=0.0)
+    friction, method = bulk_friction_of_shear(signals)
+    assert method == "second half"
+    assert friction.coefficient == pytest.approx(7.5 / 50.0, abs=1e-12)
+    assert friction.window.t_start == pytest.approx(0.5)

@@ -37,5 +37,5 @@ def test_calibrated_values_replace_the_configured_ones():
 
 
 def test_parameters_without_internal_result_are_refused():
-    with pytest.raises(ValueError, match="no particle_particle entry"):
+    with pytest.raises(ValueError, match="the calibration chose no particle-particle friction"):
         apply_calibrated_parameters(validate_config({}), {"shape": "sphere2", "rolling_friction": 0.1}, "hdpe")

@@ -4,7 +4,7 @@ import csv
 
 import yaml
 
-from calibration.inversion import UnreachableTarget, curves_from_table, invert_calibration
+from calibration.inversion import curves_from_table, invert_calibration
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
@@ -18,12 +18,11 @@ with logged_to(snakemake.log[0]) as log:
     skipped = sorted(set(calibration["targets_deg"]) - set(targets))
     if skipped:
         log.warning("no shear test for %s: those targets are not inverted", ", ".join(skipped))
-    try:
-        parameters = invert_calibration(curves, targets, calibration["tolerance_deg"],
-                                        shape=calibration["shape"], rolling_friction=calibration["rolling_friction"])
-    except UnreachableTarget as error:
-        raise SystemExit(f"calibration target unreachable: {error}") from None
-    parameters["not_calibrated"] = skipped
+    parameters = invert_calibration(curves, targets, calibration["tolerance_deg"], shape=calibration["shape"],
+                                    rolling_friction=calibration["rolling_friction"], record_unreachable=True)
+    for name, reason in parameters["unreachable"].items():
+        log.warning("target %s: %s", name, reason)
+    parameters["not_tested"] = skipped
     with open(snakemake.output.parameters, "w") as handle:
         yaml.safe_dump(parameters, handle, sort_keys=False)
     log.info("parameters: %s", parameters)

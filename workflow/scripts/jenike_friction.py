@@ -1,0 +1,44 @@
+"""Snakemake adapter: bulk friction of one Jenike sweep point from its force histories."""
+
+import json
+from pathlib import Path
+
+from analysis.tables import write_json
+from calibration.charts import plot_force_history
+from calibration.friction import bulk_friction_of_shear
+from engines.jenike import shear_signals
+from engines.liggghts_jenike import read_force_history
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    run_dir = Path(snakemake.input.record).parent
+    record = json.loads(Path(snakemake.input.record).read_text())
+    point = snakemake.params.point
+    history = read_force_history(run_dir / record["forces"])
+    signals = shear_signals(history, record["shear_start_s"], record["shear_end_s"])
+    friction, window_method = bulk_friction_of_shear(signals)
+    test = "internal" if point["test"] == "internal" else "wall"
+    summary = {
+        "run_id": record["run_id"],
+        "shape": point["shape"],
+        "test": test,
+        "wall_material": "" if test == "internal" else point["test"],
+        "rolling_friction": point["rolling_friction"],
+        "restitution": point["restitution"],
+        "rotation_blocked": point["rotation_blocked"],
+        "particle_friction": point["sliding_friction"],
+        "bulk_friction": friction.coefficient,
+        "bulk_friction_stderr": friction.standard_error,
+        "bulk_friction_angle_deg": friction.angle_deg,
+        "bottom_bulk_friction": friction.bottom_coefficient,
+        "ring_sides_relative_difference": friction.relative_difference,
+        "window_start_s": friction.window.t_start,
+        "window_end_s": friction.window.t_end,
+        "window_method": window_method,
+        "n_clumps": record["n_clumps"],
+    }
+    write_json(snakemake.output.summary, summary)
+    plot_force_history(signals, friction, snakemake.output.plot,
+                       title=f"{point['shape']} {point['test']}: mu = {point['sliding_friction']}, mu_r = {point['rolling_friction']}")
+    log.info("bulk friction %.4f +- %.4f (%s window), bottom side %.4f", friction.coefficient,
+             friction.standard_error, window_method, friction.bottom_coefficient)
