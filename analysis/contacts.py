@@ -69,14 +69,14 @@ class ContactFrame:
         return -np.einsum("ij,ij->i", self.force, branch) / safe
 
 
-def parse_local_dump(text: str, source: str = "<text>") -> ContactFrame:
-    """Parse one ``dump local`` snapshot of ``pos id force`` contacts.
+def parse_local_table(text: str, n_columns: int, source: str = "<text>") -> tuple[int, np.ndarray]:
+    """The time step and the (n, n_columns) value table of one ``dump local`` snapshot.
 
     Raises
     ------
     ContactDumpError
-        Naming ``source`` when a header item is missing, the entry count disagrees with the lines, or a
-        value is not a finite number.
+        Naming ``source`` when a header item is missing, the entry count disagrees with the lines, a row
+        has another number of columns, or a value is not a finite number.
     """
     lines = text.splitlines()
 
@@ -84,28 +84,36 @@ def parse_local_dump(text: str, source: str = "<text>") -> ContactFrame:
         for index, line in enumerate(lines):
             if line.startswith(f"ITEM: {name}"):
                 return index
-        raise ContactDumpError(f"{source}: no 'ITEM: {name}' header (not a LIGGGHTS local dump?)")
+        raise ContactDumpError(f"{source}: no 'ITEM: {name}' header (not a complete LIGGGHTS local dump?)")
 
     try:
         step = int(lines[item("TIMESTEP") + 1])
         count = int(lines[item("NUMBER OF ENTRIES") + 1])
     except (IndexError, ValueError):
         raise ContactDumpError(f"{source}: malformed TIMESTEP or NUMBER OF ENTRIES") from None
-    start = item("ENTRIES") + 1
-    rows = [line for line in lines[start:] if line.strip()]
+    rows = [line.split() for line in lines[item("ENTRIES") + 1 :] if line.strip()]
     if len(rows) != count:
         raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")
-    if count == 0:
-        values = np.empty((0, N_COLUMNS))
-    else:
-        try:
-            values = np.array([row.split() for row in rows], dtype=float)
-        except ValueError as error:
-            raise ContactDumpError(f"{source}: a contact line is not numeric ({error})") from None
-        if values.ndim != 2 or values.shape[1] != N_COLUMNS:
-            raise ContactDumpError(f"{source}: expected {N_COLUMNS} columns (pos id force) per contact")
-        if not np.all(np.isfinite(values)):
-            raise ContactDumpError(f"{source}: non-finite values in the contacts")
+    if any(len(row) != n_columns for row in rows):
+        raise ContactDumpError(f"{source}: every contact line must hold {n_columns} columns")
+    try:
+        values = np.array(rows, dtype=float).reshape(count, n_columns)
+    except ValueError as error:
+        raise ContactDumpError(f"{source}: a contact line is not numeric ({error})") from None
+    if not np.all(np.isfinite(values)):
+        raise ContactDumpError(f"{source}: non-finite values in the contacts")
+    return step, values
+
+
+def parse_local_dump(text: str, source: str = "<text>") -> ContactFrame:
+    """Parse one ``dump local`` snapshot of ``pos id force`` contacts (see the module docstring).
+
+    Raises
+    ------
+    ContactDumpError
+        As :func:`parse_local_table`.
+    """
+    step, values = parse_local_table(text, N_COLUMNS, source)
     return ContactFrame(
         step=step,
         position_i=values[:, 0:3],

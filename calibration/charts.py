@@ -236,3 +236,27 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
         return _save(figure, path)
     finally:
         plt.close(figure)
+
+
+def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -> Path:
+    """Bulk friction against particle friction with the rigid and the servo lid (rows of
+    :func:`calibration.sweep.lid_comparison`)."""
+    figure, axes = plt.subplots(figsize=(6.4, 4.4))
+    try:
+        groups: dict[tuple, list[dict]] = {}
+        for row in rows:
+            groups.setdefault((row["shape"], row["rolling_friction"]), []).append(row)
+        for (shape, rolling), group in sorted(groups.items()):
+            particle = [row["particle_friction"] for row in group]
+            axes.plot(particle, [row["bulk_friction_rigid_lid"] for row in group], "o-",
+                      label=f"{shape}, mu_r = {rolling:g}: rigid lid")
+            axes.plot(particle, [row["bulk_friction_servo_lid"] for row in group], "s--",
+                      label=f"{shape}, mu_r = {rolling:g}: servo lid")
+        axes.set_xlabel("particle-particle sliding friction coefficient [-]")
+        axes.set_ylabel("bulk friction coefficient [-]")
+        axes.set_title(title)
+        axes.grid(alpha=0.3)
+        axes.legend(fontsize=8)
+        return _save(figure, path)
+    finally:
+        plt.close(figure)

@@ -11,18 +11,27 @@ from __future__ import annotations
 INTERNAL = "internal"
 
 
-def sweep_points(sweep: dict) -> list[dict]:
+def other_lid(lid: str) -> str:
+    """The lid a comparison runs against: servo for rigid and rigid for servo."""
+    return "servo" if lid == "rigid" else "rigid"
+
+
+def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
     """Expand the ``jenike.sweep`` section into the list of distinct sweep points.
 
     The grid is every shape x test x sliding friction x rolling friction at the base restitution. The
     restitution sensitivity adds, per shape and test, the middle sliding friction at the first rolling
     friction for each extra restitution; the rotation-blocked reference adds every sliding friction at the
-    first rolling friction with particle rotation blocked. Duplicates are dropped, order is stable.
+    first rolling friction with particle rotation blocked. The lid comparison adds, per shape, the internal
+    test at every sliding friction and the first rolling friction with the other lid (key ``"lid"``).
+    Duplicates are dropped, order is stable.
 
     Parameters
     ----------
     sweep : dict
         The validated ``jenike.sweep`` configuration section.
+    lid : str
+        The configured lid (``jenike.lid``); the comparison uses the other one.
 
     Returns
     -------
@@ -57,9 +66,77 @@ def sweep_points(sweep: dict) -> list[dict]:
             if sweep["rotation_blocked"]:
                 for mu in sliding:
                     add(shape, test, mu, rolling[0], base_restitution, blocked=True)
+        if sweep["lid_comparison"] and INTERNAL in sweep["tests"]:
+            for mu in sliding:
+                point = {
+                    "shape": shape,
+                    "test": INTERNAL,
+                    "sliding_friction": float(mu),
+                    "rolling_friction": float(rolling[0]),
+                    "restitution": float(base_restitution),
+                    "rotation_blocked": False,
+                    "lid": other_lid(lid),
+                }
+                if point not in points:
+                    points.append(point)
     return points
 
 
 def is_chart_point(point: dict, base_restitution: float) -> bool:
-    """Whether a point belongs on the calibration chart (base restitution, rotation free)."""
-    return point["restitution"] == base_restitution and not point["rotation_blocked"]
+    """Whether a point belongs on the calibration chart (base restitution, rotation free, configured lid)."""
+    return point["restitution"] == base_restitution and not point["rotation_blocked"] and "lid" not in point
+
+
+def chart_rows(rows, base_restitution: float, lid: str) -> list[dict]:
+    """Rows of the calibration table (as read from CSV) that belong on the chart.
+
+    The chart holds the base restitution, free rotation and the configured lid; the sensitivity,
+    rotation-blocked and lid-comparison rows are left out.
+    """
+    return [
+        row
+        for row in rows
+        if float(row["restitution"]) == base_restitution
+        and str(row["rotation_blocked"]) == "False"
+        and row["lid"] == lid
+    ]
+
+
+def lid_comparison(rows, base_restitution: float) -> list[dict]:
+    """Pair the internal-friction results of the two lids at the same shape, rolling and sliding friction.
+
+    Parameters
+    ----------
+    rows : iterable of dict
+        Calibration table rows (strings as read from CSV are fine) with ``lid`` and ``bulk_friction``.
+    base_restitution : float
+        Only rows at this restitution, with free rotation, are compared.
+
+    Returns
+    -------
+    list of dict
+        One row per pair: shape, rolling_friction, particle_friction, bulk friction with each lid and the
+        servo-minus-rigid difference (dimensionless), sorted.
+    """
+    by_lid: dict[tuple, dict[str, float]] = {}
+    for row in rows:
+        if row["test"] != "internal" or str(row["rotation_blocked"]) != "False":
+            continue
+        if float(row["restitution"]) != base_restitution:
+            continue
+        key = (row["shape"], float(row["rolling_friction"]), float(row["particle_friction"]))
+        by_lid.setdefault(key, {})[row["lid"]] = float(row["bulk_friction"])
+    paired = []
+    for (shape, rolling, particle), lids in sorted(by_lid.items()):
+        if {"rigid", "servo"} <= set(lids):
+            paired.append(
+                {
+                    "shape": shape,
+                    "rolling_friction": rolling,
+                    "particle_friction": particle,
+                    "bulk_friction_rigid_lid": lids["rigid"],
+                    "bulk_friction_servo_lid": lids["servo"],
+                    "servo_minus_rigid": lids["servo"] - lids["rigid"],
+                }
+            )
+    return paired

@@ -600,6 +600,7 @@ class JenikeCase:
         }
 
 
+LID_KINDS = ("rigid", "servo")
 POINT_KEYS = ("shape", "test", "sliding_friction", "rolling_friction", "restitution", "rotation_blocked")
 
 
@@ -762,7 +763,8 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         Validated configuration (:func:`engines.config.validate_config`).
     point : dict
         ``{"shape": <particle model>, "test": "internal" | <wall material>, "sliding_friction": float,
-        "rolling_friction": float, "restitution": float, "rotation_blocked": bool}``.
+        "rolling_friction": float, "restitution": float, "rotation_blocked": bool}``, optionally with
+        ``"lid": "rigid" | "servo"`` overriding ``jenike.lid`` (used to compare the two lids on the same points).
 
     Raises
     ------
@@ -770,8 +772,11 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         Naming the offending key: unknown shape or material, a missing contact pair, values out of range,
         a cell too small for the clumps, or a plate too small for the shear travel.
     """
-    point = _check_point(config, point)
-    jenike = config["jenike"]
+    lid = point.get("lid", config["jenike"]["lid"])
+    if lid not in LID_KINDS:
+        raise ValueError(f"jenike point: lid must be one of {', '.join(LID_KINDS)}, got {lid!r}")
+    point = _check_point(config, {key: value for key, value in point.items() if key != "lid"})
+    jenike = {**config["jenike"], "lid": lid}
     cell = jenike["cell"]
     materials = config["materials"]
     particle_material = jenike["particle_material"]

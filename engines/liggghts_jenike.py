@@ -248,20 +248,13 @@ def read_contact_dump(path: str | Path) -> dict[str, np.ndarray]:
         Naming the file, if the header is incomplete, the entry count disagrees with the rows, or a row
         has the wrong number of columns.
     """
+    from analysis.contacts import parse_local_table
+
     path = Path(path)
-    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    try:
-        step = int(lines[lines.index("ITEM: TIMESTEP") + 1])
-        count = int(lines[lines.index("ITEM: NUMBER OF ENTRIES") + 1])
-        start = next(i for i, line in enumerate(lines) if line.startswith("ITEM: ENTRIES")) + 1
-    except (ValueError, IndexError, StopIteration):
-        raise ValueError(f"{path}: not a complete LIGGGHTS local dump (header items missing)") from None
-    rows = [line.split() for line in lines[start:] if line.strip()]
-    if len(rows) != count:
-        raise ValueError(f"{path}: header announces {count} contacts, found {len(rows)} rows (truncated?)")
-    if any(len(row) != len(CONTACT_COLUMNS) for row in rows):
-        raise ValueError(f"{path}: every row must hold {len(CONTACT_COLUMNS)} columns ({' '.join(CONTACT_COLUMNS)})")
-    table = np.array(rows, dtype=float).reshape(count, len(CONTACT_COLUMNS))
+    step, table = parse_local_table(
+        path.read_text(encoding="utf-8", errors="replace"), len(CONTACT_COLUMNS), str(path)
+    )
+    count = table.shape[0]
     contacts = {name: table[:, i] for i, name in enumerate(CONTACT_COLUMNS)}
     contacts["step"] = np.full(count, step)
     return contacts

@@ -5,7 +5,7 @@ from engines.config import validate_config
 
 
 def test_default_sweep_is_shape_x_test_x_sliding_x_rolling():
-    sweep = validate_config({})["jenike"]["sweep"]
+    sweep = {**validate_config({})["jenike"]["sweep"], "lid_comparison": False}
     points = sweep_points(sweep)
     assert len(points) == 1 * 2 * 3 * 2
     assert points[0] == {
@@ -29,6 +29,7 @@ def test_sensitivity_and_rotation_blocked_points_are_added_once():
         "restitution": 0.1,
         "restitution_sensitivity": [0.1, 0.6, 1.0],
         "rotation_blocked": True,
+        "lid_comparison": False,
         "wall_test_particle_friction": 0.35,
     }
     points = sweep_points(sweep)
@@ -41,3 +42,32 @@ def test_sensitivity_and_rotation_blocked_points_are_added_once():
     assert len(blocked) == 2 * 3
     assert len(points) == grid + 4 + 6
     assert not any(is_chart_point(p, 0.1) for p in sensitivity + blocked)
+
+
+def test_lid_comparison_runs_the_internal_points_with_the_other_lid():
+    sweep = validate_config({})["jenike"]["sweep"]
+    points = sweep_points(sweep, lid="rigid")
+    compared = [p for p in points if "lid" in p]
+    assert len(points) == 12 + 3
+    assert {p["lid"] for p in compared} == {"servo"}
+    assert sorted(p["sliding_friction"] for p in compared) == [0.1, 0.3, 0.5]
+    assert all(p["test"] == "internal" and p["rolling_friction"] == 0.0 for p in compared)
+    assert not any(is_chart_point(p, sweep["restitution"]) for p in compared)
+    assert {p["lid"] for p in sweep_points(sweep, lid="servo") if "lid" in p} == {"rigid"}
+
+
+def test_lid_comparison_pairs_rows_of_both_lids():
+    from calibration.sweep import chart_rows, lid_comparison
+
+    base = {"shape": "sphere2", "test": "internal", "rolling_friction": "0.0", "restitution": "0.1",
+            "rotation_blocked": "False"}
+    rows = [
+        {**base, "particle_friction": "0.1", "lid": "rigid", "bulk_friction": "0.40"},
+        {**base, "particle_friction": "0.1", "lid": "servo", "bulk_friction": "0.46"},
+        {**base, "particle_friction": "0.3", "lid": "rigid", "bulk_friction": "0.55"},
+        {**base, "test": "wall", "particle_friction": "0.1", "lid": "servo", "bulk_friction": "0.2"},
+    ]
+    (pair,) = lid_comparison(rows, 0.1)
+    assert pair["particle_friction"] == 0.1
+    assert pair["servo_minus_rigid"] == 0.46 - 0.40
+    assert [r["lid"] for r in chart_rows(rows, 0.1, "rigid")] == ["rigid", "rigid"]

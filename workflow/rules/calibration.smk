@@ -6,7 +6,7 @@ from engines.jenike import build_jenike_case
 
 def _jenike_points():
     points = {}
-    for point in sweep_points(config["jenike"]["sweep"]):
+    for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"]):
         try:
             case = build_jenike_case(config, point)
         except ValueError as error:
@@ -28,11 +28,19 @@ def calibration_chart_names():
     return [f"{shape}_{test}" for shape in sweep["shapes"] for test in sweep["tests"]]
 
 
+def lid_comparison_targets():
+    sweep = config["jenike"]["sweep"]
+    if not (sweep["lid_comparison"] and "internal" in sweep["tests"]):
+        return []
+    return [f"{CALIBRATION}/lid_comparison.csv", f"{CALIBRATION}/charts/lid_comparison.png"]
+
+
 def calibration_targets():
     return [
         f"{CALIBRATION}/bulk_friction.csv",
         f"{CALIBRATION}/parameters.yaml",
         *[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
+        *lid_comparison_targets(),
     ]
 
 
@@ -74,6 +82,7 @@ rule jenike_friction:
         plot=f"{CALIBRATION}/runs/{{point}}/plots/forces.png",
     params:
         point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+        lid=config["jenike"]["lid"],
     log:
         f"{CALIBRATION}/runs/{{point}}/logs/friction.log",
     script:
@@ -99,6 +108,7 @@ rule calibration_charts:
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
+        lid=config["jenike"]["lid"],
     log:
         f"{CALIBRATION}/logs/charts.log",
     script:
@@ -113,7 +123,22 @@ checkpoint calibration_parameters:
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
+        lid=config["jenike"]["lid"],
     log:
         f"{CALIBRATION}/logs/parameters.log",
     script:
         "../scripts/calibration_parameters.py"
+
+
+rule lid_comparison:
+    input:
+        table=rules.calibration_table.output.table,
+    output:
+        table=f"{CALIBRATION}/lid_comparison.csv",
+        plot=f"{CALIBRATION}/charts/lid_comparison.png",
+    params:
+        base_restitution=config["jenike"]["sweep"]["restitution"],
+    log:
+        f"{CALIBRATION}/logs/lid_comparison.log",
+    script:
+        "../scripts/lid_comparison.py"

@@ -5,13 +5,13 @@ from pathlib import Path
 
 from calibration.charts import plot_calibration_chart
 from calibration.inversion import curves_from_table
+from calibration.sweep import chart_rows
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     calibration = snakemake.params.calibration
     with open(snakemake.input.table, newline="") as handle:
-        rows = [row for row in csv.DictReader(handle)
-                if float(row["restitution"]) == snakemake.params.base_restitution and row["rotation_blocked"] == "False"]
+        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid)
     curves = curves_from_table(rows)
     for path in snakemake.output.charts:
         shape, test = Path(path).stem.split("_", 1)

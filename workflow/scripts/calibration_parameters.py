@@ -5,13 +5,13 @@ import csv
 import yaml
 
 from calibration.inversion import curves_from_table, invert_calibration
+from calibration.sweep import chart_rows
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     calibration = snakemake.params.calibration
     with open(snakemake.input.table, newline="") as handle:
-        rows = [row for row in csv.DictReader(handle)
-                if float(row["restitution"]) == snakemake.params.base_restitution and row["rotation_blocked"] == "False"]
+        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid)
     curves = curves_from_table(rows)
     tested = {"internal" if c.test == "internal" else c.wall_material for c in curves}
     targets = {name: angle for name, angle in calibration["targets_deg"].items() if name in tested}

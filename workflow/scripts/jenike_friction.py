@@ -26,6 +26,7 @@ with logged_to(snakemake.log[0]) as log:
         "rolling_friction": point["rolling_friction"],
         "restitution": point["restitution"],
         "rotation_blocked": point["rotation_blocked"],
+        "lid": point.get("lid", snakemake.params.lid),
         "particle_friction": point["sliding_friction"],
         "bulk_friction": friction.coefficient,
         "bulk_friction_stderr": friction.standard_error,

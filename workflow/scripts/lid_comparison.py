@@ -1,0 +1,18 @@
+"""Snakemake adapter: compare bulk friction measured with the rigid and the servo lid on the same points."""
+
+import csv
+
+from analysis.tables import write_flow_table
+from calibration.charts import plot_lid_comparison
+from calibration.sweep import lid_comparison
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    with open(snakemake.input.table, newline="") as handle:
+        rows = lid_comparison(csv.DictReader(handle), snakemake.params.base_restitution)
+    if not rows:
+        raise ValueError("no sweep point was run with both lids; enable jenike.sweep.lid_comparison")
+    write_flow_table(snakemake.output.table, rows)
+    plot_lid_comparison(rows, snakemake.output.plot, "Internal friction: rigid (free) lid vs servo (flat) lid")
+    for row in rows:
+        log.info("%s", row)
