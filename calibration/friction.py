@@ -667,3 +667,47 @@ def bulk_friction_of_shear(signals) -> tuple[BulkFriction, str]:
     time = np.asarray(signals.time, dtype=float)
     half = time[0] + 0.5 * (time[-1] - time[0])
     return bulk_friction(*arguments, window=(half, time[-1])), "second half"
+
+
+def mobilised_friction_by_azimuth(
+    contact_points, normal_force_vectors, tangential_force_vectors, bins: int = 36
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean mobilised friction |F_t| / |F_n| of wall contacts per azimuthal sector around the cell axis.
+
+    The azimuth of a contact is the angle of its contact point about the z axis (the cell axis through
+    the origin), measured from +x, the shear direction. Contacts with zero normal force are left out.
+
+    Parameters
+    ----------
+    contact_points : array_like, shape (n, 3)
+        Contact points on the wall (m).
+    normal_force_vectors, tangential_force_vectors : array_like, shape (n, 3)
+        Normal and tangential contact forces (N).
+    bins : int
+        Number of equal sectors over [-pi, pi).
+
+    Returns
+    -------
+    edges_rad : numpy.ndarray
+        (bins + 1,) sector edges (rad).
+    mean_ratio : numpy.ndarray
+        (bins,) mean |F_t| / |F_n| per sector (0 where a sector has no contact).
+    counts : numpy.ndarray
+        (bins,) contacts per sector.
+    """
+    points = finite_array("contact_points", contact_points, ndim=2)
+    normal = np.linalg.norm(finite_array("normal_force_vectors", normal_force_vectors, ndim=2), axis=1)
+    tangential = np.linalg.norm(finite_array("tangential_force_vectors", tangential_force_vectors, ndim=2), axis=1)
+    if not (points.shape[0] == normal.shape[0] == tangential.shape[0]) or points.shape[1] != 3:
+        raise ValueError("contact_points and the force vectors must all have shape (n, 3)")
+    if int(bins) < 1:
+        raise ValueError(f"bins must be a positive integer, got {bins!r}")
+    loaded = normal > 0.0
+    azimuth = np.arctan2(points[loaded, 1], points[loaded, 0])
+    ratio = tangential[loaded] / normal[loaded]
+    edges = np.linspace(-np.pi, np.pi, int(bins) + 1)
+    sector = np.clip(np.digitize(azimuth, edges) - 1, 0, int(bins) - 1)
+    counts = np.bincount(sector, minlength=int(bins))
+    sums = np.bincount(sector, weights=ratio, minlength=int(bins))
+    mean_ratio = np.divide(sums, counts, out=np.zeros(int(bins)), where=counts > 0)
+    return edges, mean_ratio, counts

@@ -140,3 +140,17 @@ def lid_comparison(rows, base_restitution: float) -> list[dict]:
                 }
             )
     return paired
+
+
+def diagnostic_points(points: list[dict], sweep: dict, lid: str) -> list[dict]:
+    """The chart points that get contact and rotation diagnostics (``jenike.sweep.diagnostics``).
+
+    Only rigid-lid runs record wall contacts, so a servo ``lid`` gives none.
+    """
+    if sweep["diagnostics"] == "none" or lid != "rigid":
+        return []
+    chart = [p for p in points if is_chart_point(p, sweep["restitution"])]
+    if sweep["diagnostics"] == "all":
+        return chart
+    middle = sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]
+    return [p for p in chart if p["sliding_friction"] == float(middle)]

@@ -43,8 +43,11 @@ def calibrated_pipeline(tmp_path_factory):
 
 
 def test_table_has_one_row_per_point_and_friction_grows(calibrated_pipeline):
-    rows = list(csv.DictReader((calibrated_pipeline / "results" / "calibration" / "bulk_friction.csv").open()))
-    assert [float(r["particle_friction"]) for r in rows] == [0.1, 0.5]
+    table = list(csv.DictReader((calibrated_pipeline / "results" / "calibration" / "bulk_friction.csv").open()))
+    assert sorted((r["lid"], float(r["particle_friction"])) for r in table) == [
+        ("rigid", 0.1), ("rigid", 0.5), ("servo", 0.1), ("servo", 0.5)
+    ]
+    rows = [r for r in table if r["lid"] == "rigid"]
     low, high = (float(r["bulk_friction"]) for r in rows)
     assert high > low > 0.0
     for row in rows:
@@ -70,3 +73,21 @@ def test_the_silo_ran_with_the_calibrated_parameters(calibrated_pipeline):
     assert particle_contact["sliding_friction"] == parameters["particle_particle"]["sliding_friction"]
     assert particle_contact["rolling_friction"] == 0.0
     assert (run_dir / "metrics" / "flow.csv").exists()
+
+
+def test_lids_are_compared_on_the_same_points(calibrated_pipeline):
+    calibration = calibrated_pipeline / "results" / "calibration"
+    rows = list(csv.DictReader((calibration / "lid_comparison.csv").open()))
+    assert [float(r["particle_friction"]) for r in rows] == [0.1, 0.5]
+    for row in rows:
+        assert float(row["bulk_friction_servo_lid"]) > 0.0
+    assert (calibration / "charts" / "lid_comparison.png").exists()
+
+
+def test_diagnostics_of_the_middle_point(calibrated_pipeline):
+    (diagnostics,) = (calibrated_pipeline / "results" / "calibration" / "runs").glob("*/metrics/diagnostics.json")
+    summary = json.loads(diagnostics.read_text())
+    assert summary["wall_contacts_in_shear_plane"] > 0
+    assert summary["mean_angular_speed_rad_s"] > 0.0
+    assert (diagnostics.parent.parent / "plots" / "mobilised_friction.png").exists()
+    assert (diagnostics.parent.parent / "plots" / "angular_velocity.png").exists()

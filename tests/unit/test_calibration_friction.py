@@ -347,3 +347,16 @@ def test_bulk_friction_of_shear_uses_the_plateau_or_the_second_half():
     assert method == "second half"
     assert friction.coefficient == pytest.approx(7.5 / 50.0, abs=1e-12)
     assert friction.window.t_start == pytest.approx(0.5)
+
+
+def test_mobilised_friction_by_azimuth_exact_sectors():
+    from calibration.friction import mobilised_friction_by_azimuth
+
+    points = [[1.0, 0.0, 0.0], [1.0, 0.1, 0.0], [-1.0, 0.01, 0.0], [0.0, 1.0, 0.0]]
+    normal = [[-2.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+    tangential = [[0.0, 1.0, 0.0], [0.0, 0.0, 0.5], [0.0, 1.0, 0.0], [0.0, 3.0, 0.0]]
+    edges, ratio, counts = mobilised_friction_by_azimuth(points, normal, tangential, bins=4)
+    np.testing.assert_allclose(edges, [-np.pi, -np.pi / 2, 0.0, np.pi / 2, np.pi])
+    # sector [0, pi/2): contacts at azimuth 0 and 0.0997 rad with ratios 0.5 and 0.5; the zero-load one is dropped
+    np.testing.assert_array_equal(counts, [0, 0, 2, 1])
+    np.testing.assert_allclose(ratio, [0.0, 0.0, 0.5, 0.25])

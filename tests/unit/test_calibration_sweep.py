@@ -71,3 +71,17 @@ def test_lid_comparison_pairs_rows_of_both_lids():
     assert pair["particle_friction"] == 0.1
     assert pair["servo_minus_rigid"] == 0.46 - 0.40
     assert [r["lid"] for r in chart_rows(rows, 0.1, "rigid")] == ["rigid", "rigid"]
+
+
+def test_diagnostic_points_are_the_middle_friction_of_each_curve():
+    from calibration.sweep import diagnostic_points
+
+    sweep = validate_config({})["jenike"]["sweep"]
+    points = sweep_points(sweep, lid="rigid")
+    chosen = diagnostic_points(points, sweep, "rigid")
+    assert len(chosen) == 2 * 2  # two tests x two rolling frictions
+    assert {p["sliding_friction"] for p in chosen} == {0.3}
+    assert diagnostic_points(points, sweep, "servo") == []
+    assert diagnostic_points(points, {**sweep, "diagnostics": "all"}, "rigid") == [
+        p for p in points if "lid" not in p
+    ]

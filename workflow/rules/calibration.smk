@@ -1,6 +1,6 @@
 # Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
 
-from calibration.sweep import is_chart_point, sweep_points
+from calibration.sweep import diagnostic_points, sweep_points
 from engines.jenike import build_jenike_case
 
 
@@ -35,8 +35,15 @@ def lid_comparison_targets():
     return [f"{CALIBRATION}/lid_comparison.csv", f"{CALIBRATION}/charts/lid_comparison.png"]
 
 
+def diagnostic_targets():
+    points = diagnostic_points(list(JENIKE_POINTS.values()), config["jenike"]["sweep"], config["jenike"]["lid"])
+    chosen = [run_id for run_id, point in JENIKE_POINTS.items() if point in points]
+    return [f"{jenike_dir(run_id)}/plots/{name}.png" for run_id in chosen for name in ("mobilised_friction", "angular_velocity")]
+
+
 def calibration_targets():
     return [
+        *diagnostic_targets(),
         f"{CALIBRATION}/bulk_friction.csv",
         f"{CALIBRATION}/parameters.yaml",
         *[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
@@ -142,3 +149,17 @@ rule lid_comparison:
         f"{CALIBRATION}/logs/lid_comparison.log",
     script:
         "../scripts/lid_comparison.py"
+
+
+rule jenike_diagnostics:
+    input:
+        record=rules.jenike_run.output.record,
+        case=rules.jenike_deck.output.case,
+    output:
+        friction=f"{CALIBRATION}/runs/{{point}}/plots/mobilised_friction.png",
+        rotation=f"{CALIBRATION}/runs/{{point}}/plots/angular_velocity.png",
+        summary=f"{CALIBRATION}/runs/{{point}}/metrics/diagnostics.json",
+    log:
+        f"{CALIBRATION}/runs/{{point}}/logs/diagnostics.log",
+    script:
+        "../scripts/jenike_diagnostics.py"
