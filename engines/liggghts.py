@@ -32,6 +32,7 @@ DECK_NAME = "in.liggghts"
 LOG_NAME = "log.liggghts"
 SCREEN_NAME = "engine.out"
 DUMP_PREFIX = "particles"
+CONTACT_PREFIX = "contacts"
 RUN_RECORD = "run.json"
 
 # LIGGGHTS only accepts 5e6 <= E <= 1e9 Pa (SI) unless told otherwise.
@@ -186,6 +187,7 @@ def silo_deck_context(case: SiloCase) -> dict:
                 "max_checks": case.settle_max_checks,
             },
             "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
+            "contact_dump": f"dumps/{CONTACT_PREFIX}_*.txt",
             "discharge": {"steps": case.discharge_steps},
             "thermo_every": dump_every,
         }

@@ -146,3 +146,34 @@ def test_two_mpi_ranks_give_the_same_flow_within_noise(tiny_pipeline, tmp_path, 
     parallel = silo_flow_metrics(frames, case.width, case.depth, case.outlet_width, case.particle.equivalent_diameter)
     (serial,) = list(csv.DictReader((serial_dir / "metrics" / "flow.csv").open()))
     assert parallel.fit.mass_flow_rate == pytest.approx(float(serial["mass_flow_rate_kg_s"]), rel=0.15)
+
+
+def test_profile_flow_rate_agrees_with_the_outflow(tiny_pipeline):
+    _, run_dir, _ = tiny_pipeline
+    summary = json.loads((run_dir / "metrics" / "fields.json").read_text())
+    assert summary["profile_flow_height_m"] == 0.01
+    assert summary["profile_over_outflow"] == pytest.approx(1.0, abs=0.10)
+
+
+def test_fields_open_in_pyvista_and_hold_the_fields(tiny_pipeline):
+    import pyvista
+
+    _, run_dir, _ = tiny_pipeline
+    series = pyvista.get_reader(str(run_dir / "fields" / "fields.pvd"))
+    assert len(series.time_values) > 5
+    series.set_active_time_value(series.time_values[-1])
+    image = series.read()[0]
+    for name in ("density", "velocity", "kinetic_stress"):
+        assert name in image.array_names
+    assert float(image["density"].max()) > 100.0
+
+
+def test_silo_flow_metrics_and_plots_are_written(tiny_pipeline):
+    _, run_dir, _ = tiny_pipeline
+    for name in ("profiles", "flow_channel_boundary", "kinematic", "centreline_velocity", "janssen"):
+        rows = list(csv.DictReader((run_dir / "metrics" / f"{name}.csv").open()))
+        assert rows, name
+    janssen = list(csv.DictReader((run_dir / "metrics" / "janssen.csv").open()))
+    assert all(float(row["sigma_v_dem_Pa"]) > 0 for row in janssen)
+    for name in ("profiles", "vz_contour", "kinematic_B", "centreline_velocity", "janssen", "force_chains"):
+        assert (run_dir / "plots" / f"{name}.png").read_bytes()[:4] == b"\x89PNG", name

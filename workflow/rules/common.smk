@@ -50,7 +50,13 @@ def silo_flat_targets(wildcards=None):
     return [
         path
         for run_id in silo_cases(silo_config())
-        for path in (f"{silo_dir(run_id)}/metrics/flow.csv", f"{silo_dir(run_id)}/plots/discharge.png")
+        for path in (
+            f"{silo_dir(run_id)}/metrics/flow.csv",
+            f"{silo_dir(run_id)}/plots/discharge.png",
+            f"{silo_dir(run_id)}/fields/fields.pvd",
+            f"{silo_dir(run_id)}/metrics/profiles.csv",
+            f"{silo_dir(run_id)}/plots/profiles.png",
+        )
     ]
 
 

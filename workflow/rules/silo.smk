@@ -54,3 +54,31 @@ rule silo_metrics:
         f"{RESULTS}/silo_flat/{{run}}/logs/metrics.log",
     script:
         "../scripts/silo_metrics.py"
+
+
+rule silo_fields:
+    input:
+        record=rules.silo_run.output.record,
+        case=rules.silo_deck.output.case,
+        flow=rules.silo_metrics.output.summary,
+    output:
+        pvd=f"{RESULTS}/silo_flat/{{run}}/fields/fields.pvd",
+        arrays=f"{RESULTS}/silo_flat/{{run}}/fields/averaged.npz",
+        profiles=f"{RESULTS}/silo_flat/{{run}}/metrics/profiles.csv",
+        boundaries=f"{RESULTS}/silo_flat/{{run}}/metrics/flow_channel_boundary.csv",
+        kinematic=f"{RESULTS}/silo_flat/{{run}}/metrics/kinematic.csv",
+        centreline=f"{RESULTS}/silo_flat/{{run}}/metrics/centreline_velocity.csv",
+        janssen=f"{RESULTS}/silo_flat/{{run}}/metrics/janssen.csv",
+        summary=f"{RESULTS}/silo_flat/{{run}}/metrics/fields.json",
+        profile_plot=f"{RESULTS}/silo_flat/{{run}}/plots/profiles.png",
+        contour_plot=f"{RESULTS}/silo_flat/{{run}}/plots/vz_contour.png",
+        kinematic_plot=f"{RESULTS}/silo_flat/{{run}}/plots/kinematic_B.png",
+        centreline_plot=f"{RESULTS}/silo_flat/{{run}}/plots/centreline_velocity.png",
+        janssen_plot=f"{RESULTS}/silo_flat/{{run}}/plots/janssen.png",
+        force_chain_plot=f"{RESULTS}/silo_flat/{{run}}/plots/force_chains.png",
+    params:
+        settings=lambda wildcards: config["silo_flat"]["fields"],
+    log:
+        f"{RESULTS}/silo_flat/{{run}}/logs/fields.log",
+    script:
+        "../scripts/silo_fields.py"
