@@ -149,3 +149,29 @@ def plot_force_chains(segments, width: float, outlet_width: float, top: float, p
         return _save(figure, path)
     finally:
         plt.close(figure)
+
+
+def plot_measured_comparison(comparisons, path, title: str) -> Path:
+    """Simulated against measured v_z(x), one panel row per measured profile, with the error metrics."""
+    rows = max(1, len(comparisons))
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.6 * rows), squeeze=False)
+    try:
+        for axes, comparison in zip(axes_list[:, 0], comparisons):
+            measured = comparison.measured
+            x_mm = 1e3 * measured.x
+            if measured.uncertainty is not None:
+                axes.errorbar(x_mm, measured.v_z, yerr=measured.uncertainty, fmt="o", markersize=3, label="measured")
+            else:
+                axes.plot(x_mm, measured.v_z, "o", markersize=3, label="measured")
+            axes.plot(x_mm, comparison.simulated_v_z, "-", label="DEM")
+            errors = comparison.errors
+            axes.set_title(f"z = {1e3 * measured.z:g} mm, {measured.window}: mean error {errors.mean_error_percent:.1f} %, "
+                           f"RMS {errors.rms_error:.3g} m/s", fontsize=9)
+            axes.set_ylabel("v_z [m/s]")
+            axes.grid(alpha=0.3)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        axes_list[0, 0].legend(fontsize=8)
+        figure.suptitle(title)
+        return _save(figure, path)
+    finally:
+        plt.close(figure)

@@ -56,8 +56,15 @@ def silo_flat_targets(wildcards=None):
             f"{silo_dir(run_id)}/fields/fields.pvd",
             f"{silo_dir(run_id)}/metrics/profiles.csv",
             f"{silo_dir(run_id)}/plots/profiles.png",
+            *measured_comparison_targets(run_id),
         )
     ]
+
+
+def measured_comparison_targets(run_id):
+    if config["silo_flat"]["fields"]["measured_profiles"] is None:
+        return []
+    return [f"{silo_dir(run_id)}/metrics/measured_comparison.csv", f"{silo_dir(run_id)}/plots/measured_comparison.png"]
 
 
 def print_result_locations():

@@ -82,3 +82,18 @@ rule silo_fields:
         f"{RESULTS}/silo_flat/{{run}}/logs/fields.log",
     script:
         "../scripts/silo_fields.py"
+
+
+rule silo_measured_comparison:
+    input:
+        fields=rules.silo_fields.output.arrays,
+        measured=lambda wildcards: config["silo_flat"]["fields"]["measured_profiles"],
+    output:
+        table=f"{RESULTS}/silo_flat/{{run}}/metrics/measured_comparison.csv",
+        plot=f"{RESULTS}/silo_flat/{{run}}/plots/measured_comparison.png",
+    params:
+        plane=config["silo_flat"]["fields"]["measured_plane"],
+    log:
+        f"{RESULTS}/silo_flat/{{run}}/logs/measured_comparison.log",
+    script:
+        "../scripts/silo_measured_comparison.py"
