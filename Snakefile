@@ -18,6 +18,7 @@ rule all:
     input:
         calibration_targets(),
         silo_flat_targets,
+        parametric_targets,
     default_target: True
 
 

@@ -175,3 +175,24 @@ def plot_measured_comparison(comparisons, path, title: str) -> Path:
         return _save(figure, path)
     finally:
         plt.close(figure)
+
+
+def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, title: str) -> Path:
+    """v_z profiles at one height (left) and the steady mass flow rate (right) for each run of a study."""
+    figure, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.0), gridspec_kw={"width_ratios": [3, 2]})
+    try:
+        for profile, label in zip(profiles, labels):
+            left.plot(1e3 * np.asarray(x), profile, label=label)
+        left.set_xlabel("x [mm]")
+        left.set_ylabel(f"v_z at z = {1e3 * height:g} mm [m/s]")
+        left.grid(alpha=0.3)
+        left.legend(fontsize=7)
+        positions = np.arange(len(labels))
+        right.bar(positions, flow_rates, color="tab:blue")
+        right.set_xticks(positions, labels, rotation=45, ha="right", fontsize=7)
+        right.set_ylabel("steady mass flow rate [kg/s]")
+        right.grid(alpha=0.3, axis="y")
+        figure.suptitle(title)
+        return _save(figure, path)
+    finally:
+        plt.close(figure)

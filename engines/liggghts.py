@@ -142,16 +142,16 @@ def silo_meshes(case: SiloCase) -> dict:
 def silo_deck_context(case: SiloCase) -> dict:
     """The rendering context of ``templates/liggghts/silo_flat.lmp.j2``."""
     table = case.materials
-    side, bottom, front_back = (
-        table.type_of(case.wall_materials[key]) for key in ("side", "bottom", "front_back")
-    )
+    side, bottom = (table.type_of(case.wall_materials[key]) for key in ("side", "bottom"))
+    front_back_type = table.type_of(case.wall_materials["front_back"]) if case.front_back_walls else None
     half_width = 0.5 * case.width
     context = _common_context(case)
     dump_every = case.dump_every
     context.update(
         {
             "title": f"siloflow-silo_flat-{case.run_id}",
-            "boundary": ["f", "f", "f"],
+            # Without front and back walls the depth direction is periodic.
+            "boundary": ["f", "f" if case.front_back_walls else "p", "f"],
             "domain": {
                 "x": [-half_width, half_width],
                 "y": [0.0, case.depth],
@@ -160,8 +160,14 @@ def silo_deck_context(case: SiloCase) -> dict:
             "primitive_walls": [
                 {"id": "wall_left", "type": side, "plane": "xplane", "position": -half_width},
                 {"id": "wall_right", "type": side, "plane": "xplane", "position": half_width},
-                {"id": "wall_front", "type": front_back, "plane": "yplane", "position": 0.0},
-                {"id": "wall_back", "type": front_back, "plane": "yplane", "position": case.depth},
+                *(
+                    [
+                        {"id": "wall_front", "type": front_back_type, "plane": "yplane", "position": 0.0},
+                        {"id": "wall_back", "type": front_back_type, "plane": "yplane", "position": case.depth},
+                    ]
+                    if case.front_back_walls
+                    else []
+                ),
             ],
             "meshes": [
                 {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom}

@@ -11,6 +11,7 @@ per clump is below a threshold, remove the gate, discharge for a given time. Dis
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import math
@@ -22,7 +23,7 @@ from engines.physics import engine_seeds, rayleigh_time, steps_for
 CASE_NAME = "silo_flat"
 
 #: Keys of ``silo_flat`` that only steer the analysis; they do not define (or rerun) the simulation.
-ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields")
+ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric")
 
 
 @dataclass(frozen=True)
@@ -129,6 +130,7 @@ class SiloCase:
     fill_height: float
     outlet_width: float
     wall_materials: dict
+    front_back_walls: bool
     timestep: float
     rayleigh_time: float
     fill: FillPlan
@@ -257,7 +259,8 @@ def build_silo_case(config: dict) -> SiloCase:
             f"silo_flat.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"
         )
     walls = silo["wall_materials"]
-    table = material_table(config, material_name, [walls["side"], walls["bottom"], walls["front_back"]])
+    used_walls = [walls["side"], walls["bottom"]] + ([walls["front_back"]] if silo["front_back_walls"] else [])
+    table = material_table(config, material_name, used_walls)
     t_rayleigh = rayleigh_time(
         particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
     )
@@ -293,6 +296,7 @@ def build_silo_case(config: dict) -> SiloCase:
         fill_height=silo["fill_height"],
         outlet_width=silo["outlet_width"],
         wall_materials=dict(walls),
+        front_back_walls=silo["front_back_walls"],
         timestep=timestep,
         rayleigh_time=t_rayleigh,
         fill=fill,
@@ -310,10 +314,79 @@ def build_silo_case(config: dict) -> SiloCase:
     )
 
 
+def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
+    """The configurations of the parametric studies: ``{study: [(label, config), ...]}``.
+
+    Studies (digest section 3): ``front_back_friction`` (particle-wall friction of the front and back walls,
+    plus a run without them when ``periodic_front_back``), ``restitution`` (of all particle contacts) and
+    ``friction`` (particle-particle sliding x rolling friction of all particle contacts). A front/back wall
+    friction value gets its own material (a copy of the front/back wall material), so the side walls keep
+    theirs. Labels are short and stable ("mu_fw=0.3", "periodic", "e=0.6", "mu=0.15,mu_r=0.1").
+    """
+    silo = config["silo_flat"]
+    study = silo["parametric"]
+    particle = silo["particle_material"]
+    front_back = silo["wall_materials"]["front_back"]
+
+    def variant(edit) -> dict:
+        changed = copy.deepcopy(config)
+        edit(changed)
+        return changed
+
+    def set_particle_contacts(changed, **values) -> None:
+        for contact in changed["contacts"]:
+            if particle in contact["materials"]:
+                partner = [m for m in contact["materials"] if m != particle] or [particle]
+                if partner[0] == config["jenike"]["lid_material"]:
+                    continue
+                if "sliding_friction" in values and partner[0] != particle:
+                    continue  # particle-particle sliding friction only
+                contact.update(values)
+
+    studies: dict[str, list[tuple[str, dict]]] = {}
+    runs = []
+    for value in study["front_back_friction"]:
+        name = f"{front_back}_fw{int(round(value * 1000)):04d}"
+
+        def edit(changed, value=value, name=name):
+            changed["materials"][name] = dict(changed["materials"][front_back])
+            base = next(c for c in changed["contacts"] if sorted(c["materials"]) == sorted([particle, front_back]))
+            changed["contacts"].append({**base, "materials": [particle, name], "sliding_friction": float(value)})
+            changed["silo_flat"]["wall_materials"]["front_back"] = name
+
+        runs.append((f"mu_fw={value:g}", variant(edit)))
+    if study["periodic_front_back"]:
+        runs.append(("periodic", variant(lambda changed: changed["silo_flat"].update(front_back_walls=False))))
+    if runs:
+        studies["front_back_friction"] = runs
+    if study["restitution"]:
+        studies["restitution"] = [
+            (f"e={value:g}", variant(lambda changed, value=value: set_particle_contacts(changed, restitution=float(value))))
+            for value in study["restitution"]
+        ]
+    if study["sliding_friction"] and study["rolling_friction"]:
+        studies["friction"] = [
+            (
+                f"mu={mu:g},mu_r={mu_r:g}",
+                variant(lambda changed, mu=mu, mu_r=mu_r: (
+                    set_particle_contacts(changed, rolling_friction=float(mu_r)),
+                    set_particle_contacts(changed, sliding_friction=float(mu)),
+                )),
+            )
+            for mu in study["sliding_friction"]
+            for mu_r in study["rolling_friction"]
+        ]
+    return studies
+
+
 def silo_cases(config: dict) -> dict[str, SiloCase]:
-    """The flat-bottom silo runs a validated configuration defines, keyed by run id."""
-    case = build_silo_case(config)
-    return {case.run_id: case}
+    """The flat-bottom silo runs a validated configuration defines (base run and parametric variants),
+    keyed by run id."""
+    cases = {}
+    for run_config in [config, *(c for runs in parametric_variants(config).values() for _, c in runs)]:
+        case = build_silo_case(run_config)
+        cases[case.run_id] = case
+    return cases
 
 
 def silo_case_for_run(config: dict, run: str) -> SiloCase:

@@ -21,6 +21,24 @@ from tests.conftest import TINY_SILO, require_liggghts
 
 pytestmark = pytest.mark.integration
 
+# The silo tests need the calibration stage too (it is part of the workflow): one tiny shear test.
+TINY_JENIKE_SWEEP = {
+    "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
+    "fill": {"settle_time": 0.1},
+    "consolidation": {"time": 0.05},
+    "shear": {"velocity": 0.03, "displacement": 0.004},
+    "sweep": {"tests": ["internal"], "sliding_friction": [0.3], "rolling_friction": [0.1], "lid_comparison": False,
+              "diagnostics": "none"},
+}
+
+
+def _validated(silo: dict) -> dict:
+    from engines.config import load_config_file, validate_config
+
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    raw["silo_flat"] = {**raw["silo_flat"], **silo}
+    return validate_config(raw)
+
 
 def _snakemake(workdir: Path, *arguments: str) -> subprocess.CompletedProcess:
     return subprocess.run(
@@ -37,10 +55,11 @@ def tiny_pipeline(tmp_path_factory):
     require_liggghts()
     workdir = tmp_path_factory.mktemp("tiny_silo")
     config_path = workdir / "tiny.yaml"
-    config_path.write_text(yaml.safe_dump({"silo_flat": TINY_SILO}))
+    silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}}
+    config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP}))
     result = _snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-    (run_dir,) = (workdir / "results" / "silo_flat").iterdir()
+    run_dir = workdir / "results" / "silo_flat" / build_silo_case(_validated(silo)).run_id
     yield workdir, run_dir, result
 
 
@@ -177,3 +196,12 @@ def test_silo_flow_metrics_and_plots_are_written(tiny_pipeline):
     assert all(float(row["sigma_v_dem_Pa"]) > 0 for row in janssen)
     for name in ("profiles", "vz_contour", "kinematic_B", "centreline_velocity", "janssen", "force_chains"):
         assert (run_dir / "plots" / f"{name}.png").read_bytes()[:4] == b"\x89PNG", name
+
+
+def test_parametric_study_compares_its_runs(tiny_pipeline):
+    workdir, run_dir, _ = tiny_pipeline
+    rows = list(csv.DictReader((workdir / "results" / "silo_flat" / "parametric" / "restitution.csv").open()))
+    assert [row["label"] for row in rows] == ["base", "e=0.6"]
+    assert rows[0]["run_id"] == run_dir.name
+    assert all(float(row["mass_flow_rate_kg_s"]) > 0 for row in rows)
+    assert (workdir / "results" / "silo_flat" / "parametric" / "restitution.png").exists()

@@ -7,7 +7,7 @@ sys.path.insert(0, workflow.basedir)
 
 from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
-from engines.silo import silo_case_for_run, silo_cases
+from engines.silo import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.
@@ -67,6 +67,24 @@ def measured_comparison_targets(run_id):
     return [f"{silo_dir(run_id)}/metrics/measured_comparison.csv", f"{silo_dir(run_id)}/plots/measured_comparison.png"]
 
 
+def parametric_studies():
+    """``{study: [(label, run id), ...]}`` of the configured parametric silo studies, base run first."""
+    base = silo_config()
+    base_run = build_silo_case(base).run_id
+    return {
+        study: [("base", base_run)] + [(label, build_silo_case(variant).run_id) for label, variant in runs]
+        for study, runs in parametric_variants(base).items()
+    }
+
+
+def parametric_targets(wildcards=None):
+    return [
+        path
+        for study in parametric_studies()
+        for path in (f"{RESULTS}/silo_flat/parametric/{study}.csv", f"{RESULTS}/silo_flat/parametric/{study}.png")
+    ]
+
+
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets()]:
+    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")

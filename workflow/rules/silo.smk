@@ -97,3 +97,24 @@ rule silo_measured_comparison:
         f"{RESULTS}/silo_flat/{{run}}/logs/measured_comparison.log",
     script:
         "../scripts/silo_measured_comparison.py"
+
+
+def _study_runs(wildcards):
+    return parametric_studies()[wildcards.study]
+
+
+rule silo_parametric:
+    input:
+        flows=lambda wildcards: [f"{silo_dir(run)}/metrics/flow.json" for _, run in _study_runs(wildcards)],
+        fields=lambda wildcards: [f"{silo_dir(run)}/fields/averaged.npz" for _, run in _study_runs(wildcards)],
+    output:
+        table=f"{RESULTS}/silo_flat/parametric/{{study}}.csv",
+        plot=f"{RESULTS}/silo_flat/parametric/{{study}}.png",
+    params:
+        labels=lambda wildcards: [label for label, _ in _study_runs(wildcards)],
+        runs=lambda wildcards: [run for _, run in _study_runs(wildcards)],
+        profile_height=config["silo_flat"]["parametric"]["profile_height"],
+    log:
+        f"{RESULTS}/silo_flat/parametric/logs/{{study}}.log",
+    script:
+        "../scripts/silo_parametric.py"
