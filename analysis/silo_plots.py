@@ -196,3 +196,22 @@ def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, 
         return _save(figure, path)
     finally:
         plt.close(figure)
+
+
+def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Path:
+    """Horizontal velocity from the DEM (v_x) against the kinematic model's u = -B dv_z/dx at each height."""
+    rows = len(profiles.heights)
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.2 * rows), squeeze=False, sharex=True)
+    try:
+        x_mm = 1e3 * profiles.x
+        for i, axes in enumerate(axes_list[:, 0]):
+            axes.plot(x_mm, profiles.v_x[i], "o", markersize=3, label="DEM v_x")
+            axes.plot(x_mm, profiles.kinematic_u[i], "-", label="kinematic u = -B dv_z/dx")
+            axes.set_ylabel(f"z = {1e3 * profiles.heights[i]:g} mm\n[m/s]", fontsize=8)
+            axes.grid(alpha=0.3)
+        axes_list[0, 0].legend(fontsize=8)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        figure.suptitle(title)
+        return _save(figure, path)
+    finally:
+        plt.close(figure)

@@ -189,12 +189,14 @@ def test_fields_open_in_pyvista_and_hold_the_fields(tiny_pipeline):
 
 def test_silo_flow_metrics_and_plots_are_written(tiny_pipeline):
     _, run_dir, _ = tiny_pipeline
-    for name in ("profiles", "flow_channel_boundary", "kinematic", "centreline_velocity", "janssen"):
+    for name in ("profiles", "profiles_instantaneous", "flow_channel_boundary", "kinematic", "centreline_velocity",
+                 "janssen"):
         rows = list(csv.DictReader((run_dir / "metrics" / f"{name}.csv").open()))
         assert rows, name
     janssen = list(csv.DictReader((run_dir / "metrics" / "janssen.csv").open()))
     assert all(float(row["sigma_v_dem_Pa"]) > 0 for row in janssen)
-    for name in ("profiles", "vz_contour", "kinematic_B", "centreline_velocity", "janssen", "force_chains"):
+    for name in ("profiles", "vz_contour", "kinematic_B", "kinematic_u", "centreline_velocity", "janssen",
+                 "force_chains"):
         assert (run_dir / "plots" / f"{name}.png").read_bytes()[:4] == b"\x89PNG", name
 
 

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.coarse_graining import depth_average
+from analysis.coarse_graining import depth_average, front_wall_slice
 from analysis.contacts import force_chain_segments, read_contacts
 from analysis.dumps import clumps_from_frame, read_frames
 from analysis.fields_io import save_fields_npz, write_fields_vti, write_pvd
 from analysis.flow import column_surface_heights
-from analysis.profiles import profile_flow_rate
+from analysis.profiles import profile_flow_rate, velocity_profile
 from analysis.silo_fields import (
     FieldSettings,
     analyse_profiles,
@@ -29,6 +29,7 @@ from analysis.silo_plots import (
     plot_force_chains,
     plot_janssen,
     plot_kinematic_constant,
+    plot_kinematic_horizontal_velocity,
     plot_profiles_over_silo,
     plot_velocity_contour,
 )
@@ -79,10 +80,14 @@ with logged_to(snakemake.log[0]) as log:
         raise ValueError(f"no profile height lies inside the fill (surface at {top:.3f} m): lower fields.profile_heights")
     profiles = analyse_profiles(averaged_depth, heights, options["fcb_fractions"], options["subtract_wall_velocity"],
                                 kernel_width=settings.width)
+    # What a camera behind the front wall sees, next to the depth average.
+    front = analyse_profiles(front_wall_slice(averaged), heights, options["fcb_fractions"])
     write_flow_table(snakemake.output.profiles, [
-        {"z_m": z, "x_m": x, "v_z_m_s": vz, "v_x_m_s": vx, "u_kinematic_m_s": u}
+        {"z_m": z, "x_m": x, "v_z_m_s": vz, "v_x_m_s": vx, "u_kinematic_m_s": u,
+         "v_z_front_wall_m_s": fz, "v_x_front_wall_m_s": fx}
         for i, z in enumerate(profiles.heights)
-        for x, vz, vx, u in zip(profiles.x, profiles.v_z[i], profiles.v_x[i], profiles.kinematic_u[i])
+        for x, vz, vx, u, fz, fx in zip(profiles.x, profiles.v_z[i], profiles.v_x[i], profiles.kinematic_u[i],
+                                        front.v_z[i], front.v_x[i])
     ])
     write_flow_table(snakemake.output.boundaries, [
         {"z_m": z, "fraction": f, "x_left_m": profiles.fcb_left[i, j], "x_right_m": profiles.fcb_right[i, j]}
@@ -94,6 +99,14 @@ with logged_to(snakemake.log[0]) as log:
 
     depth_series = [depth_average(f) for f in fields]
     centre = centreline_velocity(depth_series, heights)
+    instantaneous_rows = []
+    for t, frame_fields in zip(times, depth_series):
+        for z in heights:
+            profile = velocity_profile(frame_fields, z)
+            instantaneous_rows.extend(
+                {"time_s": t, "z_m": z, "x_m": x, "v_z_m_s": vz, "v_x_m_s": vx}
+                for x, vz, vx in zip(profile.x, profile.v_z, profile.v_x))
+    write_flow_table(snakemake.output.instantaneous, instantaneous_rows)
     write_flow_table(snakemake.output.centreline, [
         {"time_s": t, **{f"v_z_at_{1e3 * z:g}mm_m_s": centre[i, j] for j, z in enumerate(heights)}}
         for i, t in enumerate(times)
@@ -144,6 +157,8 @@ with logged_to(snakemake.log[0]) as log:
                           outlet, snakemake.output.contour_plot, f"Depth-averaged v_z, {run}")
     plot_kinematic_constant(profiles.heights, profiles.kinematic_B, snakemake.output.kinematic_plot,
                             "Kinematic constant B(z)")
+    plot_kinematic_horizontal_velocity(profiles, snakemake.output.kinematic_u_plot,
+                                       "Horizontal velocity: DEM against the kinematic model")
     plot_centreline_velocity(times, heights, centre, snakemake.output.centreline_plot, "Centreline velocity")
     plot_janssen(comparison, snakemake.output.janssen_plot, "Vertical stress at the end of filling")
     plot_force_chains(segments, width, outlet, top, snakemake.output.force_chain_plot,
