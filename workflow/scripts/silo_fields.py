@@ -120,6 +120,9 @@ with logged_to(snakemake.log[0]) as log:
     # Janssen: mean vertical contact stress of the settled fill against the formula.
     contacts = read_contacts(sorted((run_dir / "dumps").glob(f"{CONTACT_PREFIX}_*.txt"))[-1])
     stress = contact_stress_field(contacts, grid, settings)
+    # The settled fill with its contact stress (compression positive), for ParaView.
+    write_fields_vti(fields_dir / "settled_stress.vti", grid, fields[0], time=0.0,
+                     extra_arrays={"contact_stress": stress})
     janssen_options = options["janssen"]
     comparison = compare_janssen(
         stress, grid, float(np.nanmin(surface)), flow["filling_bulk_density_kg_m3"], width, depth,
