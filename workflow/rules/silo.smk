@@ -30,6 +30,8 @@ rule silo_run:
     resources:
         tasks=config["engine"]["mpi_ranks"],
     threads: config["engine"]["mpi_ranks"]
+    # the longest job: start it first so the short calibration runs fill the other cores meanwhile
+    priority: 10
     log:
         f"{RESULTS}/silo_flat/{{run}}/logs/run.log",
     script:

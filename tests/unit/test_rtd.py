@@ -1,0 +1,250 @@
+"""Unit tests for analysis.rtd on samples and curves with exact answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from analysis.rtd import (
+    RTD,
+    RTDMoments,
+    carson_royal_recycle,
+    johanson_rtd,
+    perfect_mixer_rtd,
+    plug_flow_rtd,
+    rtd_from_exit_times,
+    rtd_moments,
+)
+
+
+def exponential_quantiles(n: int, tau: float) -> np.ndarray:
+    """Deterministic perfect-mixer sample: the mid-quantiles of an exponential of mean tau."""
+    return -tau * np.log(1.0 - (np.arange(n) + 0.5) / n)
+
+
+# --------------------------------------------------------------------------- from exit times
+
+
+def test_discrete_sample_moments_match_closed_forms():
+    n = 400
+    t_entry = 3.25
+    exits = t_entry + np.arange(1, n + 1, dtype=float)  # residence times 1, 2, ..., n
+    rtd = rtd_from_exit_times(exits[::-1], t_entry=t_entry, bins=n)
+    assert isinstance(rtd, RTD)
+    assert rtd.t_mean == pytest.approx((n + 1) / 2, rel=1e-15)
+    assert rtd.variance == pytest.approx((n * n - 1) / 12, rel=1e-13)
+    assert rtd.t_first == 1.0 and rtd.t_last == float(n)
+    assert rtd.ts_over_td == pytest.approx(1.0 / n, rel=1e-15)
+    assert rtd.sigma_theta2 == pytest.approx(((n * n - 1) / 12) / ((n + 1) / 2) ** 2, rel=1e-13)
+    assert rtd.n_exited == n and rtd.n_total == n and rtd.fraction_exited == 1.0
+    assert float(np.sum(rtd.E * rtd.widths)) == pytest.approx(1.0, rel=1e-14)
+    assert rtd.edges[0] == 0.0 and rtd.edges[-1] == n
+    np.testing.assert_allclose(rtd.time, 0.5 * (rtd.edges[1:] + rtd.edges[:-1]))
+
+
+def test_two_point_sample():
+    rtd = rtd_from_exit_times([2.0, 6.0], bins=[0.0, 4.0, 8.0])
+    assert rtd.t_mean == 4.0 and rtd.variance == 4.0
+    np.testing.assert_array_equal(rtd.E, [0.125, 0.125])  # one of two tracers per 4 s bin
+    assert rtd.ts_over_td == pytest.approx(1.0 / 3.0)
+
+
+def test_exponential_sample_theta_form_integrates_to_one():
+    tau = 2.0
+    n = 20_000
+    rtd = rtd_from_exit_times(10.0 + exponential_quantiles(n, tau), t_entry=10.0)
+    dtheta = np.diff(rtd.edges) / rtd.t_mean
+    assert float(np.sum(rtd.E_theta * dtheta)) == pytest.approx(1.0, rel=1e-13)
+    np.testing.assert_allclose(rtd.theta, rtd.time / rtd.t_mean)
+    # the mid-quantile sample has mean and variance close to tau and tau^2
+    assert rtd.t_mean == pytest.approx(tau, rel=1e-3)
+    assert rtd.variance == pytest.approx(tau**2, rel=2e-2)
+    assert rtd.sigma_theta2 == pytest.approx(1.0, rel=2e-2)
+
+
+def test_exponential_sample_histogram_matches_bin_averaged_exponential():
+    tau = 1.5
+    n = 50_000
+    rtd = rtd_from_exit_times(exponential_quantiles(n, tau), bins=np.arange(0.0, 25.0, 0.25))
+    a, b = rtd.edges[:-1], rtd.edges[1:]
+    exact = (np.exp(-a / tau) - np.exp(-b / tau)) / (b - a)
+    expected_counts = n * exact * (b - a)
+    big = expected_counts >= 1000
+    assert big.sum() >= 5
+    # deterministic quantiles: each bin holds its expected count to within one tracer
+    np.testing.assert_allclose(rtd.E[big], exact[big], rtol=1.0 / 1000 + 1e-12)
+    # and the bin averages approach the curve at the bin centres
+    np.testing.assert_allclose(rtd.E[big], perfect_mixer_rtd(rtd.time[big], tau), rtol=5e-3)
+
+
+def test_tracers_that_did_not_leave_reduce_the_area():
+    exits = np.array([1.0, 2.0, np.nan, 3.0])
+    rtd = rtd_from_exit_times(exits, bins=3)
+    assert rtd.n_exited == 3 and rtd.n_total == 4
+    assert float(np.sum(rtd.E * rtd.widths)) == pytest.approx(0.75)
+    assert rtd.t_mean == 2.0
+    rtd = rtd_from_exit_times([1.0, 2.0, 3.0], n_total=10, bins=3)
+    assert rtd.fraction_exited == 0.3
+    assert float(np.sum(rtd.E * rtd.widths)) == pytest.approx(0.3)
+
+
+def test_per_tracer_entry_times():
+    entries = np.array([0.0, 1.0, 2.0])
+    exits = entries + np.array([5.0, 6.0, 7.0])
+    rtd = rtd_from_exit_times(exits, t_entry=entries, bins=7)
+    assert rtd.t_mean == 6.0 and rtd.t_first == 5.0 and rtd.t_last == 7.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(exit_times=[1.0, -1.0]), "t_entry"),
+        (dict(exit_times=[1.0, np.inf]), "exit_times"),
+        (dict(exit_times=[np.nan, np.nan]), "exit_times"),
+        (dict(exit_times=[]), "exit_times"),
+        (dict(exit_times=[[1.0]]), "exit_times"),
+        (dict(exit_times=[1.0, 2.0], t_entry=[0.0]), "t_entry"),
+        (dict(exit_times=[1.0, 2.0], bins=0), "bins"),
+        (dict(exit_times=[1.0, 2.0], bins="auto"), "bins"),
+        (dict(exit_times=[1.0, 2.0], bins=[0.0, 1.5]), "bins"),
+        (dict(exit_times=[1.0, 2.0], bins=[0.0, 3.0, 2.0]), "bins"),
+        (dict(exit_times=[1.0, 2.0], n_total=1), "n_total"),
+        (dict(exit_times=[1.0, 2.0], n_total=2.5), "n_total"),
+        (dict(exit_times=[0.0, 0.0]), "bins"),
+    ],
+)
+def test_rtd_from_exit_times_rejects_bad_input(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        rtd_from_exit_times(**kwargs)
+
+
+# --------------------------------------------------------------------------- moments of curves
+
+
+def test_rtd_moments_trapezoid_by_hand():
+    moments = rtd_moments([0.0, 1.0, 2.0], [0.0, 2.0, 0.0])
+    assert isinstance(moments, RTDMoments)
+    # area 2; mean (0 + 2 + 0) / 2 = 1; variance trapz((t-1)^2 E) / area = (0 + 0 + 0) / 2
+    assert moments.area == 2.0 and moments.mean == 1.0 and moments.variance == 0.0
+
+
+def test_rtd_moments_of_a_finely_sampled_perfect_mixer():
+    tau = 0.7
+    t = np.linspace(0.0, 40 * tau, 400_001)
+    moments = rtd_moments(t, perfect_mixer_rtd(t, tau))
+    assert moments.area == pytest.approx(1.0, rel=1e-8)
+    assert moments.mean == pytest.approx(tau, rel=1e-8)
+    assert moments.variance == pytest.approx(tau**2, rel=1e-7)
+    assert moments.sigma_theta2 == pytest.approx(1.0, rel=1e-7)
+
+
+def test_rtd_moments_rejects_bad_input():
+    with pytest.raises(ValueError, match="E"):
+        rtd_moments([0.0, 1.0], [1.0])
+    with pytest.raises(ValueError, match="time"):
+        rtd_moments([1.0, 0.0], [1.0, 1.0])
+    with pytest.raises(ValueError, match="E"):
+        rtd_moments([0.0, 1.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="time"):
+        rtd_moments([0.0, np.nan], [1.0, 1.0])
+
+
+# --------------------------------------------------------------------------- models
+
+
+def test_perfect_mixer_values():
+    t = np.array([-1.0, 0.0, 2.0])
+    np.testing.assert_allclose(perfect_mixer_rtd(t, 2.0), [0.0, 0.5, 0.5 * math.exp(-1.0)], rtol=1e-15)
+    with pytest.raises(ValueError, match="tau"):
+        perfect_mixer_rtd(t, 0.0)
+
+
+def test_plug_flow_pulse_is_normalised_and_centred():
+    dt = 0.01
+    t = np.arange(0, 1001) * dt
+    pulse = plug_flow_rtd(t, tau=4.0)  # width = dt
+    assert float(np.sum(pulse) * dt) == pytest.approx(1.0, abs=1e-8)
+    assert float(np.sum(t * pulse) * dt) == pytest.approx(4.0, rel=1e-8)
+    assert float(np.argmax(pulse)) == 400
+    wide = plug_flow_rtd(t, tau=4.0, width=0.05)
+    assert float(np.sum(wide) * dt) == pytest.approx(1.0, abs=1e-12)
+    assert rtd_moments(t, wide).variance == pytest.approx(0.05**2, rel=1e-6)
+    with pytest.raises(ValueError, match="width"):
+        plug_flow_rtd(t, 4.0, width=-1.0)
+    with pytest.raises(ValueError, match="width"):
+        plug_flow_rtd([1.0], 4.0)
+
+
+@pytest.mark.parametrize("v1, p", [(0.5, 1.0), (0.2, 0.6), (0.0, 0.0), (0.4, 1.3), (0.9, 0.95)])
+def test_johanson_triangle_has_unit_area_mean_tau_and_triangle_variance(v1, p):
+    tau = 2.75
+    t = np.linspace(0.0, 4.0 * tau, 440_001)
+    e = johanson_rtd(t, tau, v1, p)
+    end = 3.0 - v1 - p
+    moments = rtd_moments(t, e)
+    # (the trapezoid rule smears a jump at P = V1 or P = end over one step)
+    assert moments.area == pytest.approx(1.0, rel=5e-5)
+    assert moments.mean == pytest.approx(tau, rel=5e-5)
+    a, b, c = v1, end, p
+    variance = tau**2 * (a * a + b * b + c * c - a * b - a * c - b * c) / 18.0
+    assert moments.variance == pytest.approx(variance, rel=2e-4)
+    assert np.all(e[t < v1 * tau] == 0.0) and np.all(e[t > end * tau] == 0.0)
+    # peak at P: the largest sample sits at theta = P
+    assert t[np.argmax(e)] / tau == pytest.approx(p, abs=1e-4)
+
+
+def test_johanson_symmetric_case_by_hand():
+    # V1 = 0.5, P = 1: triangle from 0.5 to 1.5 with peak 2 at theta = 1 (tau = 1)
+    e = johanson_rtd([0.5, 0.75, 1.0, 1.25, 1.5], 1.0, 0.5, 1.0)
+    np.testing.assert_allclose(e, [0.0, 1.0, 2.0, 1.0, 0.0], atol=1e-15)
+
+
+@pytest.mark.parametrize("v1, p, match", [(1.0, 1.0, "V1"), (-0.1, 0.5, "V1"), (0.5, 0.4, "P"), (0.2, 1.5, "P")])
+def test_johanson_rejects_bad_parameters(v1, p, match):
+    with pytest.raises(ValueError, match=match):
+        johanson_rtd([0.0, 1.0], 1.0, v1, p)
+
+
+def test_carson_royal_delay_passes_shift_exactly():
+    dt = 0.125
+    t = np.arange(40) * dt
+    delay = np.zeros(40)
+    delay[3] = 1.0 / dt  # plug flow of 3 dt
+    rows = carson_royal_recycle(delay, t, passes=4)
+    assert rows.shape == (4, 40)
+    for n in range(4):
+        expected = np.zeros(40)
+        expected[3 * (n + 1)] = 1.0 / dt
+        np.testing.assert_array_equal(rows[n], expected)
+
+
+def test_carson_royal_perfect_mixer_gives_erlang_curves():
+    tau = 1.0
+    dt = 1e-3
+    t = np.arange(0, 40001) * dt
+    e1 = perfect_mixer_rtd(t, tau)
+    rows = carson_royal_recycle(e1, t, passes=4)
+    area = float(np.sum(e1) * dt)
+    for n in range(1, 5):
+        # the rectangle rule (first order) shifts the n-th pass by (n - 1) dt and scales by O(dt)
+        shifted = t + (n - 1) * dt
+        erlang = shifted ** (n - 1) * np.exp(-shifted / tau) / (tau**n * math.factorial(n - 1))
+        np.testing.assert_allclose(rows[n - 1], erlang, atol=2.5e-3 * erlang.max())
+        # discrete convolution multiplies the areas; the axis holds the whole curve
+        assert float(np.sum(rows[n - 1]) * dt) == pytest.approx(area**n, rel=1e-9)
+    total = rows.sum(axis=0)
+    assert total[-1] < 1e-9
+
+
+def test_carson_royal_rejects_bad_input():
+    t = np.arange(5) * 0.1
+    with pytest.raises(ValueError, match="passes"):
+        carson_royal_recycle(np.ones(5), t, 0)
+    with pytest.raises(ValueError, match="time"):
+        carson_royal_recycle(np.ones(5), t + 0.05, 2)
+    with pytest.raises(ValueError, match="first_pass_E"):
+        carson_royal_recycle(np.ones(4), t, 2)
+    with pytest.raises(ValueError, match="time"):
+        carson_royal_recycle(np.ones(5), [0.0, 0.1, 0.3, 0.4, 0.5], 2)
