@@ -320,26 +320,28 @@ def interpolate_velocity(points, t: float, velocities, times, origin, spacing) -
 if HAVE_NUMBA:
 
     @numba.njit(cache=True, nogil=True, inline="always")
-    def _blend(f, k, c, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz):  # pragma: no cover
-        """Trilinear blend of component c of time level k of f (nx, ny, nz, n_times, 3)."""
-        c00 = f[x0, y0, z0, k, c] * gx + f[x1, y0, z0, k, c] * fx
-        c10 = f[x0, y1, z0, k, c] * gx + f[x1, y1, z0, k, c] * fx
-        c01 = f[x0, y0, z1, k, c] * gx + f[x1, y0, z1, k, c] * fx
-        c11 = f[x0, y1, z1, k, c] * gx + f[x1, y1, z1, k, c] * fx
+    def _blend(f, b, sx, sy, sz, fx, fy, fz, gx, gy, gz):  # pragma: no cover
+        """Trilinear blend of the 8 values ``f[b + {0, sx} + {0, sy} + {0, sz}]`` (flat field, node strides)."""
+        c00 = f[b] * gx + f[b + sx] * fx
+        c10 = f[b + sy] * gx + f[b + sx + sy] * fx
+        c01 = f[b + sz] * gx + f[b + sx + sz] * fx
+        c11 = f[b + sy + sz] * gx + f[b + sx + sy + sz] * fx
         c0 = c00 * gy + c10 * fy
         c1 = c01 * gy + c11 * fy
         return c0 * gz + c1 * fz
 
     @numba.njit(cache=True, nogil=True, inline="always")
-    def _sample(f, k, w, ox, oy, oz, ix, iy, iz, x, y, z):  # pragma: no cover
+    def _sample(f, shape, k, w, ox, oy, oz, ix, iy, iz, x, y, z):  # pragma: no cover
         """Velocity at (x, y, z) for time level k with weight w (same operations as :func:`_interpolate_numpy`).
 
-        ``f`` has the time axis next to the components, shape (nx, ny, nz, n_times, 3), so that the
-        two time levels of a node are adjacent in memory.
+        ``f`` is the flattened field of shape (nx, ny, nz, n_times, 3): the time axis sits next to the
+        components so that both time levels of a node share cache lines. Offsets are unsigned, so
+        the compiled code does no negative-index wraparound.
         """
-        nx = f.shape[0]
-        ny = f.shape[1]
-        nz = f.shape[2]
+        nx = shape[0]
+        ny = shape[1]
+        nz = shape[2]
+        nt = shape[3]
         sx = min(max((x - ox) * ix - 0.5, 0.0), nx - 1.0)
         sy = min(max((y - oy) * iy - 0.5, 0.0), ny - 1.0)
         sz = min(max((z - oz) * iz - 0.5, 0.0), nz - 1.0)
@@ -349,44 +351,87 @@ if HAVE_NUMBA:
         fx = sx - x0
         fy = sy - y0
         fz = sz - z0
-        x1 = min(x0 + 1, nx - 1)
-        y1 = min(y0 + 1, ny - 1)
-        z1 = min(z0 + 1, nz - 1)
         gx = 1.0 - fx
         gy = 1.0 - fy
         gz = 1.0 - fz
-        ux = _blend(f, k, 0, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz)
-        uy = _blend(f, k, 1, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz)
-        uz = _blend(f, k, 2, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz)
+        step_z = np.uint64(3 * nt)
+        step_y = np.uint64(nz) * step_z
+        step_x = np.uint64(ny) * step_y
+        dx = step_x if nx > 1 else np.uint64(0)
+        dy = step_y if ny > 1 else np.uint64(0)
+        dz = step_z if nz > 1 else np.uint64(0)
+        b = np.uint64(x0) * step_x + np.uint64(y0) * step_y + np.uint64(z0) * step_z + np.uint64(3 * k)
+        ux = _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz)
+        uy = _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz)
+        uz = _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz)
         if w != 0.0:
             rest = 1.0 - w
-            ux = ux * rest + _blend(f, k + 1, 0, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz) * w
-            uy = uy * rest + _blend(f, k + 1, 1, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz) * w
-            uz = uz * rest + _blend(f, k + 1, 2, x0, x1, y0, y1, z0, z1, fx, fy, fz, gx, gy, gz) * w
+            b += np.uint64(3)
+            ux = ux * rest + _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
+            uy = uy * rest + _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
+            uz = uz * rest + _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
         return ux, uy, uz
+
+    _LANES = 8
+    """Tracers advanced in lockstep by the compiled loop (independent work for the CPU to overlap)."""
 
     @numba.njit(cache=True, nogil=True)
     def _integrate_compiled(
         seeds, v, origin, inv_spacing, k_steps, w_steps, dt, outlet_z, euler, record_every,
         active, history, residence, exit_position, status, n_steps,
     ):  # pragma: no cover
-        """Compiled integration loop; see :func:`integrate_pathlines`. ``v`` is (nx, ny, nz, n_times, 3); outputs are filled in place."""
+        """Compiled integration loop; see :func:`integrate_pathlines`. Outputs are filled in place.
+
+        ``v`` has shape (nx, ny, nz, n_times, 3). A step of one tracer depends on its previous step,
+        so a single tracer leaves the CPU waiting on memory and arithmetic latency; ``_LANES``
+        tracers are therefore advanced one step each in turn, and a lane whose tracer has finished
+        takes the next tracer. Every tracer goes through exactly the same operations as alone.
+        """
         ox, oy, oz = origin[0], origin[1], origin[2]
         ix, iy, iz = inv_spacing[0], inv_spacing[1], inv_spacing[2]
+        shape = v.shape
+        flat = v.ravel()
         total_steps = k_steps.size - 1
-        for p in range(seeds.shape[0]):
-            if not active[p]:
-                continue
-            x = seeds[p, 0]
-            y = seeds[p, 1]
-            z = seeds[p, 2]
-            if record_every > 0:
-                history[0, p, 0] = x
-                history[0, p, 1] = y
-                history[0, p, 2] = z
-            done = False
-            for n in range(total_steps):
-                ux, uy, uz = _sample(v, k_steps[n], w_steps[n], ox, oy, oz, ix, iy, iz, x, y, z)
+        n_seeds = seeds.shape[0]
+        lane_p = np.full(_LANES, -1, dtype=np.int64)
+        lane_n = np.zeros(_LANES, dtype=np.int64)
+        lane_x = np.zeros(_LANES)
+        lane_y = np.zeros(_LANES)
+        lane_z = np.zeros(_LANES)
+        following = 0
+        busy = 0
+        while True:
+            # fill idle lanes with the next active seeds
+            for lane in range(_LANES):
+                if lane_p[lane] >= 0:
+                    continue
+                while following < n_seeds and not active[following]:
+                    following += 1
+                if following >= n_seeds:
+                    continue
+                p = following
+                following += 1
+                lane_p[lane] = p
+                lane_n[lane] = 0
+                lane_x[lane] = seeds[p, 0]
+                lane_y[lane] = seeds[p, 1]
+                lane_z[lane] = seeds[p, 2]
+                busy += 1
+                if record_every > 0:
+                    history[0, p, 0] = seeds[p, 0]
+                    history[0, p, 1] = seeds[p, 1]
+                    history[0, p, 2] = seeds[p, 2]
+            if busy == 0:
+                break
+            for lane in range(_LANES):
+                p = lane_p[lane]
+                if p < 0:
+                    continue
+                n = lane_n[lane]
+                x = lane_x[lane]
+                y = lane_y[lane]
+                z = lane_z[lane]
+                ux, uy, uz = _sample(flat, shape, k_steps[n], w_steps[n], ox, oy, oz, ix, iy, iz, x, y, z)
                 if euler:
                     xn = x + dt * ux
                     yn = y + dt * uy
@@ -395,7 +440,7 @@ if HAVE_NUMBA:
                     px = x + dt * ux
                     py = y + dt * uy
                     pz = z + dt * uz
-                    vx, vy, vz = _sample(v, k_steps[n + 1], w_steps[n + 1], ox, oy, oz, ix, iy, iz, px, py, pz)
+                    vx, vy, vz = _sample(flat, shape, k_steps[n + 1], w_steps[n + 1], ox, oy, oz, ix, iy, iz, px, py, pz)
                     xn = x + 0.5 * dt * (ux + vx)
                     yn = y + 0.5 * dt * (uy + vy)
                     zn = z + 0.5 * dt * (uz + vz)
@@ -407,19 +452,24 @@ if HAVE_NUMBA:
                     exit_position[p, 2] = outlet_z
                     status[p] = 0
                     n_steps[p] = n + 1
-                    done = True
-                    break
-                x = xn
-                y = yn
-                z = zn
-                if record_every > 0 and (n + 1) % record_every == 0:
-                    row = (n + 1) // record_every
-                    history[row, p, 0] = x
-                    history[row, p, 1] = y
-                    history[row, p, 2] = z
-            if not done:
-                status[p] = 1
-                n_steps[p] = total_steps
+                    lane_p[lane] = -1
+                    busy -= 1
+                    continue
+                n += 1
+                lane_n[lane] = n
+                lane_x[lane] = xn
+                lane_y[lane] = yn
+                lane_z[lane] = zn
+                if record_every > 0 and n % record_every == 0:
+                    row = n // record_every
+                    history[row, p, 0] = xn
+                    history[row, p, 1] = yn
+                    history[row, p, 2] = zn
+                if n == total_steps:
+                    status[p] = 1
+                    n_steps[p] = total_steps
+                    lane_p[lane] = -1
+                    busy -= 1
 
 
 def _integrate_numpy(
