@@ -61,14 +61,16 @@ def test_uniform_downward_field_gives_exact_residence_time(backend, method):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("method", METHODS)
-def test_linear_shear_gives_exact_residence_time(backend, method):
+@pytest.mark.parametrize("shape", [SHAPE, (6, 1, 12)])  # also a one-cell-thick (planar) grid
+def test_linear_shear_gives_exact_residence_time(backend, method, shape):
     v0, a = 0.2, 0.5  # v_z = -(v0 + a x): 0.05 m/s at x = -0.3, 0.35 m/s at x = 0.3
-    x, y, z = np.meshgrid(*node_axes(), indexing="ij")
-    field = np.zeros(SHAPE + (3,))
+    spacing = (SPACING[0], 0.4 / shape[1], SPACING[2])
+    x, y, z = np.meshgrid(*node_axes(shape, ORIGIN, spacing), indexing="ij")
+    field = np.zeros(shape + (3,))
     field[..., 2] = -v0 - a * x
-    # seeds within the hull of the nodes (x from -0.25 to 0.25), where trilinear interpolation is exact
+    # seeds within the hull of the nodes in x (-0.25 to 0.25), where trilinear interpolation is exact
     seeds = lattice_seeds((-0.25, 0.04, 0.3), (0.25, 0.36, 0.5), count=(6, 3, 3))
-    result = integrate_pathlines(seeds, 0.0, field[None], [0.0], ORIGIN, SPACING, dt=0.01, outlet_z=0.0,
+    result = integrate_pathlines(seeds, 0.0, field[None], [0.0], ORIGIN, spacing, dt=0.01, outlet_z=0.0,
                                  max_time=20.0, method=method, backend=backend)
     expected = seeds[:, 2] / (v0 + a * seeds[:, 0])
     np.testing.assert_allclose(result.residence_time, expected, rtol=1e-12, atol=0)
@@ -194,7 +196,8 @@ def test_backends_and_the_scipy_peer_agree(method):
     seeds = lattice_seeds((-0.4, 0.01, 0.35), (0.4, 0.39, 0.59), count=(9, 4, 3))  # x = +-0.356 outside the box
     kwargs = dict(velocities=series, times=times, origin=ORIGIN, spacing=SPACING, dt=0.01, outlet_z=0.0,
                   max_time=6.0, method=method)
-    results = {backend: integrate_pathlines(seeds, 0.1, **kwargs, backend=backend) for backend in BACKENDS}
+    results = {backend: integrate_pathlines(seeds, 0.1, **kwargs, backend=backend, record_every=7)
+               for backend in BACKENDS}
     reference = results["numpy"]
     assert np.any(reference.status == OUTSIDE) and np.any(reference.status == EXITED)
     for result in results.values():
@@ -203,6 +206,8 @@ def test_backends_and_the_scipy_peer_agree(method):
         np.testing.assert_allclose(result.residence_time, reference.residence_time, rtol=1e-12, equal_nan=True)
         np.testing.assert_allclose(result.exit_position, reference.exit_position, rtol=1e-12, atol=1e-14,
                                    equal_nan=True)
+        np.testing.assert_allclose(result.history, reference.history, rtol=1e-12, atol=1e-14, equal_nan=True)
+        np.testing.assert_array_equal(result.history_time, reference.history_time)
     residence, status, steps = integrate_with_scipy(seeds, 0.1, **kwargs)
     np.testing.assert_array_equal(status, reference.status)
     assert steps == reference.tracer_steps
