@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -19,3 +21,19 @@ def finite_array(name: str, values, ndim: int | None = 1) -> np.ndarray:
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must contain only finite numbers")
     return array
+
+
+def positive_number(name: str, value) -> float:
+    """``value`` as a float that is finite and > 0; a ValueError names ``name`` otherwise."""
+    value = float(value)
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def non_negative_number(name: str, value) -> float:
+    """``value`` as a float that is finite and >= 0; a ValueError names ``name`` otherwise."""
+    value = float(value)
+    if not math.isfinite(value) or value < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return value

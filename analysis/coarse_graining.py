@@ -89,7 +89,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, positive_number
 
 try:  # pragma: no cover - exercised through both branches in the tests when numba is present
     import numba
@@ -136,11 +136,6 @@ _REL_TILE_TOLERANCE = 1.0e-9
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def _triple(name: str, values, positive: bool) -> tuple[float, float, float]:
@@ -465,7 +460,7 @@ def default_width(particle_radius: float, radii: float = 3.0) -> float:
     float
         Standard deviation w of the Gaussian kernel [m].
     """
-    return _positive("particle_radius", particle_radius) * _positive("radii", radii)
+    return positive_number("particle_radius", particle_radius) * positive_number("radii", radii)
 
 
 def kernel_support_radius(width: float, cutoff: float = DEFAULT_CUTOFF, kernel: str = "gaussian") -> float:
@@ -480,19 +475,19 @@ def kernel_support_radius(width: float, cutoff: float = DEFAULT_CUTOFF, kernel: 
     kernel : {"gaussian", "gaussian_shifted", "lucy"}
         Kernel name.
     """
-    width = _positive("width", width)
+    width = positive_number("width", width)
     kernel = _kernel_name(kernel)
     if kernel == "lucy":
         return _LUCY_SUPPORT_PER_WIDTH * width
-    return _positive("cutoff", cutoff) * width
+    return positive_number("cutoff", cutoff) * width
 
 
 def kernel_shift(width: float, cutoff: float = DEFAULT_CUTOFF, kernel: str = "gaussian") -> float:
     """Constant subtracted from the unit-peak Gaussian: ``exp(-cutoff^2 / 2)`` for ``"gaussian_shifted"``, else 0."""
-    _positive("width", width)
+    positive_number("width", width)
     kernel = _kernel_name(kernel)
     if kernel == "gaussian_shifted":
-        return math.exp(-0.5 * _positive("cutoff", cutoff) ** 2)
+        return math.exp(-0.5 * positive_number("cutoff", cutoff) ** 2)
     return 0.0
 
 
@@ -729,7 +724,7 @@ def deposit(
             f"values must have one row per position: {values.shape[0]} rows for {positions.shape[0]} positions"
         )
     kernel = _kernel_name(kernel)
-    width = _positive("width", width)
+    width = positive_number("width", width)
     radius = kernel_support_radius(width, cutoff, kernel)
     backend = _backend_name(backend)
 

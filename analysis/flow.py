@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, non_negative_number, positive_number
 
 __all__ = [
     "BulkDensity",
@@ -104,18 +104,8 @@ class FlowRateFit:
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
-def _non_negative(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value < 0.0:
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-    return value
 
 
 def _per_particle(name: str, values, n: int) -> np.ndarray:
@@ -174,13 +164,13 @@ def beverloo_mass_flow_rate(
         If an argument is not a finite positive number (k may be 0), or if the
         effective outlet width ``B0 - k d`` is not positive.
     """
-    bulk_density = _positive("bulk_density", bulk_density)
-    outlet_width = _positive("outlet_width", outlet_width)
-    outlet_length = _positive("outlet_length", outlet_length)
-    particle_diameter = _positive("particle_diameter", particle_diameter)
-    discharge_coefficient = _positive("discharge_coefficient", discharge_coefficient)
-    shape_coefficient = _non_negative("shape_coefficient", shape_coefficient)
-    gravity = _positive("gravity", gravity)
+    bulk_density = positive_number("bulk_density", bulk_density)
+    outlet_width = positive_number("outlet_width", outlet_width)
+    outlet_length = positive_number("outlet_length", outlet_length)
+    particle_diameter = positive_number("particle_diameter", particle_diameter)
+    discharge_coefficient = positive_number("discharge_coefficient", discharge_coefficient)
+    shape_coefficient = non_negative_number("shape_coefficient", shape_coefficient)
+    gravity = positive_number("gravity", gravity)
 
     effective_width = outlet_width - shape_coefficient * particle_diameter
     if effective_width <= 0.0:
@@ -215,7 +205,7 @@ def volumetric_flow_rate(mass_flow_rate: float, bulk_density: float) -> float:
     mass_flow_rate = float(mass_flow_rate)
     if not math.isfinite(mass_flow_rate):
         raise ValueError(f"mass_flow_rate must be finite, got {mass_flow_rate!r}")
-    bulk_density = _positive("bulk_density", bulk_density)
+    bulk_density = positive_number("bulk_density", bulk_density)
     return mass_flow_rate / bulk_density
 
 
@@ -251,7 +241,7 @@ def column_surface_heights(x, z, radius, width: float, n_columns: int) -> np.nda
     if x.shape != z.shape:
         raise ValueError(f"x and z must have the same shape, got {x.shape} and {z.shape}")
     radius = _per_particle("radius", radius, x.size)
-    width = _positive("width", width)
+    width = positive_number("width", width)
     if isinstance(n_columns, bool) or int(n_columns) != n_columns or n_columns < 1:
         raise ValueError(f"n_columns must be an integer >= 1, got {n_columns!r}")
     n_columns = int(n_columns)
@@ -333,9 +323,9 @@ def filling_bulk_density(
         raise ValueError(f"clump_position must have shape (n, 3) with n >= 1, got {positions.shape}")
     n_clumps = positions.shape[0]
     masses = _per_particle("clump_mass", clump_mass, n_clumps)
-    width = _positive("width", width)
-    depth = _positive("depth", depth)
-    surface_margin = _non_negative("surface_margin", surface_margin)
+    width = positive_number("width", width)
+    depth = positive_number("depth", depth)
+    surface_margin = non_negative_number("surface_margin", surface_margin)
     if n_columns is None:
         n_columns = 10
     if radius is None:

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, positive_number
 
 __all__ = [
     "VRRTable",
@@ -143,11 +143,6 @@ class Recirculation:
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def _finite(name: str, value: float) -> float:
@@ -272,7 +267,7 @@ def sine_input(time, mean: float, amplitude: float, period: float, phase: float 
     amplitude = _finite("amplitude", amplitude)
     if amplitude < 0.0:
         raise ValueError(f"amplitude must be >= 0, got {amplitude!r}")
-    period = _positive("period", period)
+    period = positive_number("period", period)
     phase = _finite("phase", phase)
     return mean + amplitude * np.sin(2.0 * np.pi * t / period + phase)
 
@@ -309,7 +304,7 @@ def square_input(time, mean: float, amplitude: float, period: float, duty: float
     amplitude = _finite("amplitude", amplitude)
     if amplitude < 0.0:
         raise ValueError(f"amplitude must be >= 0, got {amplitude!r}")
-    period = _positive("period", period)
+    period = positive_number("period", period)
     duty = float(duty)
     if not math.isfinite(duty) or not 0.0 < duty < 1.0:
         raise ValueError(f"duty must be a number in (0, 1), got {duty!r}")
@@ -452,7 +447,7 @@ def vrr_versus_period(
         if not area > 0.0:
             raise ValueError("E must have a positive area to be normalised")
         e = e / area
-    tm = rtd_moments(t, e).mean if t_mean is None else _positive("t_mean", t_mean)
+    tm = rtd_moments(t, e).mean if t_mean is None else positive_number("t_mean", t_mean)
     periods = fractions * tm
     vrr = np.empty(fractions.size)
     memory = e.size - 1
@@ -588,8 +583,8 @@ def recirculations_to_homogenise(c, mean=None, tolerance: float = 0.10, per_pass
     target = float(np.mean(values)) if mean is None else _finite("mean", mean)
     if target == 0.0:
         raise ValueError("mean must be non-zero (the band is relative to it)")
-    tolerance = _positive("tolerance", tolerance)
-    per_pass_length = _positive("per_pass_length", per_pass_length)
+    tolerance = positive_number("tolerance", tolerance)
+    per_pass_length = positive_number("per_pass_length", per_pass_length)
     outside = np.abs(values - target) > tolerance * abs(target)
     if outside[-1]:
         return math.nan

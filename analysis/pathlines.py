@@ -59,7 +59,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, positive_number
 
 try:  # pragma: no cover - exercised through both branches in the tests when numba is present
     import numba
@@ -163,11 +163,6 @@ class PathlineResult:
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def _finite(name: str, value: float) -> float:
@@ -580,9 +575,9 @@ def integrate_pathlines(
     origin = _triple("origin", origin, positive=False)
     spacing = _triple("spacing", spacing, positive=True)
     t0 = _finite("t0", t0)
-    dt = _positive("dt", dt)
+    dt = positive_number("dt", dt)
     outlet_z = _finite("outlet_z", outlet_z)
-    max_time = _positive("max_time", max_time)
+    max_time = positive_number("max_time", max_time)
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if isinstance(record_every, (bool, np.bool_)) or int(record_every) != record_every or record_every < 0:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, non_negative_number, positive_number
 from analysis.coarse_graining import Fields
 
 __all__ = [
@@ -39,18 +39,8 @@ __all__ = [
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
-def _non_negative(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value < 0.0:
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-    return value
 
 
 def _profile(x, v, v_name: str = "v_z", min_points: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -343,8 +333,8 @@ def kinematic_velocity(x, z: float, A: float, B: float) -> np.ndarray:
         Kinematic constant [m], > 0.
     """
     x = np.asarray(x, dtype=float)
-    z = _positive("z", z)
-    B = _positive("B", B)
+    z = positive_number("z", z)
+    B = positive_number("B", B)
     return float(A) * np.exp(-(x**2) / (4.0 * B * z))
 
 
@@ -385,8 +375,8 @@ def fit_kinematic_constant(x, v_z, z: float, kernel_width: float = 0.0) -> Kinem
     from scipy.optimize import curve_fit
 
     x, v = _profile(x, v_z, min_points=3)
-    z = _positive("z", z)
-    kernel_width = _non_negative("kernel_width", kernel_width)
+    z = positive_number("z", z)
+    kernel_width = non_negative_number("kernel_width", kernel_width)
     speed = np.abs(v)
     if not np.any(speed > 0.0):
         raise ValueError("v_z is zero everywhere; nothing to fit")
@@ -452,7 +442,7 @@ def kinematic_horizontal_velocity(x, v_z, B: float) -> np.ndarray:
         and one-sided first-order differences at the two end nodes.
     """
     x, v = _profile(x, v_z)
-    B = _positive("B", B)
+    B = positive_number("B", B)
     return -B * np.gradient(v, x, edge_order=1)
 
 
@@ -487,8 +477,8 @@ def profile_flow_rate(x, v_z, bulk_density: float, depth: float, bounds: tuple[f
         Mass flow rate [kg/s], positive for net downward flow.
     """
     x, v = _profile(x, v_z, min_points=1 if bounds is not None else 2)
-    bulk_density = _positive("bulk_density", bulk_density)
-    depth = _positive("depth", depth)
+    bulk_density = positive_number("bulk_density", bulk_density)
+    depth = positive_number("depth", depth)
     if bounds is not None:
         try:
             left, right = (float(b) for b in bounds)
@@ -525,10 +515,10 @@ def janssen_characteristic_depth(
 
     Infinite when both wall friction coefficients are 0 (no wall support: hydrostatic).
     """
-    width = _positive("width", width)
-    depth = _positive("depth", depth)
-    mu_side = _non_negative("wall_friction_side", wall_friction_side)
-    mu_front = _non_negative("wall_friction_front", wall_friction_front)
+    width = positive_number("width", width)
+    depth = positive_number("depth", depth)
+    mu_side = non_negative_number("wall_friction_side", wall_friction_side)
+    mu_front = non_negative_number("wall_friction_front", wall_friction_front)
     k = janssen_coefficient(internal_friction_angle_deg)
     support = 2.0 * k * (depth * mu_side + width * mu_front)
     return math.inf if support == 0.0 else width * depth / support
@@ -583,8 +573,8 @@ def janssen_vertical_stress(
     h = np.asarray(depth_below_surface, dtype=float)
     if not np.all(np.isfinite(h)) or np.any(h < 0.0):
         raise ValueError("depth_below_surface must contain finite numbers >= 0")
-    bulk_density = _positive("bulk_density", bulk_density)
-    gravity = _positive("gravity", gravity)
+    bulk_density = positive_number("bulk_density", bulk_density)
+    gravity = positive_number("gravity", gravity)
     z_c = janssen_characteristic_depth(width, depth, wall_friction_side, wall_friction_front, internal_friction_angle_deg)
     gamma = bulk_density * gravity
     stress = gamma * h if math.isinf(z_c) else gamma * z_c * -np.expm1(-h / z_c)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from analysis.checks import finite_array, positive_number
 
 __all__ = [
     "RTD",
@@ -141,11 +141,6 @@ class RTDMoments:
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
@@ -319,7 +314,7 @@ def perfect_mixer_rtd(t, tau: float) -> np.ndarray:
     numpy.ndarray
         ``E(t)`` [1/s], the shape of ``t``.
     """
-    tau = _positive("tau", tau)
+    tau = positive_number("tau", tau)
     t = finite_array("t", t, ndim=None)
     return np.where(t >= 0.0, np.exp(-np.maximum(t, 0.0) / tau) / tau, 0.0)
 
@@ -349,7 +344,7 @@ def plug_flow_rtd(t, tau: float, width: float | None = None) -> np.ndarray:
     numpy.ndarray
         ``E(t)`` [1/s], the shape of ``t``.
     """
-    tau = _positive("tau", tau)
+    tau = positive_number("tau", tau)
     t = finite_array("t", t, ndim=None)
     if width is None:
         flat = np.sort(t.ravel())
@@ -358,7 +353,7 @@ def plug_flow_rtd(t, tau: float, width: float | None = None) -> np.ndarray:
         if steps.size == 0:
             raise ValueError("width: give it explicitly when t has fewer than 2 distinct samples")
         width = float(steps.min())
-    width = _positive("width", width)
+    width = positive_number("width", width)
     return np.exp(-0.5 * ((t - tau) / width) ** 2) / (math.sqrt(2.0 * math.pi) * width)
 
 
@@ -399,7 +394,7 @@ def johanson_rtd(t, tau: float, V1: float, P: float) -> np.ndarray:
         ``E(t)`` [1/s], the shape of ``t``; variance ``tau^2 (a^2 + b^2 + c^2 - ab - ac - bc) / 18``
         with ``a = V1, c = P, b = 3 - V1 - P``.
     """
-    tau = _positive("tau", tau)
+    tau = positive_number("tau", tau)
     t = finite_array("t", t, ndim=None)
     v1 = float(V1)
     p = float(P)
