@@ -251,12 +251,17 @@ def _mpi_environment() -> dict:
     return environment
 
 
-def set_aside_previous_attempt(run_dir: Path) -> Path | None:
+RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME)
+
+
+def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:
     """Move the output of an unfinished earlier attempt into ``failed_attempts/<UTC time>/``.
 
-    Nothing is deleted: the user may want to inspect a failed run. Returns the new location, if any.
+    Nothing is deleted: the user may want to inspect a failed run. ``outputs`` names the files and
+    folders a run writes. Returns the new location, if any.
     """
-    leftovers = [run_dir / name for name in ("dumps", LOG_NAME, SCREEN_NAME) if (run_dir / name).exists()]
+    run_dir = Path(run_dir)
+    leftovers = [run_dir / name for name in outputs if (run_dir / name).exists()]
     if not leftovers:
         return None
     stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())

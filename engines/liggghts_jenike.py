@@ -25,6 +25,7 @@ from engines.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, Conta
 from engines.liggghts import (
     DECK_NAME,
     DUMP_PREFIX,
+    RUN_OUTPUTS,
     RUN_RECORD,
     EngineRunError,
     _common_context,
@@ -314,18 +315,7 @@ def set_aside_previous_jenike_attempt(run_dir: str | Path) -> Path | None:
 
     Returns the new location, if anything was moved; nothing is deleted.
     """
-    run_dir = Path(run_dir)
-    forces = run_dir / FORCES_NAME
-    parked = None
-    if forces.exists():
-        # set_aside_previous_attempt moves the dumps folder as a whole: park the history inside it first.
-        (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
-        parked = run_dir / "dumps" / FORCES_NAME
-        forces.replace(parked)
-    target = set_aside_previous_attempt(run_dir)
-    if target is not None and parked is not None:
-        (target / "dumps" / FORCES_NAME).replace(target / FORCES_NAME)
-    return target
+    return set_aside_previous_attempt(Path(run_dir), RUN_OUTPUTS + (FORCES_NAME,))
 
 
 def run_jenike(
