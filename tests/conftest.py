@@ -47,6 +47,7 @@ def tiny_config(raw_default_config) -> dict:
 
 
 def require_liggghts():
-    """Skip (with the reason) only when the engine is not installed; `make test` installs it."""
+    """Fail loudly when the engine is missing: integration tests must run the real LIGGGHTS, never pass
+    without it. `make test` installs it (Debian package liggghts)."""
     if shutil.which("liggghts") is None:
-        pytest.skip("LIGGGHTS is not installed (run `make test`, which installs the Debian package)")
+        pytest.fail("LIGGGHTS is not installed: run `make test`, which installs the Debian package liggghts")
