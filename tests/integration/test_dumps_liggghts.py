@@ -8,7 +8,6 @@ in binary custom/vtk with the fields the project reads.
 from __future__ import annotations
 
 import math
-import shutil
 import subprocess
 
 import numpy as np
@@ -24,10 +23,9 @@ from analysis.dumps import (
     read_frames,
 )
 
-pytestmark = [
-    pytest.mark.integration,
-    pytest.mark.skipif(shutil.which("liggghts") is None, reason="the LIGGGHTS binary 'liggghts' is not on PATH"),
-]
+from tests.conftest import require_liggghts  # noqa: E402
+
+pytestmark = pytest.mark.integration
 
 TIMESTEP = 1e-5  # [s]
 N_STEPS = 2000
@@ -74,6 +72,7 @@ run {N_STEPS}
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
+    require_liggghts()
     """Folder of one finished LIGGGHTS run of the tiny deck."""
     run_dir = tmp_path_factory.mktemp("liggghts_dumps")
     (run_dir / "dumps").mkdir()
