@@ -37,3 +37,15 @@ def non_negative_number(name: str, value) -> float:
     if not math.isfinite(value) or value < 0.0:
         raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     return value
+
+
+def per_particle_values(name: str, values, n: int) -> np.ndarray:
+    """A scalar or length-n array (masses, radii) broadcast to length n, finite and >= 0."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim == 0:
+        array = np.full(n, float(array))
+    if array.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or np.any(array < 0.0):
+        raise ValueError(f"{name} must contain finite numbers >= 0")
+    return array

@@ -89,7 +89,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from analysis.checks import finite_array, per_particle_values, positive_number
 
 try:  # pragma: no cover - exercised through both branches in the tests when numba is present
     import numba
@@ -156,15 +156,6 @@ def _points(name: str, values) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def _per_particle(name: str, values, n: int) -> np.ndarray:
-    array = np.asarray(values, dtype=float)
-    if array.ndim == 0:
-        array = np.full(n, float(array))
-    if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array < 0.0):
-        raise ValueError(f"{name} must contain finite numbers >= 0")
-    return array
 
 
 def _kernel_name(kernel: str) -> str:
@@ -410,6 +401,20 @@ def _mask_and_velocity(density: np.ndarray, momentum: np.ndarray, threshold: flo
     return mask, velocity
 
 
+def _assemble_fields(grid, density, momentum, kinetic, threshold) -> Fields:
+    """Fields from density, momentum density and kinetic stress; velocity and mask derived here."""
+    mask, velocity = _mask_and_velocity(density, momentum, threshold)
+    return Fields(
+        grid=grid,
+        density=density,
+        momentum_density=momentum,
+        velocity=velocity,
+        kinetic_stress=kinetic,
+        mask=mask,
+        density_threshold=threshold,
+    )
+
+
 def _fields_from_sums(grid: Grid, sums: np.ndarray, threshold: float) -> Fields:
     """Fields from per-node sums of (m, m v, m v v) weights (shape (n_nodes, 10))."""
     volume = grid.cell_volume
@@ -426,16 +431,7 @@ def _fields_from_sums(grid: Grid, sums: np.ndarray, threshold: float) -> Fields:
     p = momentum[occupied]
     kinetic[occupied] -= p[:, :, None] * p[:, None, :] / density[occupied][:, None, None]
     kinetic[~occupied] = 0.0
-    mask, velocity = _mask_and_velocity(density, momentum, threshold)
-    return Fields(
-        grid=grid,
-        density=density,
-        momentum_density=momentum,
-        velocity=velocity,
-        kinetic_stress=kinetic,
-        mask=mask,
-        density_threshold=threshold,
-    )
+    return _assemble_fields(grid, density, momentum, kinetic, threshold)
 
 
 # Columns 4..9 of the deposited values: m vx vx, m vy vy, m vz vz, m vx vy, m vx vz, m vy vz.
@@ -804,7 +800,7 @@ def coarse_grain(
     """
     positions = _points("positions", positions)
     n = positions.shape[0]
-    masses = _per_particle("masses", masses, n)
+    masses = per_particle_values("masses", masses, n)
     velocities = finite_array("velocities", velocities, ndim=2)
     if velocities.shape != (n, 3):
         raise ValueError(f"velocities must have shape ({n}, 3), got {velocities.shape}")
@@ -943,16 +939,7 @@ def average_fields(fields: Sequence[Fields], density_threshold: float | None = N
     density = sum(item.density for item in fields) / count
     momentum = sum(item.momentum_density for item in fields) / count
     kinetic = sum(item.kinetic_stress for item in fields) / count
-    mask, velocity = _mask_and_velocity(density, momentum, threshold)
-    return Fields(
-        grid=grid,
-        density=density,
-        momentum_density=momentum,
-        velocity=velocity,
-        kinetic_stress=kinetic,
-        mask=mask,
-        density_threshold=threshold,
-    )
+    return _assemble_fields(grid, density, momentum, kinetic, threshold)
 
 
 def depth_average(fields: Fields) -> Fields:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, non_negative_number, positive_number
+from analysis.checks import finite_array, non_negative_number, per_particle_values, positive_number
 
 __all__ = [
     "BulkDensity",
@@ -108,16 +108,6 @@ class FlowRateFit:
 
 
 
-def _per_particle(name: str, values, n: int) -> np.ndarray:
-    """Broadcast a scalar or length-n array (e.g. masses, radii) to length n."""
-    array = np.asarray(values, dtype=float)
-    if array.ndim == 0:
-        array = np.full(n, float(array))
-    if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array < 0.0):
-        raise ValueError(f"{name} must contain finite numbers >= 0")
-    return array
 
 
 # --------------------------------------------------------------------------- Beverloo
@@ -240,7 +230,7 @@ def column_surface_heights(x, z, radius, width: float, n_columns: int) -> np.nda
     z = finite_array("z", z)
     if x.shape != z.shape:
         raise ValueError(f"x and z must have the same shape, got {x.shape} and {z.shape}")
-    radius = _per_particle("radius", radius, x.size)
+    radius = per_particle_values("radius", radius, x.size)
     width = positive_number("width", width)
     if isinstance(n_columns, bool) or int(n_columns) != n_columns or n_columns < 1:
         raise ValueError(f"n_columns must be an integer >= 1, got {n_columns!r}")
@@ -322,7 +312,7 @@ def filling_bulk_density(
     if positions.shape[1] != 3 or positions.shape[0] == 0:
         raise ValueError(f"clump_position must have shape (n, 3) with n >= 1, got {positions.shape}")
     n_clumps = positions.shape[0]
-    masses = _per_particle("clump_mass", clump_mass, n_clumps)
+    masses = per_particle_values("clump_mass", clump_mass, n_clumps)
     width = positive_number("width", width)
     depth = positive_number("depth", depth)
     surface_margin = non_negative_number("surface_margin", surface_margin)
@@ -375,7 +365,7 @@ def mass_in_silo(clump_z, clump_mass, outlet_plane: float = 0.0) -> float:
         Total mass of the clumps with centre at or above the outlet plane [kg].
     """
     clump_z = finite_array("clump_z", clump_z)
-    masses = _per_particle("clump_mass", clump_mass, clump_z.size)
+    masses = per_particle_values("clump_mass", clump_mass, clump_z.size)
     outlet_plane = float(outlet_plane)
     if not math.isfinite(outlet_plane):
         raise ValueError(f"outlet_plane must be finite, got {outlet_plane!r}")

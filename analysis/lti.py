@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from analysis.checks import finite_array, non_negative_number, positive_number
 
 __all__ = [
     "VRRTable",
@@ -264,9 +264,7 @@ def sine_input(time, mean: float, amplitude: float, period: float, phase: float 
     """
     t = finite_array("time", time, ndim=None)
     mean = _finite("mean", mean)
-    amplitude = _finite("amplitude", amplitude)
-    if amplitude < 0.0:
-        raise ValueError(f"amplitude must be >= 0, got {amplitude!r}")
+    amplitude = non_negative_number("amplitude", amplitude)
     period = positive_number("period", period)
     phase = _finite("phase", phase)
     return mean + amplitude * np.sin(2.0 * np.pi * t / period + phase)
@@ -301,9 +299,7 @@ def square_input(time, mean: float, amplitude: float, period: float, duty: float
     """
     t = finite_array("time", time, ndim=None)
     mean = _finite("mean", mean)
-    amplitude = _finite("amplitude", amplitude)
-    if amplitude < 0.0:
-        raise ValueError(f"amplitude must be >= 0, got {amplitude!r}")
+    amplitude = non_negative_number("amplitude", amplitude)
     period = positive_number("period", period)
     duty = float(duty)
     if not math.isfinite(duty) or not 0.0 < duty < 1.0:

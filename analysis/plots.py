@@ -21,6 +21,14 @@ if TYPE_CHECKING:
 __all__ = ["plot_discharge"]
 
 
+def save_png(figure, path: str | os.PathLike, tight: bool = False) -> Path:
+    """Save a figure as a 150 dpi PNG, atomically: a reader never sees a half-written file."""
+    with atomic_output(path) as temporary:
+        # The temporary name has no .png suffix, so give the format explicitly.
+        figure.savefig(temporary, dpi=150, format="png", bbox_inches="tight" if tight else None)
+    return Path(path)
+
+
 def plot_discharge(
     history: "DischargeHistory",
     fit: "FlowRateFit",
@@ -87,9 +95,6 @@ def plot_discharge(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="upper left", fontsize="small")
         figure.tight_layout()
-        with atomic_output(path) as temporary:
-            # The temporary name has no .png suffix, so give the format explicitly.
-            figure.savefig(temporary, dpi=150, format="png")
+        return save_png(figure, path)
     finally:
         plt.close(figure)
-    return Path(path)

@@ -14,14 +14,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
-from analysis.tables import atomic_output  # noqa: E402
+from analysis.plots import save_png  # noqa: E402
 
 
-def _save(figure, path: str | os.PathLike) -> Path:
-    path = Path(path)
-    with atomic_output(path) as temporary:
-        figure.savefig(temporary, dpi=150, format="png", bbox_inches="tight")
-    return path
 
 
 def _silo_outline(axes, width: float, outlet_width: float, top: float) -> None:
@@ -60,7 +55,7 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.legend(loc="upper center", fontsize=8)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -78,7 +73,7 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -92,7 +87,7 @@ def plot_kinematic_constant(heights, B, path, title: str) -> Path:
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.grid(alpha=0.3)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -109,7 +104,7 @@ def plot_janssen(comparison, path, title: str) -> Path:
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -125,7 +120,7 @@ def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Pa
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -146,7 +141,7 @@ def plot_force_chains(segments, width: float, outlet_width: float, top: float, p
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -172,7 +167,7 @@ def plot_measured_comparison(comparisons, path, title: str) -> Path:
         axes_list[-1, 0].set_xlabel("x [mm]")
         axes_list[0, 0].legend(fontsize=8)
         figure.suptitle(title)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -193,7 +188,7 @@ def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, 
         right.set_ylabel("steady mass flow rate [kg/s]")
         right.grid(alpha=0.3, axis="y")
         figure.suptitle(title)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -212,6 +207,6 @@ def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Path:
         axes_list[0, 0].legend(fontsize=8)
         axes_list[-1, 0].set_xlabel("x [mm]")
         figure.suptitle(title)
-        return _save(figure, path)
+        return save_png(figure, path, tight=True)
     finally:
         plt.close(figure)

@@ -1,7 +1,7 @@
 """Calibration charts and polar diagnostics (PNG, matplotlib Agg backend, no display needed).
 
 Every writer draws a figure and saves it atomically (via
-:func:`analysis.tables.atomic_output`): a reader never sees a half-written PNG
+:func:`analysis.plots.save_png`): a reader never sees a half-written PNG
 and a failed write leaves no temporary file behind.
 """
 
@@ -19,7 +19,7 @@ matplotlib.use("Agg")  # headless: runs on clusters and in CI
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.tables import atomic_output  # noqa: E402
+from analysis.plots import save_png  # noqa: E402
 
 if TYPE_CHECKING:
     from calibration.inversion import CalibrationCurve
@@ -32,11 +32,6 @@ _X_LABELS = {
 }
 
 
-def _save(figure, path: str | os.PathLike) -> Path:
-    with atomic_output(path) as temporary:
-        # The temporary name has no .png suffix, so give the format explicitly.
-        figure.savefig(temporary, dpi=150, format="png")
-    return Path(path)
 
 
 def _curve_label(curve: "CalibrationCurve", several_shapes: bool, several_materials: bool) -> str:
@@ -145,7 +140,7 @@ def plot_calibration_chart(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="best", fontsize="small")
         figure.tight_layout()
-        return _save(figure, path)
+        return save_png(figure, path)
     finally:
         plt.close(figure)
 
@@ -195,7 +190,7 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
         )
         axes.set_title(title)
         figure.tight_layout()
-        return _save(figure, path)
+        return save_png(figure, path)
     finally:
         plt.close(figure)
 
@@ -233,7 +228,7 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
                   transform=axes.transAxes, va="top", fontsize=9)
         axes.legend(loc="lower right", fontsize=8)
         axes.grid(alpha=0.3)
-        return _save(figure, path)
+        return save_png(figure, path)
     finally:
         plt.close(figure)
 
@@ -257,6 +252,6 @@ def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return _save(figure, path)
+        return save_png(figure, path)
     finally:
         plt.close(figure)
