@@ -862,7 +862,7 @@ def frame_from_arrays(
         raise DumpFormatError(f"{source}: {error}") from None
 
 
-def clumps_from_frame(frame: ParticleFrame) -> ClumpFrame:
+def clumps_from_frame(frame: ParticleFrame, periodic_bounds=None) -> ClumpFrame:
     """Group the spheres of a frame into rigid clumps.
 
     The clump position is the mean of its sphere centres and the clump velocity the mean
@@ -876,6 +876,12 @@ def clumps_from_frame(frame: ParticleFrame) -> ClumpFrame:
     ----------
     frame : ParticleFrame
         Spheres of one step; ``mass`` holds the clump mass on every sphere of a clump.
+    periodic_bounds : sequence of 3 (lower, upper) or None, optional
+        Box bounds [m] of the periodic axes (None for the others, and None for no periodic axis, the
+        default). The engine wraps every sphere into the box on its own, so a clump that straddles a
+        periodic boundary has spheres on both sides; they are taken to the minimum image of the
+        clump's first sphere before averaging, and the clump position is wrapped back into
+        ``[lower, upper)``.
 
     Returns
     -------
@@ -900,6 +906,20 @@ def clumps_from_frame(frame: ParticleFrame) -> ClumpFrame:
         )
         return sums / n_spheres[:, None]
 
+    position = frame.position
+    if m and periodic_bounds is not None:
+        position, bounds = position.copy(), list(periodic_bounds)
+        if len(bounds) != 3:
+            raise ValueError(f"periodic_bounds must give 3 axes (None for non-periodic), got {len(bounds)}")
+        for axis, axis_bounds in enumerate(bounds):
+            if axis_bounds is None:
+                continue
+            lower, upper = (float(v) for v in axis_bounds)
+            if not upper > lower:
+                raise ValueError(f"periodic_bounds[{axis}] must have upper > lower, got {axis_bounds!r}")
+            length = upper - lower
+            anchor = position[first_index[inverse], axis]
+            position[:, axis] -= length * np.round((position[:, axis] - anchor) / length)
     if m:
         # Spheres sorted by clump, then min == max per clump <=> one mass per clump.
         order = np.argsort(inverse, kind="stable")
@@ -915,11 +935,21 @@ def clumps_from_frame(frame: ParticleFrame) -> ClumpFrame:
         time=frame.time,
         step=frame.step,
         clump_id=clump_ids,
-        position=clump_mean(frame.position) if m else np.empty((0, 3)),
+        position=_wrapped(clump_mean(position), periodic_bounds) if m else np.empty((0, 3)),
         velocity=clump_mean(frame.velocity) if m else np.empty((0, 3)),
         mass=frame.mass[first_index],
         n_spheres=n_spheres,
     )
+
+
+def _wrapped(position: np.ndarray, periodic_bounds) -> np.ndarray:
+    if periodic_bounds is None:
+        return position
+    for axis, axis_bounds in enumerate(periodic_bounds):
+        if axis_bounds is not None:
+            lower, upper = (float(v) for v in axis_bounds)
+            position[:, axis] = lower + np.mod(position[:, axis] - lower, upper - lower)
+    return position
 
 
 # --------------------------------------------------------------------------- files

@@ -171,6 +171,7 @@ def _check_references(config: dict) -> None:
         seen[pair] = index
 
     _check_jenike_references(config, require, seen)
+    _check_blending_references(config, require)
 
     particle_material = silo["particle_material"]
     if "density" not in materials[particle_material]:
@@ -184,6 +185,23 @@ def _check_references(config: dict) -> None:
                 f"config key 'contacts': no contact parameters for the pair "
                 f"[{particle_material}, {material}] used by silo_flat"
             )
+
+
+def _check_blending_references(config: dict, require) -> None:
+    blending = config["blending"]
+    presets = blending["presets"]
+    for index, pattern in enumerate(blending["flow_patterns"]):
+        require(pattern, presets, f"blending.flow_patterns[{index}]", "preset")
+    require(blending["verification"]["flow_pattern"], presets, "blending.verification.flow_pattern", "preset")
+    names = [layout["name"] for layout in blending["layouts"]]
+    for index, name in enumerate(names):
+        if names.index(name) != index:
+            raise ConfigError(f"config key 'blending.layouts[{index}].name': layout name '{name}' is used twice")
+    if blending["outlet_width"] >= blending["width"]:
+        raise ConfigError(
+            f"config key 'blending.outlet_width': {blending['outlet_width']} m must be smaller than "
+            f"blending.width ({blending['width']} m)"
+        )
 
 
 def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None:

@@ -56,6 +56,30 @@ def horizontal_rectangle(x_min: float, x_max: float, y_min: float, y_max: float,
     return TriangleMesh(vertices, faces)
 
 
+def vertical_rectangle_x(x: float, y_min: float, y_max: float, z_min: float, z_max: float, normal: float) -> TriangleMesh:
+    """Rectangle in the plane x = const, two triangles with normals along ``sign(normal)`` x.
+
+    Parameters
+    ----------
+    x : float
+        Position of the plane (m).
+    y_min, y_max, z_min, z_max : float
+        Extent of the rectangle (m); max must exceed min.
+    normal : float
+        +1 for normals pointing to +x, -1 for -x.
+    """
+    if not (y_max > y_min and z_max > z_min):
+        raise ValueError(f"empty rectangle: y [{y_min}, {y_max}], z [{z_min}, {z_max}]")
+    if normal not in (1, -1, 1.0, -1.0):
+        raise ValueError(f"normal must be +1 or -1, got {normal!r}")
+    vertices = np.array(
+        [[x, y_min, z_min], [x, y_max, z_min], [x, y_max, z_max], [x, y_min, z_max]], dtype=float
+    )
+    # (y, z) counter-clockwise seen from +x gives a +x normal.
+    faces = np.array([[0, 1, 2], [0, 2, 3]] if normal > 0 else [[0, 2, 1], [0, 3, 2]], dtype=np.int64)
+    return TriangleMesh(vertices, faces)
+
+
 def write_stl(mesh: TriangleMesh, path: str | Path) -> Path:
     """Write an ASCII STL file (LIGGGHTS reads ASCII STL), atomically."""
     path = Path(path)

@@ -352,6 +352,22 @@ def test_clumps_from_frame_exact():
     )
 
 
+def test_clump_straddling_a_periodic_boundary_is_unwrapped():
+    # z periodic in [-1, 3): clump 7 has spheres at z = 2.75 and z = -0.75 (= 3.25 unwrapped), centre 3.0,
+    # wrapped back to -1.0; clump 2 (z 0.25, 0.75) is away from the boundary and unchanged.
+    frame = three_clump_frame()
+    position = frame.position.copy()
+    position[0, 2], position[2, 2] = 2.75, -0.75
+    straddling = ParticleFrame(**{**frame.__dict__, "position": position})
+    clumps = clumps_from_frame(straddling, periodic_bounds=[None, None, (-1.0, 3.0)])
+    np.testing.assert_allclose(clumps.position[2], [0.25, 0.0, -1.0], atol=1e-15)
+    np.testing.assert_array_equal(clumps.position[0], [-0.75, 0.5, 0.5])
+    # Without the periodic bounds the naive mean lands in the middle of the box.
+    np.testing.assert_allclose(clumps_from_frame(straddling).position[2], [0.25, 0.0, 1.0])
+    with pytest.raises(ValueError, match="periodic_bounds"):
+        clumps_from_frame(straddling, periodic_bounds=[(0.0, 0.0), None, None])
+
+
 def test_clumps_with_different_masses_per_sphere_are_rejected():
     frame = three_clump_frame()
     mass = frame.mass.copy()

@@ -1,0 +1,136 @@
+"""LIGGGHTS decks and runs of the recirculating silo (blending study).
+
+The run directory has the layout of :mod:`engines.liggghts` (``deck/``, ``dumps/``, ``log.liggghts``,
+``engine.out``, ``run.json`` written last). Periodic boundaries and multisphere clumps work together in
+LIGGGHTS 3.8, serially and under MPI with the domain split along the periodic direction: clumps cross the
+bottom boundary whole and re-enter at the top with their ids. The recirculation stage therefore runs with
+``thermo_modify lost error``, and the run is checked for an unchanged clump count.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from engines.blending import RecirculationCase
+from engines.geometry import vertical_rectangle_x, write_stl
+from engines.liggghts import (
+    DECK_NAME,
+    DUMP_PREFIX,
+    RUN_RECORD,
+    EngineRunError,
+    Marker,
+    _write_text_atomic,
+    check_silo_run,
+    parse_markers,
+    run_engine,
+    set_aside_previous_attempt,
+    silo_deck_context,
+    silo_meshes,
+    write_run_record,
+)
+from engines.templating import render_deck
+
+CHANNEL_MESHES = ("channel_left", "channel_right")
+
+
+def recirculation_meshes(case: RecirculationCase) -> dict:
+    """The batch silo's floor and gate plus the two channel walls below the outlet (normals into the channel)."""
+    half_outlet, depth, length = 0.5 * case.silo.outlet_width, case.silo.depth, case.channel_length
+    meshes = silo_meshes(case.silo)
+    meshes["channel_left"] = vertical_rectangle_x(-half_outlet, 0.0, depth, -length, 0.0, normal=1)
+    meshes["channel_right"] = vertical_rectangle_x(half_outlet, 0.0, depth, -length, 0.0, normal=-1)
+    return meshes
+
+
+def recirculation_deck_context(case: RecirculationCase) -> dict:
+    """The rendering context of ``templates/liggghts/silo_recirculation.lmp.j2``."""
+    context = silo_deck_context(case.silo)
+    bottom = case.silo.materials.type_of(case.silo.wall_materials["bottom"])
+    context["title"] = f"siloflow-silo_recirculation-{case.run_id}"
+    # The vertical boundary is periodic: what leaves the channel bottom re-enters at the top.
+    context["boundary"] = [context["boundary"][0], context["boundary"][1], "p"]
+    context["meshes"] = context["meshes"] + [
+        {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom} for name in CHANNEL_MESHES
+    ]
+    context["closed_floor"] = context["closed_floor"] + list(CHANNEL_MESHES)
+    context["open_floor"] = context["open_floor"] + list(CHANNEL_MESHES)
+    context["feeder"] = {
+        "zone": list(case.feeder_zone),
+        "velocity": case.feeder_velocity,
+        "spheres_per_clump": case.silo.spheres_per_clump,
+    }
+    return context
+
+
+def render_recirculation_deck(case: RecirculationCase) -> str:
+    """The LIGGGHTS deck of a recirculation run."""
+    return render_deck("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case))
+
+
+def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    deck_dir = Path(deck_dir)
+    for name, mesh in recirculation_meshes(case).items():
+        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
+    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
+    deck_path = deck_dir / DECK_NAME
+    _write_text_atomic(deck_path, render_recirculation_deck(case))
+    return deck_path
+
+
+def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_dir: Path) -> dict:
+    """Check a finished recirculation run: the batch silo's checks, then no clump lost while recirculating.
+
+    Raises
+    ------
+    EngineRunError
+        As :func:`engines.liggghts.check_silo_run`, or when the clump count changed during recirculation.
+    """
+    if "recirculated" not in {marker.event for marker in markers}:
+        raise EngineRunError(f"{run_dir}: the log has no 'recirculated' stage marker; the deck did not run to the end")
+    # The batch silo's checks know its last stage as 'discharged'.
+    renamed = [Marker("discharged", m.values) if m.event == "recirculated" else m for m in markers]
+    record = check_silo_run(case.silo, renamed, dump_files, run_dir)
+    record["recirculated"] = record.pop("discharged")
+    final = int(round(record["recirculated"]["clumps"]))
+    if final != case.silo.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: {case.silo.fill.n_clumps} clumps were inserted but {final} remain after recirculating; "
+            "clumps were lost through a boundary"
+        )
+    return record
+
+
+def run_recirculation(
+    case: RecirculationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
+    mpirun: str = "mpirun",
+) -> Path:
+    """Run a rendered recirculation deck, check it and write ``run.json``; returns its path.
+
+    Output of an unfinished earlier attempt is moved to ``failed_attempts/`` first.
+    """
+    from analysis.dumps import list_dumps
+
+    run_dir = Path(run_dir)
+    deck = run_dir / "deck" / DECK_NAME
+    if not deck.exists():
+        raise FileNotFoundError(f"no deck at {deck}; render it first")
+    (run_dir / RUN_RECORD).unlink(missing_ok=True)
+    set_aside_previous_attempt(run_dir)
+    log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
+    dumps = list_dumps(run_dir / "dumps", DUMP_PREFIX)
+    record = check_recirculation_run(case, parse_markers(log_text), dumps, run_dir)
+    record.update(
+        {
+            "run_id": case.run_id,
+            "mpi_ranks": mpi_ranks,
+            "dump_prefix": DUMP_PREFIX,
+            "flow_pattern": case.pattern,
+            "role": case.role,
+            "estimated_residence_time_s": case.estimated_residence_time,
+            "domain_z": [-case.channel_length, case.silo.domain_top],
+            "outlet_z": 0.0,
+        }
+    )
+    return write_run_record(run_dir, record)

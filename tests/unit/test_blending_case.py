@@ -1,0 +1,136 @@
+"""The recirculating silo case: presets, sizing, deck (golden file), meshes."""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from engines.blending import (
+    apply_flow_pattern,
+    build_recirculation_case,
+    estimated_residence_time,
+    recirculation_case_for_run,
+    recirculation_cases,
+)
+from engines.config import ConfigError, load_config, validate_config
+from engines.liggghts_blending import recirculation_meshes, render_recirculation_deck, write_recirculation_inputs
+
+GOLDEN = Path(__file__).resolve().parent.parent / "golden"
+
+
+@pytest.fixture(scope="module")
+def golden_config():
+    return load_config(GOLDEN / "silo_recirculation_config.yaml")
+
+
+def test_recirculation_deck_matches_golden_file(golden_config):
+    rendered = render_recirculation_deck(build_recirculation_case(golden_config, "internal_flow"))
+    golden = GOLDEN / "silo_recirculation.lmp"
+    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
+        golden.write_text(rendered)
+    assert rendered == golden.read_text()
+
+
+def test_deck_is_periodic_in_z_with_feeder_and_no_lost_clumps(golden_config):
+    case = build_recirculation_case(golden_config, "internal_flow")
+    deck = render_recirculation_deck(case)
+    assert "boundary f f p" in deck
+    assert "region domain block -0.04 0.04 0.0 0.012 -0.04 " in deck
+    assert "region feeder block -0.012 0.012 INF INF -0.04 -0.02 units box" in deck
+    assert "variable feeder_force_z atom mass*(v_feeder_velocity-vz)/dt/2" in deck
+    assert "fix feeder all setforce NULL NULL v_feeder_force_z region feeder" in deck
+    recirculation = deck[deck.index("# --- recirculate"):]
+    assert "thermo_modify lost error" in recirculation
+    assert "meshes floor_left floor_right channel_left channel_right" in deck
+
+
+def test_presets_set_the_study_friction_and_a_dedicated_front_back_material(golden_config):
+    case = build_recirculation_case(golden_config, "internal_flow")
+    table = case.silo.materials
+    assert table.names == ("hdpe", "aluminium", "perspex_front_back")
+    friction, rolling = np.array(table.sliding_friction), np.array(table.rolling_friction)
+    np.testing.assert_array_equal(friction[0], [0.55, 0.5, 0.5])
+    np.testing.assert_array_equal(rolling[0], [0.2, 0.2, 0.2])
+    semi = build_recirculation_case(golden_config, "semi_mass_flow").silo.materials
+    np.testing.assert_array_equal(np.array(semi.sliding_friction)[0], [0.35, 0.17, 0.0])
+    np.testing.assert_array_equal(np.array(semi.rolling_friction)[0], [0.0, 0.0, 0.0])
+    # Restitution comes from the original contacts.
+    np.testing.assert_array_equal(np.array(semi.restitution)[0], [0.1, 0.1, 0.1])
+
+
+def test_apply_flow_pattern_leaves_its_input_alone(golden_config):
+    before = copy.deepcopy(golden_config)
+    apply_flow_pattern(golden_config, golden_config["blending"]["presets"]["internal_flow"])
+    assert golden_config == before
+
+
+def test_estimated_residence_time_is_holdup_over_throughput():
+    # W H / (B0 V r) = 0.15 * 0.27 / (0.04 * 0.4 * 1) = 2.53125 s (the study's "about 2.75 s").
+    assert estimated_residence_time(0.15, 0.27, 0.04, 0.4) == pytest.approx(2.53125, rel=1e-15)
+    assert estimated_residence_time(0.15, 0.27, 0.04, 0.4, 0.5) == pytest.approx(5.0625, rel=1e-15)
+    with pytest.raises(ValueError, match="feeder_velocity"):
+        estimated_residence_time(0.15, 0.27, 0.04, 0.0)
+
+
+def test_recirculation_time_covers_the_asked_recirculations(golden_config):
+    case = build_recirculation_case(golden_config, "internal_flow")
+    t_res = 0.08 * 0.05 / (0.024 * 0.4 * 0.5)
+    expected = 2.0 * t_res
+    assert case.estimated_residence_time == pytest.approx(t_res, rel=1e-12)
+    assert expected <= case.recirculation_time < expected + case.silo.timestep
+    assert case.feeder_zone == (-0.012, 0.012, -0.04, -0.02)
+    assert case.silo.sink_depth == 0.04
+
+
+def test_channel_meshes_face_into_the_channel(golden_config):
+    meshes = recirculation_meshes(build_recirculation_case(golden_config, "internal_flow"))
+    np.testing.assert_allclose(meshes["channel_left"].normals(), [[1.0, 0.0, 0.0]] * 2)
+    np.testing.assert_allclose(meshes["channel_right"].normals(), [[-1.0, 0.0, 0.0]] * 2)
+    np.testing.assert_allclose(meshes["channel_left"].area(), 0.012 * 0.04)
+
+
+def test_runs_are_keyed_by_pattern_and_role(golden_config):
+    raw = copy.deepcopy(golden_config)
+    raw["blending"]["flow_patterns"] = ["internal_flow", "semi_mass_flow"]
+    raw["blending"]["verification"]["enabled"] = True
+    cases = recirculation_cases(raw)
+    prefixes = sorted(run.rsplit("-", 1)[0] for run in cases)
+    assert prefixes == ["internal_flow", "semi_mass_flow", "thin-semi_mass_flow"]
+    thin = next(case for case in cases.values() if case.role == "verification")
+    assert thin.silo.depth == raw["blending"]["verification"]["depth"]
+    with pytest.raises(KeyError, match="it defines"):
+        recirculation_case_for_run(raw, "internal_flow-0000000000")
+    raw["blending"]["enabled"] = False
+    assert recirculation_cases(raw) == {}
+
+
+def test_write_inputs_writes_deck_meshes_and_case(tmp_path, golden_config):
+    case = build_recirculation_case(golden_config, "internal_flow")
+    deck = write_recirculation_inputs(case, tmp_path / "deck")
+    assert deck.read_text() == render_recirculation_deck(case)
+    assert sorted(p.name for p in (tmp_path / "deck" / "meshes").iterdir()) == [
+        "channel_left.stl", "channel_right.stl", "floor_left.stl", "floor_right.stl", "outlet_gate.stl"
+    ]
+    assert '"flow_pattern": "internal_flow"' in (tmp_path / "deck" / "case.json").read_text()
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda b: b.update(flow_patterns=["funnel"]), "blending.flow_patterns\\[0\\]': unknown preset 'funnel'"),
+        (lambda b: b["verification"].update(flow_pattern="nope"), "blending.verification.flow_pattern"),
+        (lambda b: b.update(outlet_width=0.2), "blending.outlet_width"),
+        (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 0.2}, {"name": "a", "blue_fraction": 0.3}]),
+         "used twice"),
+        (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 1.0}]), "blending.layouts"),
+    ],
+)
+def test_bad_blending_config_is_named(golden_config, edit, message):
+    raw = copy.deepcopy(golden_config)
+    edit(raw["blending"])
+    with pytest.raises(ConfigError, match=message):
+        validate_config(raw)
