@@ -12,6 +12,7 @@ configfile: "config/config.yaml"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
+include: "workflow/rules/blending.smk"
 
 
 rule all:
@@ -19,6 +20,7 @@ rule all:
         calibration_targets(),
         silo_flat_targets,
         parametric_targets,
+        blending_targets,
     default_target: True
 
 

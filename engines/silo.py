@@ -200,8 +200,9 @@ def plan_fill(
 ) -> FillPlan:
     """Size the central pour: clump count from the target fill height, zone above the heap, rate.
 
-    The clump count is n = rho_b,est W T H / m_clump. The insertion zone is centred, spans the depth
-    (kept one bounding radius off the walls so ``all_in`` can place clumps), and its floor sits above
+    The clump count is n = rho_b,est W T H / m_clump. The insertion zone is centred and spans the whole depth
+    (with ``all_in`` LIGGGHTS keeps each clump's bounding sphere inside the zone, so clumps never overlap the
+    front and back walls, and a silo one clump thick still has room for the centres), and its floor sits above
     the highest heap the pile can form, H + (W/2) tan(heap angle), plus two clump diameters. Each insertion
     event fills the zone to the given solid fraction; the next one comes when the batch has moved one zone
     height down, so batches never overlap.
@@ -212,8 +213,8 @@ def plan_fill(
     clearance = particle.bounding_radius
     zone_half_width = 0.5 * fill_config["zone_width_fraction"] * width
     x_min, x_max = -zone_half_width + clearance, zone_half_width - clearance
-    y_min, y_max = clearance, depth - clearance
-    if x_max <= x_min or y_max <= y_min:
+    y_min, y_max = 0.0, depth
+    if x_max - x_min <= 2.0 * clearance or y_max - y_min <= 2.0 * clearance:
         raise ValueError("insertion zone thinner than one clump: increase silo depth or zone_width_fraction")
     heap_rise = 0.5 * width * math.tan(math.radians(fill_config["heap_angle"]))
     z_min = fill_height + heap_rise + 4.0 * particle.bounding_radius

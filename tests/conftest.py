@@ -26,6 +26,27 @@ TINY_SILO = {
 }
 
 
+# A tiny recirculating silo (about 1,000 clumps, Nr about 4 in 1.8 s) and a thin one (about 400 clumps).
+TINY_BLENDING = {
+    "width": 0.06,
+    "depth": 0.012,
+    "fill_height": 0.04,
+    "outlet_width": 0.02,
+    "channel_length": 0.04,
+    "recirculations": 3.0,
+    "flow_patterns": ["semi_mass_flow"],
+    "concentration_window": 0.1,
+    "snapshots": [0, 0.5, 1, 2],
+    "tracer": {"start_recirculations": 0.5, "bins": 15},
+    "lti": {"period_fractions": [0.2, 0.5, 1.0, 2.0], "passes": 6},
+    "verification": {"width": 0.06, "depth": 0.0045, "fill_height": 0.04, "recirculations": 3.0,
+                     "bin_sizes": [0.005, 0.01, 0.015]},
+}
+
+# Pipelines that test other stages leave the blending study out.
+NO_BLENDING = {"enabled": False}
+
+
 @pytest.fixture
 def raw_default_config() -> dict:
     """The default configuration file as read, before validation."""

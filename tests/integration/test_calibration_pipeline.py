@@ -12,7 +12,7 @@ import json
 import pytest
 import yaml
 
-from tests.conftest import TINY_SILO, require_liggghts
+from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts
 from tests.integration.test_silo_pipeline import _snakemake
 
 pytestmark = pytest.mark.integration
@@ -28,6 +28,7 @@ TINY_CALIBRATION = {
     "calibration": {"targets_deg": {"internal": 24.0, "aluminium": 9.5}, "tolerance_deg": 1.0, "shape": "sphere2",
                     "rolling_friction": 0.0},
     "silo_flat": {**TINY_SILO, "parameters": "calibrated"},
+    "blending": NO_BLENDING,
 }
 
 

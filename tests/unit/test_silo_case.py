@@ -34,8 +34,15 @@ def test_insertion_zone_lies_above_the_heap_and_inside_the_walls(tiny_config):
     heap_top = case.fill_height + 0.5 * case.width * math.tan(math.radians(40.0))
     assert z_min > heap_top
     assert -case.width / 2 < x_min < x_max < case.width / 2
-    assert 0.0 < y_min < y_max < case.depth
+    # the zone spans the depth; all_in keeps the clumps' bounding spheres off the front and back walls
+    assert (y_min, y_max) == (0.0, case.depth)
     assert case.domain_top > z_max
+
+
+def test_a_silo_one_clump_thick_still_has_an_insertion_zone(tiny_config):
+    tiny_config["silo_flat"]["depth"] = 0.0045  # one 3.75 mm clump
+    x_min, x_max, y_min, y_max, _, _ = build_silo_case(tiny_config).fill.zone
+    assert (y_min, y_max) == (0.0, 0.0045)
 
 
 def test_insertion_events_do_not_overlap(tiny_config):

@@ -7,6 +7,7 @@ sys.path.insert(0, workflow.basedir)
 
 from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
+from engines.blending import recirculation_case_for_run, recirculation_cases
 from engines.silo import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
 
 try:
@@ -22,6 +23,10 @@ try:
     silo_cases(config)
 except ValueError as error:
     raise WorkflowError(f"Invalid silo_flat configuration: {error}") from None
+try:
+    recirculation_cases(config)
+except ValueError as error:
+    raise WorkflowError(f"Invalid blending configuration: {error}") from None
 
 
 def uses_calibrated_parameters():
@@ -85,6 +90,33 @@ def parametric_targets(wildcards=None):
     ]
 
 
+def blending_dir(run_id):
+    return f"{RESULTS}/blending/{run_id}"
+
+
+def blending_runs(role="blending"):
+    """Run ids of the recirculation runs with the given role (the blending study or the thin verification silo)."""
+    return [run for run, case in recirculation_cases(config).items() if case.role == role]
+
+
+def blending_targets(wildcards=None):
+    runs = blending_runs()
+    targets = [
+        f"{blending_dir(run)}/{name}"
+        for run in runs
+        for name in ("metrics/blending.json", "plots/concentration.png", "plots/vrr.png", "plots/rtd.png",
+                     "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png", "plots/snapshots")
+    ]
+    if runs:
+        targets += [f"{RESULTS}/blending/summary/blending.csv", f"{RESULTS}/blending/summary/vrr.png"]
+    targets += [
+        f"{blending_dir(run)}/verification/{name}"
+        for run in blending_runs("verification")
+        for name in ("verification.json", "paths.png", "residence_times.png")
+    ]
+    return targets
+
+
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets()]:
+    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *blending_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")

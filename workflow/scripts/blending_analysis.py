@@ -1,0 +1,159 @@
+"""Snakemake adapter: direct blending measurement, RTDs (particle ids and Eulerian) and LTI predictions of one run."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from analysis.blending import sampling_noise_vrr_limit
+from analysis.blending_io import load_tracks
+from analysis.blending_plots import (
+    plot_coloured_snapshots,
+    plot_lti_comparison,
+    plot_outlet_concentration,
+    plot_recirculation_model,
+    plot_rtd_comparison,
+    plot_vrr_versus_period,
+    plot_vrr_versus_recirculations,
+)
+from analysis.blending_study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
+from analysis.rtd import johanson_rtd
+from analysis.tables import write_flow_table, write_json
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    out = snakemake.output
+    settings = snakemake.params.blending
+    case = json.loads(Path(snakemake.input.case).read_text())
+    loaded = load_tracks(snakemake.input.tracks)
+    tracks = loaded.tracks
+    bottom, top = case["domain_z"]
+    layouts = [Layout(l["name"], l["blue_fraction"], l["sublayers"], l["blue_at"]) for l in settings["layouts"]]
+    lti = settings["lti"]
+    result = analyse_blending(
+        tracks, layouts, bottom, top, settings["concentration_window"], settings["tracer"]["volume_fraction"],
+        settings["tracer"]["start_recirculations"], settings["tracer"]["bins"], lti["period_fractions"],
+        lti["passes"], lti["tolerance"],
+    )
+    timing = result.timing
+    log.info("t_res %.4g s (holdup %.1f clumps, throughput %.1f clumps/s), run covers Nr = %.2f",
+             timing.residence_time, timing.holdup, timing.throughput, timing.recirculations)
+    eulerian = settings["eulerian"]
+    eulerian_rtd = main_run_eulerian_rtd(
+        tracks, loaded.velocity, loaded.mass, result, case["width_m"], case["depth_m"], top, case["outlet_width_m"],
+        eulerian["bin_size"], eulerian["integration_step"], eulerian["max_recirculations"],
+        settings["tracer"]["bins"],
+    )
+    silo_rtd = result.rtd.silo
+    title = f"{case['flow_pattern']} ({case['run_id']})"
+
+    # --- tables
+    concentration_rows, vrr_rows, model_rows = [], [], []
+    for layout in result.layouts:
+        c = layout.concentration
+        for i in range(c.centres.size):
+            concentration_rows.append({
+                "layout": layout.layout.name, "time_s": c.centres[i], "recirculations": layout.recirculation_number[i],
+                "crossings": int(c.n_total[i]), "concentration": c.concentration[i],
+                "first_exit_concentration": layout.first_pass.concentration[i], "predicted": layout.predicted[i],
+                "predicted_johanson": layout.predicted_johanson[i],
+            })
+        for row, predicted in zip(layout.vrr.rows(), layout.vrr_predicted.vrr):
+            vrr_rows.append({"layout": layout.layout.name, **row, "vrr_predicted": predicted})
+        for nr, value in zip(layout.model_time_nr, layout.model_concentration):
+            model_rows.append({"layout": layout.layout.name, "recirculations": nr, "concentration": value})
+    write_flow_table(out.concentration, concentration_rows)
+    write_flow_table(out.vrr, vrr_rows)
+    write_flow_table(out.model, model_rows)
+    johanson = johanson_rtd(silo_rtd.time, silo_rtd.t_mean, result.rtd.johanson_V1, result.rtd.johanson_P)
+    rtd_rows = [
+        {"method": method, "time_s": t, "E_per_s": e, "t_mean_s": tm}
+        for method, rtd_time, values, tm in (
+            ("particle_ids", silo_rtd.time, silo_rtd.E, silo_rtd.t_mean),
+            ("eulerian", eulerian_rtd.time, eulerian_rtd.E, eulerian_rtd.t_mean),
+            ("johanson", silo_rtd.time, johanson, silo_rtd.t_mean),
+        )
+        for t, e in zip(rtd_time, values)
+    ]
+    write_flow_table(out.rtd, rtd_rows)
+    write_flow_table(out.vrr_period, result.vrr_sine.rows() + result.vrr_square.rows())
+    particles_per_window = timing.throughput * result.window
+    summary = {
+        "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
+        "residence_time_s": timing.residence_time, "estimated_residence_time_s": case["estimated_residence_time_s"],
+        "holdup_clumps": timing.holdup, "throughput_clumps_per_s": timing.throughput,
+        "recirculations": timing.recirculations, "window_s": result.window,
+        "clumps_per_window": particles_per_window,
+        "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window),
+        "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
+                             "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
+                             "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited},
+        "rtd_eulerian": {"t_mean_s": eulerian_rtd.t_mean, "variance_s2": eulerian_rtd.variance,
+                         "t_s": eulerian_rtd.t_first, "t_d": eulerian_rtd.t_last,
+                         "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian["bin_size"]},
+        "johanson": {"V1": result.rtd.johanson_V1, "P": result.rtd.johanson_P},
+        "layouts": {
+            layout.layout.name: {
+                "blue_fraction": layout.layout.blue_fraction, "sublayers": layout.layout.sublayers,
+                "vrr_by_recirculation": layout.vrr.vrr, "vrr_predicted": layout.vrr_predicted.vrr,
+                "prediction_rms_error": layout.prediction_rms_error(),
+                "homogenised_after_recirculations": layout.homogenised_after,
+                "model_homogenised_after_recirculations": layout.model_homogenised_after,
+            }
+            for layout in result.layouts
+        },
+    }
+    write_json(out.summary, summary)
+
+    # --- plots
+    plot_outlet_concentration(
+        [(f"{l.layout.name}", l.recirculation_number, l.concentration.concentration) for l in result.layouts],
+        result.layouts[0].layout.blue_fraction, out.concentration_plot, f"Outlet concentration, {title}",
+        tolerance=lti["tolerance"],
+    )
+    plot_vrr_versus_recirculations(
+        [(l.layout.name, l.vrr.recirculation_number, l.vrr.vrr) for l in result.layouts],
+        out.vrr_plot, f"VRR per recirculation, {title}", noise_limit=particles_per_window,
+    )
+    plot_rtd_comparison(
+        [("particle ids", silo_rtd.time, silo_rtd.E, silo_rtd.t_mean),
+         (f"Eulerian, {1000 * eulerian['bin_size']:g} mm bins", eulerian_rtd.time, eulerian_rtd.E, eulerian_rtd.t_mean),
+         (f"Johanson V1={result.rtd.johanson_V1:.2f}, P={result.rtd.johanson_P:.2f}", silo_rtd.time, johanson,
+          silo_rtd.t_mean)],
+        out.rtd_plot, f"RTD, {title}",
+    )
+    plot_vrr_versus_period(
+        result.vrr_sine.period_over_tm, [("sine", result.vrr_sine.vrr), ("square", result.vrr_square.vrr)],
+        out.vrr_period_plot, f"LTI continuous mode, {title}",
+    )
+    Path(out.snapshots).mkdir(parents=True, exist_ok=True)
+    Path(out.per_layout).mkdir(parents=True, exist_ok=True)
+    frames = snapshot_frames(tracks.times, timing.t_open, timing.residence_time, settings["snapshots"])
+    for index, layout in enumerate(result.layouts):
+        name = layout.layout.name
+        series = [("direct (particles)", layout.concentration.concentration, "direct"),
+                  ("renewal prediction, measured loop RTD", layout.predicted, "predicted"),
+                  ("renewal prediction, Johanson RTD", layout.predicted_johanson, "predicted"),
+                  ("first exits of the initial fill", layout.first_pass.concentration, "first pass")]
+        lti_paths = [Path(out.per_layout) / f"lti_{name}.png"] + ([Path(out.lti_plot)] if index == 0 else [])
+        for path in lti_paths:
+            plot_lti_comparison(layout.recirculation_number, series, path, f"{name}: direct vs LTI, {title}",
+                                blue_fraction=layout.layout.blue_fraction, x_label="Nr [-]")
+        model_paths = [Path(out.per_layout) / f"model_{name}.png"] + ([Path(out.model_plot)] if index == 0 else [])
+        for path in model_paths:
+            plot_recirculation_model(layout.model_time_nr, layout.model_concentration, layout.layout.blue_fraction,
+                                     layout.model_homogenised_after, path,
+                                     f"{name}: batch recirculated through the measured RTD, {title}",
+                                     tolerance=lti["tolerance"])
+        snapshots = [
+            ((tracks.times[k] - timing.t_open) / timing.residence_time, tracks.position[k, :, 0],
+             tracks.position[k, :, 2], layout.colours)
+            for k in frames
+        ]
+        plot_coloured_snapshots(snapshots, case["width_m"], case["outlet_width_m"], top, case["channel_length_m"],
+                                Path(out.snapshots) / f"{name}.png", f"{name}, {title}")
+        log.info("%s: VRR per recirculation %s, predicted %s, RMS(prediction - direct) %.3f, homogenised after Nr %s",
+                 name, np.round(layout.vrr.vrr, 2).tolist(), np.round(layout.vrr_predicted.vrr, 2).tolist(),
+                 layout.prediction_rms_error(), layout.homogenised_after)
+    log.info("RTD ids: t_m %.4g s, t_s/t_d %.3f; Eulerian: t_m %.4g s", silo_rtd.t_mean,
+             silo_rtd.t_first / silo_rtd.t_last, eulerian_rtd.t_mean)
