@@ -112,7 +112,8 @@ class LayoutResult:
 
 @dataclass(frozen=True, eq=False)
 class ParticleRTD:
-    """RTD from particle ids: the silo RTD (re-entry to outlet) and the loop RTD (outlet to outlet)."""
+    """RTD from particle ids: the tracer's silo RTD (re-entry to outlet), and the large steady samples of passes
+    (``steady``: re-entry to outlet, ``loop``: outlet to outlet) that feed the LTI models."""
 
     tracer: TracerPasses
     silo: RTD
@@ -122,6 +123,7 @@ class ParticleRTD:
     n_tracer: int
     johanson_V1: float
     johanson_P: float
+    steady: TracerPasses
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,35 +169,82 @@ def _johanson_parameters(rtd: RTD) -> tuple[float, float]:
     return v1, min(max(mode, v1), 0.5 * (3.0 - v1))
 
 
+def _steady_passes(events: RecirculationEvents, start: float, t_end: float, horizon: float, at_least: int,
+                   entry_at: str) -> TracerPasses:
+    """Every pass entering in ``[start, t_end - horizon]`` (at least ``at_least``): a large sample whose passes all
+    had ``horizon`` to leave, so the right-censoring by the end of the run is as small as for the tracer."""
+    entry = np.asarray(events.entry_time if entry_at == "wrap" else events.previous_exit_time, dtype=float)
+    in_window = int(np.count_nonzero(np.isfinite(entry) & (entry >= start) & (entry <= t_end - horizon)))
+    return tracer_passes(events, start, max(at_least, in_window), entry_at=entry_at)
+
+
 def particle_rtd(events: RecirculationEvents, timing: LoopTiming, tracer_fraction: float, tracer_start: float,
-                 bins: int, window: float) -> ParticleRTD:
+                 bins: int, window: float, horizon_recirculations: float = 2.0) -> ParticleRTD:
     """RTD from particle ids: the first ``tracer_fraction`` x holdup passes re-entering after ``Nr = tracer_start``.
 
-    The silo RTD uses the re-entry at the top as the entry; the loop RTD (previous outlet crossing to exit)
-    of passes entering after the same time is tabulated on bins of width ``window`` from 0 for the LTI
-    prediction (the renewal equation needs the whole loop).
+    The silo RTD of the study uses that tracer, with the re-entry at the top as the entry. The LTI models need a
+    smoother RTD than a 10 % tracer gives: they take every pass entering between the tracer's start and
+    ``horizon_recirculations`` t_res before the end of the run (at least the tracer's count), for the silo
+    (re-entry to outlet) and for the whole loop (previous outlet crossing to exit, which the renewal equation
+    needs), tabulated on bins of width ``window`` from 0.
     """
     n_tracer = max(1, int(round(tracer_fraction * timing.holdup)))
     start = timing.t_open + tracer_start * timing.residence_time
     tracer = tracer_passes(events, start, n_tracer, entry_at="wrap")
-    loop = tracer_passes(events, start, n_tracer, entry_at="outlet")
+    horizon = horizon_recirculations * timing.residence_time
+    loop = _steady_passes(events, start, timing.t_end, horizon, n_tracer, "outlet")
+    steady = _steady_passes(events, start, timing.t_end, horizon, n_tracer, "wrap")
     for passes, what in ((tracer, "re-entry"), (loop, "loop")):
         if not np.any(np.isfinite(passes.exit_time)):
             raise ValueError(
-                f"none of the {n_tracer} tracer passes ({what} RTD) entering after Nr = {tracer_start:g} left the silo "
-                f"before the end of the run (Nr = {timing.recirculations:.2f}); run more recirculations "
-                "(blending.recirculations) or mark the tracer earlier (blending.tracer.start_recirculations)"
+                f"none of the {passes.exit_time.size} tracer passes ({what} RTD) entering after Nr = {tracer_start:g} "
+                f"left the silo before the end of the run (Nr = {timing.recirculations:.2f}); run more "
+                "recirculations (blending.recirculations) or mark the tracer earlier "
+                "(blending.tracer.start_recirculations)"
             )
     silo = rtd_from_exit_times(tracer.exit_time, t_entry=tracer.entry_time, bins=bins, n_total=n_tracer)
-    loop_times = loop.exit_time - loop.entry_time
-    longest = float(np.nanmax(loop_times))
-    edges = np.arange(0.0, longest + 2.0 * window, window)
-    loop_rtd = rtd_from_exit_times(loop.exit_time, t_entry=loop.entry_time, bins=edges, n_total=n_tracer)
+    loop_E = _with_little_tail(loop, window, events.n_clumps / timing.throughput)
     v1, p = _johanson_parameters(silo)
     return ParticleRTD(
-        tracer=tracer, silo=silo, loop=loop, loop_E_on_windows=loop_rtd.E, start_time=start, n_tracer=n_tracer,
-        johanson_V1=v1, johanson_P=p,
+        tracer=tracer, silo=silo, loop=loop, loop_E_on_windows=loop_E, start_time=start, n_tracer=n_tracer,
+        johanson_V1=v1, johanson_P=p, steady=steady,
     )
+
+
+def _with_little_tail(passes: TracerPasses, step: float, mean_loop_time: float, max_tail_steps: int = 20000) -> np.ndarray:
+    """Loop RTD on bins of width ``step`` from 0, its censored part restored as an exponential tail.
+
+    Passes still in the loop at the end of the run (slow paths along the walls) are missing from the histogram;
+    normalising it would shorten the mean loop time and make the renewal prediction recycle too fast. In a
+    closed loop the mean loop time is known exactly, every clump over the throughput (Little's law), so the
+    missing fraction ``f_c`` is put back as ``f_c exp(-(t - T) / tau) / tau`` after the longest observed loop
+    time ``T``, with ``tau`` chosen so that the whole RTD has that mean. Without a censored part, or when the
+    observed part already has the mean, the histogram is returned as it is.
+    """
+    residence = passes.exit_time - passes.entry_time
+    exited = np.isfinite(residence)
+    E = _histogram_from_zero(passes, step)
+    censored = 1.0 - exited.sum() / residence.size
+    if censored <= 0.0:
+        return E
+    longest = float(residence[exited].max())
+    observed_mean = float(residence[exited].mean())
+    tau = (mean_loop_time - (1.0 - censored) * observed_mean) / censored - longest
+    if not tau > 0.0:
+        return E
+    n_tail = min(max_tail_steps, int(math.ceil((longest + 8.0 * tau) / step)) + 1)
+    t = np.arange(n_tail) * step
+    tail = np.where(t >= longest, censored * np.exp(-(t - longest) / tau) / tau, 0.0)
+    tail[: E.size] += E[: min(E.size, n_tail)]
+    return tail
+
+
+def _histogram_from_zero(passes: TracerPasses, step: float) -> np.ndarray:
+    """E of a sample of passes on bins of width ``step`` from 0 (unexited passes count in the total)."""
+    residence = passes.exit_time - passes.entry_time
+    edges = np.arange(0.0, float(np.nanmax(residence)) + 2.0 * step, step)
+    return rtd_from_exit_times(passes.exit_time, t_entry=passes.entry_time, bins=edges,
+                               n_total=passes.exit_time.size).E
 
 
 def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, timing: LoopTiming, window: float,
@@ -242,12 +291,8 @@ def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, 
 
 
 def _silo_rtd_on_step(rtd: ParticleRTD, window: float) -> tuple[np.ndarray, float]:
-    """The silo RTD histogrammed on bins of width ``window`` from 0 (for the discontinuous model)."""
-    residence = rtd.tracer.exit_time - rtd.tracer.entry_time
-    edges = np.arange(0.0, float(np.nanmax(residence)) + 2.0 * window, window)
-    on_step = rtd_from_exit_times(rtd.tracer.exit_time, t_entry=rtd.tracer.entry_time, bins=edges,
-                                  n_total=rtd.n_tracer)
-    return on_step.E, window
+    """The steady silo RTD on bins of width ``window`` from 0 (for the discontinuous model)."""
+    return _histogram_from_zero(rtd.steady, window), window
 
 
 def _homogenised_after(measured: OutletConcentration, timing: LoopTiming, blue_fraction: float,
@@ -265,17 +310,15 @@ def _homogenised_after(measured: OutletConcentration, timing: LoopTiming, blue_f
 
 
 def continuous_mode(rtd: ParticleRTD, period_fractions, samples_per_shortest_period: int = 8) -> tuple[VRRTable, VRRTable]:
-    """VRR of sine and square inputs against their period, through the measured silo RTD."""
+    """VRR of sine and square inputs against their period (over the tracer's t_m), through the steady silo RTD."""
     fractions = np.asarray(period_fractions, dtype=float)
     step = float(fractions.min()) * rtd.silo.t_mean / samples_per_shortest_period
-    residence = rtd.tracer.exit_time - rtd.tracer.entry_time
-    edges = np.arange(0.0, float(np.nanmax(residence)) + 2.0 * step, step)
-    fine = rtd_from_exit_times(rtd.tracer.exit_time, t_entry=rtd.tracer.entry_time, bins=edges, n_total=rtd.n_tracer)
-    time = edges[:-1]
+    E = _histogram_from_zero(rtd.steady, step)
+    time = np.arange(E.size) * step
     t_mean = rtd.silo.t_mean
     return (
-        vrr_versus_period(fine.E, time, fractions, waveform="sine", t_mean=t_mean),
-        vrr_versus_period(fine.E, time, fractions, waveform="square", t_mean=t_mean),
+        vrr_versus_period(E, time, fractions, waveform="sine", t_mean=t_mean),
+        vrr_versus_period(E, time, fractions, waveform="square", t_mean=t_mean),
     )
 
 

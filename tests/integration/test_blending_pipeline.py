@@ -7,6 +7,7 @@ minutes in all.
 
 from __future__ import annotations
 
+import copy
 import csv
 import json
 import subprocess
@@ -20,12 +21,16 @@ import yaml
 from analysis.blending import recirculation_events
 from analysis.blending_io import load_tracks
 from engines.blending import recirculation_cases
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from tests.conftest import TINY_BLENDING, require_liggghts
+from engines.config import REPO_ROOT, validate_config
+from tests.conftest import TINY_BLENDING, TINY_SILO, require_liggghts
 
 pytestmark = pytest.mark.integration
 
-CONFIG = {"blending": TINY_BLENDING, "engine": {"mpi_ranks": 2}}
+CONFIG = {
+    "blending": TINY_BLENDING,
+    "engine": {"mpi_ranks": 2},
+    "silo_flat": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
+}
 
 
 @pytest.fixture(scope="module")
@@ -42,9 +47,8 @@ def blending_pipeline(tmp_path_factory):
         capture_output=True, text=True, check=False,
     )
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
-    raw.update(CONFIG)
-    cases = recirculation_cases(validate_config(raw))
+    # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus CONFIG.
+    cases = recirculation_cases(validate_config(copy.deepcopy(CONFIG)))
     runs = {case.role: workdir / "results" / "blending" / run for run, case in cases.items()}
     yield workdir, runs, cases
 

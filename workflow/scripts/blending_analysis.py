@@ -146,7 +146,7 @@ with logged_to(snakemake.log[0]) as log:
                                      f"{name}: batch recirculated through the measured RTD, {title}",
                                      tolerance=lti["tolerance"])
         snapshots = [
-            ((tracks.times[k] - timing.t_open) / timing.residence_time, tracks.position[k, :, 0],
+            (round((tracks.times[k] - timing.t_open) / timing.residence_time, 2), tracks.position[k, :, 0],
              tracks.position[k, :, 2], layout.colours)
             for k in frames
         ]
