@@ -64,7 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from analysis.checks import finite_array, finite_number, positive_number
 
 __all__ = [
     "ClumpTracks",
@@ -356,11 +356,6 @@ class TracerPasses:
 # --------------------------------------------------------------------------- validation
 
 
-def _finite(name: str, value) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
 
 
 def _integer(name: str, value, minimum: int) -> int:
@@ -447,8 +442,8 @@ def _checked_tracks(tracks: ClumpTracks) -> tuple[np.ndarray, np.ndarray]:
 
 def _window_edges(window, t_start, t_end) -> tuple[np.ndarray, float]:
     window = positive_number("window", window)
-    t_start = _finite("t_start", t_start)
-    t_end = _finite("t_end", t_end)
+    t_start = finite_number("t_start", t_start)
+    t_end = finite_number("t_end", t_end)
     if t_end <= t_start:
         raise ValueError(f"t_end must be > t_start = {t_start!r} s, got {t_end!r}")
     n_windows = int(math.floor((t_end - t_start) / window + 1.0e-9))
@@ -559,9 +554,9 @@ def recirculation_events(tracks: ClumpTracks, outlet_z: float, domain_bottom: fl
         malformed, or a height lies outside the domain.
     """
     times, position = _checked_tracks(tracks)
-    outlet = _finite("outlet_z", outlet_z)
-    bottom = _finite("domain_bottom", domain_bottom)
-    top = _finite("domain_top", domain_top)
+    outlet = finite_number("outlet_z", outlet_z)
+    bottom = finite_number("domain_bottom", domain_bottom)
+    top = finite_number("domain_top", domain_top)
     if not bottom < outlet < top:
         raise ValueError(
             f"outlet_z must lie strictly between domain_bottom and domain_top, got "
@@ -689,7 +684,7 @@ def clumps_above_outlet(tracks: ClumpTracks, outlet_z: float) -> np.ndarray:
         Clumps above the outlet plane per frame [-].
     """
     _, position = _checked_tracks(tracks)
-    outlet = _finite("outlet_z", outlet_z)
+    outlet = finite_number("outlet_z", outlet_z)
     z = np.where(np.isfinite(position[:, :, 2]), position[:, :, 2], -np.inf)  # absent: not counted
     return np.count_nonzero(z > outlet, axis=1).astype(np.int64)
 
@@ -933,7 +928,7 @@ def recirculation_number(t, t_open: float, residence_time: float):
         ``Nr``, the shape of ``t`` (a float for a scalar ``t``).
     """
     times = finite_array("t", t, ndim=None)
-    t_open = _finite("t_open", t_open)
+    t_open = finite_number("t_open", t_open)
     t_res = positive_number("residence_time", residence_time)
     nr = (times - t_open) / t_res
     return float(nr) if nr.ndim == 0 else nr
@@ -972,8 +967,8 @@ def holdup_residence_time(n_in_silo, exit_times, t_start: float, t_end: float) -
     if np.any(holdup < 0.0):
         raise ValueError("n_in_silo must contain counts >= 0")
     exits = _event_times("exit_times", exit_times)
-    t_start = _finite("t_start", t_start)
-    t_end = _finite("t_end", t_end)
+    t_start = finite_number("t_start", t_start)
+    t_end = finite_number("t_end", t_end)
     if t_end <= t_start:
         raise ValueError(f"t_end must be > t_start = {t_start!r} s, got {t_end!r}")
     n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
@@ -1113,7 +1108,7 @@ def tracer_passes(events: RecirculationEvents, start_time: float, n_tracer: int,
     ValueError
         If fewer than ``n_tracer`` passes enter at or after ``start_time``.
     """
-    start = _finite("start_time", start_time)
+    start = finite_number("start_time", start_time)
     n_tracer = _integer("n_tracer", n_tracer, 1)
     if entry_at == "wrap":
         entry = np.asarray(events.entry_time, dtype=float)

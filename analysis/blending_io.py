@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.blending import ClumpTracks, clump_tracks
-from analysis.dumps import clumps_from_frame, read_frame, list_dumps
+from analysis.dumps import clumps_from_frame, list_dumps, read_frame
 from analysis.tables import atomic_output
 
 
@@ -53,10 +53,8 @@ def read_recirculation_tracks(
     if len(times) < 2:
         raise ValueError(f"{dump_dir}: a recirculation run needs at least 2 dumps, found {len(times)}")
     tracks = clump_tracks(np.array(times), ids, positions)
-    column = {clump_id: index for index, clump_id in enumerate(tracks.clump_id.tolist())}
-    velocity = np.full(tracks.position.shape, np.nan)
-    for k, (frame_ids, frame_velocity) in enumerate(zip(ids, velocities)):
-        velocity[k, [column[i] for i in frame_ids.tolist()]] = frame_velocity
+    # the same assembly lays the velocities out in the tracks' columns
+    velocity = clump_tracks(tracks.times, ids, velocities).position
     mass = np.array([masses[i] for i in tracks.clump_id.tolist()])
     return RecirculationTracks(tracks=tracks, velocity=velocity, mass=mass)
 

@@ -113,7 +113,9 @@ class LayoutResult:
 @dataclass(frozen=True, eq=False)
 class ParticleRTD:
     """RTD from particle ids: the tracer's silo RTD (re-entry to outlet), and the large steady samples of passes
-    (``steady``: re-entry to outlet, ``loop``: outlet to outlet) that feed the LTI models."""
+    (``steady``: re-entry to outlet, ``loop``: outlet to outlet) that feed the LTI models, with the kernels
+    tabulated once on the concentration windows: the loop RTD, the silo RTD, and Johanson's triangle shifted by
+    the channel-and-fall lag."""
 
     tracer: TracerPasses
     silo: RTD
@@ -124,6 +126,8 @@ class ParticleRTD:
     johanson_V1: float
     johanson_P: float
     steady: TracerPasses
+    silo_E_on_windows: np.ndarray
+    johanson_loop_E_on_windows: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,9 +209,14 @@ def particle_rtd(events: RecirculationEvents, timing: LoopTiming, tracer_fractio
     silo = rtd_from_exit_times(tracer.exit_time, t_entry=tracer.entry_time, bins=bins, n_total=n_tracer)
     loop_E = _with_little_tail(loop, window, events.n_clumps / timing.throughput)
     v1, p = _johanson_parameters(silo)
+    # Johanson's triangle stands in for the silo part of the loop; the loop adds the channel and the fall.
+    loop_lag = max(0.0, float(np.nanmean(loop.exit_time - loop.entry_time)) - silo.t_mean)
+    lags = np.arange(loop_E.size) * window
+    johanson = np.where(lags >= loop_lag, johanson_rtd(np.maximum(lags - loop_lag, 0.0), silo.t_mean, v1, p), 0.0)
     return ParticleRTD(
         tracer=tracer, silo=silo, loop=loop, loop_E_on_windows=loop_E, start_time=start, n_tracer=n_tracer,
-        johanson_V1=v1, johanson_P=p, steady=steady,
+        johanson_V1=v1, johanson_P=p, steady=steady, silo_E_on_windows=_histogram_from_zero(steady, window),
+        johanson_loop_E_on_windows=johanson,
     )
 
 
@@ -257,11 +266,7 @@ def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, 
     first = first_pass_concentration(events, colours, window, timing.t_open, timing.t_end)
     c_first = np.nan_to_num(first.concentration, nan=0.0)
     predicted = predicted_concentration_from_first_pass(c_first, rtd.loop_E_on_windows, window, passes)
-    # Johanson's triangle stands in for the silo part of the loop; the loop adds the channel and the fall.
-    loop_lag = max(0.0, float(np.nanmean(rtd.loop.exit_time - rtd.loop.entry_time)) - rtd.silo.t_mean)
-    lags = np.arange(rtd.loop_E_on_windows.size) * window
-    johanson = johanson_rtd(np.maximum(lags - loop_lag, 0.0), rtd.silo.t_mean, rtd.johanson_V1, rtd.johanson_P)
-    johanson = np.where(lags >= loop_lag, johanson, 0.0)
+    johanson = rtd.johanson_loop_E_on_windows
     predicted_johanson = (
         predicted_concentration_from_first_pass(c_first, johanson, window, passes) if johanson.sum() > 0 else
         np.full_like(c_first, np.nan)
@@ -273,11 +278,10 @@ def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, 
                                          layout.blue_fraction, n_recirculations)
     homogenised = _homogenised_after(measured, timing, layout.blue_fraction, tolerance)
     # Discontinuous mode: the batch fed over one t_res, then recirculated with the measured silo RTD.
-    silo_E, silo_step = _silo_rtd_on_step(rtd, window)
     _, c_in = batch_inlet_signal(layout.blue_fraction, layout.sublayers, layout.blue_at, timing.residence_time,
-                                 silo_step)
-    model = recirculate(c_in, silo_E, np.arange(c_in.size) * silo_step, passes)
-    samples_per_pass = timing.residence_time / silo_step
+                                 window)
+    model = recirculate(c_in, rtd.silo_E_on_windows, np.arange(c_in.size) * window, passes)
+    samples_per_pass = timing.residence_time / window
     model_nr = np.arange(model.concentration.size) / samples_per_pass
     model_after = recirculations_to_homogenise(model.concentration[: int(passes * samples_per_pass)],
                                                mean=layout.blue_fraction, tolerance=tolerance,
@@ -288,11 +292,6 @@ def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, 
         model_time_nr=model_nr, model_concentration=model.concentration, model_homogenised_after=model_after,
         recirculation_number=recirculation_number(measured.centres, timing.t_open, timing.residence_time),
     )
-
-
-def _silo_rtd_on_step(rtd: ParticleRTD, window: float) -> tuple[np.ndarray, float]:
-    """The steady silo RTD on bins of width ``window`` from 0 (for the discontinuous model)."""
-    return _histogram_from_zero(rtd.steady, window), window
 
 
 def _homogenised_after(measured: OutletConcentration, timing: LoopTiming, blue_fraction: float,
@@ -396,6 +395,15 @@ class VerificationResult:
     particle_paths: list
     pathlines: dict
     timing: LoopTiming
+
+
+def residence_summary(times) -> dict:
+    """Count, count exited, mean and standard deviation (population) of a residence-time sample [s]; NaN = not out."""
+    times = np.asarray(times, dtype=float)
+    finite = times[np.isfinite(times)]
+    return {"n": int(times.size), "n_exited": int(finite.size),
+            "mean_s": float(finite.mean()) if finite.size else None,
+            "std_s": float(finite.std()) if finite.size else None}
 
 
 def _clump_path(tracks: ClumpTracks, column: int, t_from: float, t_to: float) -> np.ndarray:

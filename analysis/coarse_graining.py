@@ -89,7 +89,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, per_particle_values, positive_number
+from analysis.checks import compute_backend, finite_array, per_particle_values, points3, positive_number, vector3
 
 try:  # pragma: no cover - exercised through both branches in the tests when numba is present
     import numba
@@ -139,21 +139,9 @@ _REL_TILE_TOLERANCE = 1.0e-9
 
 
 def _triple(name: str, values, positive: bool) -> tuple[float, float, float]:
-    array = np.asarray(values, dtype=float)
-    if array.shape != (3,):
-        raise ValueError(f"{name} must have 3 components (x, y, z), got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must contain only finite numbers, got {array.tolist()}")
-    if positive and np.any(array <= 0.0):
-        raise ValueError(f"{name} must be > 0 in every component, got {array.tolist()}")
-    return (float(array[0]), float(array[1]), float(array[2]))
+    return tuple(float(v) for v in vector3(name, values, positive))
 
 
-def _points(name: str, values) -> np.ndarray:
-    array = finite_array(name, values, ndim=2)
-    if array.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3), got {array.shape}")
-    return np.ascontiguousarray(array)
 
 
 
@@ -164,14 +152,6 @@ def _kernel_name(kernel: str) -> str:
     return kernel
 
 
-def _backend_name(backend: str) -> str:
-    if backend not in ("auto", "numba", "numpy"):
-        raise ValueError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-    if backend == "numba" and not HAVE_NUMBA:
-        raise ValueError("backend='numba' requested but numba is not installed")
-    if backend == "auto":
-        return "numba" if HAVE_NUMBA else "numpy"
-    return backend
 
 
 def _threshold(value: float) -> float:
@@ -321,7 +301,7 @@ class Grid:
 
     def contains(self, points) -> np.ndarray:
         """Whether each point lies in the closed box ``[lower, upper]``; shape (n,) bool."""
-        points = _points("points", points)
+        points = points3("points", points)
         return np.all((points >= self.lower) & (points <= self.upper), axis=1)
 
 
@@ -713,7 +693,7 @@ def deposit(
     """
     if not isinstance(grid, Grid):
         raise ValueError(f"grid must be a Grid, got {type(grid).__name__}")
-    positions = _points("positions", positions)
+    positions = points3("positions", positions)
     values = finite_array("values", values, ndim=2)
     if values.shape[0] != positions.shape[0]:
         raise ValueError(
@@ -722,7 +702,7 @@ def deposit(
     kernel = _kernel_name(kernel)
     width = positive_number("width", width)
     radius = kernel_support_radius(width, cutoff, kernel)
-    backend = _backend_name(backend)
+    backend = compute_backend(backend, HAVE_NUMBA)
 
     inside = grid.contains(positions) if positions.shape[0] else np.zeros(0, dtype=bool)
     positions = np.ascontiguousarray(positions[inside])
@@ -798,7 +778,7 @@ def coarse_grain(
     ``rho > 0`` (independent of the mask), so ``sigma_k`` is positive semi-definite up to
     round-off, and 0 where ``rho = 0``.
     """
-    positions = _points("positions", positions)
+    positions = points3("positions", positions)
     n = positions.shape[0]
     masses = per_particle_values("masses", masses, n)
     velocities = finite_array("velocities", velocities, ndim=2)
@@ -881,9 +861,9 @@ def contact_stress(
     """
     if not isinstance(grid, Grid):
         raise ValueError(f"grid must be a Grid, got {type(grid).__name__}")
-    first = _points("contact_positions_i", contact_positions_i)
-    second = _points("contact_positions_j", contact_positions_j)
-    forces = _points("forces_ij", forces_ij)
+    first = points3("contact_positions_i", contact_positions_i)
+    second = points3("contact_positions_j", contact_positions_j)
+    forces = points3("forces_ij", forces_ij)
     if second.shape != first.shape or forces.shape != first.shape:
         raise ValueError(
             "contact_positions_i, contact_positions_j and forces_ij must have the same shape, got "

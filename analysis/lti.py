@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, non_negative_number, positive_number
+from analysis.checks import finite_array, finite_number, non_negative_number, positive_number, uniform_step
 
 __all__ = [
     "VRRTable",
@@ -58,8 +58,6 @@ __all__ = [
 _DIRECT_LIMIT = 4_000_000
 """Largest ``len(c_in) * len(E)`` convolved directly in ``method="auto"``; larger use FFT."""
 
-_UNIFORM_TOLERANCE = 1.0e-6
-"""Relative tolerance on the steps of a uniform time axis."""
 
 
 # --------------------------------------------------------------------------- results
@@ -145,11 +143,6 @@ class Recirculation:
 
 
 
-def _finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
 
 
 def _count(name: str, value, minimum: int = 1) -> int:
@@ -160,13 +153,14 @@ def _count(name: str, value, minimum: int = 1) -> int:
     return int(value)
 
 
-def _uniform_step(name: str, time: np.ndarray) -> float:
-    if time.size < 2:
-        raise ValueError(f"{name} must have at least 2 samples, got {time.size}")
-    dt = (time[-1] - time[0]) / (time.size - 1)
-    if not dt > 0.0 or np.max(np.abs(np.diff(time) - dt)) > _UNIFORM_TOLERANCE * dt:
-        raise ValueError(f"{name} must be uniformly spaced and increasing")
-    return float(dt)
+
+
+def _unit_area(e: np.ndarray, dt: float) -> np.ndarray:
+    """``e`` scaled so that ``sum(e) dt = 1`` (the discrete RTD of a process that loses nothing)."""
+    area = float(np.sum(e)) * dt
+    if not area > 0.0:
+        raise ValueError("E must have a positive area to be normalised")
+    return e / area
 
 
 def _method(method: str) -> str:
@@ -218,14 +212,14 @@ def convolve_with_rtd(time, c_in, E, c_before: float = 0.0, method: str = "auto"
         Output concentration at ``time``.
     """
     t = finite_array("time", time, ndim=1)
-    dt = _uniform_step("time", t)
+    dt = uniform_step("time", t)
     c = finite_array("c_in", c_in, ndim=1)
     if c.shape != t.shape:
         raise ValueError(f"c_in must have the shape of time {t.shape}, got {c.shape}")
     e = finite_array("E", E, ndim=1)
     if e.size == 0:
         raise ValueError("E must have at least 1 sample")
-    c_before = _finite("c_before", c_before)
+    c_before = finite_number("c_before", c_before)
     method = _method(method)
     out = dt * _full_convolution(c, e, method)[: c.size]
     if c_before != 0.0:
@@ -263,10 +257,10 @@ def sine_input(time, mean: float, amplitude: float, period: float, phase: float 
         The signal, the shape of ``time``.
     """
     t = finite_array("time", time, ndim=None)
-    mean = _finite("mean", mean)
+    mean = finite_number("mean", mean)
     amplitude = non_negative_number("amplitude", amplitude)
     period = positive_number("period", period)
-    phase = _finite("phase", phase)
+    phase = finite_number("phase", phase)
     return mean + amplitude * np.sin(2.0 * np.pi * t / period + phase)
 
 
@@ -298,7 +292,7 @@ def square_input(time, mean: float, amplitude: float, period: float, duty: float
         The signal, the shape of ``time``.
     """
     t = finite_array("time", time, ndim=None)
-    mean = _finite("mean", mean)
+    mean = finite_number("mean", mean)
     amplitude = non_negative_number("amplitude", amplitude)
     period = positive_number("period", period)
     duty = float(duty)
@@ -348,7 +342,7 @@ def variance_reduction_ratio(c_in, c_out, steady_from=0, time=None) -> float:
         t = finite_array("time", time, ndim=1)
         if t.shape != a.shape:
             raise ValueError(f"time must have the shape of c_in {a.shape}, got {t.shape}")
-        window = t >= _finite("steady_from", steady_from)
+        window = t >= finite_number("steady_from", steady_from)
         n = int(window.sum())
     if n < 2:
         raise ValueError(f"steady_from leaves {n} samples; at least 2 are needed")
@@ -425,7 +419,7 @@ def vrr_versus_period(
     from analysis.rtd import rtd_moments
 
     t = finite_array("time", time, ndim=1)
-    dt = _uniform_step("time", t)
+    dt = uniform_step("time", t)
     if abs(t[0]) > 1.0e-9 * dt:
         raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
     e = finite_array("E", E, ndim=1)
@@ -439,10 +433,7 @@ def vrr_versus_period(
     n_periods = _count("n_periods", n_periods)
     method = _method(method)
     if normalise:
-        area = float(np.sum(e)) * dt
-        if not area > 0.0:
-            raise ValueError("E must have a positive area to be normalised")
-        e = e / area
+        e = _unit_area(e, dt)
     tm = rtd_moments(t, e).mean if t_mean is None else positive_number("t_mean", t_mean)
     periods = fractions * tm
     vrr = np.empty(fractions.size)
@@ -511,7 +502,7 @@ def recirculate(c_first_input, E, time, passes: int, normalise: bool = True, met
     Recirculation
     """
     t = finite_array("time", time, ndim=1)
-    dt = _uniform_step("time", t)
+    dt = uniform_step("time", t)
     c = finite_array("c_first_input", c_first_input, ndim=1)
     if c.shape != t.shape:
         raise ValueError(f"c_first_input must have the shape of time {t.shape}, got {c.shape}")
@@ -521,10 +512,7 @@ def recirculate(c_first_input, E, time, passes: int, normalise: bool = True, met
     passes = _count("passes", passes)
     method = _method(method)
     if normalise:
-        area = float(np.sum(e)) * dt
-        if not area > 0.0:
-            raise ValueError("E must have a positive area to be normalised")
-        e = e / area
+        e = _unit_area(e, dt)
     outputs = []
     current = c
     for _ in range(passes + 1):
@@ -576,7 +564,7 @@ def recirculations_to_homogenise(c, mean=None, tolerance: float = 0.10, per_pass
     values = finite_array("c", c, ndim=1)
     if values.size == 0:
         raise ValueError("c must not be empty")
-    target = float(np.mean(values)) if mean is None else _finite("mean", mean)
+    target = float(np.mean(values)) if mean is None else finite_number("mean", mean)
     if target == 0.0:
         raise ValueError("mean must be non-zero (the band is relative to it)")
     tolerance = positive_number("tolerance", tolerance)

@@ -59,7 +59,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from analysis.checks import compute_backend, finite_array, finite_number, points3, positive_number, vector3
 
 try:  # pragma: no cover - exercised through both branches in the tests when numba is present
     import numba
@@ -165,34 +165,10 @@ class PathlineResult:
 
 
 
-def _finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
 
 
-def _triple(name: str, values, positive: bool) -> np.ndarray:
-    array = np.asarray(values, dtype=float)
-    if array.ndim == 0:
-        array = np.full(3, float(array))
-    if array.shape != (3,):
-        raise ValueError(f"{name} must have 3 components (x, y, z), got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must contain only finite numbers, got {array.tolist()}")
-    if positive and np.any(array <= 0.0):
-        raise ValueError(f"{name} must be > 0 in every component, got {array.tolist()}")
-    return array
 
 
-def _points(name: str, values) -> np.ndarray:
-    array = np.asarray(values, dtype=float)
-    if array.ndim == 1 and array.size == 0:
-        array = array.reshape(0, 3)
-    array = finite_array(name, array, ndim=2)
-    if array.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3), got {array.shape}")
-    return np.ascontiguousarray(array)
 
 
 def _velocity_series(velocities, times) -> tuple[np.ndarray, np.ndarray]:
@@ -210,14 +186,6 @@ def _velocity_series(velocities, times) -> tuple[np.ndarray, np.ndarray]:
     return v, t
 
 
-def _backend_name(backend: str) -> str:
-    if backend not in ("auto", "numba", "numpy"):
-        raise ValueError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-    if backend == "numba" and not HAVE_NUMBA:
-        raise ValueError("backend='numba' requested but numba is not installed")
-    if backend == "auto":
-        return "numba" if HAVE_NUMBA else "numpy"
-    return backend
 
 
 # --------------------------------------------------------------------------- interpolation
@@ -309,11 +277,11 @@ def interpolate_velocity(points, t: float, velocities, times, origin, spacing) -
     numpy.ndarray, shape (n, 3)
         Velocity [m/s]: trilinear with clamping in space, linear in time (module docstring).
     """
-    pts = _points("points", points)
+    pts = points3("points", points)
     v, t_levels = _velocity_series(velocities, times)
-    origin = _triple("origin", origin, positive=False)
-    spacing = _triple("spacing", spacing, positive=True)
-    k, w = time_levels(t_levels, [_finite("t", t)])
+    origin = vector3("origin", origin, positive=False, scalar_to_all=True)
+    spacing = vector3("spacing", spacing, positive=True, scalar_to_all=True)
+    k, w = time_levels(t_levels, [finite_number("t", t)])
     return _interpolate_numpy(v, int(k[0]), float(w[0]), origin, 1.0 / spacing, pts)
 
 
@@ -570,20 +538,20 @@ def integrate_pathlines(
     ValueError
         Naming the argument with a wrong shape, a non-finite value or an invalid option.
     """
-    pts = _points("seeds", seeds)
+    pts = points3("seeds", seeds)
     v, t_levels = _velocity_series(velocities, times)
-    origin = _triple("origin", origin, positive=False)
-    spacing = _triple("spacing", spacing, positive=True)
-    t0 = _finite("t0", t0)
+    origin = vector3("origin", origin, positive=False, scalar_to_all=True)
+    spacing = vector3("spacing", spacing, positive=True, scalar_to_all=True)
+    t0 = finite_number("t0", t0)
     dt = positive_number("dt", dt)
-    outlet_z = _finite("outlet_z", outlet_z)
+    outlet_z = finite_number("outlet_z", outlet_z)
     max_time = positive_number("max_time", max_time)
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if isinstance(record_every, (bool, np.bool_)) or int(record_every) != record_every or record_every < 0:
         raise ValueError(f"record_every must be an integer >= 0, got {record_every!r}")
     record_every = int(record_every)
-    backend = _backend_name(backend)
+    backend = compute_backend(backend, HAVE_NUMBA)
 
     total_steps = max(1, int(math.ceil(max_time / dt - 1.0e-9)))
     k_steps, w_steps = time_levels(t_levels, t0 + np.arange(total_steps + 1) * dt)
@@ -663,8 +631,8 @@ def lattice_seeds(region_lower, region_upper, count=None, spacing=None) -> np.nd
     numpy.ndarray, shape (n_x n_y n_z, 3)
         Positions [m], x index slowest and z fastest.
     """
-    lower = _triple("region_lower", region_lower, positive=False)
-    upper = _triple("region_upper", region_upper, positive=False)
+    lower = vector3("region_lower", region_lower, positive=False, scalar_to_all=True)
+    upper = vector3("region_upper", region_upper, positive=False, scalar_to_all=True)
     if np.any(upper < lower):
         raise ValueError(f"region_upper must be >= region_lower per axis, got {lower.tolist()} and {upper.tolist()}")
     if (count is None) == (spacing is None):
@@ -689,7 +657,7 @@ def lattice_seeds(region_lower, region_upper, count=None, spacing=None) -> np.nd
             if np.any(per_axis[flat] != 1):
                 raise ValueError("count must be 1 along a flat axis of the region (upper == lower)")
     else:
-        step = _triple("spacing", spacing, positive=True)
+        step = vector3("spacing", spacing, positive=True, scalar_to_all=True)
         per_axis = np.maximum(1, np.round(lengths / step)).astype(np.int64)
     axes = [lower[a] + (np.arange(per_axis[a]) + 0.5) * lengths[a] / per_axis[a] for a in range(3)]
     grids = np.meshgrid(*axes, indexing="ij")

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from analysis.checks import finite_array, positive_number, uniform_step
 
 __all__ = [
     "RTD",
@@ -147,15 +147,6 @@ def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
     return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
 
 
-def _uniform_step(name: str, time: np.ndarray) -> float:
-    """The step of a uniform, increasing time axis (relative tolerance 1e-6)."""
-    if time.size < 2:
-        raise ValueError(f"{name} must have at least 2 samples, got {time.size}")
-    steps = np.diff(time)
-    dt = (time[-1] - time[0]) / (time.size - 1)
-    if dt <= 0.0 or np.max(np.abs(steps - dt)) > 1.0e-6 * dt:
-        raise ValueError(f"{name} must be uniformly spaced and increasing")
-    return float(dt)
 
 
 # --------------------------------------------------------------------------- measured RTD
@@ -447,7 +438,7 @@ def carson_royal_recycle(first_pass_E, time, passes: int) -> np.ndarray:
     from analysis.lti import convolve_with_rtd
 
     t = finite_array("time", time, ndim=1)
-    dt = _uniform_step("time", t)
+    dt = uniform_step("time", t)
     if abs(t[0]) > 1.0e-9 * dt:
         raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
     e1 = finite_array("first_pass_E", first_pass_E, ndim=1)

@@ -213,15 +213,20 @@ def _write_text_atomic(path: Path, text: str) -> None:
     os.replace(partial, path)
 
 
+def write_case_inputs(meshes: dict, summary: dict, deck_text: str, deck_dir: str | Path) -> Path:
+    """Write wall meshes, ``case.json`` and the deck into ``deck_dir`` (each atomically); returns the deck path."""
+    deck_dir = Path(deck_dir)
+    for name, mesh in meshes.items():
+        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
+    _write_text_atomic(deck_dir / "case.json", json.dumps(summary, indent=2, sort_keys=True, default=float))
+    deck_path = deck_dir / DECK_NAME
+    _write_text_atomic(deck_path, deck_text)
+    return deck_path
+
+
 def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
     """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
-    deck_dir = Path(deck_dir)
-    for name, mesh in silo_meshes(case).items():
-        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
-    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
-    deck_path = deck_dir / DECK_NAME
-    _write_text_atomic(deck_path, render_silo_deck(case))
-    return deck_path
+    return write_case_inputs(silo_meshes(case), case.summary(), render_silo_deck(case), deck_dir)
 
 
 # ---------------------------------------------------------------------------------------------- running
@@ -304,8 +309,13 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     return log_text
 
 
-def check_silo_run(case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path) -> dict:
+def check_silo_run(
+    case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged"
+) -> dict:
     """Check that a finished silo run did what the case asked; returns the stage record.
+
+    ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
+    drains; ``recirculated`` in the recirculating one); the record keeps it under that name.
 
     Raises
     ------
@@ -316,7 +326,7 @@ def check_silo_run(case: SiloCase, markers: list[Marker], dump_files: list[Path]
     by_event = {}
     for marker in markers:
         by_event.setdefault(marker.event, []).append(marker)
-    for event in ("filled", "settled", "opened", "discharged"):
+    for event in ("filled", "settled", "opened", last_stage):
         if event not in by_event:
             raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
     filled = by_event["filled"][-1].values
@@ -335,12 +345,11 @@ def check_silo_run(case: SiloCase, markers: list[Marker], dump_files: list[Path]
     if len(dump_files) < 2:
         raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
     opened = by_event["opened"][-1].values
-    discharged = by_event["discharged"][-1].values
     return {
         "filled": filled,
         "settled": settled,
         "opened": opened,
-        "discharged": discharged,
+        last_stage: by_event[last_stage][-1].values,
         "settle_checks": [m.values for m in by_event.get("settle", [])],
         "open_step": int(round(opened["step"])),
         "open_time_s": opened["time"],
@@ -357,24 +366,36 @@ def write_run_record(run_dir: Path, record: dict) -> Path:
     return path
 
 
-def run_silo(
-    case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
-) -> Path:
-    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns its path.
+def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None) -> Path:
+    """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns its path.
 
-    Output of an earlier unfinished attempt is moved to ``failed_attempts/`` first, so the dumps of this
-    run are never mixed with older ones.
+    Output of an earlier unfinished attempt is moved to ``failed_attempts/`` first, so the dumps of this run are
+    never mixed with older ones. ``check(markers, dump_files)`` raises :class:`EngineRunError` or returns the
+    stage record; ``engine`` holds the :func:`run_engine` options (executable, mpi_ranks, mpirun) and ``record``
+    extra entries for ``run.json``.
     """
     from analysis.dumps import list_dumps
 
     run_dir = Path(run_dir)
+    engine = dict(engine or {})
     deck = run_dir / "deck" / DECK_NAME
     if not deck.exists():
         raise FileNotFoundError(f"no deck at {deck}; render it first")
     (run_dir / RUN_RECORD).unlink(missing_ok=True)
     set_aside_previous_attempt(run_dir)
-    log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
-    dumps = list_dumps(run_dir / "dumps", DUMP_PREFIX)
-    record = check_silo_run(case, parse_markers(log_text), dumps, run_dir)
-    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX})
-    return write_run_record(run_dir, record)
+    log_text = run_engine(run_dir, **engine)
+    checked = check(parse_markers(log_text), list_dumps(run_dir / "dumps", DUMP_PREFIX))
+    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX, **(record or {})})
+    return write_run_record(run_dir, checked)
+
+
+def run_silo(
+    case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
+) -> Path:
+    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns its path."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun},
+        {"run_id": case.run_id},
+    )

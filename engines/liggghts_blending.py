@@ -9,25 +9,17 @@ bottom boundary whole and re-enter at the top with their ids. The recirculation 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from engines.blending import RecirculationCase
-from engines.geometry import vertical_rectangle_x, write_stl
+from engines.geometry import vertical_rectangle_x
 from engines.liggghts import (
-    DECK_NAME,
-    DUMP_PREFIX,
-    RUN_RECORD,
     EngineRunError,
-    Marker,
-    _write_text_atomic,
     check_silo_run,
-    parse_markers,
-    run_engine,
-    set_aside_previous_attempt,
+    run_checked,
     silo_deck_context,
     silo_meshes,
-    write_run_record,
+    write_case_inputs,
 )
 from engines.templating import render_deck
 
@@ -70,13 +62,7 @@ def render_recirculation_deck(case: RecirculationCase) -> str:
 
 def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) -> Path:
     """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
-    deck_dir = Path(deck_dir)
-    for name, mesh in recirculation_meshes(case).items():
-        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
-    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
-    deck_path = deck_dir / DECK_NAME
-    _write_text_atomic(deck_path, render_recirculation_deck(case))
-    return deck_path
+    return write_case_inputs(recirculation_meshes(case), case.summary(), render_recirculation_deck(case), deck_dir)
 
 
 def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_dir: Path) -> dict:
@@ -87,12 +73,7 @@ def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_di
     EngineRunError
         As :func:`engines.liggghts.check_silo_run`, or when the clump count changed during recirculation.
     """
-    if "recirculated" not in {marker.event for marker in markers}:
-        raise EngineRunError(f"{run_dir}: the log has no 'recirculated' stage marker; the deck did not run to the end")
-    # The batch silo's checks know its last stage as 'discharged'.
-    renamed = [Marker("discharged", m.values) if m.event == "recirculated" else m for m in markers]
-    record = check_silo_run(case.silo, renamed, dump_files, run_dir)
-    record["recirculated"] = record.pop("discharged")
+    record = check_silo_run(case.silo, markers, dump_files, run_dir, last_stage="recirculated")
     final = int(round(record["recirculated"]["clumps"]))
     if final != case.silo.fill.n_clumps:
         raise EngineRunError(
@@ -106,31 +87,17 @@ def run_recirculation(
     case: RecirculationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
     mpirun: str = "mpirun",
 ) -> Path:
-    """Run a rendered recirculation deck, check it and write ``run.json``; returns its path.
-
-    Output of an unfinished earlier attempt is moved to ``failed_attempts/`` first.
-    """
-    from analysis.dumps import list_dumps
-
-    run_dir = Path(run_dir)
-    deck = run_dir / "deck" / DECK_NAME
-    if not deck.exists():
-        raise FileNotFoundError(f"no deck at {deck}; render it first")
-    (run_dir / RUN_RECORD).unlink(missing_ok=True)
-    set_aside_previous_attempt(run_dir)
-    log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
-    dumps = list_dumps(run_dir / "dumps", DUMP_PREFIX)
-    record = check_recirculation_run(case, parse_markers(log_text), dumps, run_dir)
-    record.update(
+    """Run a rendered recirculation deck, check it and write ``run.json``; returns its path."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_recirculation_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun},
         {
             "run_id": case.run_id,
-            "mpi_ranks": mpi_ranks,
-            "dump_prefix": DUMP_PREFIX,
             "flow_pattern": case.pattern,
             "role": case.role,
             "estimated_residence_time_s": case.estimated_residence_time,
             "domain_z": [-case.channel_length, case.silo.domain_top],
             "outlet_z": 0.0,
-        }
+        },
     )
-    return write_run_record(run_dir, record)

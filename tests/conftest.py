@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import copy
 import shutil
+import subprocess
+import sys
 
 import pytest
 
@@ -65,6 +67,17 @@ def tiny_config(raw_default_config) -> dict:
     raw = copy.deepcopy(raw_default_config)
     raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(TINY_SILO)}
     return validate_config(raw)
+
+
+def run_snakemake(workdir, *arguments: str, targets=()) -> subprocess.CompletedProcess:
+    """Run the repository's workflow in ``workdir``; targets go first, since --configfile takes every word after it."""
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", *targets, "-s", str(REPO_ROOT / "Snakefile"), "--directory", str(workdir),
+         *arguments],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
 
 
 def require_liggghts():

@@ -10,8 +10,6 @@ from __future__ import annotations
 import copy
 import csv
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +19,8 @@ import yaml
 from analysis.blending import recirculation_events
 from analysis.blending_io import load_tracks
 from engines.blending import recirculation_cases
-from engines.config import REPO_ROOT, validate_config
-from tests.conftest import TINY_BLENDING, TINY_SILO, require_liggghts
+from engines.config import validate_config
+from tests.conftest import TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -40,12 +38,7 @@ def blending_pipeline(tmp_path_factory):
     workdir = tmp_path_factory.mktemp("blending")
     config_path = workdir / "blending.yaml"
     config_path.write_text(yaml.safe_dump(CONFIG))
-    result = subprocess.run(
-        # the target goes first: --configfile takes every following word as a file
-        [sys.executable, "-m", "snakemake", "blending_all", "-s", str(REPO_ROOT / "Snakefile"), "--directory",
-         str(workdir), "--cores", "2", "--configfile", str(config_path)],
-        capture_output=True, text=True, check=False,
-    )
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["blending_all"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus CONFIG.
     cases = recirculation_cases(validate_config(copy.deepcopy(CONFIG)))

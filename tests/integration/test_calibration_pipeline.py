@@ -12,8 +12,7 @@ import json
 import pytest
 import yaml
 
-from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts
-from tests.integration.test_silo_pipeline import _snakemake
+from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -38,7 +37,7 @@ def calibrated_pipeline(tmp_path_factory):
     workdir = tmp_path_factory.mktemp("calibration")
     config_path = workdir / "calibration.yaml"
     config_path.write_text(yaml.safe_dump(TINY_CALIBRATION))
-    result = _snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     return workdir
 

@@ -7,9 +7,6 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 import yaml
@@ -17,7 +14,7 @@ import yaml
 from engines.config import REPO_ROOT
 from engines.liggghts import EngineRunError, run_engine, write_silo_inputs, run_silo
 from engines.silo import build_silo_case
-from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts
+from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -40,15 +37,6 @@ def _validated(silo: dict) -> dict:
     return validate_config(raw)
 
 
-def _snakemake(workdir: Path, *arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "snakemake", "-s", str(REPO_ROOT / "Snakefile"), "--directory", str(workdir), *arguments],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-
-
 @pytest.fixture(scope="module")
 def tiny_pipeline(tmp_path_factory):
     """Run the whole workflow once on the tiny silo; yields (workdir, run directory)."""
@@ -57,7 +45,7 @@ def tiny_pipeline(tmp_path_factory):
     config_path = workdir / "tiny.yaml"
     silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}}
     config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "blending": NO_BLENDING}))
-    result = _snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     run_dir = workdir / "results" / "silo_flat" / build_silo_case(_validated(silo)).run_id
     yield workdir, run_dir, result
@@ -103,7 +91,7 @@ def test_outputs_and_logs_are_where_the_workflow_says(tiny_pipeline):
 
 def test_a_second_call_has_nothing_to_do(tiny_pipeline):
     workdir, _, _ = tiny_pipeline
-    result = _snakemake(workdir, "-n", "--cores", "2", "--configfile", str(workdir / "tiny.yaml"))
+    result = run_snakemake(workdir, "-n", "--cores", "2", "--configfile", str(workdir / "tiny.yaml"))
     assert result.returncode == 0
     assert "Nothing to be done" in result.stdout + result.stderr
 
@@ -131,7 +119,7 @@ def test_an_unsettled_fill_fails_without_a_run_record(tmp_path, tiny_config):
 
 
 def test_thesis_config_plans_without_error(tmp_path):
-    result = _snakemake(tmp_path, "-n", "--cores", "2", "--configfile", str(REPO_ROOT / "config" / "thesis.yaml"))
+    result = run_snakemake(tmp_path, "-n", "--cores", "2", "--configfile", str(REPO_ROOT / "config" / "thesis.yaml"))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert "silo_run" in result.stdout
 
@@ -139,7 +127,7 @@ def test_thesis_config_plans_without_error(tmp_path):
 def test_invalid_config_stops_the_workflow_with_the_key_named(tmp_path):
     config_path = tmp_path / "bad.yaml"
     config_path.write_text("silo_flat:\n  outlet_width: -0.04\n")
-    result = _snakemake(tmp_path, "-n", "--cores", "1", "--configfile", str(config_path))
+    result = run_snakemake(tmp_path, "-n", "--cores", "1", "--configfile", str(config_path))
     assert result.returncode != 0
     assert "config key 'silo_flat.outlet_width': -0.04 is less than or equal to the minimum of 0" in result.stdout + result.stderr
 

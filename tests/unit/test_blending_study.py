@@ -23,6 +23,7 @@ import pytest
 
 from analysis.blending import ClumpTracks, RecirculationEvents, recirculation_events
 from analysis.blending_study import (
+    residence_summary,
     BlendingResult,
     Layout,
     LoopTiming,
@@ -514,3 +515,9 @@ def test_verify_eulerian_rtd_of_uniform_downflow(tracks):
             np.testing.assert_array_equal(np.isfinite(line[:, 1]), inside)
             np.testing.assert_allclose(line[inside, 0], x, rtol=0, atol=1e-12)
             np.testing.assert_allclose(line[inside, 1], z - SPEED * DT * history_steps[inside], rtol=0, atol=1e-10)
+
+
+def test_residence_summary_counts_and_moments():
+    summary = residence_summary([1.0, 3.0, np.nan])
+    assert summary == {"n": 3, "n_exited": 2, "mean_s": 2.0, "std_s": 1.0}
+    assert residence_summary([np.nan]) == {"n": 1, "n_exited": 0, "mean_s": None, "std_s": None}

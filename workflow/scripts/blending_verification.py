@@ -3,20 +3,11 @@
 import json
 from pathlib import Path
 
-import numpy as np
-
 from analysis.blending_io import load_tracks
 from analysis.blending_plots import plot_paths_comparison, plot_residence_time_comparison
-from analysis.blending_study import verify_eulerian_rtd
+from analysis.blending_study import residence_summary, verify_eulerian_rtd
 from analysis.tables import write_flow_table, write_json
 from engines.logs import logged_to
-
-
-def moments(times):
-    finite = times[np.isfinite(times)]
-    return {"n": int(times.size), "n_exited": int(finite.size),
-            "mean_s": float(finite.mean()) if finite.size else None,
-            "std_s": float(finite.std()) if finite.size else None}
 
 
 with logged_to(snakemake.log[0]) as log:
@@ -37,8 +28,8 @@ with logged_to(snakemake.log[0]) as log:
         rows += [{"method": "eulerian", "bin_size_m": bin_size, "residence_time_s": t} for t in times]
     write_flow_table(out.table, rows)
     summary = {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
-               "particles": moments(result.particle_residence),
-               "eulerian": {f"{1000 * b:g} mm": moments(t) for b, t in result.eulerian_residence.items()}}
+               "particles": residence_summary(result.particle_residence),
+               "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}
     write_json(out.summary, summary)
     samples = [("particle tracks", result.particle_residence)] + [
         (f"Eulerian, {1000 * b:g} mm bins", t) for b, t in result.eulerian_residence.items()]
