@@ -13,6 +13,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
 include: "workflow/rules/blending.smk"
+include: "workflow/rules/blender.smk"
 
 
 rule all:
@@ -21,6 +22,7 @@ rule all:
         silo_flat_targets,
         parametric_targets,
         blending_targets,
+        blender_targets,
     default_target: True
 
 

@@ -24,6 +24,8 @@ import numpy as np
 __all__ = [
     "atomic_output",
     "write_flow_table",
+    "write_text",
+    "markdown_table",
     "write_json",
     "write_discharge_history_csv",
 ]
@@ -77,6 +79,25 @@ def _write_text_atomic(path: str | os.PathLike, text: str) -> Path:
             stream.flush()
             os.fsync(stream.fileno())
     return Path(path)
+
+
+def write_text(path: str | os.PathLike, text: str) -> Path:
+    """Write a text file (UTF-8) atomically."""
+    return _write_text_atomic(path, text)
+
+
+def markdown_table(rows: list[dict], digits: int = 4) -> str:
+    """A Markdown table of rows (columns: the first row's keys); numbers with ``digits`` significant digits."""
+    if not rows:
+        raise ValueError("a table needs at least one row")
+    columns = list(rows[0])
+
+    def cell(value: Any) -> str:
+        return f"{value:.{digits}g}" if isinstance(value, float) else str(value)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(row.get(column, "")) for column in columns) + " |" for row in rows]
+    return "\n".join(lines) + "\n"
 
 
 def _plain(value: Any) -> Any:

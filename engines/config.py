@@ -172,6 +172,7 @@ def _check_references(config: dict) -> None:
 
     _check_jenike_references(config, require, seen)
     _check_blending_references(config, require)
+    _check_blender_references(config, require)
 
     particle_material = silo["particle_material"]
     if "density" not in materials[particle_material]:
@@ -201,6 +202,36 @@ def _check_blending_references(config: dict, require) -> None:
         raise ConfigError(
             f"config key 'blending.outlet_width': {blending['outlet_width']} m must be smaller than "
             f"blending.width ({blending['width']} m)"
+        )
+
+
+def _check_blender_references(config: dict, require) -> None:
+    from engines.blender_geometry import INSERT_PRESETS
+
+    blender = config["blender"]
+    for name in blender["inserts"]:
+        if name in INSERT_PRESETS:
+            raise ConfigError(
+                f"config key 'blender.inserts.{name}': '{name}' is a built-in preset; give your insert another name"
+            )
+    defined = {**{name: None for name in INSERT_PRESETS}, **blender["inserts"]}
+    for index, name in enumerate(blender["configurations"]):
+        require(name, defined, f"blender.configurations[{index}]", "insert configuration")
+    if blender["outlet_width"] >= blender["width"]:
+        raise ConfigError(
+            f"config key 'blender.outlet_width': {blender['outlet_width']} m must be smaller than blender.width "
+            f"({blender['width']} m)"
+        )
+    if blender["pathlines"]["release_height"] >= blender["fill_height"]:
+        raise ConfigError(
+            f"config key 'blender.pathlines.release_height': {blender['pathlines']['release_height']} m must be below "
+            f"the fill height blender.fill_height ({blender['fill_height']} m)"
+        )
+    start, end = blender["discharge"]["steady_window"]
+    if not start < end <= blender["discharge"]["time"]:
+        raise ConfigError(
+            f"config key 'blender.discharge.steady_window': {[start, end]} must be an increasing window within "
+            f"blender.discharge.time ({blender['discharge']['time']} s)"
         )
 
 

@@ -197,17 +197,20 @@ def plan_fill(
     fill_config: dict,
     timestep: float,
     gravity: float,
+    n_clumps: int | None = None,
 ) -> FillPlan:
     """Size the central pour: clump count from the target fill height, zone above the heap, rate.
 
-    The clump count is n = rho_b,est W T H / m_clump. The insertion zone is centred and spans the whole depth
+    The clump count is n = rho_b,est W T H / m_clump unless given (a silo whose cross-section is not a rectangle
+    counts its own). The insertion zone is centred and spans the whole depth
     (with ``all_in`` LIGGGHTS keeps each clump's bounding sphere inside the zone, so clumps never overlap the
     front and back walls, and a silo one clump thick still has room for the centres), and its floor sits above
     the highest heap the pile can form, H + (W/2) tan(heap angle), plus two clump diameters. Each insertion
     event fills the zone to the given solid fraction; the next one comes when the batch has moved one zone
     height down, so batches never overlap.
     """
-    n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
+    if n_clumps is None:
+        n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
     if n_clumps < 1:
         raise ValueError("fill_height too small: less than one clump fits")
     clearance = particle.bounding_radius

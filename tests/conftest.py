@@ -45,8 +45,31 @@ TINY_BLENDING = {
                      "bin_sizes": [0.005, 0.01, 0.015]},
 }
 
-# Pipelines that test other stages leave the blending study out.
+# Pipelines that test other stages leave the blending study and the blender out.
 NO_BLENDING = {"enabled": False}
+NO_BLENDER = {"enabled": False}
+
+# A tiny blender (about 2,000 two-sphere clumps, one layer deep): a 150 mm hopper with no tube and an insert given
+# by its plate end points, wide enough (passages of 7 clump sizes and more) to flow without arching; continuous
+# discharge at gravity factors 1 and 4.
+TINY_BLENDER = {
+    "configurations": ["tiny"],
+    "inserts": {"tiny": {"inlet": [0.045, 0.1223], "outlet": [0.03, 0.08]}},
+    "width": 0.15,
+    "depth": 0.0045,
+    "vertical_height": 0.16,
+    "outlet_width": 0.024,
+    "fill_height": 0.14,
+    "wall_thickness": 0.002,
+    "tube_width": 0.0,
+    "fill_zone_width_fraction": 0.6,
+    "discharge": {"mode": "continuous", "time": 0.8, "steady_window": [0.3, 0.8], "profile_windows": 2},
+    "gravity_factors": [1.0, 4.0],
+    "bin_size": 0.005,
+    "profile_heights_above": [0.01],
+    "pathlines": {"release_height": 0.13, "spacing": 0.0075, "integration_step": 0.001, "max_time": 100.0},
+    "continuous": {"period_fractions": [0.2, 0.5, 1.0, 2.0], "comparison_fractions": [0.5, 1.0]},
+}
 
 
 @pytest.fixture

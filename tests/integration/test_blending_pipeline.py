@@ -20,12 +20,13 @@ from analysis.blending import recirculation_events
 from analysis.blending_io import load_tracks
 from engines.blending import recirculation_cases
 from engines.config import validate_config
-from tests.conftest import TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
 CONFIG = {
     "blending": TINY_BLENDING,
+    "blender": NO_BLENDER,
     "engine": {"mpi_ranks": 2},
     "silo_flat": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
 }

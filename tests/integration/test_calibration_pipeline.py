@@ -12,7 +12,7 @@ import json
 import pytest
 import yaml
 
-from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -28,6 +28,7 @@ TINY_CALIBRATION = {
                     "rolling_friction": 0.0},
     "silo_flat": {**TINY_SILO, "parameters": "calibrated"},
     "blending": NO_BLENDING,
+    "blender": NO_BLENDER,
 }
 
 

@@ -14,7 +14,7 @@ import yaml
 from engines.config import REPO_ROOT
 from engines.liggghts import EngineRunError, run_engine, write_silo_inputs, run_silo
 from engines.silo import build_silo_case
-from tests.conftest import NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -44,7 +44,7 @@ def tiny_pipeline(tmp_path_factory):
     workdir = tmp_path_factory.mktemp("tiny_silo")
     config_path = workdir / "tiny.yaml"
     silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}}
-    config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "blending": NO_BLENDING}))
+    config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "blending": NO_BLENDING, "blender": NO_BLENDER}))
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     run_dir = workdir / "results" / "silo_flat" / build_silo_case(_validated(silo)).run_id

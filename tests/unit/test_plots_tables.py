@@ -108,3 +108,14 @@ def test_write_discharge_history_csv_round_trip(tmp_path):
     np.testing.assert_array_equal(table["time_s"].to_numpy(), history.time)
     np.testing.assert_array_equal(table["discharged_mass_kg"].to_numpy(), history.discharged_mass)
     _only_file(tmp_path, "history.csv")
+
+
+def test_markdown_table_writes_columns_of_the_first_row_with_significant_digits(tmp_path):
+    from analysis.tables import markdown_table, write_text
+
+    text = markdown_table([{"name": "a", "rate": 0.0123456, "n": 3}, {"name": "b", "rate": float("nan")}], digits=3)
+    assert text == "| name | rate | n |\n|---|---|---|\n| a | 0.0123 | 3 |\n| b | nan |  |\n"
+    path = write_text(tmp_path / "table.md", text)
+    assert path.read_text() == text
+    with pytest.raises(ValueError, match="at least one row"):
+        markdown_table([])

@@ -7,6 +7,7 @@ sys.path.insert(0, workflow.basedir)
 
 from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
+from engines.blender import blender_case_for_run, blender_cases
 from engines.blending import recirculation_case_for_run, recirculation_cases
 from engines.silo import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
 
@@ -27,6 +28,10 @@ try:
     recirculation_cases(config)
 except ValueError as error:
     raise WorkflowError(f"Invalid blending configuration: {error}") from None
+try:
+    blender_cases(config)
+except (ValueError, KeyError) as error:
+    raise WorkflowError(f"Invalid blender configuration: {error}") from None
 
 
 def uses_calibrated_parameters():
@@ -117,6 +122,33 @@ def blending_targets(wildcards=None):
     return targets
 
 
+def blender_dir(run_id):
+    return f"{RESULTS}/blender/{run_id}"
+
+
+def blender_runs():
+    """Run ids of the blender runs (configurations x gravity factors)."""
+    return list(blender_cases(config))
+
+
+def blender_targets(wildcards=None):
+    runs = blender_runs()
+    targets = [
+        f"{blender_dir(run)}/{name}"
+        for run in runs
+        for name in ("metrics/blender.json", "plots/profiles.png", "plots/insert_velocities.png",
+                     "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png", "plots/discontinuous.png",
+                     "plots/vrr_period.png")
+    ]
+    if runs:
+        targets += [f"{RESULTS}/blender/comparison/{name}"
+                    for name in ("configurations.csv", "configurations.md", "configurations.png", "rtd.png")]
+    if len(config["blender"]["gravity_factors"]) > 1:
+        targets += [f"{RESULTS}/blender/gravity/scaling.csv", f"{RESULTS}/blender/gravity/scaling.png"]
+    return targets
+
+
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *blending_targets()]:
+    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *blending_targets(),
+                 *blender_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")

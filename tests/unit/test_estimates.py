@@ -1,0 +1,377 @@
+"""Run estimates before a run starts: steps, times, dump frames, disk space, calibration, formatting."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from types import SimpleNamespace
+
+import pytest
+
+from engines.blender import blender_cases, build_blender_case
+from engines.blending import recirculation_cases
+from engines.config import REPO_ROOT, load_config
+from engines.estimates import (
+    ESTIMATE_COLUMNS,
+    KINDS,
+    CostModel,
+    InsufficientDiskSpace,
+    RunEstimate,
+    calibrate_cost_model,
+    check_disk_space,
+    dump_frames,
+    estimate_blender_case,
+    estimate_jenike_case,
+    estimate_recirculation_case,
+    estimate_rows,
+    estimate_run,
+    estimate_silo_case,
+    format_bytes,
+    format_duration,
+    jenike_run_steps,
+    parallel_speedup,
+    silo_run_steps,
+    total_dump_bytes,
+    wall_time,
+)
+from engines.jenike import build_jenike_case
+from engines.silo import build_silo_case
+
+JENIKE_POINT = {
+    "shape": "sphere2",
+    "test": "internal",
+    "sliding_friction": 0.5,
+    "rolling_friction": 0.1,
+    "restitution": 0.1,
+    "rotation_blocked": False,
+}
+
+
+@pytest.fixture(scope="module")
+def config() -> dict:
+    return load_config(REPO_ROOT / "config" / "config.yaml")
+
+
+def _silo_like(**overrides) -> SimpleNamespace:
+    """A hand-made silo case: 100 two-sphere clumps, fill 1000 steps, 4 x 50 settle steps, 2000 discharge."""
+    values = dict(
+        run_id="silo-test", fill=SimpleNamespace(n_clumps=100, fill_steps=1000), spheres_per_clump=2,
+        settle_check_steps=50, settle_max_checks=4, discharge_steps=2000, dump_every=300, timestep=1.0e-5,
+    )
+    values.update(overrides)
+    return SimpleNamespace(**values)
+
+
+# ---------------------------------------------------------------------------------------------- model
+
+
+def test_cost_model_defaults_are_the_measured_values():
+    model = CostModel()
+    assert model.seconds_per_sphere_step == 5.0e-7
+    assert model.bytes_per_sphere_per_dump == 128
+    assert model.dump_header_bytes == 1024
+    assert model.cache_factor == 1.0
+    assert model.parallel_efficiency == 0.8
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [("seconds_per_sphere_step", 0.0), ("bytes_per_sphere_per_dump", -1.0), ("cache_factor", float("nan")),
+     ("parallel_efficiency", 0.0), ("parallel_efficiency", 1.5), ("dump_header_bytes", float("inf"))],
+)
+def test_cost_model_refuses_impossible_values_and_names_them(field, value):
+    with pytest.raises(ValueError, match=field):
+        CostModel(**{field: value})
+
+
+@pytest.mark.parametrize("ranks, speedup", [(1, 1.0), (2, 1.6), (4, 2.56), (8, 4.096)])
+def test_parallel_speedup_loses_the_efficiency_per_doubling(ranks, speedup):
+    assert parallel_speedup(ranks, 0.8) == pytest.approx(speedup, rel=1e-12)
+    # wall = serial / (ranks * efficiency^log2(ranks))
+    assert wall_time(100.0, ranks, CostModel()) == pytest.approx(100.0 / speedup, rel=1e-12)
+
+
+def test_perfect_efficiency_divides_by_the_ranks():
+    assert wall_time(90.0, 3, CostModel(parallel_efficiency=1.0)) == pytest.approx(30.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("ranks", [0, -2, 1.5, True])
+def test_parallel_speedup_refuses_bad_rank_counts(ranks):
+    with pytest.raises(ValueError, match="mpi_ranks"):
+        parallel_speedup(ranks, 0.8)
+
+
+# ---------------------------------------------------------------------------------------------- calibration
+
+
+SYNTHETIC_LOG = """\
+LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0)
+Loop time of 4 on 1 procs for 1000 steps with 2000 atoms, finish time Sat Nov 21 12:23:30 2026
+Loop time of 6.21e-07 on 1 procs for 0 steps with 13078 atoms, finish time Sat Nov 21 15:27:18 2026
+Pair  time (%) = 1.54284 (31.0069)
+Loop time of 3 on 2 procs for 500 steps with 4000 atoms
+Loop time of 1.5 on 1 procs for 100 steps with 0 atoms
+"""
+
+
+def test_calibration_divides_cpu_seconds_by_sphere_steps():
+    # (4 * 1 + 3 * 2) / (1000 * 2000 + 500 * 4000); the 0-step and 0-atom lines do not count
+    base = CostModel(bytes_per_sphere_per_dump=100.0, parallel_efficiency=0.9)
+    model = calibrate_cost_model(SYNTHETIC_LOG, base)
+    assert model.seconds_per_sphere_step == pytest.approx(10.0 / 4.0e6, rel=1e-12)
+    assert dataclasses.replace(model, seconds_per_sphere_step=base.seconds_per_sphere_step) == base
+
+
+def test_calibration_of_a_real_log_line_with_mpi():
+    line = "Loop time of 296.734 on 4 procs for 103983 steps with 2134 atoms, finish time Sat Nov 21 15:32:15 2026\n"
+    model = calibrate_cost_model(line)
+    assert model.seconds_per_sphere_step == pytest.approx(296.734 * 4 / (103983 * 2134), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "text", ["", "no timing here\n", "Loop time of 6.2e-07 on 1 procs for 0 steps with 13078 atoms\n"]
+)
+def test_calibration_without_usable_loop_lines_is_refused(text):
+    with pytest.raises(ValueError, match="Loop time of"):
+        calibrate_cost_model(text)
+
+
+# ---------------------------------------------------------------------------------------------- core estimate
+
+
+def test_estimate_run_exact_numbers():
+    estimate = estimate_run("r", "silo_flat", clumps=1000, spheres_per_clump=2, steps=10_000, timestep=1.0e-5,
+                            dump_frames=11)
+    assert estimate.spheres == 2000
+    assert estimate.simulated_time_s == pytest.approx(0.1, rel=1e-12)
+    # 2000 spheres x 10,000 steps x 0.5 microseconds
+    assert estimate.wall_time_s == pytest.approx(10.0, rel=1e-12)
+    # 11 dumps of 1024 + 2000 x 128 bytes, and a cache as large
+    assert estimate.dump_bytes == 2 * 11 * (1024 + 2000 * 128) == 5_654_528
+    assert (estimate.run_id, estimate.kind, estimate.clumps, estimate.steps, estimate.dump_frames,
+            estimate.mpi_ranks) == ("r", "silo_flat", 1000, 10_000, 11, 1)
+
+
+def test_estimate_run_with_ranks_lid_spheres_contacts_and_no_cache():
+    estimate = estimate_run("r", "jenike", clumps=100, spheres_per_clump=3, steps=1000, timestep=2.0e-6,
+                            dump_frames=5, mpi_ranks=2, extra_spheres=20, contact_frames=4, frame_cache=False)
+    assert estimate.spheres == 320
+    assert estimate.wall_time_s == pytest.approx(320 * 1000 * 5.0e-7 / 1.6, rel=1e-12)
+    assert estimate.dump_bytes == 5 * (1024 + 320 * 128) + 4 * (1024 + 320 * 200)
+
+
+@pytest.mark.parametrize(
+    "changes, message",
+    [({"kind": "hopper"}, "unknown run kind 'hopper'"), ({"mpi_ranks": 0}, "mpi_ranks"),
+     ({"timestep": 0.0}, "timestep"), ({"clumps": -1}, "clumps"), ({"spheres_per_clump": 0}, "spheres_per_clump"),
+     ({"dump_frames": 2.5}, "dump_frames")],
+)
+def test_estimate_run_refuses_bad_input_and_names_it(changes, message):
+    arguments = dict(run_id="r", kind="silo_flat", clumps=10, spheres_per_clump=2, steps=100, timestep=1e-5,
+                     dump_frames=2)
+    arguments.update(changes)
+    with pytest.raises(ValueError, match=message):
+        estimate_run(**arguments)
+
+
+@pytest.mark.parametrize("steps, every, frames", [(0, 10, 1), (100, 10, 11), (101, 10, 12), (9, 10, 2),
+                                                  (103983, 434, 241), (21664, 1733, 14)])
+def test_dump_frames_is_the_first_dump_plus_the_multiples_a_stage_can_hold(steps, every, frames):
+    # 241: the recorded silo_flat run (1.2 s discharge at 434 steps per dump); 14: a recorded Jenike run
+    assert dump_frames(steps, every) == frames
+
+
+def test_dump_frames_refuses_a_zero_interval():
+    with pytest.raises(ValueError, match="dump_every"):
+        dump_frames(100, 0)
+
+
+# ---------------------------------------------------------------------------------------------- case kinds
+
+
+def test_hand_made_silo_case_exact_numbers():
+    estimate = estimate_silo_case(_silo_like())
+    assert estimate.steps == 1000 + 4 * 50 + 2000 == 3200
+    assert estimate.spheres == 200
+    assert estimate.dump_frames == 1 + math.ceil(2000 / 300) == 8
+    assert estimate.simulated_time_s == pytest.approx(0.032, rel=1e-12)
+    assert estimate.wall_time_s == pytest.approx(200 * 3200 * 5.0e-7, rel=1e-12)
+    # 8 dumps and their cache, plus the one contact snapshot of the settled fill
+    assert estimate.dump_bytes == 2 * 8 * (1024 + 200 * 128) + (1024 + 200 * 200) == 467_008
+    assert (estimate.run_id, estimate.kind) == ("silo-test", "silo_flat")
+
+
+def test_silo_case_from_config_counts_the_settle_stage_at_its_longest(config):
+    case = build_silo_case(config)
+    estimate = estimate_silo_case(case, mpi_ranks=2)
+    expected_steps = case.fill.fill_steps + case.settle_max_checks * case.settle_check_steps + case.discharge_steps
+    assert estimate.steps == silo_run_steps(case) == expected_steps
+    assert estimate.clumps == case.fill.n_clumps
+    assert estimate.spheres == case.fill.n_clumps * case.particle.n_spheres
+    assert estimate.simulated_time_s == pytest.approx(expected_steps * case.timestep, rel=1e-12)
+    assert estimate.wall_time_s == pytest.approx(estimate.spheres * expected_steps * 5.0e-7 / 1.6, rel=1e-12)
+    assert estimate.dump_frames == 1 + math.ceil(case.discharge_steps / case.dump_every)
+    frames_bytes = estimate.dump_frames * (1024 + estimate.spheres * 128)
+    assert estimate.dump_bytes == 2 * frames_bytes + 1024 + estimate.spheres * 200
+    assert estimate.run_id == case.run_id and estimate.mpi_ranks == 2
+
+
+def test_changing_a_silo_case_changes_its_estimate_exactly(config):
+    case = build_silo_case(config)
+    changed = dataclasses.replace(
+        case, fill=dataclasses.replace(case.fill, n_clumps=500, fill_steps=7000), settle_check_steps=100,
+        settle_max_checks=3, discharge_steps=9000, dump_every=1000, timestep=2.0e-5,
+    )
+    estimate = estimate_silo_case(changed)
+    assert estimate.steps == 7000 + 300 + 9000
+    assert estimate.dump_frames == 10
+    assert estimate.simulated_time_s == pytest.approx(16300 * 2.0e-5, rel=1e-12)
+    spheres = 500 * case.particle.n_spheres
+    assert estimate.dump_bytes == 2 * 10 * (1024 + spheres * 128) + 1024 + spheres * 200
+
+
+def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
+    cases = recirculation_cases(config)
+    assert cases, "the default config defines blending runs"
+    for run_id, case in cases.items():
+        estimate = estimate_recirculation_case(case)
+        silo = case.silo
+        assert estimate.run_id == run_id != silo.run_id
+        assert estimate.kind == "blending"
+        assert estimate.steps == silo.fill.fill_steps + silo.settle_max_checks * silo.settle_check_steps + silo.discharge_steps
+        assert estimate.dump_frames == 1 + math.ceil(silo.discharge_steps / silo.dump_every)
+        assert estimate.spheres == silo.fill.n_clumps * silo.particle.n_spheres
+        # the recirculation stage is the silo's discharge stage
+        assert silo.discharge_steps * silo.timestep == pytest.approx(case.recirculation_time, rel=1e-12)
+
+
+def test_blender_cases_use_their_gravity_scaled_silo(config):
+    cases = blender_cases(config)
+    assert cases, "the default config defines blender runs"
+    for run_id, case in cases.items():
+        estimate = estimate_blender_case(case)
+        silo = case.silo
+        assert (estimate.run_id, estimate.kind) == (run_id, "blender")
+        assert estimate.steps == silo_run_steps(silo)
+        assert estimate.dump_frames == dump_frames(silo.discharge_steps, silo.dump_every)
+    configuration = config["blender"]["configurations"][0]
+    normal, heavy = (estimate_blender_case(build_blender_case(config, configuration, f)) for f in (1.0, 4.0))
+    # at 4 g the flow times halve, the dump interval with them: fewer steps, as many frames
+    assert heavy.steps < normal.steps
+    assert heavy.dump_frames == normal.dump_frames
+
+
+def test_hand_made_jenike_case_exact_numbers():
+    case = SimpleNamespace(
+        run_id="jenike-test", particle=SimpleNamespace(n_spheres=2), timestep=1.0e-5,
+        fill=SimpleNamespace(n_clumps=453, steps=16900, relax_steps=1734),
+        ramp_steps=1083, hold_steps=3250, shear_steps=17331, dump_every=1733,
+        rigid_lid=SimpleNamespace(n_spheres=280), servo_lid=None,
+    )
+    estimate = estimate_jenike_case(case)
+    # 40299: the last step of the recorded calibration run with these numbers
+    assert estimate.steps == jenike_run_steps(case) == 16900 + 1 + 1734 + 1083 + 3250 + 17331 == 40299
+    assert estimate.clumps == 453 and estimate.spheres == 906 + 280
+    # as the recorded run: 14 particle dumps over consolidation and shear
+    assert estimate.dump_frames == 14
+    # particle dumps and contact dumps, no frame cache
+    assert estimate.dump_bytes == 14 * (1024 + 1186 * 128) + 14 * (1024 + 1186 * 200)
+    assert estimate.simulated_time_s == pytest.approx(0.40299, rel=1e-12)
+    assert estimate.kind == "jenike"
+
+
+def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
+    for lid in ("rigid", "servo"):
+        case = build_jenike_case(config, {**JENIKE_POINT, "lid": lid})
+        estimate = estimate_jenike_case(case)
+        assert estimate.steps == (case.fill.steps + 1 + case.fill.relax_steps + case.ramp_steps + case.hold_steps
+                                  + case.shear_steps)
+        lid_atoms = case.rigid_lid.n_spheres if lid == "rigid" else 2
+        assert estimate.spheres == case.fill.n_clumps * case.particle.n_spheres + lid_atoms
+        dumped = case.ramp_steps + case.hold_steps + case.shear_steps
+        assert estimate.dump_frames == 1 + math.ceil(dumped / case.dump_every)
+        assert estimate.run_id == case.run_id
+
+
+def test_kinds_are_the_four_run_kinds():
+    assert KINDS == ("silo_flat", "blending", "blender", "jenike")
+
+
+# ---------------------------------------------------------------------------------------------- disk
+
+
+def test_disk_check_refuses_when_the_estimate_exceeds_the_free_space():
+    with pytest.raises(InsufficientDiskSpace) as caught:
+        check_disk_space(12.3e9, 4.5e9, "/data", "of the blender study")
+    assert str(caught.value) == (
+        "the runs of the blender study need about 12.3 GB for dumps and caches but only 4.5 GB are free on "
+        "/data; free space, move results/ to a larger disk, or raise dump intervals"
+    )
+    assert isinstance(caught.value, RuntimeError)
+
+
+def test_disk_check_of_estimated_runs_names_both_sizes():
+    estimates = [estimate_silo_case(_silo_like()), estimate_silo_case(_silo_like(run_id="silo-2"))]
+    required = total_dump_bytes(estimates)
+    assert required == 2 * 467_008
+    with pytest.raises(InsufficientDiskSpace, match=r"need about 934 kB .* only 900 kB are free on results/"):
+        check_disk_space(required, 900_000, "results/", "of silo_flat")
+
+
+def test_disk_check_returns_the_margin():
+    assert check_disk_space(1.0e9, 4.5e9, "/data", "x") == 3.5e9
+    assert check_disk_space(4.5e9, 4.5e9, "/data", "x") == 0.0
+
+
+@pytest.mark.parametrize("required, free", [(-1.0, 10.0), (1.0, float("nan"))])
+def test_disk_check_refuses_impossible_sizes(required, free):
+    with pytest.raises(ValueError, match="bytes"):
+        check_disk_space(required, free, "/data", "x")
+
+
+# ---------------------------------------------------------------------------------------------- formatting
+
+
+@pytest.mark.parametrize(
+    "size, text",
+    [(0, "0 B"), (999, "999 B"), (1000, "1 kB"), (1536, "1.54 kB"), (999_999, "1 MB"), (12.3e9, "12.3 GB"),
+     (4.5e9, "4.5 GB"), (2.0e12, "2 TB"), (1.234e15, "1230 TB")],
+)
+def test_format_bytes_uses_powers_of_1000(size, text):
+    assert format_bytes(size) == text
+
+
+@pytest.mark.parametrize(
+    "seconds, text",
+    [(0, "0 s"), (0.5, "0.5 s"), (42, "42 s"), (59.97, "1 min"), (180, "3 min"), (336, "5.6 min"),
+     (5400, "1.5 h"), (86400, "1 d"), (150 * 86400, "150 d")],
+)
+def test_format_duration_uses_s_min_h_d(seconds, text):
+    assert format_duration(seconds) == text
+
+
+@pytest.mark.parametrize("function", [format_bytes, format_duration])
+def test_formatting_refuses_negative_values(function):
+    with pytest.raises(ValueError, match=">= 0"):
+        function(-1)
+
+
+# ---------------------------------------------------------------------------------------------- table
+
+
+def test_estimate_rows_have_stable_columns_and_a_totals_row():
+    first = estimate_silo_case(_silo_like())
+    second = RunEstimate(run_id="b", kind="blender", clumps=10, spheres=20, steps=100, simulated_time_s=0.5,
+                         wall_time_s=3600.0, dump_frames=7, dump_bytes=2_000_000_000, mpi_ranks=2)
+    rows = estimate_rows([first, second])
+    assert [list(row) for row in rows] == [list(ESTIMATE_COLUMNS)] * 3
+    assert rows[1] == {"run": "b", "kind": "blender", "mpi_ranks": 2, "clumps": 10, "spheres": 20, "steps": 100,
+                       "simulated_s": 0.5, "wall_time": "1 h", "dump_frames": 7, "disk": "2 GB"}
+    assert rows[0]["disk"] == "467 kB" and rows[0]["wall_time"] == "0.32 s"
+    assert rows[2] == {"run": "total (2 runs)", "kind": "", "mpi_ranks": "", "clumps": "", "spheres": "",
+                       "steps": "", "simulated_s": "", "wall_time": "1 h", "dump_frames": 15, "disk": "2 GB"}
+
+
+def test_estimate_rows_of_no_runs_is_a_zero_totals_row():
+    assert estimate_rows([]) == [{**dict.fromkeys(ESTIMATE_COLUMNS, ""), "run": "total (0 runs)",
+                                  "wall_time": "0 s", "dump_frames": 0, "disk": "0 B"}]

@@ -1,0 +1,88 @@
+"""Snakemake adapter: the blender study of one run (profiles, passages, flow channel, pathlines, RTD, modes)."""
+
+import json
+from pathlib import Path
+
+from analysis.blender import BlenderField
+from analysis.blender_io import read_planar_fields
+from analysis.blender_plots import (
+    plot_channel_boundary,
+    plot_continuous_mode,
+    plot_discontinuous_mode,
+    plot_passage_distributions,
+    plot_profiles_over_time,
+    plot_rtd_theta,
+    plot_tracer_pathlines,
+)
+from analysis.blender_study import (
+    BlenderSettings,
+    analyse_blender,
+    key_heights,
+    rtd_summary,
+    study_metrics,
+    study_summary,
+)
+from analysis.tables import write_flow_table, write_json
+from engines.blender import blender_case_for_run
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    blender = snakemake.params.blender
+    case = json.loads(Path(snakemake.input.case).read_text())
+    flow = json.loads(Path(snakemake.input.flow).read_text())
+    geometry = blender_case_for_run(snakemake.config, case["run_id"]).geometry
+    steady, windows = read_planar_fields(snakemake.input.fields)
+    settings = BlenderSettings.from_config(blender)
+    heights = key_heights(case["geometry"], blender["bin_size"], blender["fill_height"], blender["profile_heights_above"])
+    window_times = [0.5 * (w.window[0] + w.window[1]) - windows[0].window[0] for w in windows]
+    study = analyse_blender(BlenderField.from_planar(steady), [BlenderField.from_planar(w) for w in windows],
+                            window_times, heights, geometry.annulus_bounds, geometry.wall_x, settings)
+    name = f"{case['configuration']} ({case['gravity_factor']:g} g)"
+    metrics = study_metrics(case["configuration"], study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions)
+    rtd = study.rtd.rtd
+    summary = {
+        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
+        "geometry": case["geometry"], "mode": case["mode"], "n_clumps": case["n_clumps"],
+        "steady_window_s": case["steady_window"], "mass_flow_rate_standard_error_kg_s":
+            flow["mass_flow_rate_standard_error_kg_s"],
+        **study_summary(study, metrics),
+        "rtd_curve": rtd_summary(rtd),
+        "flow_history": {"time_since_open_s": flow["time_since_open_s"], "discharged_mass_kg": flow["discharged_mass_kg"],
+                         "mean_v_z_m_s": flow["mean_v_z_m_s"]},
+    }
+    write_json(snakemake.output.summary, summary)
+
+    profiles = study.profiles
+    write_flow_table(snakemake.output.profiles, [
+        {"window_time_s": float(t), "height_m": float(h), "x_m": float(x), "v_z_m_s": float(v), "normalised": float(n)}
+        for w, t in enumerate(profiles.window_time) for k, h in enumerate(profiles.heights)
+        for x, v, n in zip(profiles.x, profiles.v_z[w, k], profiles.normalised[w, k])
+    ])
+    write_flow_table(snakemake.output.residence, [
+        {"release_x_m": float(x), "residence_time_s": float(t)}
+        for x, t in zip(study.pathlines.release_x, study.pathlines.residence_time)
+    ])
+    write_flow_table(snakemake.output.rtd, [
+        {"time_s": float(t), "E_per_s": float(e), "theta": float(th), "E_theta": float(et)}
+        for t, e, th, et in zip(rtd.time, rtd.E, rtd.theta, rtd.E_theta)
+    ])
+    write_flow_table(snakemake.output.vrr, [
+        {"period_over_tm": float(p), "vrr": float(v), "cov_out": float(c)}
+        for p, v, c in zip(study.continuous.period_over_tm, study.continuous.vrr, study.continuous.cov_out)
+    ])
+
+    plot_profiles_over_time(profiles, snakemake.output.profiles_plot, f"Normalised v_z profiles: {name}")
+    inlet = study.inlet if study.inlet is not None else study.outlet
+    plot_passage_distributions(inlet, study.outlet, snakemake.output.distribution_plot,
+                               f"Velocity across the insert inlet and outlet: {name}")
+    plot_channel_boundary(BlenderField.from_planar(steady), study.boundary, snakemake.output.fcb_plot,
+                          f"Flow channel boundary (10 % of centreline, wall velocity subtracted): {name}")
+    plot_tracer_pathlines(study.pathlines, snakemake.output.pathlines_plot, f"Pathlines and residence times: {name}")
+    plot_rtd_theta({name: study.rtd}, snakemake.output.rtd_plot, f"RTD of a {settings.rtd_tracer_fraction:.0%} tracer: {name}")
+    plot_discontinuous_mode(study.discontinuous, snakemake.output.discontinuous_plot,
+                            f"Discontinuous mode ({settings.discontinuous_tracer_fraction:.0%} tracer on top): {name}")
+    plot_continuous_mode({name: study.continuous}, snakemake.output.vrr_plot, f"Continuous mode, sine inputs: {name}")
+    log.info("%s: flow %.4g kg/s; exterior/interior/tube v_z %.3g/%.3g/%.3g m/s; RTD t_m %.3g s, sigma/t_m %.3g, "
+             "t_s/t_d %.3g; homogenised after %.3g passes; VRR %s", case["run_id"], metrics.mass_flow_rate,
+             metrics.exterior_v_z, metrics.interior_v_z, metrics.tube_v_z, metrics.rtd_mean, metrics.rtd_spread,
+             metrics.ts_over_td, metrics.recirculations_to_homogenise, metrics.vrr_by_period)

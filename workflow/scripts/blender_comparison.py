@@ -1,0 +1,28 @@
+"""Snakemake adapter: compare the insert configurations (at the lowest gravity factor run) in one table and plots."""
+
+import json
+from pathlib import Path
+
+from analysis.blender import best_blender, comparison_table
+from analysis.blender_plots import plot_configuration_comparison, plot_rtd_theta
+from analysis.blender_study import metrics_from_summary, rtd_from_summary
+from analysis.tables import markdown_table, write_flow_table, write_text
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    summaries = [json.loads(Path(path).read_text()) for path in snakemake.input.summaries]
+    lowest = min(summary["gravity_factor"] for summary in summaries)
+    chosen = [summary for summary in summaries if summary["gravity_factor"] == lowest]
+    metrics = [metrics_from_summary(summary) for summary in chosen]
+    rows = comparison_table(metrics)
+    best = best_blender(metrics)
+    write_flow_table(snakemake.output.table, rows)
+    tolerance = snakemake.params.blender["discontinuous"]["tolerance"]
+    write_text(snakemake.output.markdown, f"# Insert configurations at {lowest:g} g\n\n{markdown_table(rows)}\n"
+               f"Best blender: **{best}** (fewest recirculations to homogenise within +-{tolerance:.0%}, ties broken "
+               "by the highest VRR at the shortest period).\n")
+    plot_configuration_comparison(rows, [c for c in rows[0] if c != "configuration"], snakemake.output.plot,
+                                  f"Insert configurations at {lowest:g} g (best: {best})", best=best)
+    plot_rtd_theta({s["configuration"]: rtd_from_summary(s["rtd_curve"]) for s in chosen}, snakemake.output.rtd_plot,
+                   f"RTD of the configurations at {lowest:g} g")
+    log.info("best blender: %s; %s", best, rows)

@@ -1,0 +1,46 @@
+"""Snakemake adapter: steady and windowed depth-averaged fields and the discharge rate of one blender run."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from analysis.blender_fields import discharged_mass_history, mean_velocity_history, window_average_field
+from analysis.blender_io import write_planar_fields
+from analysis.blending_io import read_recirculation_tracks
+from analysis.eulerian_rtd import silo_bins
+from analysis.flow import steady_flow_rate
+from analysis.tables import write_json
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    run_dir = Path(snakemake.input.record).parent
+    record = json.loads(Path(snakemake.input.record).read_text())
+    case = json.loads(Path(snakemake.input.case).read_text())
+    recorded = read_recirculation_tracks(run_dir / "dumps", record["dump_prefix"], record["timestep_s"],
+                                         record["domain_z"], cache_dir=run_dir / "frames")
+    tracks = recorded.tracks
+    since_open = tracks.times - record["open_time_s"]
+    grid = silo_bins(case["width_m"], case["depth_m"], case["fill_height_m"], snakemake.params.bin_size)
+    density = case["clump_mass_kg"] / case["clump_volume_m3"]
+    steady_window = tuple(case["steady_window"])
+
+    def averaged(window):
+        return window_average_field(tracks.position, recorded.velocity, recorded.mass, since_open, grid, window, density)
+
+    steady = averaged(steady_window)
+    edges = np.linspace(0.0, steady_window[1], case["profile_windows"] + 1)
+    windows = [averaged((start, end)) for start, end in zip(edges[:-1], edges[1:])]
+    write_planar_fields(snakemake.output.fields, steady, windows)
+
+    time, discharged = discharged_mass_history(tracks, recorded.mass, case["mode"], case["outlet_z"], case["domain_z"])
+    fit = steady_flow_rate(time - record["open_time_s"], discharged, window=steady_window)
+    write_json(snakemake.output.flow, {
+        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
+        "mode": case["mode"], "n_clumps": case["n_clumps"], "mass_flow_rate_kg_s": fit.mass_flow_rate,
+        "mass_flow_rate_standard_error_kg_s": fit.standard_error, "steady_window_s": list(steady_window),
+        "time_since_open_s": (time - record["open_time_s"]).tolist(), "discharged_mass_kg": discharged.tolist(),
+        "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case["outlet_z"]).tolist(),
+    })
+    log.info("%s: %d frames, steady window %s s (%d frames), mass flow rate %.5g +- %.2g kg/s", case["run_id"],
+             tracks.n_times, steady_window, steady.n_frames, fit.mass_flow_rate, fit.standard_error)
