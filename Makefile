@@ -7,7 +7,7 @@ CORES    ?= 2
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 
-.PHONY: install install-system install-python run test test-unit test-integration dry-run bench
+.PHONY: install install-system install-python run test test-unit test-integration dry-run bench estimate
 
 install: install-system install-python
 
@@ -36,6 +36,10 @@ test-unit: install
 
 test-integration: install
 	$(PYTHON) -m pytest tests/integration
+
+# Particle counts, steps, wall time and disk of every run of a config, before running it: make estimate CONFIG=config/thesis.yaml
+estimate: install-python
+	$(PYTHON) -m engines.planning $(CONFIG)
 
 dry-run: install
 	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)

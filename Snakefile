@@ -26,5 +26,9 @@ rule all:
     default_target: True
 
 
+onstart:
+    check_disk_for_pending_runs()
+
+
 onsuccess:
     print_result_locations()

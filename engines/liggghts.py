@@ -14,6 +14,7 @@ Run directory layout (relative paths are what the deck sees, the engine runs ins
 from __future__ import annotations
 
 import json
+import logging
 import os
 import re
 import shutil
@@ -90,6 +91,19 @@ def log_excerpt(log_text: str, lines: int = 15) -> str:
 
 
 # ---------------------------------------------------------------------------------------------- decks
+
+#: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
+RESTART_DIR = "restart"
+RESTART_PREFIX = "state"
+RESTARTS_PER_STAGE = 20
+
+
+def restart_every(stage_steps: int) -> int:
+    """Steps between restart files of a stage of ``stage_steps`` steps: a killed run loses at most 1/20 of it."""
+    if stage_steps < 1:
+        raise ValueError(f"stage_steps must be >= 1, got {stage_steps!r}")
+    return max(1, -(-stage_steps // RESTARTS_PER_STAGE))
+
 
 
 def _flat(matrix) -> list[float]:
@@ -194,7 +208,8 @@ def silo_deck_context(case: SiloCase) -> dict:
             },
             "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
             "contact_dump": f"dumps/{CONTACT_PREFIX}_*.txt",
-            "discharge": {"steps": case.discharge_steps},
+            "discharge": {"steps": case.discharge_steps, "upto": False},
+            "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
             "thermo_every": dump_every,
         }
     )
@@ -232,14 +247,15 @@ def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
 # ---------------------------------------------------------------------------------------------- running
 
 
-def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun") -> list[str]:
+def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
+                   log_name: str = LOG_NAME) -> list[str]:
     """Command line of one engine run, serial or under MPI (no shell involved)."""
     if shutil.which(executable) is None:
         raise EngineNotFound(
             f"LIGGGHTS executable '{executable}' not found on PATH; install it with `make install` "
             "(Debian package liggghts) or set engine.executable in the config"
         )
-    command = [executable, "-in", deck, "-log", LOG_NAME]
+    command = [executable, "-in", deck, "-log", log_name]
     if mpi_ranks > 1:
         if shutil.which(mpirun) is None:
             raise EngineNotFound(f"MPI launcher '{mpirun}' not found; install openmpi-bin or set engine.mpirun")
@@ -256,7 +272,7 @@ def _mpi_environment() -> dict:
     return environment
 
 
-RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME)
+RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart")
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:
@@ -267,6 +283,7 @@ def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUT
     """
     run_dir = Path(run_dir)
     leftovers = [run_dir / name for name in outputs if (run_dir / name).exists()]
+    leftovers += sorted(run_dir.glob(f"{RESUME_STEM}*"))
     if not leftovers:
         return None
     stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
@@ -281,28 +298,55 @@ def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUT
     return target
 
 
-def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun") -> str:
-    """Run the deck ``<run_dir>/deck/in.liggghts`` inside ``run_dir`` and return the log text.
+#: Wall time between progress lines in a run's log (s) and between polls of the engine's output (s).
+PROGRESS_LOG_EVERY = 30.0
+PROGRESS_POLL_EVERY = 1.0
+
+
+def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
+               target_time: float | None = None, deck_name: str = DECK_NAME, log_name: str = LOG_NAME,
+               screen_name: str = SCREEN_NAME) -> str:
+    """Run the deck ``<run_dir>/deck/<deck_name>`` inside ``run_dir`` and return the log text.
+
+    With ``target_time`` (the simulated time the run reaches, s) progress is reported while it runs: simulated
+    time out of the target, clumps and an ETA, every 30 s in the log (``logging``) and, when the job's stderr is a
+    terminal, as a live line there.
 
     Raises
     ------
     EngineRunError
         On a non-zero exit or an ERROR line, quoting the relevant log lines; the run directory is left as is.
     """
+    import sys
+
+    from engines.progress import ProgressMonitor
+
     run_dir = Path(run_dir)
-    command = engine_command(f"deck/{DECK_NAME}", executable, mpi_ranks, mpirun)
+    command = engine_command(f"deck/{deck_name}", executable, mpi_ranks, mpirun, log_name)
     (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
-    with open(run_dir / SCREEN_NAME, "w", encoding="utf-8") as screen:
-        completed = subprocess.run(
-            command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment(), check=False
-        )
-    log_path = run_dir / LOG_NAME
+    (run_dir / RESTART_DIR).mkdir(exist_ok=True)
+    terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
+    monitor = (ProgressMonitor(run_dir / screen_name, target_time, run_dir.name, PROGRESS_LOG_EVERY,
+                               logging.getLogger("siloflow"), terminal) if target_time else None)
+    with open(run_dir / screen_name, "w", encoding="utf-8") as screen:
+        process = subprocess.Popen(command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment())
+        while True:
+            try:
+                returncode = process.wait(timeout=PROGRESS_POLL_EVERY)
+                break
+            except subprocess.TimeoutExpired:
+                if monitor is not None:
+                    screen.flush()
+                    monitor.poll()
+    if monitor is not None:
+        monitor.finish()
+    log_path = run_dir / log_name
     log_text = log_path.read_text(encoding="utf-8", errors="replace") if log_path.exists() else ""
-    screen_text = (run_dir / SCREEN_NAME).read_text(encoding="utf-8", errors="replace")
+    screen_text = (run_dir / screen_name).read_text(encoding="utf-8", errors="replace")
     problems = error_lines(log_text) or error_lines(screen_text)
-    if completed.returncode != 0 or problems:
+    if returncode != 0 or problems:
         raise EngineRunError(
-            f"LIGGGHTS run in {run_dir} failed (exit code {completed.returncode}); "
+            f"LIGGGHTS run in {run_dir} failed (exit code {returncode}); "
             f"log lines:\n{log_excerpt(log_text or screen_text)}\n"
             f"The run directory is left for inspection: {run_dir}"
         )
@@ -366,13 +410,91 @@ def write_run_record(run_dir: Path, record: dict) -> Path:
     return path
 
 
-def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None) -> Path:
+@dataclass(frozen=True)
+class Resume:
+    """How a silo-type run resumes: the deck template of its case, its rendering context and the steps of its
+    last stage (the one that writes restart files)."""
+
+    template: str
+    context: dict
+    last_stage_steps: int
+
+    def deck(self, restart_file: str, final_step: int) -> str:
+        """The resume deck: the case deck from ``restart_file`` up to ``final_step``."""
+        context = dict(self.context)
+        context.update(
+            case_template=self.template,
+            resume={"restart_file": restart_file},
+            discharge={**self.context["discharge"], "steps": int(final_step), "upto": True},
+            # the dumps go on on the steps of the first attempt (multiples of the interval), none at the restart
+            dump={**self.context["dump"], "first": False},
+        )
+        return render_deck("liggghts/resume.lmp.j2", context)
+
+
+RESUME_STEM = "resume"
+RESUME_DECK = "resume.liggghts"
+_RESTART_STEP = re.compile(rf"^{RESTART_PREFIX}_(\d+)\.restart$")
+
+
+def restart_files(run_dir: str | Path) -> list[Path]:
+    """Restart files of a run, oldest step first."""
+    found = []
+    for path in (Path(run_dir) / RESTART_DIR).glob(f"{RESTART_PREFIX}_*.restart"):
+        match = _RESTART_STEP.match(path.name)
+        if match and path.stat().st_size > 0:
+            found.append((int(match.group(1)), path))
+    return [path for _, path in sorted(found)]
+
+
+def attempt_logs(run_dir: str | Path) -> list[Path]:
+    """The log of the first attempt and those of its resumptions, in order."""
+    run_dir = Path(run_dir)
+    resumed = sorted(run_dir.glob(f"{RESUME_STEM}*.{LOG_NAME}"), key=lambda p: int(p.name.split(".")[0][len(RESUME_STEM):]))
+    return [path for path in [run_dir / LOG_NAME, *resumed] if path.exists()]
+
+
+def _logs_text(run_dir: Path) -> str:
+    return "\n".join(path.read_text(encoding="utf-8", errors="replace") for path in attempt_logs(run_dir))
+
+
+def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> str:
+    """Resume from the newest restart file (the one before it if the newest was cut off by the kill)."""
+    log = logging.getLogger("siloflow")
+    final_step = int(round(opened.values["step"])) + resume.last_stage_steps
+    candidates = restart_files(run_dir)[-2:][::-1]
+    attempt = len(attempt_logs(run_dir))
+    for index, restart in enumerate(candidates):
+        relative = f"{RESTART_DIR}/{restart.name}"
+        _write_text_atomic(run_dir / "deck" / RESUME_DECK, resume.deck(relative, final_step))
+        log.info("resuming %s from restart file %s (the last stage ends at step %d)", run_dir.name, relative, final_step)
+        options = dict(engine)
+        if options.get("target_time"):
+            # LIGGGHTS restarts the clock at zero: progress counts the simulated time still to go
+            restart_step = int(_RESTART_STEP.match(restart.name).group(1))
+            options["target_time"] *= max(final_step - restart_step, 1) / final_step
+        try:
+            return run_engine(run_dir, **options, deck_name=RESUME_DECK, log_name=f"{RESUME_STEM}{attempt}.{LOG_NAME}",
+                              screen_name=f"{RESUME_STEM}{attempt}.{SCREEN_NAME}")
+        except EngineRunError as error:
+            if index + 1 == len(candidates) or "restart" not in str(error).lower():
+                raise
+            log.warning("restart file %s is unreadable (%s); trying the one before it", relative, error)
+            attempt += 1
+    raise AssertionError("unreachable")
+
+
+def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None,
+                resume: Resume | None = None) -> Path:
     """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns its path.
 
-    Output of an earlier unfinished attempt is moved to ``failed_attempts/`` first, so the dumps of this run are
-    never mixed with older ones. ``check(markers, dump_files)`` raises :class:`EngineRunError` or returns the
-    stage record; ``engine`` holds the :func:`run_engine` options (executable, mpi_ranks, mpirun) and ``record``
-    extra entries for ``run.json``.
+    A run that was killed after its last stage began (it left restart files and its log has the ``opened``
+    marker) resumes from its newest restart file when ``resume`` is given; its logs are then the first attempt's
+    plus one per resumption, checked together. Otherwise the output of an earlier unfinished attempt is moved to
+    ``failed_attempts/`` first, so the dumps of this run are never mixed with older ones. ``check(markers,
+    dump_files)`` raises :class:`EngineRunError` or returns the stage record; ``engine`` holds the
+    :func:`run_engine` options and ``record`` extra entries for ``run.json``. Restart files are deleted once the
+    run is complete and checked: they only serve resumption.
     """
     from analysis.dumps import list_dumps
 
@@ -382,11 +504,34 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: 
     if not deck.exists():
         raise FileNotFoundError(f"no deck at {deck}; render it first")
     (run_dir / RUN_RECORD).unlink(missing_ok=True)
-    set_aside_previous_attempt(run_dir)
-    log_text = run_engine(run_dir, **engine)
-    checked = check(parse_markers(log_text), list_dumps(run_dir / "dumps", DUMP_PREFIX))
-    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX, **(record or {})})
+    earlier = parse_markers(_logs_text(run_dir)) if resume is not None else []
+    opened = [m for m in earlier if m.event == "opened"]
+    resumed = resume is not None and bool(opened) and bool(restart_files(run_dir))
+    if resumed:
+        _resume_run(run_dir, resume, opened[-1], engine)
+    else:
+        set_aside_previous_attempt(run_dir)
+        run_engine(run_dir, **engine)
+    checked = check(parse_markers(_logs_text(run_dir)), list_dumps(run_dir / "dumps", DUMP_PREFIX))
+    engine.pop("target_time", None)
+    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX,
+                    "resumed_attempts": len(attempt_logs(run_dir)) - 1, **(record or {})})
+    shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
+    checked["output_bytes"] = output_bytes(run_dir)
     return write_run_record(run_dir, checked)
+
+
+def output_bytes(run_dir: str | Path) -> int:
+    """Size of everything a run wrote (dumps, logs, deck, meshes) in bytes; ``run.json`` reports it."""
+    return sum(path.stat().st_size for path in Path(run_dir).rglob("*") if path.is_file())
+
+
+def expected_simulated_time(silo: SiloCase) -> float:
+    """Simulated time a silo-type deck is expected to reach (s): fill, the expected share of the settling time
+    (:class:`engines.estimates.CostModel`), discharge; the target of its progress reports."""
+    from engines.estimates import CostModel, silo_run_steps
+
+    return silo_run_steps(silo, CostModel().settle_fraction) * silo.timestep
 
 
 def run_silo(
@@ -396,6 +541,8 @@ def run_silo(
     return run_checked(
         run_dir,
         lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
-        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun},
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case)},
         {"run_id": case.run_id},
+        Resume("liggghts/silo_flat.lmp.j2", silo_deck_context(case), case.discharge_steps),
     )

@@ -14,7 +14,15 @@ from pathlib import Path
 from engines.blender import BlenderCase
 from engines.blender_geometry import blender_meshes
 from engines.geometry import horizontal_rectangle
-from engines.liggghts import EngineRunError, check_silo_run, run_checked, silo_deck_context, write_case_inputs
+from engines.liggghts import (
+    EngineRunError,
+    Resume,
+    check_silo_run,
+    expected_simulated_time,
+    run_checked,
+    silo_deck_context,
+    write_case_inputs,
+)
 from engines.templating import render_deck
 
 GATE = "outlet_gate"
@@ -90,7 +98,8 @@ def run_blender(
     return run_checked(
         run_dir,
         lambda markers, dumps: check_blender_run(case, markers, dumps, Path(run_dir)),
-        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun},
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case.silo)},
         {
             "run_id": case.run_id,
             "configuration": case.configuration,
@@ -99,4 +108,5 @@ def run_blender(
             "domain_z": [-case.silo.sink_depth, case.silo.domain_top],
             "outlet_z": 0.0,
         },
+        Resume("liggghts/blender.lmp.j2", blender_deck_context(case), case.silo.discharge_steps),
     )

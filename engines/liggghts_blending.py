@@ -15,7 +15,9 @@ from engines.blending import RecirculationCase
 from engines.geometry import vertical_rectangle_x
 from engines.liggghts import (
     EngineRunError,
+    Resume,
     check_silo_run,
+    expected_simulated_time,
     run_checked,
     silo_deck_context,
     silo_meshes,
@@ -91,7 +93,8 @@ def run_recirculation(
     return run_checked(
         run_dir,
         lambda markers, dumps: check_recirculation_run(case, markers, dumps, Path(run_dir)),
-        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun},
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case.silo)},
         {
             "run_id": case.run_id,
             "flow_pattern": case.pattern,
@@ -100,4 +103,5 @@ def run_recirculation(
             "domain_z": [-case.channel_length, case.silo.domain_top],
             "outlet_z": 0.0,
         },
+        Resume("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps),
     )

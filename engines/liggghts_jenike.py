@@ -34,6 +34,7 @@ from engines.liggghts import (
     parse_markers,
     run_engine,
     set_aside_previous_attempt,
+    output_bytes,
     write_run_record,
 )
 from engines.templating import render_deck
@@ -334,5 +335,6 @@ def run_jenike(
     set_aside_previous_jenike_attempt(run_dir)
     log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
     record = check_jenike_run(case, parse_markers(log_text), run_dir)
-    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX})
+    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX,
+                   "output_bytes": output_bytes(run_dir)})
     return write_run_record(run_dir, record)

@@ -292,3 +292,93 @@ def progress_report(
         stage=stage,
         run_id=run_id,
     )
+
+
+class ProgressMonitor:
+    """Follows a running engine's growing screen output and reports its progress.
+
+    Every ``log_every`` seconds of wall time a progress line (:class:`Progress`) goes to ``logger`` (the rule's
+    log); when ``terminal`` is given (a stream that is a terminal) the line is also kept live on it, rewritten in
+    place. The ETA is extrapolated from the rate since the first thermo row this monitor saw, so a run resumed
+    from a restart estimates from its own pace.
+
+    Parameters
+    ----------
+    screen_path : path-like
+        The engine's screen output file (``engine.out``), read from where the last poll stopped.
+    target_time : float
+        Simulated time at the end of the run (s).
+    run_id : str, optional
+        Run to name in the lines.
+    log_every : float
+        Wall time between logged lines (s).
+    logger : logging.Logger, optional
+    terminal : text stream, optional
+    clock : callable
+        Wall clock in seconds (tests pass a fake one).
+    """
+
+    def __init__(self, screen_path, target_time: float, run_id: str | None = None, log_every: float = 30.0,
+                 logger=None, terminal=None, clock=None):
+        import time
+
+        self._path = screen_path
+        self._target = float(target_time)
+        self._run_id = run_id
+        self._log_every = float(log_every)
+        self._logger = logger
+        self._terminal = terminal
+        self._clock = clock or time.monotonic
+        self._started = self._clock()
+        self._last_log = self._started
+        self._offset = 0
+        self._parser = ThermoProgress()
+        self._first: tuple[float, float] | None = None  # (wall, simulated) of the first row seen
+
+    def _read(self) -> None:
+        try:
+            with open(self._path, "rb") as handle:
+                handle.seek(self._offset)
+                chunk = handle.read()
+        except FileNotFoundError:
+            return
+        self._offset += len(chunk)
+        self._parser.feed(chunk.decode("utf-8", errors="replace"))
+
+    def progress(self) -> Progress:
+        """Progress as of the last poll."""
+        now = self._clock()
+        latest = self._parser.latest
+        report = progress_report(latest, self._target, now - self._started, self._parser.stage, self._run_id)
+        if latest is not None and self._first is None:
+            self._first = (now, latest.time)
+        if latest is not None and self._first is not None and latest.time > self._first[1]:
+            rate = (latest.time - self._first[1]) / max(now - self._first[0], 1e-9)
+            eta = max(self._target - latest.time, 0.0) / rate
+            report = Progress(**{**report.__dict__, "eta_s": eta})
+        return report
+
+    def poll(self) -> Progress:
+        """Read what the engine printed since the last poll; log and show the progress when due."""
+        self._read()
+        report = self.progress()
+        now = self._clock()
+        if self._logger is not None and now - self._last_log >= self._log_every:
+            self._logger.info("progress: %s", report)
+            self._last_log = now
+        if self._terminal is not None:
+            self._terminal.write(f"\r{report}\033[K")
+            self._terminal.flush()
+        return report
+
+    def finish(self) -> Progress:
+        """Last poll (whatever remains, including a last line without a newline); ends the live line."""
+        self._read()
+        self._parser.flush()
+        report = self.progress()
+        if self._logger is not None:
+            self._logger.info("progress: %s", report)
+        if self._terminal is not None:
+            self._terminal.write(f"\r{report}\033[K\n")
+            self._terminal.flush()
+        return report

@@ -46,6 +46,9 @@ JENIKE_POINT = {
     "rotation_blocked": False,
 }
 
+#: Settling counted at its longest time, the closed form the tests compare with.
+WORST_CASE = CostModel(settle_fraction=1.0)
+
 
 @pytest.fixture(scope="module")
 def config() -> dict:
@@ -190,7 +193,7 @@ def test_dump_frames_refuses_a_zero_interval():
 
 
 def test_hand_made_silo_case_exact_numbers():
-    estimate = estimate_silo_case(_silo_like())
+    estimate = estimate_silo_case(_silo_like(), model=WORST_CASE)
     assert estimate.steps == 1000 + 4 * 50 + 2000 == 3200
     assert estimate.spheres == 200
     assert estimate.dump_frames == 1 + math.ceil(2000 / 300) == 8
@@ -203,7 +206,7 @@ def test_hand_made_silo_case_exact_numbers():
 
 def test_silo_case_from_config_counts_the_settle_stage_at_its_longest(config):
     case = build_silo_case(config)
-    estimate = estimate_silo_case(case, mpi_ranks=2)
+    estimate = estimate_silo_case(case, mpi_ranks=2, model=WORST_CASE)
     expected_steps = case.fill.fill_steps + case.settle_max_checks * case.settle_check_steps + case.discharge_steps
     assert estimate.steps == silo_run_steps(case) == expected_steps
     assert estimate.clumps == case.fill.n_clumps
@@ -222,7 +225,7 @@ def test_changing_a_silo_case_changes_its_estimate_exactly(config):
         case, fill=dataclasses.replace(case.fill, n_clumps=500, fill_steps=7000), settle_check_steps=100,
         settle_max_checks=3, discharge_steps=9000, dump_every=1000, timestep=2.0e-5,
     )
-    estimate = estimate_silo_case(changed)
+    estimate = estimate_silo_case(changed, model=WORST_CASE)
     assert estimate.steps == 7000 + 300 + 9000
     assert estimate.dump_frames == 10
     assert estimate.simulated_time_s == pytest.approx(16300 * 2.0e-5, rel=1e-12)
@@ -234,7 +237,7 @@ def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
     cases = recirculation_cases(config)
     assert cases, "the default config defines blending runs"
     for run_id, case in cases.items():
-        estimate = estimate_recirculation_case(case)
+        estimate = estimate_recirculation_case(case, model=WORST_CASE)
         silo = case.silo
         assert estimate.run_id == run_id != silo.run_id
         assert estimate.kind == "blending"
@@ -249,13 +252,13 @@ def test_blender_cases_use_their_gravity_scaled_silo(config):
     cases = blender_cases(config)
     assert cases, "the default config defines blender runs"
     for run_id, case in cases.items():
-        estimate = estimate_blender_case(case)
+        estimate = estimate_blender_case(case, model=WORST_CASE)
         silo = case.silo
         assert (estimate.run_id, estimate.kind) == (run_id, "blender")
         assert estimate.steps == silo_run_steps(silo)
         assert estimate.dump_frames == dump_frames(silo.discharge_steps, silo.dump_every)
     configuration = config["blender"]["configurations"][0]
-    normal, heavy = (estimate_blender_case(build_blender_case(config, configuration, f)) for f in (1.0, 4.0))
+    normal, heavy = (estimate_blender_case(build_blender_case(config, configuration, f), model=WORST_CASE) for f in (1.0, 4.0))
     # at 4 g the flow times halve, the dump interval with them: fewer steps, as many frames
     assert heavy.steps < normal.steps
     assert heavy.dump_frames == normal.dump_frames
@@ -311,7 +314,7 @@ def test_disk_check_refuses_when_the_estimate_exceeds_the_free_space():
 
 
 def test_disk_check_of_estimated_runs_names_both_sizes():
-    estimates = [estimate_silo_case(_silo_like()), estimate_silo_case(_silo_like(run_id="silo-2"))]
+    estimates = [estimate_silo_case(_silo_like(), model=WORST_CASE), estimate_silo_case(_silo_like(run_id="silo-2"), model=WORST_CASE)]
     required = total_dump_bytes(estimates)
     assert required == 2 * 467_008
     with pytest.raises(InsufficientDiskSpace, match=r"need about 934 kB .* only 900 kB are free on results/"):
@@ -360,7 +363,7 @@ def test_formatting_refuses_negative_values(function):
 
 
 def test_estimate_rows_have_stable_columns_and_a_totals_row():
-    first = estimate_silo_case(_silo_like())
+    first = estimate_silo_case(_silo_like(), model=WORST_CASE)
     second = RunEstimate(run_id="b", kind="blender", clumps=10, spheres=20, steps=100, simulated_time_s=0.5,
                          wall_time_s=3600.0, dump_frames=7, dump_bytes=2_000_000_000, mpi_ranks=2)
     rows = estimate_rows([first, second])
@@ -375,3 +378,13 @@ def test_estimate_rows_have_stable_columns_and_a_totals_row():
 def test_estimate_rows_of_no_runs_is_a_zero_totals_row():
     assert estimate_rows([]) == [{**dict.fromkeys(ESTIMATE_COLUMNS, ""), "run": "total (0 runs)",
                                   "wall_time": "0 s", "dump_frames": 0, "disk": "0 B"}]
+
+
+def test_settling_is_counted_as_a_share_of_its_longest_time_in_whole_checks():
+    silo = _silo_like()  # fill 1000, 4 checks of 50 steps, discharge 2000
+    assert silo_run_steps(silo) == 1000 + 4 * 50 + 2000
+    assert silo_run_steps(silo, 0.25) == 1000 + 1 * 50 + 2000
+    assert silo_run_steps(silo, 0.3) == 1000 + 2 * 50 + 2000
+    assert estimate_silo_case(silo).steps == 1000 + 50 + 2000  # the default model: a quarter
+    with pytest.raises(ValueError, match="settle_fraction"):
+        CostModel(settle_fraction=0.0)

@@ -248,3 +248,41 @@ def test_progress_from_parsed_output():
 def test_progress_report_refuses_impossible_input(target, elapsed, message):
     with pytest.raises(ValueError, match=message):
         progress_report(None, target, elapsed)
+
+
+def test_monitor_follows_a_growing_screen_output_logs_when_due_and_keeps_a_live_line(tmp_path):
+    import io
+    import logging
+
+    from engines.progress import ProgressMonitor
+
+    screen = tmp_path / "engine.out"
+    screen.write_text("Step Atoms Time n_clumps ke_per_c CPU\n")
+    now = [0.0]
+    records = []
+
+    class Collect(logging.Handler):
+        def emit(self, record):
+            records.append(record.getMessage())
+
+    logger = logging.getLogger("test_progress_monitor")
+    logger.addHandler(Collect())
+    logger.setLevel(logging.INFO)
+    terminal = io.StringIO()
+    monitor = ProgressMonitor(screen, target_time=2.0, run_id="r1", log_every=30.0, logger=logger,
+                              terminal=terminal, clock=lambda: now[0])
+    with open(screen, "a") as handle:
+        handle.write("100 200 0.5 100 1e-6 1.0\n")
+    now[0] = 10.0
+    first = monitor.poll()
+    assert first.simulated_time_s == 0.5 and first.fraction == 0.25 and records == []  # not due yet
+    with open(screen, "a") as handle:
+        handle.write("200 200 1.0 100 1e-6 2.0\nSILOFLOW opened step=200 time=1.0 clumps=100 ke_per_clump=1e-6\n")
+    now[0] = 40.0
+    second = monitor.poll()
+    # 0.5 s simulated in the 30 s since the first row: 1.0 s to go takes 60 s
+    assert second.eta_s == pytest.approx(60.0) and second.stage == "opened"
+    assert len(records) == 1 and records[0].startswith("progress: run r1: ")
+    assert terminal.getvalue().count("\r") == 2
+    final = monitor.finish()
+    assert final.fraction == 0.5 and terminal.getvalue().endswith("\n") and len(records) == 2

@@ -7,6 +7,8 @@ sys.path.insert(0, workflow.basedir)
 
 from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
+from engines.estimates import InsufficientDiskSpace, format_bytes
+from engines.planning import config_estimates, ensure_disk_space
 from engines.blender import blender_case_for_run, blender_cases
 from engines.blending import recirculation_case_for_run, recirculation_cases
 from engines.silo import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
@@ -32,6 +34,17 @@ try:
     blender_cases(config)
 except (ValueError, KeyError) as error:
     raise WorkflowError(f"Invalid blender configuration: {error}") from None
+
+
+def check_disk_for_pending_runs():
+    """Refuse to start when the runs still to do would not fit on the disk of results/ (estimates.disk_check)."""
+    if not config["estimates"]["disk_check"]:
+        return
+    try:
+        margin = ensure_disk_space(config_estimates(config), RESULTS)
+    except InsufficientDiskSpace as error:
+        raise WorkflowError(f"Not enough disk space: {error}") from None
+    print(f"siloflow: the runs still to do fit on the disk of {RESULTS}/ ({format_bytes(margin)} to spare)")
 
 
 def uses_calibrated_parameters():

@@ -1,0 +1,105 @@
+"""A run killed with SIGKILL resumes from its newest restart file on the next workflow call.
+
+The tiny silo (about 1,400 clumps) runs twice side by side: once uninterrupted, once killed (the whole process
+group: Snakemake, the script and LIGGGHTS) after its discharge has written two restart files. The killed workflow
+is unlocked and called again; it resumes, and both runs end with the same clumps and flow rates within noise.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+import yaml
+
+from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.liggghts import restart_files
+from engines.silo import build_silo_case
+from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+
+pytestmark = pytest.mark.integration
+
+CONFIG = {"silo_flat": TINY_SILO, "blending": NO_BLENDING, "blender": NO_BLENDER}
+
+
+def _snakemake_command(workdir, config_path, target):
+    return [sys.executable, "-m", "snakemake", target, "-s", str(REPO_ROOT / "Snakefile"), "--directory",
+            str(workdir), "--cores", "1", "--configfile", str(config_path)]
+
+
+@pytest.fixture(scope="module")
+def killed_and_uninterrupted(tmp_path_factory):
+    require_liggghts()
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    raw["silo_flat"] = {**raw["silo_flat"], **TINY_SILO}
+    run_id = build_silo_case(validate_config(raw)).run_id
+    target = f"results/silo_flat/{run_id}/metrics/flow.csv"
+    dirs = {}
+    for name in ("killed", "uninterrupted"):
+        dirs[name] = tmp_path_factory.mktemp(name)
+        (dirs[name] / "tiny.yaml").write_text(yaml.safe_dump(CONFIG))
+    uninterrupted = subprocess.Popen(_snakemake_command(dirs["uninterrupted"], dirs["uninterrupted"] / "tiny.yaml", target),
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    killed = subprocess.Popen(_snakemake_command(dirs["killed"], dirs["killed"] / "tiny.yaml", target),
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    run_dir = dirs["killed"] / "results" / "silo_flat" / run_id
+    deadline = time.monotonic() + 600
+    while len(restart_files(run_dir)) < 2 and killed.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.5)
+    assert killed.poll() is None, "the run finished before it could be killed; lengthen the discharge"
+    assert len(restart_files(run_dir)) >= 2, "no restart files within 10 minutes"
+    os.killpg(killed.pid, signal.SIGKILL)
+    killed.wait()
+    # let the orphaned engine die with its group before looking at the run directory
+    time.sleep(1.0)
+    assert not (run_dir / "run.json").exists()
+    unlock = run_snakemake(dirs["killed"], "--unlock", "--configfile", str(dirs["killed"] / "tiny.yaml"))
+    assert unlock.returncode == 0, unlock.stdout[-2000:] + unlock.stderr[-2000:]
+    resumed = run_snakemake(dirs["killed"], "--cores", "1", "--rerun-incomplete", "--configfile",
+                            str(dirs["killed"] / "tiny.yaml"), targets=[target])
+    assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
+    output, _ = uninterrupted.communicate(timeout=900)
+    assert uninterrupted.returncode == 0, output[-3000:]
+    yield run_dir, dirs["uninterrupted"] / "results" / "silo_flat" / run_id
+
+
+def test_the_killed_run_resumes_from_its_restart_file(killed_and_uninterrupted):
+    run_dir, _ = killed_and_uninterrupted
+    log = (run_dir / "logs" / "run.log").read_text()
+    assert "resuming" in log and "from restart file restart/state_" in log
+    record = json.loads((run_dir / "run.json").read_text())
+    assert record["resumed_attempts"] == 1
+    assert "SILOFLOW resumed" in (run_dir / "resume1.log.liggghts").read_text()
+    # restart files only serve resumption; a finished run has none left
+    assert not (run_dir / "restart").exists()
+
+
+def test_resumed_and_uninterrupted_runs_agree(killed_and_uninterrupted):
+    resumed_dir, uninterrupted_dir = killed_and_uninterrupted
+    resumed = json.loads((resumed_dir / "run.json").read_text())
+    uninterrupted = json.loads((uninterrupted_dir / "run.json").read_text())
+    assert resumed["filled"]["clumps"] == uninterrupted["filled"]["clumps"] == resumed["n_clumps"]
+    assert resumed["n_dumps"] == uninterrupted["n_dumps"]
+    assert resumed["discharged"]["step"] == uninterrupted["discharged"]["step"]
+    (a,) = csv.DictReader((resumed_dir / "metrics" / "flow.csv").open())
+    (b,) = csv.DictReader((uninterrupted_dir / "metrics" / "flow.csv").open())
+    rate_a, rate_b = float(a["mass_flow_rate_kg_s"]), float(b["mass_flow_rate_kg_s"])
+    # After the restart the trajectories part (the engine rebuilds its neighbour lists in another order), so the
+    # two runs differ like two realisations: counting noise of the clumps discharged in the steady window,
+    # rate / sqrt(N), for each run.
+    clump_mass = float(b["initial_mass_kg"]) / float(b["n_clumps"])
+    window = float(b["steady_window_end_s"]) - float(b["steady_window_start_s"])
+    counted = rate_b * window / clump_mass
+    noise = 3.0 * math.sqrt(2.0) * rate_b / math.sqrt(counted)
+    print(f"flow rate resumed {rate_a:.5g} kg/s, uninterrupted {rate_b:.5g} kg/s, 3 sigma of counting noise "
+          f"{noise:.2g} kg/s ({counted:.0f} clumps in the window); clumps left {resumed['discharged']['clumps']:.0f} "
+          f"and {uninterrupted['discharged']['clumps']:.0f}")
+    assert abs(rate_a - rate_b) <= noise
+    assert abs(resumed["discharged"]["clumps"] - uninterrupted["discharged"]["clumps"]) <= 0.05 * resumed["n_clumps"]
