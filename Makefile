@@ -25,8 +25,12 @@ install-system:
 install-python:
 	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
+# The report collects every plot with its caption and the summary page (results/report.html).
+# Reruns follow changed inputs and parameters, not changed siloflow code: an upgrade must not repeat hours of
+# finished simulations (run ids already change with every parameter that defines a run).
 run: install
-	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete
+	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete --rerun-triggers mtime params input
+	$(PYTHON) -m snakemake --report results/report.html --configfile $(CONFIG)
 
 test: install
 	$(PYTHON) -m pytest tests

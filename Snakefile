@@ -9,11 +9,15 @@ min_version("9.0")
 configfile: "config/config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
 include: "workflow/rules/blending.smk"
 include: "workflow/rules/blender.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:
@@ -23,6 +27,7 @@ rule all:
         parametric_targets,
         blending_targets,
         blender_targets,
+        f"{RESULTS}/summary/summary.html",
     default_target: True
 
 

@@ -59,13 +59,13 @@ rule blender_analysis:
         residence=f"{RESULTS}/blender/{{run}}/metrics/residence_across_width.csv",
         rtd=f"{RESULTS}/blender/{{run}}/metrics/rtd.csv",
         vrr=f"{RESULTS}/blender/{{run}}/metrics/vrr_period.csv",
-        profiles_plot=f"{RESULTS}/blender/{{run}}/plots/profiles.png",
-        distribution_plot=f"{RESULTS}/blender/{{run}}/plots/insert_velocities.png",
-        fcb_plot=f"{RESULTS}/blender/{{run}}/plots/flow_channel.png",
-        pathlines_plot=f"{RESULTS}/blender/{{run}}/plots/pathlines.png",
-        rtd_plot=f"{RESULTS}/blender/{{run}}/plots/rtd.png",
-        discontinuous_plot=f"{RESULTS}/blender/{{run}}/plots/discontinuous.png",
-        vrr_plot=f"{RESULTS}/blender/{{run}}/plots/vrr_period.png",
+        profiles_plot=report(f"{RESULTS}/blender/{{run}}/plots/profiles.png", caption="../report/blender_profiles.rst", category="4 Blender", subcategory="{run}", labels={"figure": "profiles"}),
+        distribution_plot=report(f"{RESULTS}/blender/{{run}}/plots/insert_velocities.png", caption="../report/blender_insert.rst", category="4 Blender", subcategory="{run}", labels={"figure": "insert velocities"}),
+        fcb_plot=report(f"{RESULTS}/blender/{{run}}/plots/flow_channel.png", caption="../report/blender_fcb.rst", category="4 Blender", subcategory="{run}", labels={"figure": "flow channel"}),
+        pathlines_plot=report(f"{RESULTS}/blender/{{run}}/plots/pathlines.png", caption="../report/blender_pathlines.rst", category="4 Blender", subcategory="{run}", labels={"figure": "pathlines"}),
+        rtd_plot=report(f"{RESULTS}/blender/{{run}}/plots/rtd.png", caption="../report/blender_rtd.rst", category="4 Blender", subcategory="{run}", labels={"figure": "RTD"}),
+        discontinuous_plot=report(f"{RESULTS}/blender/{{run}}/plots/discontinuous.png", caption="../report/blender_discontinuous.rst", category="4 Blender", subcategory="{run}", labels={"figure": "discontinuous"}),
+        vrr_plot=report(f"{RESULTS}/blender/{{run}}/plots/vrr_period.png", caption="../report/blender_vrr.rst", category="4 Blender", subcategory="{run}", labels={"figure": "VRR vs period"}),
     params:
         blender=config["blender"],
     log:
@@ -80,8 +80,8 @@ rule blender_comparison:
     output:
         table=f"{RESULTS}/blender/comparison/configurations.csv",
         markdown=f"{RESULTS}/blender/comparison/configurations.md",
-        plot=f"{RESULTS}/blender/comparison/configurations.png",
-        rtd_plot=f"{RESULTS}/blender/comparison/rtd.png",
+        plot=report(f"{RESULTS}/blender/comparison/configurations.png", caption="../report/blender_comparison.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "configurations"}),
+        rtd_plot=report(f"{RESULTS}/blender/comparison/rtd.png", caption="../report/blender_comparison_rtd.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "RTDs"}),
     params:
         runs=lambda wildcards: blender_runs(),
         blender=config["blender"],
@@ -96,7 +96,7 @@ rule blender_gravity:
         summaries=lambda wildcards: [f"{blender_dir(run)}/metrics/blender.json" for run in blender_runs()],
     output:
         table=f"{RESULTS}/blender/gravity/scaling.csv",
-        plot=f"{RESULTS}/blender/gravity/scaling.png",
+        plot=report(f"{RESULTS}/blender/gravity/scaling.png", caption="../report/blender_gravity.rst", category="4 Blender", subcategory="Gravity scaling", labels={"figure": "gravity"}),
     params:
         runs=lambda wildcards: blender_runs(),
     log:

@@ -56,13 +56,15 @@ rule blending_analysis:
         rtd=f"{RESULTS}/blending/{{run}}/metrics/rtd.csv",
         vrr_period=f"{RESULTS}/blending/{{run}}/metrics/vrr_period.csv",
         model=f"{RESULTS}/blending/{{run}}/metrics/recirculation_model.csv",
-        concentration_plot=f"{RESULTS}/blending/{{run}}/plots/concentration.png",
-        vrr_plot=f"{RESULTS}/blending/{{run}}/plots/vrr.png",
-        rtd_plot=f"{RESULTS}/blending/{{run}}/plots/rtd.png",
-        lti_plot=f"{RESULTS}/blending/{{run}}/plots/lti.png",
-        vrr_period_plot=f"{RESULTS}/blending/{{run}}/plots/vrr_period.png",
-        model_plot=f"{RESULTS}/blending/{{run}}/plots/recirculation_model.png",
-        snapshots=directory(f"{RESULTS}/blending/{{run}}/plots/snapshots"),
+        concentration_plot=report(f"{RESULTS}/blending/{{run}}/plots/concentration.png", caption="../report/blending_concentration.rst", category="3 Blending", subcategory="{run}", labels={"figure": "concentration"}),
+        vrr_plot=report(f"{RESULTS}/blending/{{run}}/plots/vrr.png", caption="../report/blending_vrr.rst", category="3 Blending", subcategory="{run}", labels={"figure": "VRR"}),
+        rtd_plot=report(f"{RESULTS}/blending/{{run}}/plots/rtd.png", caption="../report/blending_rtd.rst", category="3 Blending", subcategory="{run}", labels={"figure": "RTD"}),
+        lti_plot=report(f"{RESULTS}/blending/{{run}}/plots/lti.png", caption="../report/blending_lti.rst", category="3 Blending", subcategory="{run}", labels={"figure": "LTI"}),
+        vrr_period_plot=report(f"{RESULTS}/blending/{{run}}/plots/vrr_period.png", caption="../report/blending_vrr_period.rst", category="3 Blending", subcategory="{run}", labels={"figure": "VRR vs period"}),
+        model_plot=report(f"{RESULTS}/blending/{{run}}/plots/recirculation_model.png", caption="../report/blending_model.rst", category="3 Blending", subcategory="{run}", labels={"figure": "recirculation model"}),
+        snapshots=report(directory(f"{RESULTS}/blending/{{run}}/plots/snapshots"), patterns=["{layout}.png"],
+                         caption="../report/blending_snapshots.rst", category="3 Blending", subcategory="{run}",
+                         labels={"figure": "snapshots {layout}"}),
         per_layout=directory(f"{RESULTS}/blending/{{run}}/plots/layouts"),
     params:
         blending=config["blending"],
@@ -79,8 +81,8 @@ rule blending_verification:
     output:
         table=f"{RESULTS}/blending/{{run}}/verification/residence_times.csv",
         summary=f"{RESULTS}/blending/{{run}}/verification/verification.json",
-        paths_plot=f"{RESULTS}/blending/{{run}}/verification/paths.png",
-        residence_plot=f"{RESULTS}/blending/{{run}}/verification/residence_times.png",
+        paths_plot=report(f"{RESULTS}/blending/{{run}}/verification/paths.png", caption="../report/blending_paths.rst", category="3 Blending", subcategory="Verification", labels={"figure": "paths"}),
+        residence_plot=report(f"{RESULTS}/blending/{{run}}/verification/residence_times.png", caption="../report/blending_residence.rst", category="3 Blending", subcategory="Verification", labels={"figure": "residence times"}),
     params:
         blending=config["blending"],
     log:
@@ -95,7 +97,7 @@ rule blending_summary:
         vrr=lambda wildcards: [f"{blending_dir(run)}/metrics/vrr.csv" for run in blending_runs()],
     output:
         table=f"{RESULTS}/blending/summary/blending.csv",
-        vrr_plot=f"{RESULTS}/blending/summary/vrr.png",
+        vrr_plot=report(f"{RESULTS}/blending/summary/vrr.png", caption="../report/blending_summary.rst", category="3 Blending", subcategory="Summary", labels={"figure": "VRR all"}),
     params:
         runs=lambda wildcards: blending_runs(),
     log:

@@ -86,7 +86,7 @@ rule jenike_friction:
         case=rules.jenike_deck.output.case,
     output:
         summary=f"{CALIBRATION}/runs/{{point}}/metrics/bulk_friction.json",
-        plot=f"{CALIBRATION}/runs/{{point}}/plots/forces.png",
+        plot=report(f"{CALIBRATION}/runs/{{point}}/plots/forces.png", caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{point}"}),
     params:
         point=lambda wildcards: JENIKE_POINTS[wildcards.point],
         lid=config["jenike"]["lid"],
@@ -111,7 +111,11 @@ rule calibration_charts:
     input:
         table=rules.calibration_table.output.table,
     output:
-        charts=[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
+        charts=[
+            report(f"{CALIBRATION}/charts/{name}.png", caption="../report/calibration_chart.rst",
+                   category="1 Calibration", subcategory="Charts", labels={"figure": name})
+            for name in calibration_chart_names()
+        ],
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
@@ -142,7 +146,7 @@ rule lid_comparison:
         table=rules.calibration_table.output.table,
     output:
         table=f"{CALIBRATION}/lid_comparison.csv",
-        plot=f"{CALIBRATION}/charts/lid_comparison.png",
+        plot=report(f"{CALIBRATION}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
     params:
         base_restitution=config["jenike"]["sweep"]["restitution"],
     log:
@@ -156,8 +160,8 @@ rule jenike_diagnostics:
         record=rules.jenike_run.output.record,
         case=rules.jenike_deck.output.case,
     output:
-        friction=f"{CALIBRATION}/runs/{{point}}/plots/mobilised_friction.png",
-        rotation=f"{CALIBRATION}/runs/{{point}}/plots/angular_velocity.png",
+        friction=report(f"{CALIBRATION}/runs/{{point}}/plots/mobilised_friction.png", caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{point}"}),
+        rotation=report(f"{CALIBRATION}/runs/{{point}}/plots/angular_velocity.png", caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{point}"}),
         summary=f"{CALIBRATION}/runs/{{point}}/metrics/diagnostics.json",
     log:
         f"{CALIBRATION}/runs/{{point}}/logs/diagnostics.log",

@@ -46,7 +46,7 @@ rule silo_metrics:
         table=f"{RESULTS}/silo_flat/{{run}}/metrics/flow.csv",
         history=f"{RESULTS}/silo_flat/{{run}}/metrics/discharge.csv",
         summary=f"{RESULTS}/silo_flat/{{run}}/metrics/flow.json",
-        plot=f"{RESULTS}/silo_flat/{{run}}/plots/discharge.png",
+        plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/discharge.png", caption="../report/silo_discharge.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "discharge"}),
     params:
         analysis=lambda wildcards: {
             "steady_window": config["silo_flat"]["steady_window"],
@@ -73,13 +73,13 @@ rule silo_fields:
         centreline=f"{RESULTS}/silo_flat/{{run}}/metrics/centreline_velocity.csv",
         janssen=f"{RESULTS}/silo_flat/{{run}}/metrics/janssen.csv",
         summary=f"{RESULTS}/silo_flat/{{run}}/metrics/fields.json",
-        profile_plot=f"{RESULTS}/silo_flat/{{run}}/plots/profiles.png",
-        contour_plot=f"{RESULTS}/silo_flat/{{run}}/plots/vz_contour.png",
-        kinematic_plot=f"{RESULTS}/silo_flat/{{run}}/plots/kinematic_B.png",
-        kinematic_u_plot=f"{RESULTS}/silo_flat/{{run}}/plots/kinematic_u.png",
-        centreline_plot=f"{RESULTS}/silo_flat/{{run}}/plots/centreline_velocity.png",
-        janssen_plot=f"{RESULTS}/silo_flat/{{run}}/plots/janssen.png",
-        force_chain_plot=f"{RESULTS}/silo_flat/{{run}}/plots/force_chains.png",
+        profile_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/profiles.png", caption="../report/silo_profiles.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "velocity profiles"}),
+        contour_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/vz_contour.png", caption="../report/silo_contour.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "v_z field"}),
+        kinematic_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/kinematic_B.png", caption="../report/silo_kinematic_b.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic B"}),
+        kinematic_u_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/kinematic_u.png", caption="../report/silo_kinematic_u.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic u"}),
+        centreline_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/centreline_velocity.png", caption="../report/silo_centreline.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "centreline"}),
+        janssen_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/janssen.png", caption="../report/silo_janssen.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "Janssen"}),
+        force_chain_plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/force_chains.png", caption="../report/silo_force_chains.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "force chains"}),
     params:
         settings=lambda wildcards: config["silo_flat"]["fields"],
     log:
@@ -94,7 +94,7 @@ rule silo_measured_comparison:
         measured=lambda wildcards: config["silo_flat"]["fields"]["measured_profiles"],
     output:
         table=f"{RESULTS}/silo_flat/{{run}}/metrics/measured_comparison.csv",
-        plot=f"{RESULTS}/silo_flat/{{run}}/plots/measured_comparison.png",
+        plot=report(f"{RESULTS}/silo_flat/{{run}}/plots/measured_comparison.png", caption="../report/silo_measured.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "measured"}),
     params:
         plane=config["silo_flat"]["fields"]["measured_plane"],
     log:
@@ -113,7 +113,7 @@ rule silo_parametric:
         fields=lambda wildcards: [f"{silo_dir(run)}/fields/averaged.npz" for _, run in _study_runs(wildcards)],
     output:
         table=f"{RESULTS}/silo_flat/parametric/{{study}}.csv",
-        plot=f"{RESULTS}/silo_flat/parametric/{{study}}.png",
+        plot=report(f"{RESULTS}/silo_flat/parametric/{{study}}.png", caption="../report/silo_parametric.rst", category="2 Silo validation", subcategory="Parametric studies", labels={"figure": "{study}"}),
     params:
         labels=lambda wildcards: [label for label, _ in _study_runs(wildcards)],
         runs=lambda wildcards: [run for _, run in _study_runs(wildcards)],

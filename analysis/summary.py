@@ -1,0 +1,55 @@
+"""The summary page of the report: the figures of merit of every stage as HTML tables.
+
+Pure: the caller reads the stage results and passes plain rows; :func:`summary_html` returns the page.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Mapping, Sequence
+
+__all__ = ["summary_html", "format_cell"]
+
+
+def format_cell(value) -> str:
+    """A table cell: numbers with 4 significant digits, NaN and None as "n/a", text escaped."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "n/a"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return html.escape(str(value))
+
+
+def _table(rows: Sequence[Mapping]) -> str:
+    columns: list[str] = []
+    for row in rows:
+        columns += [key for key in row if key not in columns]
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in columns)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{format_cell(row.get(c))}</td>" for c in columns) + "</tr>" for row in rows
+    )
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def summary_html(title: str, sections: Sequence[tuple[str, str, Sequence[Mapping]]]) -> str:
+    """A self-contained HTML page: a heading, then per section its title, a sentence and a table of rows.
+
+    Parameters
+    ----------
+    title : str
+        Page title.
+    sections : sequence of (str, str, sequence of mapping)
+        ``(section title, explanation, rows)``; the columns are the rows' keys in order of first appearance. A
+        section without rows says so instead of a table.
+    """
+    parts = [f"<h1>{html.escape(title)}</h1>"]
+    for heading, explanation, rows in sections:
+        parts.append(f"<h2>{html.escape(heading)}</h2><p>{html.escape(explanation)}</p>")
+        parts.append(_table(rows) if rows else "<p><em>Not run in this configuration.</em></p>")
+    style = ("body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin-bottom:1.5em}"
+             "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}")
+    return (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>"
+            f"<style>{style}</style></head><body>{''.join(parts)}</body></html>\n")
