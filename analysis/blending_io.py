@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.blending import ClumpTracks, clump_tracks
-from analysis.dumps import clumps_from_frame, list_dumps, read_frame
+from analysis.dumps import clumps_from_frame, list_dumps, readable_frames
 from analysis.tables import atomic_output
 
 
@@ -38,13 +38,14 @@ class RecirculationTracks:
 
 def read_recirculation_tracks(
     dump_dir: str | os.PathLike, prefix: str, timestep: float, domain_z: tuple[float, float],
-    cache_dir: str | os.PathLike | None = None,
+    cache_dir: str | os.PathLike | None = None, on_damaged: str = "error",
 ) -> RecirculationTracks:
-    """Read every dump of a recirculation run into clump tracks (z periodic in ``domain_z``)."""
+    """Read every dump of a recirculation run into clump tracks (z periodic in ``domain_z``); a damaged dump
+    raises or is skipped with a warning (:func:`analysis.dumps.readable_frames`)."""
     periodic = [None, None, tuple(domain_z)]
     times, ids, positions, velocities, masses = [], [], [], [], {}
-    for path in list_dumps(dump_dir, prefix):
-        clumps = clumps_from_frame(read_frame(path, timestep, cache_dir), periodic_bounds=periodic)
+    for frame in readable_frames(list_dumps(dump_dir, prefix), timestep, cache_dir, on_damaged):
+        clumps = clumps_from_frame(frame, periodic_bounds=periodic)
         times.append(clumps.time)
         ids.append(clumps.clump_id)
         positions.append(clumps.position)

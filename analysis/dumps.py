@@ -28,11 +28,13 @@ All quantities are SI: metres, seconds, kilograms, newtons, radians.
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import re
 import tempfile
+import warnings
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -1125,8 +1127,30 @@ def read_frame(
     return frame
 
 
+DAMAGED_DUMP_POLICIES = ("error", "skip")
+
+
+def readable_frames(paths, timestep: float, cache_dir: str | os.PathLike | None = None,
+                    on_damaged: str = "error") -> Iterator[ParticleFrame]:
+    """Read dumps one after another; a damaged one (truncated, garbled number, non-finite value) raises
+    :class:`DumpFormatError` naming the file, or with ``on_damaged="skip"`` is left out with a warning
+    (``warnings`` and the ``siloflow`` logger) that names the file and the problem."""
+    if on_damaged not in DAMAGED_DUMP_POLICIES:
+        raise ValueError(f"on_damaged must be one of {DAMAGED_DUMP_POLICIES}, got {on_damaged!r}")
+    for path in paths:
+        try:
+            yield read_frame(path, timestep, cache_dir)
+        except DumpFormatError as error:
+            if on_damaged == "error":
+                raise
+            message = f"skipping damaged dump ({error})"
+            warnings.warn(message, stacklevel=2)
+            logging.getLogger("siloflow").warning(message)
+
+
 def read_frames(
-    dump_dir: str | os.PathLike, prefix: str, timestep: float, cache_dir: str | os.PathLike | None = None
+    dump_dir: str | os.PathLike, prefix: str, timestep: float, cache_dir: str | os.PathLike | None = None,
+    on_damaged: str = "error",
 ) -> list[ParticleFrame]:
     """Read every ``<prefix>_<step>.vtk`` dump of a folder, in step order.
 
@@ -1140,10 +1164,12 @@ def read_frames(
         Simulation time step [s].
     cache_dir : str or path-like, optional
         Cache folder, see :func:`read_frame`.
+    on_damaged : {"error", "skip"}
+        What a damaged dump does (:func:`readable_frames`).
 
     Returns
     -------
     list of ParticleFrame
-        One frame per dump, ascending step.
+        One frame per readable dump, ascending step.
     """
-    return [read_frame(path, timestep, cache_dir) for path in list_dumps(dump_dir, prefix)]
+    return list(readable_frames(list_dumps(dump_dir, prefix), timestep, cache_dir, on_damaged))

@@ -9,7 +9,7 @@ import html
 import math
 from collections.abc import Mapping, Sequence
 
-__all__ = ["summary_html", "format_cell"]
+__all__ = ["summary_html", "format_cell", "calibration_rows"]
 
 
 def format_cell(value) -> str:
@@ -53,3 +53,19 @@ def summary_html(title: str, sections: Sequence[tuple[str, str, Sequence[Mapping
              "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}")
     return (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>"
             f"<style>{style}</style></head><body>{''.join(parts)}</body></html>\n")
+
+
+def calibration_rows(parameters: Mapping) -> list[dict]:
+    """Rows of the calibration result (``results/calibration/parameters.yaml`` as read): the chosen sliding
+    friction of each contact with its band, then the contacts whose target could not be reached (with the
+    reason) and those not tested."""
+    rows = []
+    if "particle_particle" in parameters:
+        rows.append({"contact": "particle-particle", **parameters["particle_particle"]})
+    for wall, values in (parameters.get("particle_wall") or {}).items():
+        rows.append({"contact": f"particle-{wall}", **values})
+    for test, reason in (parameters.get("unreachable") or {}).items():
+        rows.append({"contact": test, "sliding_friction": None, "note": f"target not reached: {reason}"})
+    for wall in parameters.get("not_tested") or []:
+        rows.append({"contact": f"particle-{wall}", "sliding_friction": None, "note": "not tested; config value kept"})
+    return rows

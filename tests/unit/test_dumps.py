@@ -517,3 +517,21 @@ def test_read_frame_rejects_bad_timestep(tmp_path):
     for bad in (0.0, -1e-5, float("nan")):
         with pytest.raises(ValueError, match="timestep"):
             read_frame(dump, bad)
+
+
+def test_a_damaged_dump_among_good_ones_raises_naming_it_or_is_skipped_with_a_warning(tmp_path):
+    from analysis.dumps import read_frames
+
+    points, fields = liggghts_like_fields(5)
+    content = format_legacy_vtk_polydata(points, fields, binary=True)
+    for step in (100, 200, 300):
+        (tmp_path / f"particles_{step}.vtk").write_bytes(content)
+    damaged = tmp_path / "particles_200.vtk"
+    damaged.write_bytes(content[: len(content) // 2])
+    with pytest.raises(DumpFormatError, match=r"particles_200\.vtk"):
+        read_frames(tmp_path, "particles", TIMESTEP)
+    with pytest.warns(UserWarning, match=r"skipping damaged dump \(.*particles_200\.vtk"):
+        frames = read_frames(tmp_path, "particles", TIMESTEP, on_damaged="skip")
+    assert [frame.step for frame in frames] == [100, 300]
+    with pytest.raises(ValueError, match="on_damaged"):
+        read_frames(tmp_path, "particles", TIMESTEP, on_damaged="ignore")

@@ -20,3 +20,17 @@ def test_summary_page_has_one_table_per_section_with_the_union_of_columns():
     assert "<th>run</th><th>rate</th><th>error</th>" in page
     assert "<td>b</td><td>n/a</td><td>0.05</td>" in page
     assert "Not run in this configuration" in page
+
+
+def test_calibration_rows_cover_chosen_unreachable_and_untested_contacts():
+    from analysis.summary import calibration_rows
+
+    rows = calibration_rows({
+        "particle_particle": {"sliding_friction": 0.27, "lower": 0.25, "upper": 0.3},
+        "particle_wall": {"aluminium": {"sliding_friction": 0.17}},
+        "unreachable": {"perspex": "above the highest swept friction"},
+        "not_tested": ["steel"],
+    })
+    assert [row["contact"] for row in rows] == ["particle-particle", "particle-aluminium", "perspex", "particle-steel"]
+    assert rows[2]["note"] == "target not reached: above the highest swept friction"
+    assert calibration_rows({"unreachable": {"internal": "no test"}})[0]["sliding_friction"] is None

@@ -18,7 +18,8 @@ with logged_to(snakemake.log[0]) as log:
     record = json.loads(Path(snakemake.input.record).read_text())
     case = json.loads(Path(snakemake.input.case).read_text())
     recorded = read_recirculation_tracks(run_dir / "dumps", record["dump_prefix"], record["timestep_s"],
-                                         record["domain_z"], cache_dir=run_dir / "frames")
+                                         record["domain_z"], cache_dir=run_dir / "frames",
+                                       on_damaged=snakemake.config["dumps"]["on_damaged"])
     tracks = recorded.tracks
     since_open = tracks.times - record["open_time_s"]
     grid = silo_bins(case["width_m"], case["depth_m"], case["fill_height_m"], snakemake.params.bin_size)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import yaml
 
-from analysis.summary import summary_html
+from analysis.summary import calibration_rows, summary_html
 from analysis.tables import write_text
 from engines.logs import logged_to
 
@@ -25,8 +25,7 @@ def _number(text):
 
 with logged_to(snakemake.log[0]) as log:
     parameters = yaml.safe_load(Path(snakemake.input.parameters).read_text())
-    calibration = [{"contact": "particle-particle", **parameters["particle_particle"]}]
-    calibration += [{"contact": f"particle-{wall}", **values} for wall, values in parameters["particle_wall"].items()]
+    calibration = calibration_rows(parameters)
     silo = []
     for path in snakemake.input.flows:
         flow = json.loads(Path(path).read_text())
@@ -38,9 +37,10 @@ with logged_to(snakemake.log[0]) as log:
                 for path in snakemake.input.blending for row in csv_rows(path)]
     blender = [row for path in snakemake.input.blender for row in csv_rows(path)]
     page = summary_html("siloflow: figures of merit", [
-        ("Calibration", f"Contact parameters chosen from the Jenike shear sweep (particle model {parameters['shape']}, "
-                        f"rolling friction {parameters['rolling_friction']}), with the band that reproduces the target "
-                        f"angles {parameters['targets_deg']} deg within {parameters['tolerance_deg']} deg.", calibration),
+        ("Calibration", f"Contact parameters chosen from the Jenike shear sweep (particle model {parameters.get('shape')}, "
+                        f"rolling friction {parameters.get('rolling_friction')}), with the band that reproduces the "
+                        f"target angles {parameters.get('targets_deg')} deg within {parameters.get('tolerance_deg')} deg.",
+         calibration),
         ("Silo validation", "Steady discharge rate of each flat-bottom silo run against Beverloo's prediction.", silo),
         ("Silo against measurements", "Velocity profile errors against the measured profiles.", measured),
         ("Blending", "Mean residence time, RTD spread and VRR after each recirculation per flow pattern and batch "

@@ -49,7 +49,8 @@ with logged_to(snakemake.log[0]) as log:
                              options["cutoff"])
 
     frames = [clumps_from_frame(frame) for frame in
-              read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames")
+              read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames",
+                              on_damaged=snakemake.config["dumps"]["on_damaged"])
               if frame.step >= record["open_step"]]
     settled = frames[0]
     surface = column_surface_heights(settled.position[:, 0], settled.position[:, 2], radius, width,

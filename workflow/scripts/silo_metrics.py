@@ -16,7 +16,8 @@ with logged_to(snakemake.log[0]) as log:
     analysis = snakemake.params.analysis
     beverloo = analysis["beverloo"]
 
-    frames = read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames")
+    frames = read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames",
+                              on_damaged=snakemake.config["dumps"]["on_damaged"])
     discharge = [clumps_from_frame(frame) for frame in frames if frame.step >= record["open_step"]]
     log.info("%d discharge frames from %s", len(discharge), run_dir / "dumps")
 

@@ -1,0 +1,80 @@
+"""Benchmark: one flat-bottom silo run on 1 and on 2 MPI ranks (strong scaling on this machine).
+
+The same silo (the tiny test silo made deeper and wider, about 4,000 two-sphere clumps) runs serially and with
+`mpirun -np 2`, the domain split by LIGGGHTS. Reports the wall time of each, the speed-up (baseline: the serial
+run, measured in the same benchmark) and, to show the physics does not change with the rank count, the steady
+mass flow rate of each with its counting noise (3 sigma of the clumps discharged in the steady window). Prints a
+table and writes it as CSV (``argv[1]``, default ``results/bench/mpi.csv``).
+
+Run with ``python -m tests.bench.bench_mpi results/bench/mpi.csv`` (a few minutes on 2 cores).
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from analysis.dumps import clumps_from_frame, read_frames
+from analysis.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
+from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.liggghts import run_silo, write_silo_inputs
+from engines.silo import build_silo_case
+from tests.conftest import TINY_SILO
+
+SILO = {**TINY_SILO, "width": 0.12, "fill_height": 0.06, "discharge_time": 0.5}
+
+
+def flow_rate(run_dir: Path, case) -> tuple[float, float]:
+    """Steady mass flow rate (kg/s) and its counting noise (3 sigma, kg/s) of a finished run."""
+    import json
+
+    record = json.loads((run_dir / "run.json").read_text())
+    frames = [clumps_from_frame(f) for f in read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"])]
+    times = [f.time - record["open_time_s"] for f in frames]
+    history = discharged_mass_history(times, [mass_in_silo(f.position[:, 2], f.mass) for f in frames])
+    fit = steady_flow_rate(history.time, history.discharged_mass)
+    counted = fit.mass_flow_rate * (fit.t_end - fit.t_start) / case.particle.mass
+    return fit.mass_flow_rate, 3.0 * fit.mass_flow_rate / math.sqrt(max(counted, 1.0))
+
+
+def main(argv: list[str]) -> int:
+    output = Path(argv[1] if len(argv) > 1 else "results/bench/mpi.csv")
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(SILO)}
+    case = build_silo_case(validate_config(raw))
+    rows = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for ranks in (1, 2):
+            run_dir = Path(scratch) / f"ranks{ranks}"
+            write_silo_inputs(case, run_dir / "deck")
+            start = time.perf_counter()
+            run_silo(case, run_dir, mpi_ranks=ranks)
+            wall = time.perf_counter() - start
+            rate, noise = flow_rate(run_dir, case)
+            rows.append({"mpi_ranks": ranks, "clumps": case.fill.n_clumps, "wall_time_s": wall,
+                         "mass_flow_rate_kg_s": rate, "flow_rate_noise_3sigma_kg_s": noise})
+    serial = rows[0]
+    for row in rows:
+        row["speedup_vs_1_rank"] = serial["wall_time_s"] / row["wall_time_s"]
+        row["flow_rate_difference_kg_s"] = row["mass_flow_rate_kg_s"] - serial["mass_flow_rate_kg_s"]
+        row["within_noise"] = abs(row["flow_rate_difference_kg_s"]) <= math.hypot(
+            row["flow_rate_noise_3sigma_kg_s"], serial["flow_rate_noise_3sigma_kg_s"])
+    output.parent.mkdir(parents=True, exist_ok=True)
+    with open(output, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    for row in rows:
+        print(f"{row['mpi_ranks']} rank(s): {row['wall_time_s']:.1f} s wall, speed-up {row['speedup_vs_1_rank']:.2f}x, "
+              f"flow rate {row['mass_flow_rate_kg_s']:.5g} +- {row['flow_rate_noise_3sigma_kg_s']:.2g} kg/s, "
+              f"within noise of 1 rank: {row['within_noise']}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv))

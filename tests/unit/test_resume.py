@@ -1,0 +1,81 @@
+"""Resuming a killed run: the resume deck of each case, restart files and attempt logs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from engines.blender import build_blender_case
+from engines.blending import build_recirculation_case
+from engines.config import load_config
+from engines.liggghts import (
+    Resume,
+    attempt_logs,
+    restart_every,
+    restart_files,
+    silo_deck_context,
+)
+from engines.liggghts_blender import blender_deck_context
+from engines.liggghts_blending import recirculation_deck_context
+from engines.silo import build_silo_case
+
+GOLDEN = Path(__file__).resolve().parent.parent / "golden"
+
+
+def _resume_deck(template, context, steps):
+    return Resume(template, context, steps).deck("restart/state_31200.restart", 77952)
+
+
+def _check_common(deck: str) -> None:
+    assert "read_restart restart/state_31200.restart\nnewton off" in deck
+    assert "create_box" not in deck and "fix pour" not in deck and "settle_loop" not in deck
+    assert "run 77952 upto" in deck
+    assert "dump_modify particle_dump binary yes first no" in deck
+    assert "outlet_gate" not in deck.split("fix floor_wall", 1)[1].splitlines()[0]
+    assert deck.index("run 0") < deck.index("SILOFLOW resumed")
+
+
+def test_silo_resume_deck_reads_the_restart_and_runs_up_to_the_end():
+    case = build_silo_case(load_config(GOLDEN / "silo_flat_config.yaml"))
+    deck = _resume_deck("liggghts/silo_flat.lmp.j2", silo_deck_context(case), case.discharge_steps)
+    _check_common(deck)
+    assert "thermo_modify lost ignore norm no flush yes" in deck.split("# --- discharge")[1]
+
+
+def test_recirculation_resume_deck_keeps_the_feeder_and_loses_no_clump():
+    case = build_recirculation_case(load_config(GOLDEN / "silo_recirculation_config.yaml"), "internal_flow")
+    deck = _resume_deck("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps)
+    _check_common(deck)
+    assert "fix feeder all setforce NULL NULL v_feeder_force_z region feeder" in deck
+    assert "thermo_modify lost error" in deck.split("# --- recirculate")[1]
+
+
+def test_blender_resume_deck_has_the_open_walls():
+    case = build_blender_case(load_config(GOLDEN / "blender_config.yaml"), "straight")
+    deck = _resume_deck("liggghts/blender.lmp.j2", blender_deck_context(case), case.silo.discharge_steps)
+    _check_common(deck)
+    assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right\n" in deck
+
+
+def test_restart_files_are_ordered_by_step_and_empty_ones_ignored(tmp_path):
+    folder = tmp_path / "restart"
+    folder.mkdir()
+    for step, size in ((2600, 10), (26000, 10), (5200, 10), (7800, 0)):
+        (folder / f"state_{step}.restart").write_bytes(b"x" * size)
+    (folder / "notes.txt").write_text("not a restart file")
+    assert [p.name for p in restart_files(tmp_path)] == ["state_2600.restart", "state_5200.restart",
+                                                          "state_26000.restart"]
+    assert restart_files(tmp_path / "missing") == []
+
+
+def test_attempt_logs_are_the_first_then_the_resumptions_in_order(tmp_path):
+    for name in ("resume10.log.liggghts", "log.liggghts", "resume2.log.liggghts", "resume1.engine.out"):
+        (tmp_path / name).write_text("")
+    assert [p.name for p in attempt_logs(tmp_path)] == ["log.liggghts", "resume2.log.liggghts", "resume10.log.liggghts"]
+
+
+def test_about_twenty_restart_files_per_stage():
+    assert restart_every(52000) == 2600 and restart_every(7) == 1
+    with pytest.raises(ValueError):
+        restart_every(0)
