@@ -649,8 +649,9 @@ class ParticleFrame:
         Sphere centre [m].
     velocity : numpy.ndarray of float64, shape (n, 3)
         Velocity of the sphere centre [m/s].
-    angular_velocity : numpy.ndarray of float64, shape (n, 3)
-        Angular velocity [rad/s] (for a clump sphere, that of its clump).
+    angular_velocity : numpy.ndarray of float64, shape (n, 3), or None
+        Angular velocity [rad/s] (for a clump sphere, that of its clump); None when the dump has no omega
+        columns (the silo-type decks leave them out: their analyses do not use them).
     radius : numpy.ndarray of float64, shape (n,)
         Sphere radius [m].
     mass : numpy.ndarray of float64, shape (n,)
@@ -667,7 +668,7 @@ class ParticleFrame:
     clump_id: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
-    angular_velocity: np.ndarray
+    angular_velocity: np.ndarray | None
     radius: np.ndarray
     mass: np.ndarray
     force: np.ndarray | None = None
@@ -681,12 +682,13 @@ class ParticleFrame:
         set_field(self, "id", ids)
         set_field(self, "type", _frozen_array(self.type, np.int32, (), "type", n))
         set_field(self, "clump_id", _frozen_array(self.clump_id, np.int64, (), "clump_id", n))
-        for name in ("position", "velocity", "angular_velocity"):
+        for name in ("position", "velocity"):
             set_field(self, name, _frozen_array(getattr(self, name), np.float64, (3,), name, n))
         for name in ("radius", "mass"):
             set_field(self, name, _frozen_array(getattr(self, name), np.float64, (), name, n))
-        if self.force is not None:
-            set_field(self, "force", _frozen_array(self.force, np.float64, (3,), "force", n))
+        for name in OPTIONAL_VECTORS:
+            if getattr(self, name) is not None:
+                set_field(self, name, _frozen_array(getattr(self, name), np.float64, (3,), name, n))
         sorted_ids = np.sort(ids)
         if np.any(sorted_ids[1:] == sorted_ids[:-1]):
             raise ValueError("sphere ids in a frame must be unique")
@@ -815,13 +817,12 @@ def frame_from_arrays(
         "radius": "radius" in arrays,
         "mass": "mass" in arrays,
         "v (or vx vy vz)": velocity is not None,
-        "omega (or omegax omegay omegaz)": angular_velocity is not None,
     }
     missing = [name for name, found in present.items() if not found]
     if missing and n > 0:
         raise DumpFormatError(
-            f"{source}: missing fields {', '.join(missing)} (dump 'id type id_multisphere x y z vx vy vz "
-            "fx fy fz omegax omegay omegaz radius mass')"
+            f"{source}: missing fields {', '.join(missing)} (dump at least 'id type id_multisphere x y z vx vy vz "
+            "radius mass')"
         )
 
     def column(name: str) -> np.ndarray:
@@ -855,7 +856,7 @@ def frame_from_arrays(
             clump_id=clump_id,
             position=position,
             velocity=empty_vectors if velocity is None else velocity,
-            angular_velocity=empty_vectors if angular_velocity is None else angular_velocity,
+            angular_velocity=empty_vectors if angular_velocity is None and n == 0 else angular_velocity,
             radius=column("radius"),
             mass=column("mass"),
             force=force,
@@ -1008,8 +1009,10 @@ def list_dumps(dump_dir: str | os.PathLike, prefix: str) -> list[Path]:
     return [entry for _, entry in sorted(matches)]
 
 
-_CACHE_FORMAT = 1  # bump when the cached arrays change meaning
-_FRAME_ARRAYS = ("id", "type", "clump_id", "position", "velocity", "angular_velocity", "radius", "mass")
+_CACHE_FORMAT = 2  # bump when the cached arrays change meaning (2: angular velocity optional)
+_FRAME_ARRAYS = ("id", "type", "clump_id", "position", "velocity", "radius", "mass")
+#: Per-sphere vectors a dump may leave out (None in the frame).
+OPTIONAL_VECTORS = ("angular_velocity", "force")
 
 
 def _cache_path(dump: Path, cache_dir: Path) -> Path:
@@ -1042,8 +1045,7 @@ def _write_cache(cache_path: Path, dump: Path, dump_stat: os.stat_result, frame:
     """Write the cache entry atomically: a killed writer leaves only a temporary file."""
     cache_path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {name: getattr(frame, name) for name in _FRAME_ARRAYS}
-    if frame.force is not None:
-        arrays["force"] = frame.force
+    arrays.update({name: getattr(frame, name) for name in OPTIONAL_VECTORS if getattr(frame, name) is not None})
     fd, temporary = tempfile.mkstemp(dir=cache_path.parent, prefix=f".{cache_path.name}.", suffix=".tmp")
     try:
         os.fchmod(fd, 0o644)  # mkstemp makes 0600; others on the cluster read the cache too
@@ -1112,7 +1114,7 @@ def read_frame(
         return ParticleFrame(
             time=time,
             step=step,
-            force=cached.get("force"),
+            **{name: cached.get(name) for name in OPTIONAL_VECTORS},
             **{name: cached[name] for name in _FRAME_ARRAYS},
         )
     content = path.read_bytes()

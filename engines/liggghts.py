@@ -92,6 +92,11 @@ def log_excerpt(log_text: str, lines: int = 15) -> str:
 
 # ---------------------------------------------------------------------------------------------- decks
 
+#: What the silo-type decks dump per sphere: what their analyses read (ids, clump ids, centres, velocities,
+#: radii, masses), in binary. Forces and angular velocities are left out (a third of the volume); contact forces
+#: come from the separate contact dump.
+SILO_DUMP_FIELDS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass")
+
 #: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
 RESTART_DIR = "restart"
 RESTART_PREFIX = "state"
@@ -206,7 +211,8 @@ def silo_deck_context(case: SiloCase) -> dict:
                 "check_steps": case.settle_check_steps,
                 "max_checks": case.settle_max_checks,
             },
-            "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
+            "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
+                     "fields": list(SILO_DUMP_FIELDS)},
             "contact_dump": f"dumps/{CONTACT_PREFIX}_*.txt",
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},

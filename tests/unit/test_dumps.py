@@ -259,10 +259,22 @@ def test_wrong_count_in_binary_is_reported_not_misread():
 
 def test_missing_fields_are_named():
     points, fields = liggghts_like_fields(2)
-    del fields["omega"], fields["mass"]
+    del fields["v"], fields["mass"]
     parsed = parse_legacy_vtk_polydata(format_legacy_vtk_polydata(points, fields), "d_1.vtk")
-    with pytest.raises(DumpFormatError, match=r"^d_1\.vtk: missing fields mass, omega"):
+    with pytest.raises(DumpFormatError, match=r"^d_1\.vtk: missing fields mass, v \(or vx vy vz\)"):
         frame_from_arrays(parsed, step=1, time=1e-5, source="d_1.vtk")
+
+
+def test_a_dump_without_forces_and_angular_velocities_reads_and_caches(tmp_path):
+    points, fields = liggghts_like_fields(3)
+    del fields["omega"], fields["f"]
+    path = tmp_path / "particles_10.vtk"
+    path.write_bytes(format_legacy_vtk_polydata(points, fields, binary=True))
+    frame = read_frame(path, TIMESTEP, tmp_path / "cache")
+    assert frame.angular_velocity is None and frame.force is None and len(frame) == 6  # 3 two-sphere clumps
+    cached = read_frame(path, TIMESTEP, tmp_path / "cache")
+    assert cached.angular_velocity is None
+    np.testing.assert_array_equal(cached.velocity, frame.velocity)
 
 
 # --------------------------------------------------------------------------- frames and clumps

@@ -35,6 +35,9 @@ with logged_to(snakemake.log[0]) as log:
                          "Mean |Ft|/|Fn| at ring-wall contacts in the shear plane\n(as reported by compute wall/gran/local)")
 
     frame = read_frame(list_dumps(run_dir / "dumps", record["dump_prefix"])[-1], record["timestep_s"])
+    if frame.angular_velocity is None:
+        raise ValueError(f"{run_dir}: the last dump has no angular velocities (omegax omegay omegaz); the Jenike deck "
+                         "must dump them for the diagnostics")
     omega_edges, omega_counts = angular_histogram(frame.angular_velocity, axis="y", bins=36)
     plot_polar_histogram(omega_edges, omega_counts, snakemake.output.rotation,
                          "Direction of particle angular velocity in the x-z plane")
