@@ -360,12 +360,14 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
 
 
 def check_silo_run(
-    case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged"
+    case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged",
+    clumps_conserved: bool = False,
 ) -> dict:
     """Check that a finished silo run did what the case asked; returns the stage record.
 
     ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
-    drains; ``recirculated`` in the recirculating one); the record keeps it under that name.
+    drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
+    ``clumps_conserved`` (periodic runs, where nothing may leave) the clump count must be unchanged at its end.
 
     Raises
     ------
@@ -394,6 +396,12 @@ def check_silo_run(
         )
     if len(dump_files) < 2:
         raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
+    final = int(round(by_event[last_stage][-1].values["clumps"]))
+    if clumps_conserved and final != case.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: {case.fill.n_clumps} clumps were inserted but {final} remain after the '{last_stage}' stage; "
+            "clumps were lost through a boundary"
+        )
     opened = by_event["opened"][-1].values
     return {
         "filled": filled,

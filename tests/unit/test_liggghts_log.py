@@ -107,3 +107,15 @@ def test_an_earlier_attempt_is_moved_aside_not_deleted(tmp_path):
     assert (moved / "log.liggghts").read_text() == "old log"
     assert not (tmp_path / "dumps").exists()
     assert set_aside_previous_attempt(tmp_path) is None
+
+
+def test_a_periodic_run_that_lost_clumps_is_reported(tiny_config, tmp_path):
+    case = build_silo_case(tiny_config)
+    n = case.fill.n_clumps
+    log = LOG.replace("clumps=1395", f"clumps={n}").replace("clumps=355", f"clumps={n - 3}")
+    # a batch silo drains: fewer clumps at the end is the point
+    assert check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path)["discharged"]["clumps"] == n - 3
+    with pytest.raises(EngineRunError, match=rf"{n} clumps were inserted but {n - 3} remain after the 'discharged' stage"):
+        check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path, clumps_conserved=True)
+    conserved = log.replace(f"clumps={n - 3}", f"clumps={n}")
+    assert check_silo_run(case, parse_markers(conserved), _dumps(tmp_path, 3), tmp_path, clumps_conserved=True)
