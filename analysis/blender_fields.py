@@ -22,7 +22,7 @@ import numpy as np
 from analysis.blending import ClumpTracks, recirculation_events
 from analysis.checks import finite_number, positive_number
 from analysis.coarse_graining import Grid
-from analysis.eulerian_rtd import bin_velocity_series
+from analysis.eulerian_rtd import bin_sums
 
 __all__ = ["PlanarField", "window_average_field", "discharged_mass_history", "frames_in_window", "mean_velocity_history"]
 
@@ -95,24 +95,19 @@ def window_average_field(positions, velocities, masses, times, grid: Grid, windo
     selected = frames_in_window(times, window)
     n_frames = selected.size
     # Pool the clumps of all frames into one instant: the bin mean is then sum(m v) / sum(m) over the window.
-    pooled_positions = positions[selected].reshape(1, -1, 3)
-    pooled_velocities = velocities[selected].reshape(1, -1, 3)
-    pooled_masses = np.tile(masses, n_frames)
-    velocity, occupied = bin_velocity_series(pooled_positions, pooled_velocities, pooled_masses, grid)
-    velocity = np.where(occupied[..., None], velocity, np.nan)[0, :, 0, :, :]
-    origin, spacing, shape = np.asarray(grid.origin), np.asarray(grid.spacing), grid.shape
-    present = np.all(np.isfinite(pooled_positions[0]), axis=1)
-    index = np.floor((pooled_positions[0, present] - origin) / spacing).astype(np.int64)
-    inside = np.all((index >= 0) & (index < np.asarray(shape)), axis=1)
-    mass_in_bins = np.zeros((shape[0], shape[2]))
-    np.add.at(mass_in_bins, (index[inside, 0], index[inside, 2]), pooled_masses[present][inside])
-    bin_volume = float(np.prod(spacing))
+    mass, momentum = bin_sums(positions[selected].reshape(1, -1, 3), velocities[selected].reshape(1, -1, 3),
+                              np.tile(masses, n_frames), grid)
+    shape = (grid.shape[0], grid.shape[2])
+    mass = mass[0].reshape(shape)
+    velocity = np.divide(momentum[0].reshape(*shape, 3), mass[..., None], out=np.full((*shape, 3), np.nan),
+                         where=mass[..., None] > 0.0)
+    origin, spacing = np.asarray(grid.origin), np.asarray(grid.spacing)
     x = origin[0] + (np.arange(shape[0]) + 0.5) * spacing[0]
-    z = origin[2] + (np.arange(shape[2]) + 0.5) * spacing[2]
+    z = origin[2] + (np.arange(shape[1]) + 0.5) * spacing[2]
     times = np.asarray(times, dtype=float)
     return PlanarField(
         x=x, z=z, v_x=velocity[..., 0], v_z=velocity[..., 2],
-        solid_fraction=mass_in_bins / (n_frames * rho * bin_volume),
+        solid_fraction=mass / (n_frames * rho * float(np.prod(spacing))),
         window=(float(times[selected[0]]), float(times[selected[-1]])), n_frames=int(n_frames),
     )
 

@@ -27,7 +27,7 @@ from analysis.checks import finite_array, positive_number
 from analysis.coarse_graining import Grid
 from analysis.pathlines import PathlineResult, integrate_pathlines, lattice_seeds
 
-__all__ = ["silo_bins", "bin_velocity_series", "inlet_bins", "EulerianRTD", "eulerian_residence_times"]
+__all__ = ["silo_bins", "bin_sums", "bin_velocity_series", "inlet_bins", "EulerianRTD", "eulerian_residence_times"]
 
 
 def silo_bins(width: float, depth: float, top: float, bin_size: float) -> Grid:
@@ -69,6 +69,41 @@ def bin_velocity_series(positions, velocities, masses, grid: Grid) -> tuple[np.n
     occupied : numpy.ndarray of bool, shape (n_times, nx, ny, nz)
         Whether the bin held a clump at that instant.
     """
+    mass_sum, momentum_sum = bin_sums(positions, velocities, masses, grid)
+    shape = grid.shape
+    n_times, n_bins = mass_sum.shape
+    occupied = mass_sum > 0.0
+    total_mass = mass_sum.sum(axis=0)
+    mean_over_time = np.divide(
+        momentum_sum.sum(axis=0), total_mass[:, None], out=np.zeros((n_bins, 3)), where=total_mass[:, None] > 0.0
+    )
+    velocity = np.where(
+        occupied[..., None],
+        momentum_sum / np.where(occupied, mass_sum, 1.0)[..., None],
+        mean_over_time[None, :, :],
+    )
+    return velocity.reshape(n_times, *shape, 3), occupied.reshape(n_times, *shape)
+
+
+def bin_sums(positions, velocities, masses, grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """Clump mass and momentum summed per bin at every instant (clumps outside the grid or absent ignored).
+
+    Parameters
+    ----------
+    positions, velocities : array_like, shape (n_times, n_clumps, 3)
+        Clump centres [m] and velocities [m/s]; NaN rows mark clumps absent at an instant.
+    masses : array_like, shape (n_clumps,)
+        Clump masses [kg], > 0.
+    grid : Grid
+        The bins.
+
+    Returns
+    -------
+    mass : numpy.ndarray, shape (n_times, n_bins)
+        Mass per bin [kg], bins in C order of ``grid.shape``.
+    momentum : numpy.ndarray, shape (n_times, n_bins, 3)
+        Momentum per bin [kg m/s].
+    """
     positions = np.asarray(positions, dtype=float)
     velocities = np.asarray(velocities, dtype=float)
     if positions.ndim != 3 or positions.shape[-1] != 3:
@@ -96,17 +131,7 @@ def bin_velocity_series(positions, velocities, masses, grid: Grid) -> tuple[np.n
             momentum_sum[k, :, axis] = np.bincount(
                 flat, weights=weight * velocities[k, present][inside][:, axis], minlength=n_bins
             )
-    occupied = mass_sum > 0.0
-    total_mass = mass_sum.sum(axis=0)
-    mean_over_time = np.divide(
-        momentum_sum.sum(axis=0), total_mass[:, None], out=np.zeros((n_bins, 3)), where=total_mass[:, None] > 0.0
-    )
-    velocity = np.where(
-        occupied[..., None],
-        momentum_sum / np.where(occupied, mass_sum, 1.0)[..., None],
-        mean_over_time[None, :, :],
-    )
-    return velocity.reshape(n_times, *shape, 3), occupied.reshape(n_times, *shape)
+    return mass_sum, momentum_sum
 
 
 def inlet_bins(grid: Grid, inlet_width: float) -> tuple[np.ndarray, np.ndarray]:

@@ -419,8 +419,12 @@ def check_silo_run(
 
 def write_run_record(run_dir: Path, record: dict) -> Path:
     """Write ``run.json`` last and atomically: its presence means the run is complete and checked."""
+    from engines.estimates import format_bytes
+
     path = Path(run_dir) / RUN_RECORD
     _write_text_atomic(path, json.dumps(record, indent=2, sort_keys=True, default=float))
+    if "output_bytes" in record:
+        logging.getLogger("siloflow").info("run complete: %s; the run wrote %s", path, format_bytes(record["output_bytes"]))
     return path
 
 
@@ -472,13 +476,12 @@ def _logs_text(run_dir: Path) -> str:
     return "\n".join(path.read_text(encoding="utf-8", errors="replace") for path in attempt_logs(run_dir))
 
 
-def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> str:
+def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> None:
     """Resume from the newest restart file (the one before it if the newest was cut off by the kill)."""
     log = logging.getLogger("siloflow")
     final_step = int(round(opened.values["step"])) + resume.last_stage_steps
-    candidates = restart_files(run_dir)[-2:][::-1]
-    attempt = len(attempt_logs(run_dir))
-    for index, restart in enumerate(candidates):
+
+    def run_from(restart: Path) -> None:
         relative = f"{RESTART_DIR}/{restart.name}"
         _write_text_atomic(run_dir / "deck" / RESUME_DECK, resume.deck(relative, final_step))
         log.info("resuming %s from restart file %s (the last stage ends at step %d)", run_dir.name, relative, final_step)
@@ -487,15 +490,18 @@ def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> 
             # LIGGGHTS restarts the clock at zero: progress counts the simulated time still to go
             restart_step = int(_RESTART_STEP.match(restart.name).group(1))
             options["target_time"] *= max(final_step - restart_step, 1) / final_step
-        try:
-            return run_engine(run_dir, **options, deck_name=RESUME_DECK, log_name=f"{RESUME_STEM}{attempt}.{LOG_NAME}",
-                              screen_name=f"{RESUME_STEM}{attempt}.{SCREEN_NAME}")
-        except EngineRunError as error:
-            if index + 1 == len(candidates) or "restart" not in str(error).lower():
-                raise
-            log.warning("restart file %s is unreadable (%s); trying the one before it", relative, error)
-            attempt += 1
-    raise AssertionError("unreachable")
+        attempt = len(attempt_logs(run_dir))
+        run_engine(run_dir, **options, deck_name=RESUME_DECK, log_name=f"{RESUME_STEM}{attempt}.{LOG_NAME}",
+                   screen_name=f"{RESUME_STEM}{attempt}.{SCREEN_NAME}")
+
+    newest, *older = restart_files(run_dir)[-2:][::-1]
+    try:
+        run_from(newest)
+    except EngineRunError as error:
+        if not older or "restart" not in str(error).lower():
+            raise
+        log.warning("restart file %s is unreadable (%s); trying the one before it", newest.name, error)
+        run_from(older[0])
 
 
 def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None,
@@ -527,7 +533,6 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: 
         set_aside_previous_attempt(run_dir)
         run_engine(run_dir, **engine)
     checked = check(parse_markers(_logs_text(run_dir)), list_dumps(run_dir / "dumps", DUMP_PREFIX))
-    engine.pop("target_time", None)
     checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX,
                     "resumed_attempts": len(attempt_logs(run_dir)) - 1, **(record or {})})
     shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)

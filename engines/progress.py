@@ -15,6 +15,7 @@ Both spellings are recognised. Stage markers (``SILOFLOW <event> key=value ...``
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -355,7 +356,7 @@ class ProgressMonitor:
         if latest is not None and self._first is not None and latest.time > self._first[1]:
             rate = (latest.time - self._first[1]) / max(now - self._first[0], 1e-9)
             eta = max(self._target - latest.time, 0.0) / rate
-            report = Progress(**{**report.__dict__, "eta_s": eta})
+            report = dataclasses.replace(report, eta_s=eta)
         return report
 
     def poll(self) -> Progress:

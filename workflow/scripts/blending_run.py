@@ -1,11 +1,10 @@
 """Snakemake adapter: run LIGGGHTS on one recirculation deck and check that no clump was lost."""
 
-import json
 from pathlib import Path
 
 from engines.blending import recirculation_case_for_run
 from engines.liggghts_blending import run_recirculation
-from engines.estimates import estimate_recirculation_case, format_bytes
+from engines.estimates import estimate_recirculation_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight
 
@@ -13,6 +12,4 @@ with logged_to(snakemake.log[0]) as log:
     case = recirculation_case_for_run(snakemake.config, snakemake.wildcards.run)
     estimate = estimate_recirculation_case(case, snakemake.params.engine["mpi_ranks"], cost_model(snakemake.config))
     log.info(preflight(snakemake.config, estimate, Path(snakemake.output.record).parent))
-    record_path = run_recirculation(case, Path(snakemake.output.record).parent, **snakemake.params.engine)
-    size = json.loads(Path(record_path).read_text())["output_bytes"]
-    log.info("run complete: %s; the run wrote %s", record_path, format_bytes(size))
+    run_recirculation(case, Path(snakemake.output.record).parent, **snakemake.params.engine)

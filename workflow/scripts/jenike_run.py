@@ -1,11 +1,10 @@
 """Snakemake adapter: run LIGGGHTS on one Jenike shear-cell deck and check the run."""
 
-import json
 from pathlib import Path
 
 from engines.jenike import build_jenike_case
 from engines.liggghts_jenike import run_jenike
-from engines.estimates import estimate_jenike_case, format_bytes
+from engines.estimates import estimate_jenike_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight
 
@@ -13,6 +12,4 @@ with logged_to(snakemake.log[0]) as log:
     case = build_jenike_case(snakemake.config, snakemake.params.point)
     estimate = estimate_jenike_case(case, snakemake.params.engine["mpi_ranks"], cost_model(snakemake.config))
     log.info(preflight(snakemake.config, estimate, Path(snakemake.output.record).parent))
-    record = run_jenike(case, Path(snakemake.output.record).parent, **snakemake.params.engine)
-    size = json.loads(Path(record).read_text())["output_bytes"]
-    log.info("run complete: %s; the run wrote %s", record, format_bytes(size))
+    run_jenike(case, Path(snakemake.output.record).parent, **snakemake.params.engine)

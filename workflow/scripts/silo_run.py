@@ -1,11 +1,10 @@
 """Snakemake adapter: run LIGGGHTS on one flat-bottom silo deck and check the run."""
 
-import json
 from pathlib import Path
 
 from calibration.parameters import calibrated_config
 from engines.liggghts import run_silo
-from engines.estimates import estimate_silo_case, format_bytes
+from engines.estimates import estimate_silo_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight
 from engines.silo import silo_case_for_run
@@ -16,6 +15,4 @@ with logged_to(snakemake.log[0]) as log:
     engine = snakemake.params.engine
     estimate = estimate_silo_case(case, snakemake.params.engine["mpi_ranks"], cost_model(config))
     log.info(preflight(config, estimate, Path(snakemake.output.record).parent))
-    record_path = run_silo(case, Path(snakemake.output.record).parent, **engine)
-    size = json.loads(Path(record_path).read_text())["output_bytes"]
-    log.info("run complete: %s; the run wrote %s", record_path, format_bytes(size))
+    run_silo(case, Path(snakemake.output.record).parent, **engine)
