@@ -1,7 +1,7 @@
 """Calibration charts and polar diagnostics (PNG, matplotlib Agg backend, no display needed).
 
 Every writer draws a figure and saves it atomically (via
-:func:`analysis.plots.save_png`): a reader never sees a half-written PNG
+:func:`analysis.io.plots.save_png`): a reader never sees a half-written PNG
 and a failed write leaves no temporary file behind.
 """
 
@@ -19,7 +19,7 @@ matplotlib.use("Agg")  # headless: runs on clusters and in CI
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.plots import save_png  # noqa: E402
+from analysis.io.plots import save_png  # noqa: E402
 
 if TYPE_CHECKING:
     from calibration.inversion import CalibrationCurve
@@ -200,7 +200,7 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
 
     Parameters
     ----------
-    signals : engines.jenike.ShearSignals or any object with ``time``, ``lid_force``, ``ring_force``,
+    signals : engines.cases.jenike.ShearSignals or any object with ``time``, ``lid_force``, ``ring_force``,
         ``bottom_force``, ``normal_force``, ``weight_above``
         Force histories of the shear stage (s, N).
     friction : calibration.friction.BulkFriction

@@ -206,7 +206,7 @@ def _check_blending_references(config: dict, require) -> None:
 
 
 def _check_blender_references(config: dict, require) -> None:
-    from engines.blender_geometry import INSERT_PRESETS
+    from engines.cases.blender_geometry import INSERT_PRESETS
 
     blender = config["blender"]
     for name in blender["inserts"]:

@@ -1,7 +1,7 @@
 """What a run will cost before it starts: engine steps, simulated and wall time, dump frames and disk space.
 
-Pure computation: callers pass case objects (:mod:`engines.silo`, :mod:`engines.blending`,
-:mod:`engines.blender`, :mod:`engines.jenike`), log text and numbers; nothing here reads or writes files.
+Pure computation: callers pass case objects (:mod:`engines.cases.silo_flat`, :mod:`engines.cases.silo_recirculation`,
+:mod:`engines.cases.blender`, :mod:`engines.cases.jenike`), log text and numbers; nothing here reads or writes files.
 
 The cost model (:class:`CostModel`) is linear in the work: a run of S steps over N spheres costs
 ``N S c`` seconds on one core, with c measured on this machine (:func:`calibrate_cost_model` measures it from
@@ -23,17 +23,17 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Iterable
 
 if TYPE_CHECKING:  # the case classes are only read through their attributes
-    from engines.blender import BlenderCase
-    from engines.blending import RecirculationCase
-    from engines.jenike import JenikeCase
-    from engines.silo import SiloCase
+    from engines.cases.blender import BlenderCase
+    from engines.cases.silo_recirculation import RecirculationCase
+    from engines.cases.jenike import JenikeCase
+    from engines.cases.silo_flat import SiloCase
 
 #: Kinds of run this module estimates.
 SILO_FLAT, BLENDING, BLENDER, JENIKE = "silo_flat", "blending", "blender", "jenike"
 KINDS = (SILO_FLAT, BLENDING, BLENDER, JENIKE)
 
 #: The Jenike deck runs one step after ``delete_atoms`` so LIGGGHTS removes the partner spheres of the
-#: deleted clumps (:mod:`engines.jenike`, stage 2).
+#: deleted clumps (:mod:`engines.cases.jenike`, stage 2).
 JENIKE_LEVEL_DELETION_STEPS = 1
 
 #: Contact snapshots the silo decks write: one local dump of the settled fill (``contacts_<step>.txt``).
@@ -345,7 +345,7 @@ def _estimate_silo_deck(
 
 
 def estimate_silo_case(case: SiloCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
-    """Estimate a flat-bottom silo run (:class:`engines.silo.SiloCase`).
+    """Estimate a flat-bottom silo run (:class:`engines.cases.silo_flat.SiloCase`).
 
     All clumps are counted over the whole run, also while the silo drains (worst case).
     """

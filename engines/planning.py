@@ -12,8 +12,8 @@ import sys
 from pathlib import Path
 
 from calibration.sweep import sweep_points
-from engines.blender import blender_cases
-from engines.blending import recirculation_cases
+from engines.cases.blender import blender_cases
+from engines.cases.silo_recirculation import recirculation_cases
 from engines.config import load_config
 from engines.estimates import (
     CostModel,
@@ -28,8 +28,8 @@ from engines.estimates import (
     format_duration,
     total_dump_bytes,
 )
-from engines.jenike import build_jenike_case
-from engines.silo import silo_cases
+from engines.cases.jenike import build_jenike_case
+from engines.cases.silo_flat import silo_cases
 
 #: Where the runs of each kind live under ``results/`` (as the workflow's rules put them).
 RUN_DIRECTORIES = {"jenike": "calibration/runs", "silo_flat": "silo_flat", "blending": "blending", "blender": "blender"}

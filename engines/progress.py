@@ -10,7 +10,7 @@ without their ``v_`` prefix::
         870      906    0.010040124            453  8.8671113e-08     0.12652729
 
 Both spellings are recognised. Stage markers (``SILOFLOW <event> key=value ...``) are parsed by
-:func:`engines.liggghts.parse_markers`, the parser the orchestrator checks finished runs with.
+:func:`engines.liggghts.run.parse_markers`, the parser the orchestrator checks finished runs with.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 from engines.estimates import format_duration
-from engines.liggghts import Marker, parse_markers
+from engines.liggghts.run import Marker, parse_markers
 
 #: Canonical thermo columns: the decks' thermo keywords without the ``v_`` prefix of variables.
 STEP, ATOMS, TIME, CLUMPS, KE_PER_CLUMP, CPU = "step", "atoms", "time", "n_clumps", "ke_per_clump", "cpu"

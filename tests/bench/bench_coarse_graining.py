@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.coarse_graining import HAVE_NUMBA, Grid, coarse_grain
+from analysis.numerics.coarse_graining import HAVE_NUMBA, Grid, coarse_grain
 
 N_PARTICLES = 100_000
 N_LARGE = 500_000

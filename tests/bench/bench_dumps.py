@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.dumps import parse_legacy_vtk_polydata, write_legacy_vtk_polydata
+from engines.liggghts.dumps import parse_legacy_vtk_polydata, write_legacy_vtk_polydata
 
 N_SPHERES = 100_000
 REPEATS = 5

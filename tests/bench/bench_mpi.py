@@ -19,11 +19,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from analysis.dumps import clumps_from_frame, read_frames
-from analysis.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
+from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
 from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.liggghts import run_silo, write_silo_inputs
-from engines.silo import build_silo_case
+from engines.liggghts.run import run_silo, write_silo_inputs
+from engines.cases.silo_flat import build_silo_case
 from tests.conftest import TINY_SILO
 
 SILO = {**TINY_SILO, "width": 0.12, "fill_height": 0.06, "discharge_time": 0.5}

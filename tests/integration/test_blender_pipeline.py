@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.blending import recirculation_events
-from analysis.blending_io import read_recirculation_tracks
-from engines.blender import blender_cases
+from analysis.studies.silo_recirculation.blending import recirculation_events
+from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks
+from engines.cases.blender import blender_cases
 from engines.config import validate_config
 from tests.conftest import NO_BLENDING, TINY_BLENDER, TINY_SILO, require_liggghts, run_snakemake
 

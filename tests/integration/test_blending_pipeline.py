@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.blending import recirculation_events
-from analysis.blending_io import load_tracks
-from engines.blending import recirculation_cases
+from analysis.studies.silo_recirculation.blending import recirculation_events
+from analysis.studies.silo_recirculation.tracks_io import load_tracks
+from engines.cases.silo_recirculation import recirculation_cases
 from engines.config import validate_config
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import pyvista
 
-from analysis.dumps import (
+from engines.liggghts.dumps import (
     clumps_from_frame,
     dump_step,
     list_dumps,

@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.dumps import list_dumps, parse_legacy_vtk_polydata
+from engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
 from calibration.friction import BulkFriction, bulk_friction
 from engines.config import validate_config
-from engines.jenike import LID_TYPE, JenikeCase, ShearSignals, build_jenike_case, shear_signals
-from engines.liggghts import DUMP_PREFIX
-from engines.liggghts_jenike import (
+from engines.cases.jenike import LID_TYPE, JenikeCase, ShearSignals, build_jenike_case, shear_signals
+from engines.liggghts.run import DUMP_PREFIX
+from engines.liggghts.jenike import (
     PAIR_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,
     read_contact_dump,

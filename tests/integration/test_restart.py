@@ -20,8 +20,8 @@ import pytest
 import yaml
 
 from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.liggghts import restart_files
-from engines.silo import build_silo_case
+from engines.liggghts.run import restart_files
+from engines.cases.silo_flat import build_silo_case
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.blender: exact answers on uniform, linear and closed-form cases."""
+"""Unit tests for analysis.studies.blender.blender: exact answers on uniform, linear and closed-form cases."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.blender import (
+from analysis.studies.blender.blender import (
     BlenderField,
     BlenderMetrics,
     best_blender,
@@ -27,7 +27,7 @@ from analysis.blender import (
     tracer_pathlines,
     virtual_tracer_rtd,
 )
-from analysis.coarse_graining import Fields, Grid
+from analysis.numerics.coarse_graining import Fields, Grid
 
 SPEED = 0.5  # m/s, downward
 DX = 0.01

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.blender import blender_case_for_run, blender_cases, build_blender_case, fill_cross_section_area
-from engines.blender_geometry import blender_geometry, is_watertight
+from engines.cases.blender import blender_case_for_run, blender_cases, build_blender_case, fill_cross_section_area
+from engines.cases.blender_geometry import blender_geometry, is_watertight
 from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts_blender import blender_mesh_set, render_blender_deck, write_blender_inputs
+from engines.liggghts.blender import blender_mesh_set, render_blender_deck, write_blender_inputs
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 

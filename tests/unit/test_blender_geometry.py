@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from engines.blender_geometry import (
+from engines.cases.blender_geometry import (
     INSERT_PRESETS,
     blender_geometry,
     blender_meshes,
@@ -16,7 +16,7 @@ from engines.blender_geometry import (
     mirror_x,
     signed_volume,
 )
-from engines.geometry import horizontal_rectangle, read_stl, write_stl
+from engines.cases.geometry import horizontal_rectangle, read_stl, write_stl
 
 # The study's full scale (SEED_DIGEST section 5) and a half scale with thinner walls.
 FULL = dict(width=0.45, depth=0.04, vertical_height=1.5, hopper_half_angle=30.0, outlet_width=0.04,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.blender_plots: PNGs are written and the plotted data are the input (files under tmp_path)."""
+"""Unit tests for analysis.studies.blender.plots: PNGs are written and the plotted data are the input (files under tmp_path)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-import analysis.blender_plots as blender_plots
-import analysis.blending_plots as blending_plots
-from analysis.blender import (
+import analysis.studies.blender.plots as blender_plots
+import analysis.studies.silo_recirculation.plots as blending_plots
+from analysis.studies.blender.blender import (
     BlenderField,
     comparison_table,
     continuous_mode,
@@ -20,7 +20,7 @@ from analysis.blender import (
     profiles_over_time,
     tracer_pathlines,
 )
-from analysis.blender_plots import (
+from analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_configuration_comparison,
     plot_continuous_mode,
@@ -31,7 +31,7 @@ from analysis.blender_plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from analysis.plots import save_png
+from analysis.io.plots import save_png
 from test_blender_analysis import PASSAGES, X_FULL, Z_ROWS, channel_field, metrics, shear_field, uniform_field
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.blender import BlenderField
-from analysis.blender_study import (
+from analysis.studies.blender.blender import BlenderField
+from analysis.studies.blender.study import (
     BlenderSettings,
     analyse_blender,
     key_heights,
@@ -17,7 +17,7 @@ from analysis.blender_study import (
     study_metrics,
     study_summary,
 )
-from analysis.tables import write_json
+from analysis.io.tables import write_json
 
 V = 0.05          # downward speed [m/s]
 FILL = 0.2        # fill height [m]

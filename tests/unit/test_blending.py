@@ -1,4 +1,4 @@
-"""Unit tests for analysis.blending (passes, batch layers, outlet concentration) on exact cases.
+"""Unit tests for analysis.studies.silo_recirculation.blending (passes, batch layers, outlet concentration) on exact cases.
 
 Most tests use a "conveyor": N clumps evenly spaced along z, all moving down at a constant speed
 through the periodic domain, so every crossing, re-entry and pass is known in closed form.
@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.blending import (
+from analysis.studies.silo_recirculation.blending import (
     ClumpTracks,
     OutletConcentration,
     RecirculationEvents,
@@ -32,7 +32,7 @@ from analysis.blending import (
     tracer_passes,
     vrr_by_recirculation,
 )
-from analysis.rtd import rtd_from_exit_times
+from analysis.numerics.rtd import rtd_from_exit_times
 
 # --------------------------------------------------------------------------- the conveyor
 

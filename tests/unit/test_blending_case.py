@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.blending import (
+from engines.cases.silo_recirculation import (
     apply_flow_pattern,
     build_recirculation_case,
     estimated_residence_time,
@@ -17,7 +17,7 @@ from engines.blending import (
     recirculation_cases,
 )
 from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts_blending import recirculation_meshes, render_recirculation_deck, write_recirculation_inputs
+from engines.liggghts.silo_recirculation import recirculation_meshes, render_recirculation_deck, write_recirculation_inputs
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 

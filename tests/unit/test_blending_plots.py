@@ -1,11 +1,11 @@
-"""Unit tests for analysis.blending_plots (files under tmp_path only)."""
+"""Unit tests for analysis.studies.silo_recirculation.plots (files under tmp_path only)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from analysis.blending_plots import (
+from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
     plot_lti_comparison,
     plot_outlet_concentration,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.blending_study (the composed blending analysis) on exact cases.
+"""Unit tests for analysis.studies.silo_recirculation.study (the composed blending analysis) on exact cases.
 
 Most tests use the "conveyor" of ``test_blending.py`` (helpers copied here): 100 clumps evenly spaced
 along z, all moving down at 0.1 m/s through a domain periodic in z, so every crossing, re-entry, pass,
@@ -21,8 +21,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.blending import ClumpTracks, RecirculationEvents, recirculation_events
-from analysis.blending_study import (
+from analysis.studies.silo_recirculation.blending import ClumpTracks, RecirculationEvents, recirculation_events
+from analysis.studies.silo_recirculation.study import (
     residence_summary,
     BlendingResult,
     Layout,
@@ -36,7 +36,7 @@ from analysis.blending_study import (
     snapshot_frames,
     verify_eulerian_rtd,
 )
-from analysis.rtd import johanson_rtd
+from analysis.numerics.rtd import johanson_rtd
 
 # --------------------------------------------------------------------------- the conveyor
 

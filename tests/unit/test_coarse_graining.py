@@ -1,4 +1,4 @@
-"""Unit tests for analysis.coarse_graining on synthetic particles with exact answers."""
+"""Unit tests for analysis.numerics.coarse_graining on synthetic particles with exact answers."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.coarse_graining import (
+from analysis.numerics.coarse_graining import (
     HAVE_NUMBA,
     KERNELS,
     Fields,

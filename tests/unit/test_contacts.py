@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from analysis.contacts import ContactDumpError, force_chain_segments, parse_local_dump, read_contacts
+from engines.liggghts.contacts import ContactDumpError, force_chain_segments, parse_local_dump, read_contacts
 
 DUMP = """ITEM: TIMESTEP
 22000

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.dumps: exact round trips, malformed files, clumps, file lists, cache."""
+"""Unit tests for engines.liggghts.dumps: exact round trips, malformed files, clumps, file lists, cache."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from analysis import dumps
-from analysis.dumps import (
+from engines.liggghts.dumps import (
     ClumpFrame,
     DumpFormatError,
     ParticleFrame,
@@ -532,7 +532,7 @@ def test_read_frame_rejects_bad_timestep(tmp_path):
 
 
 def test_a_damaged_dump_among_good_ones_raises_naming_it_or_is_skipped_with_a_warning(tmp_path):
-    from analysis.dumps import read_frames
+    from engines.liggghts.dumps import read_frames
 
     points, fields = liggghts_like_fields(5)
     content = format_legacy_vtk_polydata(points, fields, binary=True)

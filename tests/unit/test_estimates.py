@@ -8,8 +8,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from engines.blender import blender_cases, build_blender_case
-from engines.blending import recirculation_cases
+from engines.cases.blender import blender_cases, build_blender_case
+from engines.cases.silo_recirculation import recirculation_cases
 from engines.config import REPO_ROOT, load_config
 from engines.estimates import (
     ESTIMATE_COLUMNS,
@@ -34,8 +34,8 @@ from engines.estimates import (
     total_dump_bytes,
     wall_time,
 )
-from engines.jenike import build_jenike_case
-from engines.silo import build_silo_case
+from engines.cases.jenike import build_jenike_case
+from engines.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
     "shape": "sphere2",

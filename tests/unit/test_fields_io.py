@@ -1,12 +1,12 @@
-"""Unit tests for analysis.fields_io: .vti/.pvd open in pyvista with the arrays; .npz round trip is exact."""
+"""Unit tests for analysis.io.fields: .vti/.pvd open in pyvista with the arrays; .npz round trip is exact."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from analysis.coarse_graining import Grid, coarse_grain, contact_stress, depth_average
-from analysis.fields_io import (
+from analysis.numerics.coarse_graining import Grid, coarse_grain, contact_stress, depth_average
+from analysis.io.fields import (
     load_fields_npz,
     read_fields_vti,
     save_fields_npz,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.flow on synthetic input with exact answers (no engine)."""
+"""Unit tests for analysis.numerics.flow on synthetic input with exact answers (no engine)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.flow import (
+from analysis.numerics.flow import (
     BulkDensity,
     DischargeHistory,
     FlowRateFit,

@@ -14,8 +14,8 @@ import pytest
 from scipy.spatial import cKDTree
 
 from engines.config import load_config, validate_config
-from engines.geometry import read_stl
-from engines.jenike import (
+from engines.cases.geometry import read_stl
+from engines.cases.jenike import (
     CHORD_TOLERANCE,
     FILL_SOLID_FRACTION,
     LID_TYPE,
@@ -31,8 +31,8 @@ from engines.jenike import (
     segments_for_chord,
     shear_signals,
 )
-from engines.liggghts import EngineRunError, Marker
-from engines.liggghts_jenike import (
+from engines.liggghts.run import EngineRunError, Marker
+from engines.liggghts.jenike import (
     CONTACT_COLUMNS,
     FORCE_COLUMNS,
     check_jenike_run,
@@ -42,7 +42,7 @@ from engines.liggghts_jenike import (
     render_jenike_deck,
     write_jenike_inputs,
 )
-from engines.physics import rayleigh_time
+from engines.cases.physics import rayleigh_time
 from engines.templating import UnsafeDeckValue, render_deck
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
@@ -575,7 +575,7 @@ def test_contact_dump_reader(tmp_path):
 
 
 def test_an_earlier_attempt_is_set_aside_with_its_force_history(tmp_path):
-    from engines.liggghts_jenike import set_aside_previous_jenike_attempt
+    from engines.liggghts.jenike import set_aside_previous_jenike_attempt
 
     assert set_aside_previous_jenike_attempt(tmp_path) is None
     (tmp_path / "dumps").mkdir()

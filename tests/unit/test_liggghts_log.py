@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from engines.liggghts import (
+from engines.liggghts.run import (
     EngineNotFound,
     EngineRunError,
     check_silo_run,
@@ -15,7 +15,7 @@ from engines.liggghts import (
     parse_markers,
     set_aside_previous_attempt,
 )
-from engines.silo import build_silo_case
+from engines.cases.silo_flat import build_silo_case
 
 LOG = """\
 print "SILOFLOW filled step=$(step) time=$(time) clumps=${n_clumps} ke_per_clump=${ke_per_clump}"

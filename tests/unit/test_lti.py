@@ -1,4 +1,4 @@
-"""Unit tests for analysis.lti (convolution with the RTD, VRR, recirculation) on exact cases."""
+"""Unit tests for analysis.numerics.lti (convolution with the RTD, VRR, recirculation) on exact cases."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.lti import (
+from analysis.numerics.lti import (
     Recirculation,
     VRRTable,
     coefficient_of_variation,
@@ -19,7 +19,7 @@ from analysis.lti import (
     variance_reduction_ratio,
     vrr_versus_period,
 )
-from analysis.rtd import perfect_mixer_rtd, plug_flow_rtd
+from analysis.numerics.rtd import perfect_mixer_rtd, plug_flow_rtd
 
 TAU = 1.0
 DT = 2.0e-3
@@ -290,7 +290,7 @@ def test_recirculation_of_a_perfect_mixer_is_homogeneous_once_the_batch_is_in():
 
 
 def test_recirculation_of_a_triangular_rtd_homogenises_in_a_few_passes():
-    from analysis.rtd import johanson_rtd
+    from analysis.numerics.rtd import johanson_rtd
 
     dt = 5e-3
     t_e = np.arange(int(round(4.0 / dt)) + 1) * dt

@@ -1,11 +1,11 @@
-"""Unit tests for analysis.pathlines: virtual tracers through velocity fields with exact residence times."""
+"""Unit tests for analysis.numerics.pathlines: virtual tracers through velocity fields with exact residence times."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from analysis.pathlines import (
+from analysis.numerics.pathlines import (
     EXITED,
     HAVE_NUMBA,
     NOT_EXITED,
@@ -16,7 +16,7 @@ from analysis.pathlines import (
     lattice_seeds,
     time_levels,
 )
-from analysis.rtd import rtd_from_exit_times
+from analysis.numerics.rtd import rtd_from_exit_times
 
 BACKENDS = ["numba", "numpy"] if HAVE_NUMBA else ["numpy"]
 METHODS = ["rk2", "euler"]

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from engines.physics import engine_seeds, is_prime, rayleigh_time, steps_for
+from engines.cases.physics import engine_seeds, is_prime, rayleigh_time, steps_for
 
 
 def test_rayleigh_time_of_a_3mm_hdpe_sphere_by_hand():

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.profiles on synthetic profiles with exact answers."""
+"""Unit tests for analysis.numerics.profiles on synthetic profiles with exact answers."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.coarse_graining import Fields, Grid, coarse_grain, depth_average
-from analysis.profiles import (
+from analysis.numerics.coarse_graining import Fields, Grid, coarse_grain, depth_average
+from analysis.numerics.profiles import (
     FlowChannelBoundary,
     KinematicFit,
     ProfileErrors,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.rtd on samples and curves with exact answers."""
+"""Unit tests for analysis.numerics.rtd on samples and curves with exact answers."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.rtd import (
+from analysis.numerics.rtd import (
     RTD,
     RTDMoments,
     carson_royal_recycle,

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from analysis.coarse_graining import depth_average
-from analysis.dumps import ClumpFrame
-from analysis.profiles import janssen_vertical_stress
-from analysis.silo_fields import (
+from analysis.numerics.coarse_graining import depth_average
+from engines.liggghts.dumps import ClumpFrame
+from analysis.numerics.profiles import janssen_vertical_stress
+from analysis.studies.silo_flat.fields import (
     FieldSettings,
     analyse_profiles,
     centreline_velocity,

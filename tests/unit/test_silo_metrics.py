@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.dumps import ClumpFrame
-from analysis.silo import EscapedParticles, flow_table_row, silo_flow_metrics, vanished_above_outlet
+from engines.liggghts.dumps import ClumpFrame
+from analysis.studies.silo_flat.metrics import EscapedParticles, flow_table_row, silo_flow_metrics, vanished_above_outlet
 
 SPACING = 0.004  # m, simple cubic lattice
 WIDTH, DEPTH, LAYERS = 0.08, 0.012, 10

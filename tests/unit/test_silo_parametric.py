@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import copy
 
-from engines.liggghts import render_silo_deck
-from engines.silo import build_silo_case, parametric_variants, silo_cases
+from engines.liggghts.run import render_silo_deck
+from engines.cases.silo_flat import build_silo_case, parametric_variants, silo_cases
 
 
 def _contact(config, a, b):

@@ -1,7 +1,7 @@
 # Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
 
 from calibration.sweep import diagnostic_points, sweep_points
-from engines.jenike import build_jenike_case
+from engines.cases.jenike import build_jenike_case
 
 
 def _jenike_points():

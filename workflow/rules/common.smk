@@ -9,9 +9,9 @@ from calibration.parameters import calibrated_config
 from engines.config import ConfigError, validate_config
 from engines.estimates import InsufficientDiskSpace, format_bytes
 from engines.planning import config_estimates, ensure_disk_space
-from engines.blender import blender_case_for_run, blender_cases
-from engines.blending import recirculation_case_for_run, recirculation_cases
-from engines.silo import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
+from engines.cases.blender import blender_case_for_run, blender_cases
+from engines.cases.silo_recirculation import recirculation_case_for_run, recirculation_cases
+from engines.cases.silo_flat import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.

@@ -3,9 +3,9 @@
 import json
 from pathlib import Path
 
-from analysis.blender import BlenderField
-from analysis.blender_io import read_planar_fields
-from analysis.blender_plots import (
+from analysis.studies.blender.blender import BlenderField
+from analysis.studies.blender.fields_io import read_planar_fields
+from analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_continuous_mode,
     plot_discontinuous_mode,
@@ -14,7 +14,7 @@ from analysis.blender_plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from analysis.blender_study import (
+from analysis.studies.blender.study import (
     BlenderSettings,
     analyse_blender,
     key_heights,
@@ -22,8 +22,8 @@ from analysis.blender_study import (
     study_metrics,
     study_summary,
 )
-from analysis.tables import write_flow_table, write_json
-from engines.blender import blender_case_for_run
+from analysis.io.tables import write_flow_table, write_json
+from engines.cases.blender import blender_case_for_run
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

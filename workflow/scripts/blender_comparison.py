@@ -3,10 +3,10 @@
 import json
 from pathlib import Path
 
-from analysis.blender import best_blender, comparison_table
-from analysis.blender_plots import plot_configuration_comparison, plot_rtd_theta
-from analysis.blender_study import metrics_from_summary, rtd_from_summary
-from analysis.tables import markdown_table, write_flow_table, write_text
+from analysis.studies.blender.blender import best_blender, comparison_table
+from analysis.studies.blender.plots import plot_configuration_comparison, plot_rtd_theta
+from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
+from analysis.io.tables import markdown_table, write_flow_table, write_text
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

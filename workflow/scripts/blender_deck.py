@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.blender import blender_case_for_run
-from engines.liggghts_blender import write_blender_inputs
+from engines.cases.blender import blender_case_for_run
+from engines.liggghts.blender import write_blender_inputs
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -5,12 +5,12 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.blender_fields import discharged_mass_history, mean_velocity_history, window_average_field
-from analysis.blender_io import write_planar_fields
-from analysis.blending_io import read_recirculation_tracks
-from analysis.eulerian_rtd import silo_bins
-from analysis.flow import steady_flow_rate
-from analysis.tables import write_json
+from analysis.studies.blender.fields import discharged_mass_history, mean_velocity_history, window_average_field
+from analysis.studies.blender.fields_io import write_planar_fields
+from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks
+from analysis.numerics.eulerian_rtd import silo_bins
+from analysis.numerics.flow import steady_flow_rate
+from analysis.io.tables import write_json
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

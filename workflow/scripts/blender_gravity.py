@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.blender import gravity_scaling
-from analysis.blender_plots import plot_gravity_scaling
-from analysis.tables import write_flow_table
+from analysis.studies.blender.blender import gravity_scaling
+from analysis.studies.blender.plots import plot_gravity_scaling
+from analysis.io.tables import write_flow_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.blender import blender_case_for_run
-from engines.liggghts_blender import run_blender
+from engines.cases.blender import blender_case_for_run
+from engines.liggghts.blender import run_blender
 from engines.estimates import estimate_blender_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight

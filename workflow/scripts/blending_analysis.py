@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.blending import sampling_noise_vrr_limit
-from analysis.blending_io import load_tracks
-from analysis.blending_plots import (
+from analysis.studies.silo_recirculation.blending import sampling_noise_vrr_limit
+from analysis.studies.silo_recirculation.tracks_io import load_tracks
+from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
     plot_lti_comparison,
     plot_outlet_concentration,
@@ -16,9 +16,9 @@ from analysis.blending_plots import (
     plot_vrr_versus_period,
     plot_vrr_versus_recirculations,
 )
-from analysis.blending_study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
-from analysis.rtd import johanson_rtd
-from analysis.tables import write_flow_table, write_json
+from analysis.studies.silo_recirculation.study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
+from analysis.numerics.rtd import johanson_rtd
+from analysis.io.tables import write_flow_table, write_json
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.blending import recirculation_case_for_run
-from engines.liggghts_blending import write_recirculation_inputs
+from engines.cases.silo_recirculation import recirculation_case_for_run
+from engines.liggghts.silo_recirculation import write_recirculation_inputs
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

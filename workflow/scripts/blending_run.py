@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.blending import recirculation_case_for_run
-from engines.liggghts_blending import run_recirculation
+from engines.cases.silo_recirculation import recirculation_case_for_run
+from engines.liggghts.silo_recirculation import run_recirculation
 from engines.estimates import estimate_recirculation_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight

@@ -3,8 +3,8 @@
 import json
 from pathlib import Path
 
-from analysis.blending_plots import plot_vrr_versus_recirculations
-from analysis.tables import write_flow_table
+from analysis.studies.silo_recirculation.plots import plot_vrr_versus_recirculations
+from analysis.io.tables import write_flow_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -3,7 +3,7 @@
 import json
 from pathlib import Path
 
-from analysis.blending_io import read_recirculation_tracks, write_tracks
+from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks, write_tracks
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

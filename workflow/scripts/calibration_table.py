@@ -3,7 +3,7 @@
 import json
 from pathlib import Path
 
-from analysis.tables import write_flow_table
+from analysis.io.tables import write_flow_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

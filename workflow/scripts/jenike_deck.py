@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.jenike import build_jenike_case
-from engines.liggghts_jenike import write_jenike_inputs
+from engines.cases.jenike import build_jenike_case
+from engines.liggghts.jenike import write_jenike_inputs
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -5,11 +5,11 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.dumps import list_dumps, read_frame
-from analysis.tables import write_json
+from engines.liggghts.dumps import list_dumps, read_frame
+from analysis.io.tables import write_json
 from calibration.charts import plot_polar_histogram
 from calibration.friction import angular_histogram, mobilised_friction_by_azimuth
-from engines.liggghts_jenike import WALL_CONTACT_PREFIX, read_contact_dump
+from engines.liggghts.jenike import WALL_CONTACT_PREFIX, read_contact_dump
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

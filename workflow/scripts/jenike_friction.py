@@ -3,11 +3,11 @@
 import json
 from pathlib import Path
 
-from analysis.tables import write_json
+from analysis.io.tables import write_json
 from calibration.charts import plot_force_history
 from calibration.friction import bulk_friction_of_shear
-from engines.jenike import shear_signals
-from engines.liggghts_jenike import read_force_history
+from engines.cases.jenike import shear_signals
+from engines.liggghts.jenike import read_force_history
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from engines.jenike import build_jenike_case
-from engines.liggghts_jenike import run_jenike
+from engines.cases.jenike import build_jenike_case
+from engines.liggghts.jenike import run_jenike
 from engines.estimates import estimate_jenike_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight

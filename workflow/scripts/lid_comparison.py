@@ -2,7 +2,7 @@
 
 import csv
 
-from analysis.tables import write_flow_table
+from analysis.io.tables import write_flow_table
 from calibration.charts import plot_lid_comparison
 from calibration.sweep import lid_comparison
 from engines.logs import logged_to

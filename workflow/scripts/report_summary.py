@@ -6,8 +6,8 @@ from pathlib import Path
 
 import yaml
 
-from analysis.summary import calibration_rows, summary_html
-from analysis.tables import write_text
+from analysis.report.summary import calibration_rows, summary_html
+from analysis.io.tables import write_text
 from engines.logs import logged_to
 
 

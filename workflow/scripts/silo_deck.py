@@ -3,9 +3,9 @@
 from pathlib import Path
 
 from calibration.parameters import calibrated_config
-from engines.liggghts import write_silo_inputs
+from engines.liggghts.run import write_silo_inputs
 from engines.logs import logged_to
-from engines.silo import silo_case_for_run
+from engines.cases.silo_flat import silo_case_for_run
 
 with logged_to(snakemake.log[0]) as log:
     config = calibrated_config(snakemake.config, snakemake.input.get("parameters"))

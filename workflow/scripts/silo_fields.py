@@ -7,13 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.coarse_graining import depth_average, front_wall_slice
-from analysis.contacts import force_chain_segments, read_contacts
-from analysis.dumps import clumps_from_frame, read_frames
-from analysis.fields_io import save_fields_npz, write_fields_vti, write_pvd
-from analysis.flow import column_surface_heights
-from analysis.profiles import profile_flow_rate, velocity_profile
-from analysis.silo_fields import (
+from analysis.numerics.coarse_graining import depth_average, front_wall_slice
+from engines.liggghts.contacts import force_chain_segments, read_contacts
+from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.io.fields import save_fields_npz, write_fields_vti, write_pvd
+from analysis.numerics.flow import column_surface_heights
+from analysis.numerics.profiles import profile_flow_rate, velocity_profile
+from analysis.studies.silo_flat.fields import (
     FieldSettings,
     analyse_profiles,
     centreline_velocity,
@@ -24,7 +24,7 @@ from analysis.silo_fields import (
     silo_grid,
     time_average,
 )
-from analysis.silo_plots import (
+from analysis.studies.silo_flat.plots import (
     plot_centreline_velocity,
     plot_force_chains,
     plot_janssen,
@@ -33,8 +33,8 @@ from analysis.silo_plots import (
     plot_profiles_over_silo,
     plot_velocity_contour,
 )
-from analysis.tables import write_flow_table, write_json
-from engines.liggghts import CONTACT_PREFIX
+from analysis.io.tables import write_flow_table, write_json
+from engines.liggghts.run import CONTACT_PREFIX
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

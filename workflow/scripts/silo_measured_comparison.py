@@ -1,11 +1,11 @@
 """Snakemake adapter: compare the simulated time-averaged profiles with measured ones (e.g. PIV)."""
 
-from analysis.coarse_graining import depth_average, front_wall_slice
-from analysis.fields_io import load_fields_npz
-from analysis.measurements import compare_with_measurement, read_measured_profiles
-from analysis.profiles import velocity_profile
-from analysis.silo_plots import plot_measured_comparison
-from analysis.tables import write_flow_table
+from analysis.numerics.coarse_graining import depth_average, front_wall_slice
+from analysis.io.fields import load_fields_npz
+from analysis.studies.silo_flat.measured import compare_with_measurement, read_measured_profiles
+from analysis.numerics.profiles import velocity_profile
+from analysis.studies.silo_flat.plots import plot_measured_comparison
+from analysis.io.tables import write_flow_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -3,10 +3,10 @@
 import json
 from pathlib import Path
 
-from analysis.dumps import clumps_from_frame, read_frames
-from analysis.plots import plot_discharge
-from analysis.silo import flow_table_row, silo_flow_metrics
-from analysis.tables import write_discharge_history_csv, write_flow_table, write_json
+from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.io.plots import plot_discharge
+from analysis.studies.silo_flat.metrics import flow_table_row, silo_flow_metrics
+from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -5,11 +5,11 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.coarse_graining import depth_average
-from analysis.fields_io import load_fields_npz
-from analysis.profiles import velocity_profile
-from analysis.silo_plots import plot_parametric_study
-from analysis.tables import write_flow_table
+from analysis.numerics.coarse_graining import depth_average
+from analysis.io.fields import load_fields_npz
+from analysis.numerics.profiles import velocity_profile
+from analysis.studies.silo_flat.plots import plot_parametric_study
+from analysis.io.tables import write_flow_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

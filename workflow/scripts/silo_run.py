@@ -3,11 +3,11 @@
 from pathlib import Path
 
 from calibration.parameters import calibrated_config
-from engines.liggghts import run_silo
+from engines.liggghts.run import run_silo
 from engines.estimates import estimate_silo_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight
-from engines.silo import silo_case_for_run
+from engines.cases.silo_flat import silo_case_for_run
 
 with logged_to(snakemake.log[0]) as log:
     config = calibrated_config(snakemake.config, snakemake.input.get("parameters"))

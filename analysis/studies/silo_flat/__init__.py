@@ -1,0 +1,1 @@
+"""analysis.studies.silo_flat."""

@@ -1,0 +1,212 @@
+"""Plots of the flat-bottom silo flow in the study's style. Each writer takes arrays or dataclasses and a path,
+draws one figure and saves it atomically as a 150 dpi PNG."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.collections import LineCollection  # noqa: E402
+
+from analysis.io.plots import save_png  # noqa: E402
+
+
+
+
+def _silo_outline(axes, width: float, outlet_width: float, top: float) -> None:
+    half, slot = 0.5 * width, 0.5 * outlet_width
+    outline = dict(color="black", linewidth=1.5)
+    axes.plot([-half, -half, -slot], [top, 0.0, 0.0], **outline)
+    axes.plot([half, half, slot], [top, 0.0, 0.0], **outline)
+
+
+def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
+                            fcb_fraction_index: int = -1) -> Path:
+    """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary in red.
+
+    Each profile is drawn at its height z as z + s v_z(x), with the scale s chosen so that the fastest
+    profile spans 80 % of the spacing between heights; the red dots mark the flow channel boundary at the
+    chosen fraction of the centreline velocity.
+    """
+    heights = profiles.heights
+    spacing = np.min(np.diff(heights)) if heights.size > 1 else 0.02
+    peak = np.nanmax(np.abs(profiles.v_z)) or 1.0
+    scale = 0.8 * spacing / peak
+    x_mm = 1e3 * profiles.x
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        for i, z in enumerate(heights):
+            axes.axhline(1e3 * z, color="0.8", linewidth=0.6)
+            axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
+            left, right = profiles.fcb_left[i, fcb_fraction_index], profiles.fcb_right[i, fcb_fraction_index]
+            axes.plot(1e3 * np.array([left, right]), [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
+        fraction = profiles.fcb_fractions[fcb_fraction_index]
+        axes.plot([], [], "o", color="red", label=f"FCB at {100 * fraction:g} % of centreline v_z")
+        axes.plot([], [], color="tab:blue", label=f"v_z (1 mm = {1e-3 / scale:.3g} m/s)")
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        axes.legend(loc="upper center", fontsize=8)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, title: str) -> Path:
+    """Contours of the depth-averaged vertical velocity v_z(x, z) (m/s); ``v_z`` has shape (nx, nz)."""
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        levels = np.linspace(np.min(v_z), 0.0, 21) if np.min(v_z) < 0 else 21
+        filled = axes.contourf(1e3 * np.asarray(x), 1e3 * np.asarray(z), np.asarray(v_z).T, levels=levels,
+                               cmap="viridis")
+        figure.colorbar(filled, ax=axes, label="v_z [m/s]")
+        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * np.max(z))
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_kinematic_constant(heights, B, path, title: str) -> Path:
+    """Kinematic constant B (mm) against height above the outlet (mm)."""
+    figure, axes = plt.subplots(figsize=(5.0, 4.0))
+    try:
+        axes.plot(1e3 * np.asarray(B), 1e3 * np.asarray(heights), "o-")
+        axes.set_xlabel("B [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        axes.grid(alpha=0.3)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_janssen(comparison, path, title: str) -> Path:
+    """Mean vertical stress against depth below the surface: DEM contacts and Janssen's formula."""
+    figure, axes = plt.subplots(figsize=(5.0, 4.0))
+    try:
+        axes.plot(comparison.simulated, 1e3 * comparison.depth_below_surface, "o", label="DEM (contact stress)")
+        axes.plot(comparison.janssen, 1e3 * comparison.depth_below_surface, "-", label="Janssen")
+        axes.invert_yaxis()
+        axes.set_xlabel("vertical stress [Pa]")
+        axes.set_ylabel("depth below surface [mm]")
+        axes.set_title(title)
+        axes.legend(fontsize=8)
+        axes.grid(alpha=0.3)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Path:
+    """Centreline vertical velocity against time since opening, one line per height."""
+    figure, axes = plt.subplots(figsize=(6.0, 4.0))
+    try:
+        for j, z in enumerate(heights):
+            axes.plot(times, velocities[:, j], label=f"z = {1e3 * z:g} mm")
+        axes.set_xlabel("time since opening [s]")
+        axes.set_ylabel("v_z on the axis [m/s]")
+        axes.set_title(title)
+        axes.legend(fontsize=8)
+        axes.grid(alpha=0.3)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_force_chains(segments, width: float, outlet_width: float, top: float, path, title: str) -> Path:
+    """Branch vectors of contacts in a slice, coloured by normal force (capped)."""
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        lines = np.stack([1e3 * segments.start[:, [0, 2]], 1e3 * segments.end[:, [0, 2]]], axis=1)
+        collection = LineCollection(lines, array=segments.normal_force, cmap="inferno_r", linewidths=1.2)
+        collection.set_clim(0.0, segments.cap)
+        axes.add_collection(collection)
+        figure.colorbar(collection, ax=axes, shrink=0.6, label=f"normal force [N] (capped at {segments.cap:.3g} N)")
+        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        axes.set_xlim(-0.55e3 * width, 0.55e3 * width)
+        axes.set_ylim(-2.0, 1e3 * top)
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_measured_comparison(comparisons, path, title: str) -> Path:
+    """Simulated against measured v_z(x), one panel row per measured profile, with the error metrics."""
+    rows = max(1, len(comparisons))
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.6 * rows), squeeze=False)
+    try:
+        for axes, comparison in zip(axes_list[:, 0], comparisons):
+            measured = comparison.measured
+            x_mm = 1e3 * measured.x
+            if measured.uncertainty is not None:
+                axes.errorbar(x_mm, measured.v_z, yerr=measured.uncertainty, fmt="o", markersize=3, label="measured")
+            else:
+                axes.plot(x_mm, measured.v_z, "o", markersize=3, label="measured")
+            axes.plot(x_mm, comparison.simulated_v_z, "-", label="DEM")
+            errors = comparison.errors
+            axes.set_title(f"z = {1e3 * measured.z:g} mm, {measured.window}: mean error {errors.mean_error_percent:.1f} %, "
+                           f"RMS {errors.rms_error:.3g} m/s", fontsize=9)
+            axes.set_ylabel("v_z [m/s]")
+            axes.grid(alpha=0.3)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        axes_list[0, 0].legend(fontsize=8)
+        figure.suptitle(title)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, title: str) -> Path:
+    """v_z profiles at one height (left) and the steady mass flow rate (right) for each run of a study."""
+    figure, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.0), gridspec_kw={"width_ratios": [3, 2]})
+    try:
+        for profile, label in zip(profiles, labels):
+            left.plot(1e3 * np.asarray(x), profile, label=label)
+        left.set_xlabel("x [mm]")
+        left.set_ylabel(f"v_z at z = {1e3 * height:g} mm [m/s]")
+        left.grid(alpha=0.3)
+        left.legend(fontsize=7)
+        positions = np.arange(len(labels))
+        right.bar(positions, flow_rates, color="tab:blue")
+        right.set_xticks(positions, labels, rotation=45, ha="right", fontsize=7)
+        right.set_ylabel("steady mass flow rate [kg/s]")
+        right.grid(alpha=0.3, axis="y")
+        figure.suptitle(title)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+
+
+def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Path:
+    """Horizontal velocity from the DEM (v_x) against the kinematic model's u = -B dv_z/dx at each height."""
+    rows = len(profiles.heights)
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.2 * rows), squeeze=False, sharex=True)
+    try:
+        x_mm = 1e3 * profiles.x
+        for i, axes in enumerate(axes_list[:, 0]):
+            axes.plot(x_mm, profiles.v_x[i], "o", markersize=3, label="DEM v_x")
+            axes.plot(x_mm, profiles.kinematic_u[i], "-", label="kinematic u = -B dv_z/dx")
+            axes.set_ylabel(f"z = {1e3 * profiles.heights[i]:g} mm\n[m/s]", fontsize=8)
+            axes.grid(alpha=0.3)
+        axes_list[0, 0].legend(fontsize=8)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        figure.suptitle(title)
+        return save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)

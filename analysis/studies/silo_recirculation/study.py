@@ -1,0 +1,470 @@
+"""The blending study of one recirculation run, composed from :mod:`analysis.studies.silo_recirculation.blending`, :mod:`analysis.numerics.rtd`,
+:mod:`analysis.numerics.lti` and :mod:`analysis.numerics.eulerian_rtd`.
+
+Pure computation on arrays; the workflow scripts read the tracks and write tables and plots. SI units.
+
+Steps (SEED_DIGEST section 4):
+
+1. Events: re-entries at the top and outlet crossings of every clump (:func:`analysis.studies.silo_recirculation.blending.recirculation_events`);
+   the mean residence time ``t_res`` = holdup / throughput over the steady part of the run (after the first
+   ``startup_fraction`` of it).
+2. Direct measurement, per batch layout: colours from the heights at the opening, outlet concentration in windows
+   of ``window_fraction t_res``, ``Nr = (t - t_open) / t_res``, VRR per recirculation, and the first-exit
+   concentration of the initial contents.
+3. RTD from particle ids: a tracer of ``tracer_fraction`` of the holdup, the first passes re-entering after
+   ``Nr = tracer_start``; ``E(t)``, moments, ``t_s / t_d``. The loop RTD (outlet to outlet) of the same passes
+   feeds the LTI prediction.
+4. LTI: the direct concentration against the renewal (Carson and Royal) prediction from the first-exit
+   concentration with the measured loop RTD; continuous mode (sine and square VRR against period), discontinuous
+   mode (layered batch fed over one t_res and recirculated), and Johanson's triangular RTD fitted to the first
+   appearance and the mode of the measured one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from analysis.studies.silo_recirculation.blending import (
+    ClumpTracks,
+    OutletConcentration,
+    RecirculationEvents,
+    RecirculationVRR,
+    TracerPasses,
+    batch_inlet_signal,
+    clumps_above_outlet,
+    first_pass_concentration,
+    holdup_residence_time,
+    layer_colours,
+    outlet_concentration,
+    predicted_concentration_from_first_pass,
+    recirculation_events,
+    recirculation_number,
+    tracer_passes,
+    vrr_by_recirculation,
+)
+from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
+from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
+
+
+@dataclass(frozen=True)
+class Layout:
+    """A batch colouring: blue fraction, number of blue sub-layers and where the first one lies."""
+
+    name: str
+    blue_fraction: float
+    sublayers: int = 1
+    blue_at: str = "bottom"
+
+
+@dataclass(frozen=True, eq=False)
+class LoopTiming:
+    """Steady-state timing of a recirculation run.
+
+    Attributes
+    ----------
+    t_open, t_end : float
+        First and last frame (outlet opening, end of run) [s].
+    residence_time : float
+        Holdup over throughput in the steady part [s].
+    holdup : float
+        Mean number of clumps above the outlet plane in the steady part [-].
+    throughput : float
+        Outlet crossings per second in the steady part [1/s].
+    recirculations : float
+        ``(t_end - t_open) / t_res``: recirculations the run covers [-].
+    """
+
+    t_open: float
+    t_end: float
+    residence_time: float
+    holdup: float
+    throughput: float
+    recirculations: float
+
+
+@dataclass(frozen=True, eq=False)
+class LayoutResult:
+    """Direct measurement and LTI prediction of one batch layout."""
+
+    layout: Layout
+    colours: np.ndarray
+    concentration: OutletConcentration
+    first_pass: OutletConcentration
+    predicted: np.ndarray
+    predicted_johanson: np.ndarray
+    vrr: RecirculationVRR
+    vrr_predicted: RecirculationVRR
+    homogenised_after: float
+    model_time_nr: np.ndarray
+    model_concentration: np.ndarray
+    model_homogenised_after: float
+    recirculation_number: np.ndarray
+
+    def prediction_rms_error(self) -> float:
+        """RMS difference between the predicted and the measured concentration over the windows with data [-]."""
+        measured = self.concentration.concentration
+        valid = np.isfinite(measured)
+        return float(np.sqrt(np.mean((self.predicted[valid] - measured[valid]) ** 2))) if valid.any() else math.nan
+
+
+@dataclass(frozen=True, eq=False)
+class ParticleRTD:
+    """RTD from particle ids: the tracer's silo RTD (re-entry to outlet), and the large steady samples of passes
+    (``steady``: re-entry to outlet, ``loop``: outlet to outlet) that feed the LTI models, with the kernels
+    tabulated once on the concentration windows: the loop RTD, the silo RTD, and Johanson's triangle shifted by
+    the channel-and-fall lag."""
+
+    tracer: TracerPasses
+    silo: RTD
+    loop: TracerPasses
+    loop_E_on_windows: np.ndarray
+    start_time: float
+    n_tracer: int
+    johanson_V1: float
+    johanson_P: float
+    steady: TracerPasses
+    silo_E_on_windows: np.ndarray
+    johanson_loop_E_on_windows: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class BlendingResult:
+    """Everything measured and predicted for one recirculation run."""
+
+    timing: LoopTiming
+    events: RecirculationEvents
+    window: float
+    rtd: ParticleRTD
+    layouts: list[LayoutResult] = field(default_factory=list)
+    vrr_sine: VRRTable | None = None
+    vrr_square: VRRTable | None = None
+
+
+def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: float = 0.0,
+                startup_fraction: float = 0.1) -> LoopTiming:
+    """Holdup, throughput and mean residence time over the run after its first ``startup_fraction``."""
+    if not 0.0 <= startup_fraction < 1.0:
+        raise ValueError(f"startup_fraction must be in [0, 1), got {startup_fraction!r}")
+    times = tracks.times
+    t_open, t_end = float(times[0]), float(times[-1])
+    t_start = t_open + startup_fraction * (t_end - t_open)
+    steady = times >= t_start
+    holdup_counts = clumps_above_outlet(tracks, outlet_z)[steady]
+    exits = np.asarray(events.exit_times_all, dtype=float)
+    t_res = holdup_residence_time(holdup_counts, exits, t_start, t_end)
+    n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
+    return LoopTiming(
+        t_open=t_open,
+        t_end=t_end,
+        residence_time=t_res,
+        holdup=float(np.mean(holdup_counts)),
+        throughput=n_exits / (t_end - t_start),
+        recirculations=(t_end - t_open) / t_res,
+    )
+
+
+def _johanson_parameters(rtd: RTD) -> tuple[float, float]:
+    """Johanson's V1 (first appearance) and P (mode) in throughput units, clipped to the model's range."""
+    v1 = min(max(rtd.t_first / rtd.t_mean, 0.0), 0.99)
+    mode = float(rtd.time[int(np.argmax(rtd.E))]) / rtd.t_mean
+    return v1, min(max(mode, v1), 0.5 * (3.0 - v1))
+
+
+def _steady_passes(events: RecirculationEvents, start: float, t_end: float, horizon: float, at_least: int,
+                   entry_at: str) -> TracerPasses:
+    """Every pass entering in ``[start, t_end - horizon]`` (at least ``at_least``): a large sample whose passes all
+    had ``horizon`` to leave, so the right-censoring by the end of the run is as small as for the tracer."""
+    entry = np.asarray(events.entry_time if entry_at == "wrap" else events.previous_exit_time, dtype=float)
+    in_window = int(np.count_nonzero(np.isfinite(entry) & (entry >= start) & (entry <= t_end - horizon)))
+    return tracer_passes(events, start, max(at_least, in_window), entry_at=entry_at)
+
+
+def particle_rtd(events: RecirculationEvents, timing: LoopTiming, tracer_fraction: float, tracer_start: float,
+                 bins: int, window: float, horizon_recirculations: float = 2.0) -> ParticleRTD:
+    """RTD from particle ids: the first ``tracer_fraction`` x holdup passes re-entering after ``Nr = tracer_start``.
+
+    The silo RTD of the study uses that tracer, with the re-entry at the top as the entry. The LTI models need a
+    smoother RTD than a 10 % tracer gives: they take every pass entering between the tracer's start and
+    ``horizon_recirculations`` t_res before the end of the run (at least the tracer's count), for the silo
+    (re-entry to outlet) and for the whole loop (previous outlet crossing to exit, which the renewal equation
+    needs), tabulated on bins of width ``window`` from 0.
+    """
+    n_tracer = max(1, int(round(tracer_fraction * timing.holdup)))
+    start = timing.t_open + tracer_start * timing.residence_time
+    tracer = tracer_passes(events, start, n_tracer, entry_at="wrap")
+    horizon = horizon_recirculations * timing.residence_time
+    loop = _steady_passes(events, start, timing.t_end, horizon, n_tracer, "outlet")
+    steady = _steady_passes(events, start, timing.t_end, horizon, n_tracer, "wrap")
+    for passes, what in ((tracer, "re-entry"), (loop, "loop")):
+        if not np.any(np.isfinite(passes.exit_time)):
+            raise ValueError(
+                f"none of the {passes.exit_time.size} tracer passes ({what} RTD) entering after Nr = {tracer_start:g} "
+                f"left the silo before the end of the run (Nr = {timing.recirculations:.2f}); run more "
+                "recirculations (blending.recirculations) or mark the tracer earlier "
+                "(blending.tracer.start_recirculations)"
+            )
+    silo = rtd_from_exit_times(tracer.exit_time, t_entry=tracer.entry_time, bins=bins, n_total=n_tracer)
+    loop_E = _with_little_tail(loop, window, events.n_clumps / timing.throughput)
+    v1, p = _johanson_parameters(silo)
+    # Johanson's triangle stands in for the silo part of the loop; the loop adds the channel and the fall.
+    loop_lag = max(0.0, float(np.nanmean(loop.exit_time - loop.entry_time)) - silo.t_mean)
+    lags = np.arange(loop_E.size) * window
+    johanson = np.where(lags >= loop_lag, johanson_rtd(np.maximum(lags - loop_lag, 0.0), silo.t_mean, v1, p), 0.0)
+    return ParticleRTD(
+        tracer=tracer, silo=silo, loop=loop, loop_E_on_windows=loop_E, start_time=start, n_tracer=n_tracer,
+        johanson_V1=v1, johanson_P=p, steady=steady, silo_E_on_windows=_histogram_from_zero(steady, window),
+        johanson_loop_E_on_windows=johanson,
+    )
+
+
+def _with_little_tail(passes: TracerPasses, step: float, mean_loop_time: float, max_tail_steps: int = 20000) -> np.ndarray:
+    """Loop RTD on bins of width ``step`` from 0, its censored part restored as an exponential tail.
+
+    Passes still in the loop at the end of the run (slow paths along the walls) are missing from the histogram;
+    normalising it would shorten the mean loop time and make the renewal prediction recycle too fast. In a
+    closed loop the mean loop time is known exactly, every clump over the throughput (Little's law), so the
+    missing fraction ``f_c`` is put back as ``f_c exp(-(t - T) / tau) / tau`` after the longest observed loop
+    time ``T``, with ``tau`` chosen so that the whole RTD has that mean. Without a censored part, or when the
+    observed part already has the mean, the histogram is returned as it is.
+    """
+    residence = passes.exit_time - passes.entry_time
+    exited = np.isfinite(residence)
+    E = _histogram_from_zero(passes, step)
+    censored = 1.0 - exited.sum() / residence.size
+    if censored <= 0.0:
+        return E
+    longest = float(residence[exited].max())
+    observed_mean = float(residence[exited].mean())
+    tau = (mean_loop_time - (1.0 - censored) * observed_mean) / censored - longest
+    if not tau > 0.0:
+        return E
+    n_tail = min(max_tail_steps, int(math.ceil((longest + 8.0 * tau) / step)) + 1)
+    t = np.arange(n_tail) * step
+    tail = np.where(t >= longest, censored * np.exp(-(t - longest) / tau) / tau, 0.0)
+    tail[: E.size] += E[: min(E.size, n_tail)]
+    return tail
+
+
+def _histogram_from_zero(passes: TracerPasses, step: float) -> np.ndarray:
+    """E of a sample of passes on bins of width ``step`` from 0 (unexited passes count in the total)."""
+    residence = passes.exit_time - passes.entry_time
+    edges = np.arange(0.0, float(np.nanmax(residence)) + 2.0 * step, step)
+    return rtd_from_exit_times(passes.exit_time, t_entry=passes.entry_time, bins=edges,
+                               n_total=passes.exit_time.size).E
+
+
+def analyse_layout(layout: Layout, initial_height, events: RecirculationEvents, timing: LoopTiming, window: float,
+                   rtd: ParticleRTD, passes: int, tolerance: float) -> LayoutResult:
+    """Direct measurement, renewal prediction and discontinuous LTI model of one batch layout."""
+    colours = layer_colours(initial_height, layout.blue_fraction, layout.sublayers, layout.blue_at)
+    exits = np.asarray(events.exit_times_all, dtype=float)
+    crossing_blue = colours[np.asarray(events.exit_clump_index, dtype=np.int64)]
+    measured = outlet_concentration(exits, crossing_blue, window, timing.t_open, timing.t_end)
+    first = first_pass_concentration(events, colours, window, timing.t_open, timing.t_end)
+    c_first = np.nan_to_num(first.concentration, nan=0.0)
+    predicted = predicted_concentration_from_first_pass(c_first, rtd.loop_E_on_windows, window, passes)
+    johanson = rtd.johanson_loop_E_on_windows
+    predicted_johanson = (
+        predicted_concentration_from_first_pass(c_first, johanson, window, passes) if johanson.sum() > 0 else
+        np.full_like(c_first, np.nan)
+    )
+    n_recirculations = max(1, int(math.floor(timing.recirculations)))
+    vrr = vrr_by_recirculation(measured.centres, measured.concentration, timing.t_open, timing.residence_time,
+                               layout.blue_fraction, n_recirculations)
+    vrr_predicted = vrr_by_recirculation(measured.centres, predicted, timing.t_open, timing.residence_time,
+                                         layout.blue_fraction, n_recirculations)
+    homogenised = _homogenised_after(measured, timing, layout.blue_fraction, tolerance)
+    # Discontinuous mode: the batch fed over one t_res, then recirculated with the measured silo RTD.
+    _, c_in = batch_inlet_signal(layout.blue_fraction, layout.sublayers, layout.blue_at, timing.residence_time,
+                                 window)
+    model = recirculate(c_in, rtd.silo_E_on_windows, np.arange(c_in.size) * window, passes)
+    samples_per_pass = timing.residence_time / window
+    model_nr = np.arange(model.concentration.size) / samples_per_pass
+    model_after = recirculations_to_homogenise(model.concentration[: int(passes * samples_per_pass)],
+                                               mean=layout.blue_fraction, tolerance=tolerance,
+                                               per_pass_length=samples_per_pass)
+    return LayoutResult(
+        layout=layout, colours=colours, concentration=measured, first_pass=first, predicted=predicted,
+        predicted_johanson=predicted_johanson, vrr=vrr, vrr_predicted=vrr_predicted, homogenised_after=homogenised,
+        model_time_nr=model_nr, model_concentration=model.concentration, model_homogenised_after=model_after,
+        recirculation_number=recirculation_number(measured.centres, timing.t_open, timing.residence_time),
+    )
+
+
+def _homogenised_after(measured: OutletConcentration, timing: LoopTiming, blue_fraction: float,
+                       tolerance: float) -> float:
+    """Nr from which every measured window stays within +-tolerance of the blue fraction (NaN if never)."""
+    c = measured.concentration
+    inside = np.isfinite(c) & (np.abs(c - blue_fraction) <= tolerance * blue_fraction)
+    outside = np.flatnonzero(~inside)
+    if outside.size == 0:
+        return 0.0
+    last_outside = outside[-1]
+    if last_outside == c.size - 1:
+        return math.nan
+    return float((measured.edges[last_outside + 1] - timing.t_open) / timing.residence_time)
+
+
+def continuous_mode(rtd: ParticleRTD, period_fractions, samples_per_shortest_period: int = 8) -> tuple[VRRTable, VRRTable]:
+    """VRR of sine and square inputs against their period (over the tracer's t_m), through the steady silo RTD."""
+    fractions = np.asarray(period_fractions, dtype=float)
+    step = float(fractions.min()) * rtd.silo.t_mean / samples_per_shortest_period
+    E = _histogram_from_zero(rtd.steady, step)
+    time = np.arange(E.size) * step
+    t_mean = rtd.silo.t_mean
+    return (
+        vrr_versus_period(E, time, fractions, waveform="sine", t_mean=t_mean),
+        vrr_versus_period(E, time, fractions, waveform="square", t_mean=t_mean),
+    )
+
+
+def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_top: float, window_fraction: float,
+                     tracer_fraction: float, tracer_start: float, rtd_bins: int, period_fractions, passes: int,
+                     tolerance: float, outlet_z: float = 0.0) -> BlendingResult:
+    """The whole direct + RTD + LTI analysis of one recirculation run (see the module docstring).
+
+    Parameters
+    ----------
+    tracks : ClumpTracks
+        Clump centres from the outlet opening (first frame) to the end of the run [m].
+    layouts : sequence of Layout
+        Batch colourings.
+    domain_bottom, domain_top : float
+        Periodic bounds of the domain in z [m].
+    window_fraction : float
+        Concentration window as a fraction of the measured t_res [-].
+    tracer_fraction, tracer_start : float
+        Tracer size (fraction of the holdup) and the Nr after which it is marked [-].
+    rtd_bins : int
+        Bins of the silo RTD histogram [-].
+    period_fractions : sequence of float
+        Input periods over t_m for the continuous mode [-].
+    passes : int
+        Recirculations summed by the LTI models [-].
+    tolerance : float
+        Relative band that counts as homogenised [-].
+    outlet_z : float, optional
+        Height of the outlet plane [m].
+    """
+    events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
+    timing = loop_timing(tracks, events, outlet_z)
+    window = window_fraction * timing.residence_time
+    rtd = particle_rtd(events, timing, tracer_fraction, tracer_start, rtd_bins, window)
+    initial_height = tracks.position[0, :, 2]
+    results = [analyse_layout(layout, initial_height, events, timing, window, rtd, passes, tolerance)
+               for layout in layouts]
+    sine, square = continuous_mode(rtd, period_fractions)
+    return BlendingResult(timing=timing, events=events, window=window, rtd=rtd, layouts=results, vrr_sine=sine,
+                          vrr_square=square)
+
+
+def snapshot_frames(times, t_open: float, residence_time: float, recirculation_numbers) -> list[int]:
+    """Index of the frame nearest to each wanted Nr (those beyond the run are dropped)."""
+    times = np.asarray(times, dtype=float)
+    indices = []
+    for nr in recirculation_numbers:
+        wanted = t_open + float(nr) * residence_time
+        if wanted <= times[-1] + 0.5 * (times[-1] - times[-2] if times.size > 1 else 0.0):
+            indices.append(int(np.argmin(np.abs(times - wanted))))
+    return indices
+
+
+@dataclass(frozen=True, eq=False)
+class VerificationResult:
+    """Particle tracks against Eulerian pathlines in the one-particle-thick silo.
+
+    Attributes
+    ----------
+    particle_residence : numpy.ndarray
+        Residence times (re-entry to outlet) of the tracer passes [s], NaN if not out by the end.
+    eulerian_residence : dict
+        Bin size [m] -> residence times of the virtual tracers [s] (NaN: not out within the time followed).
+    particle_paths : list of numpy.ndarray
+        (n_i, 2) arrays of (x, z) of a few tracer clumps from re-entry to exit [m].
+    pathlines : dict
+        Bin size [m] -> list of (n_i, 2) arrays of (x, z) of a few virtual tracers [m].
+    timing : LoopTiming
+        Holdup, throughput and t_res of the run.
+    """
+
+    particle_residence: np.ndarray
+    eulerian_residence: dict
+    particle_paths: list
+    pathlines: dict
+    timing: LoopTiming
+
+
+def residence_summary(times) -> dict:
+    """Count, count exited, mean and standard deviation (population) of a residence-time sample [s]; NaN = not out."""
+    times = np.asarray(times, dtype=float)
+    finite = times[np.isfinite(times)]
+    return {"n": int(times.size), "n_exited": int(finite.size),
+            "mean_s": float(finite.mean()) if finite.size else None,
+            "std_s": float(finite.std()) if finite.size else None}
+
+
+def _clump_path(tracks: ClumpTracks, column: int, t_from: float, t_to: float) -> np.ndarray:
+    """(x, z) of one clump between two times, with a NaN row where it wraps through the periodic boundary."""
+    inside = (tracks.times >= t_from) & (tracks.times <= t_to)
+    path = tracks.position[inside, column][:, [0, 2]]
+    jumps = np.flatnonzero(np.abs(np.diff(path[:, 1])) > 0.5 * (np.nanmax(tracks.z) - np.nanmin(tracks.z)))
+    return np.insert(path, jumps + 1, np.nan, axis=0) if jumps.size else path
+
+
+def verify_eulerian_rtd(tracks: ClumpTracks, velocity, mass, width: float, depth: float, domain_bottom: float,
+                        domain_top: float, inlet_width: float, bin_sizes, tracer_start: float, dt: float,
+                        max_recirculations: float, paths_shown: int, tracer_fraction: float = 0.1,
+                        outlet_z: float = 0.0) -> VerificationResult:
+    """Residence times and paths of real clumps against virtual tracers through bin velocities of several sizes.
+
+    The particle side takes the passes re-entering after ``Nr = tracer_start`` (as many as ``tracer_fraction`` of
+    the holdup); the Eulerian side seeds the same number of virtual tracers in the inlet bins at the same time.
+    """
+    from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
+
+    events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
+    timing = loop_timing(tracks, events, outlet_z)
+    start = timing.t_open + tracer_start * timing.residence_time
+    n_tracer = max(1, int(round(tracer_fraction * timing.holdup)))
+    tracer = tracer_passes(events, start, n_tracer, entry_at="wrap")
+    residence = tracer.exit_time - tracer.entry_time
+    shown = np.flatnonzero(np.isfinite(residence))
+    shown = shown[np.linspace(0, shown.size - 1, min(paths_shown, shown.size)).astype(int)] if shown.size else shown
+    particle_paths = [
+        _clump_path(tracks, int(tracer.clump_index[i]), tracer.entry_time[i], tracer.exit_time[i]) for i in shown
+    ]
+    max_time = max_recirculations * timing.residence_time
+    record_every = max(1, int(round(0.01 / dt)))
+    eulerian, pathlines = {}, {}
+    for bin_size in bin_sizes:
+        grid = silo_bins(width, depth, domain_top, bin_size)
+        result = eulerian_residence_times(
+            tracks.times, tracks.position, velocity, mass, grid, inlet_width, n_tracer, start, dt, max_time,
+            outlet_z=outlet_z, record_every=record_every,
+        )
+        eulerian[float(bin_size)] = result.residence_time
+        history = result.pathlines.history
+        chosen = np.linspace(0, result.seeds.shape[0] - 1, min(paths_shown, result.seeds.shape[0])).astype(int)
+        pathlines[float(bin_size)] = [history[:, i][:, [0, 2]] for i in chosen]
+    return VerificationResult(particle_residence=residence, eulerian_residence=eulerian,
+                              particle_paths=particle_paths, pathlines=pathlines, timing=timing)
+
+
+def main_run_eulerian_rtd(tracks: ClumpTracks, velocity, mass, result: BlendingResult, width: float, depth: float,
+                          domain_top: float, inlet_width: float, bin_size: float, dt: float,
+                          max_recirculations: float, bins: int, outlet_z: float = 0.0) -> RTD:
+    """The Eulerian RTD of a blending run: as many virtual tracers as the particle tracer, released when it starts."""
+    from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
+
+    grid = silo_bins(width, depth, domain_top, bin_size)
+    eulerian = eulerian_residence_times(
+        tracks.times, tracks.position, velocity, mass, grid, inlet_width, result.rtd.n_tracer, result.rtd.start_time,
+        dt, max_recirculations * result.timing.residence_time, outlet_z=outlet_z,
+    )
+    residence = eulerian.residence_time
+    if not np.any(np.isfinite(residence)):
+        raise ValueError("no virtual tracer reached the outlet; raise blending.eulerian.max_recirculations")
+    return rtd_from_exit_times(residence, t_entry=0.0, bins=bins, n_total=residence.size)

@@ -1,0 +1,171 @@
+"""Parts every case shares: materials and their contact pairs, the run id, the central pour.
+
+Engine-neutral data only: a material table numbers materials as engine types, but what a type means to an
+engine is the engine's business.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass
+
+from engines.cases.particles import ParticleTemplate
+from engines.cases.physics import steps_for
+
+#: Standard gravity (m/s^2).
+GRAVITY = 9.81
+
+
+@dataclass(frozen=True)
+class MaterialTable:
+    """Materials numbered as engine atom types, with per-pair contact parameters.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Material names; type i + 1 is ``names[i]``; the particle material is type 1.
+    youngs_modulus, poisson_ratio : tuple of float
+        Per type (Pa, -).
+    sliding_friction, rolling_friction, restitution : tuple of tuple of float
+        Symmetric per-pair matrices (-). Pairs that never touch in the case (wall-wall) carry neutral
+        values: friction 0, rolling friction 0, restitution 0.5.
+    """
+
+    names: tuple[str, ...]
+    youngs_modulus: tuple[float, ...]
+    poisson_ratio: tuple[float, ...]
+    sliding_friction: tuple[tuple[float, ...], ...]
+    rolling_friction: tuple[tuple[float, ...], ...]
+    restitution: tuple[tuple[float, ...], ...]
+
+    def type_of(self, name: str) -> int:
+        """Engine atom type (1-based) of a material."""
+        return self.names.index(name) + 1
+
+
+NEUTRAL_CONTACT = {"sliding_friction": 0.0, "rolling_friction": 0.0, "restitution": 0.5}
+
+
+def material_table(config: dict, particle_material: str, wall_materials: list[str]) -> MaterialTable:
+    """Number the materials (particle first, then walls in order of appearance) and build pair matrices."""
+    names: list[str] = [particle_material]
+    for name in wall_materials:
+        if name not in names:
+            names.append(name)
+    contacts = {frozenset(c["materials"]): c for c in config["contacts"]}
+
+    def matrix(key: str) -> tuple[tuple[float, ...], ...]:
+        rows = []
+        for a in names:
+            row = []
+            for b in names:
+                contact = contacts.get(frozenset((a, b)))
+                if contact is None and particle_material in (a, b):
+                    # validate_config guarantees these exist; a missing one here is a programming error.
+                    raise KeyError(f"no contact parameters for [{a}, {b}]")
+                row.append(float(contact[key]) if contact else NEUTRAL_CONTACT[key])
+            rows.append(tuple(row))
+        return tuple(rows)
+
+    materials = config["materials"]
+    return MaterialTable(
+        names=tuple(names),
+        youngs_modulus=tuple(float(materials[n]["youngs_modulus"]) for n in names),
+        poisson_ratio=tuple(float(materials[n]["poisson_ratio"]) for n in names),
+        sliding_friction=matrix("sliding_friction"),
+        rolling_friction=matrix("rolling_friction"),
+        restitution=matrix("restitution"),
+    )
+
+
+@dataclass(frozen=True)
+class FillPlan:
+    """How the silo is poured: an insertion zone above the heap and an insertion rate.
+
+    Attributes
+    ----------
+    n_clumps : int
+        Clumps to insert.
+    zone : tuple of float
+        Insertion zone (x_min, x_max, y_min, y_max, z_min, z_max) (m).
+    insertion_velocity : float
+        Downward velocity of inserted clumps (m/s).
+    insert_every : int
+        Steps between insertion events; long enough for a batch to leave the zone.
+    clumps_per_insertion : int
+        Clumps per insertion event.
+    particle_rate : float
+        Insertion rate (clumps/s).
+    fill_steps : int
+        Steps of the filling stage (all insertions plus the last batch's fall to the heap).
+    """
+
+    n_clumps: int
+    zone: tuple[float, float, float, float, float, float]
+    insertion_velocity: float
+    insert_every: int
+    clumps_per_insertion: int
+    particle_rate: float
+    fill_steps: int
+
+
+def run_id(prefix: str, parameters: dict) -> str:
+    """Stable run directory name: ``<prefix>-<first 10 hex digits of sha256 of canonical JSON>``."""
+    canonical = json.dumps(parameters, sort_keys=True, separators=(",", ":"))
+    return f"{prefix}-{hashlib.sha256(canonical.encode()).hexdigest()[:10]}"
+
+
+def plan_fill(
+    particle: ParticleTemplate,
+    width: float,
+    depth: float,
+    fill_height: float,
+    fill_config: dict,
+    timestep: float,
+    gravity: float,
+    n_clumps: int | None = None,
+) -> FillPlan:
+    """Size the central pour: clump count from the target fill height, zone above the heap, rate.
+
+    The clump count is n = rho_b,est W T H / m_clump unless given (a silo whose cross-section is not a rectangle
+    counts its own). The insertion zone is centred and spans the whole depth
+    (with ``all_in`` LIGGGHTS keeps each clump's bounding sphere inside the zone, so clumps never overlap the
+    front and back walls, and a silo one clump thick still has room for the centres), and its floor sits above
+    the highest heap the pile can form, H + (W/2) tan(heap angle), plus two clump diameters. Each insertion
+    event fills the zone to the given solid fraction; the next one comes when the batch has moved one zone
+    height down, so batches never overlap.
+    """
+    if n_clumps is None:
+        n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
+    if n_clumps < 1:
+        raise ValueError("fill_height too small: less than one clump fits")
+    clearance = particle.bounding_radius
+    zone_half_width = 0.5 * fill_config["zone_width_fraction"] * width
+    x_min, x_max = -zone_half_width + clearance, zone_half_width - clearance
+    y_min, y_max = 0.0, depth
+    if x_max - x_min <= 2.0 * clearance or y_max - y_min <= 2.0 * clearance:
+        raise ValueError("insertion zone thinner than one clump: increase silo depth or zone_width_fraction")
+    heap_rise = 0.5 * width * math.tan(math.radians(fill_config["heap_angle"]))
+    z_min = fill_height + heap_rise + 4.0 * particle.bounding_radius
+    z_max = z_min + fill_config["zone_height"]
+    zone_volume = (x_max - x_min) * (y_max - y_min) * (z_max - z_min)
+    clumps_per_insertion = max(1, int(fill_config["volume_fraction"] * zone_volume / particle.volume))
+    velocity = fill_config["insertion_velocity"]
+    insert_every = steps_for(fill_config["zone_height"] / velocity, timestep)
+    particle_rate = clumps_per_insertion / (insert_every * timestep)
+    insertions = math.ceil(n_clumps / clumps_per_insertion)
+    # Worst-case fall of the last batch from the top of the zone to the floor.
+    fall_height = z_max
+    fall_time = (-velocity + math.sqrt(velocity**2 + 2.0 * gravity * fall_height)) / gravity
+    fill_steps = insertions * insert_every + steps_for(fall_time, timestep)
+    return FillPlan(
+        n_clumps=n_clumps,
+        zone=(x_min, x_max, y_min, y_max, z_min, z_max),
+        insertion_velocity=velocity,
+        insert_every=insert_every,
+        clumps_per_insertion=clumps_per_insertion,
+        particle_rate=particle_rate,
+        fill_steps=fill_steps,
+    )

@@ -1,0 +1,243 @@
+"""The planar flat-bottom silo: an engine-neutral case built from validated configuration.
+
+Geometry (SI units): inner width W along x (side walls at x = -W/2 and +W/2), depth T along y (front wall
+at y = 0, back wall at y = T), z up with the floor and outlet plane at z = 0. A slot outlet of width B0,
+centred on x = 0, spans the full depth; a gate closes it until the fill has settled.
+
+Stages: pour clumps centrally from an insertion zone above the pile, settle until the mean kinetic energy
+per clump is below a threshold, remove the gate, discharge for a given time. Discharged clumps fall
+``sink_depth`` below the outlet plane and leave the domain through its bottom boundary.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import asdict, dataclass, field
+
+from engines.cases.common import GRAVITY, FillPlan, MaterialTable, material_table, plan_fill, run_id
+from engines.cases.particles import ParticleTemplate, particle_template
+from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
+
+CASE_NAME = "silo_flat"
+
+#: Keys of ``silo_flat`` that only steer the analysis; they do not define (or rerun) the simulation.
+ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric")
+
+
+@dataclass(frozen=True)
+class SiloCase:
+    """Everything that defines one flat-bottom silo run, derived from validated configuration."""
+
+    particle: ParticleTemplate
+    materials: MaterialTable
+    width: float
+    depth: float
+    fill_height: float
+    outlet_width: float
+    wall_materials: dict
+    front_back_walls: bool
+    timestep: float
+    rayleigh_time: float
+    fill: FillPlan
+    settle_threshold: float
+    settle_check_steps: int
+    settle_max_checks: int
+    discharge_steps: int
+    dump_every: int
+    sink_depth: float
+    domain_top: float
+    seeds: tuple[int, ...]
+    steady_window: tuple[float, float]
+    beverloo: dict
+    defining_parameters: dict = field(repr=False)
+
+    @property
+    def run_id(self) -> str:
+        """Directory name of the run: particle model plus a hash of every defining parameter."""
+        return run_id(self.particle.name, self.defining_parameters)
+
+    @property
+    def spheres_per_clump(self) -> int:
+        return self.particle.n_spheres
+
+    def summary(self) -> dict:
+        """Plain-data summary of the derived quantities (for ``case.json``)."""
+        return {
+            "case": CASE_NAME,
+            "run_id": self.run_id,
+            "particle_model": self.particle.name,
+            "spheres_per_clump": self.particle.n_spheres,
+            "clump_mass_kg": self.particle.mass,
+            "clump_volume_m3": self.particle.volume,
+            "equivalent_diameter_m": self.particle.equivalent_diameter,
+            "rayleigh_time_s": self.rayleigh_time,
+            "timestep_s": self.timestep,
+            "n_clumps": self.fill.n_clumps,
+            "dump_interval_s": self.dump_every * self.timestep,
+            "width_m": self.width,
+            "depth_m": self.depth,
+            "fill_height_m": self.fill_height,
+            "outlet_width_m": self.outlet_width,
+            "fill": asdict(self.fill),
+            "settle_threshold_J": self.settle_threshold,
+            "discharge_time_s": self.discharge_steps * self.timestep,
+            "steady_window": list(self.steady_window),
+            "beverloo": dict(self.beverloo),
+            "materials": list(self.materials.names),
+            "parameters": self.defining_parameters,
+        }
+
+def build_silo_case(config: dict) -> SiloCase:
+    """Derive a :class:`SiloCase` from a validated configuration (see :func:`engines.config.validate_config`)."""
+    silo = config["silo_flat"]
+    material_name = silo["particle_material"]
+    material = config["materials"][material_name]
+    particle = particle_template(
+        silo["particle_model"], config["particle_models"][silo["particle_model"]], material["density"]
+    )
+    if silo["outlet_width"] >= silo["width"]:
+        raise ValueError(
+            f"silo_flat.outlet_width ({silo['outlet_width']} m) must be smaller than silo_flat.width ({silo['width']} m)"
+        )
+    if silo["depth"] < 2.0 * particle.bounding_radius:
+        raise ValueError(
+            f"silo_flat.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"
+        )
+    walls = silo["wall_materials"]
+    used_walls = [walls["side"], walls["bottom"]] + ([walls["front_back"]] if silo["front_back_walls"] else [])
+    table = material_table(config, material_name, used_walls)
+    t_rayleigh = rayleigh_time(
+        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
+    )
+    timestep = silo["timestep_fraction"] * t_rayleigh
+    fill = plan_fill(particle, silo["width"], silo["depth"], silo["fill_height"], silo["fill"], timestep, GRAVITY)
+    settle = silo["settle"]
+    settle_check_steps = steps_for(settle["check_interval"], timestep)
+    settle_max_checks = max(1, math.ceil(settle["max_time"] / (settle_check_steps * timestep)))
+    sink_depth = silo["sink_depth"]
+    if sink_depth < 2.0 * particle.bounding_radius:
+        raise ValueError(
+            f"silo_flat.sink_depth ({sink_depth} m) must exceed one clump size ({2 * particle.bounding_radius:.4g} m)"
+        )
+
+    defining = {
+        "case": CASE_NAME,
+        "materials": {name: config["materials"][name] for name in table.names},
+        "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
+        "contacts": sorted(
+            (c for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
+            key=lambda c: sorted(c["materials"]),
+        ),
+        "silo": {k: v for k, v in silo.items() if k not in ANALYSIS_ONLY_KEYS},
+    }
+    # Normalise the contact pair order so [a, b] and [b, a] key the same run.
+    defining["contacts"] = [{**c, "materials": sorted(c["materials"])} for c in defining["contacts"]]
+
+    return SiloCase(
+        particle=particle,
+        materials=table,
+        width=silo["width"],
+        depth=silo["depth"],
+        fill_height=silo["fill_height"],
+        outlet_width=silo["outlet_width"],
+        wall_materials=dict(walls),
+        front_back_walls=silo["front_back_walls"],
+        timestep=timestep,
+        rayleigh_time=t_rayleigh,
+        fill=fill,
+        settle_threshold=settle["kinetic_energy_threshold"],
+        settle_check_steps=settle_check_steps,
+        settle_max_checks=settle_max_checks,
+        discharge_steps=steps_for(silo["discharge_time"], timestep),
+        dump_every=steps_for(silo["dump_interval"], timestep),
+        sink_depth=sink_depth,
+        domain_top=fill.zone[5] + 2.0 * particle.bounding_radius,
+        seeds=tuple(engine_seeds(silo["seed"], 3)),
+        steady_window=tuple(silo["steady_window"]),
+        beverloo=dict(silo["beverloo"]),
+        defining_parameters=defining,
+    )
+
+
+def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
+    """The configurations of the parametric studies: ``{study: [(label, config), ...]}``.
+
+    Studies (digest section 3): ``front_back_friction`` (particle-wall friction of the front and back walls,
+    plus a run without them when ``periodic_front_back``), ``restitution`` (of all particle contacts) and
+    ``friction`` (particle-particle sliding x rolling friction of all particle contacts). A front/back wall
+    friction value gets its own material (a copy of the front/back wall material), so the side walls keep
+    theirs. Labels are short and stable ("mu_fw=0.3", "periodic", "e=0.6", "mu=0.15,mu_r=0.1").
+    """
+    silo = config["silo_flat"]
+    study = silo["parametric"]
+    particle = silo["particle_material"]
+    front_back = silo["wall_materials"]["front_back"]
+
+    def variant(edit) -> dict:
+        changed = copy.deepcopy(config)
+        edit(changed)
+        return changed
+
+    def set_particle_contacts(changed, **values) -> None:
+        for contact in changed["contacts"]:
+            if particle in contact["materials"]:
+                partner = [m for m in contact["materials"] if m != particle] or [particle]
+                if partner[0] == config["jenike"]["lid_material"]:
+                    continue
+                if "sliding_friction" in values and partner[0] != particle:
+                    continue  # particle-particle sliding friction only
+                contact.update(values)
+
+    studies: dict[str, list[tuple[str, dict]]] = {}
+    runs = []
+    for value in study["front_back_friction"]:
+        name = f"{front_back}_fw{int(round(value * 1000)):04d}"
+
+        def edit(changed, value=value, name=name):
+            changed["materials"][name] = dict(changed["materials"][front_back])
+            base = next(c for c in changed["contacts"] if sorted(c["materials"]) == sorted([particle, front_back]))
+            changed["contacts"].append({**base, "materials": [particle, name], "sliding_friction": float(value)})
+            changed["silo_flat"]["wall_materials"]["front_back"] = name
+
+        runs.append((f"mu_fw={value:g}", variant(edit)))
+    if study["periodic_front_back"]:
+        runs.append(("periodic", variant(lambda changed: changed["silo_flat"].update(front_back_walls=False))))
+    if runs:
+        studies["front_back_friction"] = runs
+    if study["restitution"]:
+        studies["restitution"] = [
+            (f"e={value:g}", variant(lambda changed, value=value: set_particle_contacts(changed, restitution=float(value))))
+            for value in study["restitution"]
+        ]
+    if study["sliding_friction"] and study["rolling_friction"]:
+        studies["friction"] = [
+            (
+                f"mu={mu:g},mu_r={mu_r:g}",
+                variant(lambda changed, mu=mu, mu_r=mu_r: (
+                    set_particle_contacts(changed, rolling_friction=float(mu_r)),
+                    set_particle_contacts(changed, sliding_friction=float(mu)),
+                )),
+            )
+            for mu in study["sliding_friction"]
+            for mu_r in study["rolling_friction"]
+        ]
+    return studies
+
+
+def silo_cases(config: dict) -> dict[str, SiloCase]:
+    """The flat-bottom silo runs a validated configuration defines (base run and parametric variants),
+    keyed by run id."""
+    cases = {}
+    for run_config in [config, *(c for runs in parametric_variants(config).values() for _, c in runs)]:
+        case = build_silo_case(run_config)
+        cases[case.run_id] = case
+    return cases
+
+
+def silo_case_for_run(config: dict, run: str) -> SiloCase:
+    """The case of run id ``run`` in ``config``; an error names the runs the config does define."""
+    cases = silo_cases(config)
+    if run not in cases:
+        raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
+    return cases[run]

@@ -1,0 +1,224 @@
+"""The recirculating flat-bottom silo of the blending study: an engine-neutral case from validated configuration.
+
+Geometry (SI units, as :mod:`engines.cases.silo_flat`): the planar silo of width W and depth T with its floor and outlet
+plane at z = 0, plus a vertical channel of the outlet width B0 from z = 0 down to z = -L (``channel_length``).
+In the lower half of the channel a feeder holds the clumps at the downward velocity ``V_out``. The domain is
+periodic in z: a clump leaving the bottom z = -L re-enters at the top of the domain (above the pile) and falls
+back onto it, so the silo is fed with its own outflow (SEED_DIGEST section 4).
+
+Stages: pour and settle exactly as the batch silo (the gate closes the outlet, the channel is empty), open the
+outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times
+(:func:`estimated_residence_time`).
+
+A flow pattern is a named preset of friction coefficients (``blending.presets``); it replaces the particle-
+particle and particle-wall friction of the contacts for this run. The front and back walls get their own copy
+of their material (``<material>_front_back``), so that their friction can differ from the side walls' even
+when both are made of the same material.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+from engines.cases.common import run_id
+from engines.cases.silo_flat import SiloCase, build_silo_case
+
+CASE_NAME = "silo_recirculation"
+
+#: Roles of a recirculation run: the blending study proper, or the one-particle-thick verification silo.
+ROLES = ("blending", "verification")
+
+
+@dataclass(frozen=True)
+class RecirculationCase:
+    """Everything that defines one recirculation run.
+
+    Attributes
+    ----------
+    pattern : str
+        Name of the flow-pattern preset.
+    role : str
+        ``"blending"`` or ``"verification"``.
+    silo : SiloCase
+        The silo with the preset's contacts; its fill, settle, time step and dumps are used unchanged and its
+        discharge stage is the recirculation stage.
+    channel_length : float
+        Length L of the channel below the outlet (m).
+    feeder_velocity : float
+        Downward velocity V_out held in the feeder (m/s).
+    feeder_zone : tuple of float
+        (x_min, x_max, z_min, z_max) of the feeder: the channel's width and lower half (m).
+    estimated_residence_time : float
+        ``W H / (B0 V_out)`` (s).
+    recirculation_time : float
+        Simulated time of the recirculation stage (s).
+    """
+
+    pattern: str
+    role: str
+    silo: SiloCase
+    channel_length: float
+    feeder_velocity: float
+    feeder_zone: tuple[float, float, float, float]
+    estimated_residence_time: float
+    recirculation_time: float
+    defining_parameters: dict = field(repr=False)
+
+    @property
+    def run_id(self) -> str:
+        """Directory name: role, flow pattern and a hash of every defining parameter."""
+        prefix = self.pattern if self.role == "blending" else f"thin-{self.pattern}"
+        return run_id(prefix, self.defining_parameters)
+
+    def summary(self) -> dict:
+        """Plain-data summary for ``case.json``."""
+        summary = self.silo.summary()
+        summary.update(
+            {
+                "case": CASE_NAME,
+                "run_id": self.run_id,
+                "flow_pattern": self.pattern,
+                "role": self.role,
+                "channel_length_m": self.channel_length,
+                "feeder_velocity_m_s": self.feeder_velocity,
+                "feeder_zone": list(self.feeder_zone),
+                "estimated_residence_time_s": self.estimated_residence_time,
+                "recirculation_time_s": self.recirculation_time,
+                "domain_z": [-self.channel_length, self.silo.domain_top],
+                "parameters": self.defining_parameters,
+            }
+        )
+        return summary
+
+
+def estimated_residence_time(
+    width: float, fill_height: float, outlet_width: float, feeder_velocity: float, channel_density_ratio: float = 1.0
+) -> float:
+    """A-priori mean residence time of the recirculating silo, ``t_res = W H / (B0 V_out r)`` (s).
+
+    Holdup over throughput: the fill mass per unit depth ``rho_b W H`` over the mass flow per unit depth
+    ``r rho_b B0 V_out`` through the channel, where ``r`` is the channel's bulk density relative to the fill's
+    (the sheared channel is looser). Sizes the run only; the analysis measures holdup over throughput.
+    """
+    for name, value in (("width", width), ("fill_height", fill_height), ("outlet_width", outlet_width),
+                        ("feeder_velocity", feeder_velocity), ("channel_density_ratio", channel_density_ratio)):
+        if not value > 0:
+            raise ValueError(f"{name} must be > 0, got {value!r}")
+    return width * fill_height / (outlet_width * feeder_velocity * channel_density_ratio)
+
+
+def apply_flow_pattern(config: dict, preset: dict) -> dict:
+    """A copy of ``config`` whose particle contacts carry the friction of a flow-pattern preset.
+
+    Particle-particle: ``sliding_friction``, ``rolling_friction``. Particle with the side and bottom wall materials:
+    ``wall_sliding_friction``, ``wall_rolling_friction``. The front/back walls get a new material
+    ``<front_back>_front_back`` (a copy of theirs) with ``front_back_sliding_friction`` and
+    ``wall_rolling_friction``. Restitution is kept from the particle's contact with the original material.
+    """
+    changed = copy.deepcopy(config)
+    silo = changed["silo_flat"]
+    particle = silo["particle_material"]
+    walls = silo["wall_materials"]
+    contacts = changed["contacts"]
+
+    def contact_of(material: str) -> dict:
+        return next(c for c in contacts if sorted(c["materials"]) == sorted([particle, material]))
+
+    contact_of(particle).update(
+        sliding_friction=float(preset["sliding_friction"]), rolling_friction=float(preset["rolling_friction"])
+    )
+    for material in {walls["side"], walls["bottom"]}:
+        contact_of(material).update(
+            sliding_friction=float(preset["wall_sliding_friction"]),
+            rolling_friction=float(preset["wall_rolling_friction"]),
+        )
+    front_back = walls["front_back"]
+    dedicated = f"{front_back}_front_back"
+    changed["materials"][dedicated] = dict(changed["materials"][front_back])
+    contacts.append(
+        {
+            **contact_of(front_back),
+            "materials": [particle, dedicated],
+            "sliding_friction": float(preset["front_back_sliding_friction"]),
+            "rolling_friction": float(preset["wall_rolling_friction"]),
+        }
+    )
+    walls["front_back"] = dedicated
+    return changed
+
+
+def build_recirculation_case(config: dict, pattern: str, role: str = "blending") -> RecirculationCase:
+    """Derive the :class:`RecirculationCase` of flow pattern ``pattern`` from a validated configuration.
+
+    ``role="blending"`` takes the geometry from ``blending``; ``role="verification"`` the thin silo of
+    ``blending.verification`` (same outlet, channel and feeder).
+    """
+    if role not in ROLES:
+        raise ValueError(f"role must be one of {ROLES}, got {role!r}")
+    blending = config["blending"]
+    if pattern not in blending["presets"]:
+        known = ", ".join(sorted(blending["presets"]))
+        raise KeyError(f"unknown flow pattern '{pattern}'; blending.presets defines: {known}")
+    geometry = blending if role == "blending" else blending["verification"]
+    recirculations = geometry["recirculations"]
+    t_res = estimated_residence_time(
+        geometry["width"], geometry["fill_height"], blending["outlet_width"], blending["feeder_velocity"],
+        blending["channel_density_ratio"],
+    )
+    changed = apply_flow_pattern(config, blending["presets"][pattern])
+    silo = changed["silo_flat"]
+    silo.update(
+        width=geometry["width"],
+        depth=geometry["depth"],
+        fill_height=geometry["fill_height"],
+        outlet_width=blending["outlet_width"],
+        front_back_walls=True,
+        sink_depth=blending["channel_length"],
+        discharge_time=recirculations * t_res,
+        dump_interval=blending["dump_interval"],
+    )
+    silo_case = build_silo_case(changed)
+    half_outlet = 0.5 * blending["outlet_width"]
+    channel = blending["channel_length"]
+    feeder_zone = (-half_outlet, half_outlet, -channel, -0.5 * channel)
+    defining = {
+        "case": CASE_NAME,
+        "role": role,
+        "pattern": pattern,
+        "silo": silo_case.defining_parameters,
+        "channel_length": channel,
+        "feeder_velocity": blending["feeder_velocity"],
+    }
+    return RecirculationCase(
+        pattern=pattern,
+        role=role,
+        silo=silo_case,
+        channel_length=channel,
+        feeder_velocity=blending["feeder_velocity"],
+        feeder_zone=feeder_zone,
+        estimated_residence_time=t_res,
+        recirculation_time=silo_case.discharge_steps * silo_case.timestep,
+        defining_parameters=defining,
+    )
+
+
+def recirculation_cases(config: dict) -> dict[str, RecirculationCase]:
+    """The recirculation runs a validated configuration defines (one per flow pattern, plus the thin silo when
+    ``blending.verification.enabled``), keyed by run id; empty when ``blending.enabled`` is false."""
+    blending = config["blending"]
+    if not blending["enabled"]:
+        return {}
+    cases = [build_recirculation_case(config, pattern) for pattern in blending["flow_patterns"]]
+    if blending["verification"]["enabled"]:
+        cases.append(build_recirculation_case(config, blending["verification"]["flow_pattern"], "verification"))
+    return {case.run_id: case for case in cases}
+
+
+def recirculation_case_for_run(config: dict, run: str) -> RecirculationCase:
+    """The case of run id ``run``; an error names the runs the config does define."""
+    cases = recirculation_cases(config)
+    if run not in cases:
+        raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
+    return cases[run]
+

@@ -1,0 +1,91 @@
+"""Particle-particle contacts from LIGGGHTS local dumps, read into neutral :class:`ContactFrame` objects.
+
+The silo deck writes ``compute pair/gran/local pos id force`` through ``dump local`` as text::
+
+    ITEM: TIMESTEP
+    22000
+    ITEM: NUMBER OF ENTRIES
+    533
+    ITEM: BOX BOUNDS ff ff ff
+    ...three lines...
+    ITEM: ENTRIES c_contacts[1] ... c_contacts[12]
+    x_i y_i z_i x_j y_j z_j id_i id_j periodic f_x f_y f_z
+
+``f`` is the force on particle i by particle j (N). Parsing is pure (text in, arrays out); reading a file
+is a thin wrapper.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from analysis.data.contacts import ContactFrame
+
+N_COLUMNS = 12
+
+
+class ContactDumpError(ValueError):
+    """A local dump is truncated or malformed; the message names the file."""
+
+
+def parse_local_table(text: str, n_columns: int, source: str = "<text>") -> tuple[int, np.ndarray]:
+    """The time step and the (n, n_columns) value table of one ``dump local`` snapshot.
+
+    Raises
+    ------
+    ContactDumpError
+        Naming ``source`` when a header item is missing, the entry count disagrees with the lines, a row
+        has another number of columns, or a value is not a finite number.
+    """
+    lines = text.splitlines()
+
+    def item(name: str) -> int:
+        for index, line in enumerate(lines):
+            if line.startswith(f"ITEM: {name}"):
+                return index
+        raise ContactDumpError(f"{source}: no 'ITEM: {name}' header (not a complete LIGGGHTS local dump?)")
+
+    try:
+        step = int(lines[item("TIMESTEP") + 1])
+        count = int(lines[item("NUMBER OF ENTRIES") + 1])
+    except (IndexError, ValueError):
+        raise ContactDumpError(f"{source}: malformed TIMESTEP or NUMBER OF ENTRIES") from None
+    rows = [line.split() for line in lines[item("ENTRIES") + 1 :] if line.strip()]
+    if len(rows) != count:
+        raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")
+    if any(len(row) != n_columns for row in rows):
+        raise ContactDumpError(f"{source}: every contact line must hold {n_columns} columns")
+    try:
+        values = np.array(rows, dtype=float).reshape(count, n_columns)
+    except ValueError as error:
+        raise ContactDumpError(f"{source}: a contact line is not numeric ({error})") from None
+    if not np.all(np.isfinite(values)):
+        raise ContactDumpError(f"{source}: non-finite values in the contacts")
+    return step, values
+
+
+def parse_local_dump(text: str, source: str = "<text>") -> ContactFrame:
+    """Parse one ``dump local`` snapshot of ``pos id force`` contacts (see the module docstring).
+
+    Raises
+    ------
+    ContactDumpError
+        As :func:`parse_local_table`.
+    """
+    step, values = parse_local_table(text, N_COLUMNS, source)
+    return ContactFrame(
+        step=step,
+        position_i=values[:, 0:3],
+        position_j=values[:, 3:6],
+        id_i=values[:, 6].astype(np.int64),
+        id_j=values[:, 7].astype(np.int64),
+        force=values[:, 9:12],
+    )
+
+
+def read_contacts(path: str | Path) -> ContactFrame:
+    """Read a local dump file written by the silo deck."""
+    path = Path(path)
+    return parse_local_dump(path.read_text(encoding="utf-8", errors="replace"), str(path))

@@ -1,0 +1,340 @@
+"""LIGGGHTS: the Jenike direct shear deck, its inputs, running it and reading its force history.
+
+Run directory layout (the engine runs inside the run directory; relative paths are what the deck sees)::
+
+    <run>/deck/in.liggghts     the rendered deck
+    <run>/deck/meshes/*.stl    base (bottom ring or plate), shear_ring, mould, and lid (servo lid only)
+    <run>/deck/case.json       derived case quantities
+    <run>/dumps/               particle dumps during consolidation and shear (binary legacy VTK), and
+                               contact dumps pair_contacts_<step>.txt, wall_contacts_<step>.txt (rigid lid)
+    <run>/forces.txt           force history during consolidation and shear (see read_force_history)
+    <run>/log.liggghts         the engine log
+    <run>/engine.out           the engine's screen output
+    <run>/run.json             written last, only after every check passed
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from engines.cases.geometry import write_stl
+from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
+from engines.liggghts.run import (
+    DECK_NAME,
+    DUMP_PREFIX,
+    RUN_OUTPUTS,
+    RUN_RECORD,
+    EngineRunError,
+    _common_context,
+    _flat,
+    _write_text_atomic,
+    parse_markers,
+    run_engine,
+    set_aside_previous_attempt,
+    output_bytes,
+    write_run_record,
+)
+from engines.templating import render_deck
+
+FORCES_NAME = "forces.txt"
+
+#: Columns of the force history, in file order after the time step (SI units: s, N, m, kg).
+FORCE_COLUMNS = (
+    "time",
+    "lid_fx",
+    "lid_fy",
+    "lid_fz",
+    "ring_fx",
+    "ring_fy",
+    "ring_fz",
+    "bottom_fx",
+    "bottom_fy",
+    "bottom_fz",
+    "lid_z",
+    "mass_above",
+)
+
+STAGES = ("filled", "levelled", "lid_placed", "consolidated", "sheared")
+
+PAIR_CONTACT_PREFIX = "pair_contacts"
+WALL_CONTACT_PREFIX = "wall_contacts"
+
+#: Columns of the contact dumps (``compute pair/gran/local`` and ``wall/gran/local`` with ``pos id
+#: force_normal force_tangential``). Pair contacts: both sphere centres, both atom ids and a periodic
+#: flag. Wall contacts: the contact point on the wall, the sphere centre, the mesh index in the wall
+#: (0 base, 1 shear ring, 2 mould, 3 lid), the triangle index and the atom id. Forces (N) act on the
+#: first sphere; normal and tangential parts along the line of centres. Caution (LIGGGHTS-PUBLIC 3.8):
+#: the tangential parts are not the applied forces: summed over the plate contacts they exceed the
+#: plate's measured horizontal force by about 20 %, and weak contacts show |F_t| / |F_n| far above the
+#: sliding friction; normal parts add up to the measured loads. The computes do not change the dynamics.
+CONTACT_COLUMNS = (
+    "x1", "y1", "z1", "x2", "y2", "z2", "id1", "id2", "id3",
+    "fn_x", "fn_y", "fn_z", "ft_x", "ft_y", "ft_z",
+)  # fmt: skip
+
+
+def _contact_context(contacts: ContactSet, n_types: int) -> dict:
+    return {
+        "n_types": n_types,
+        "restitution": _flat(contacts.restitution),
+        "sliding_friction": _flat(contacts.sliding_friction),
+        "rolling_friction": _flat(contacts.rolling_friction),
+    }
+
+
+def jenike_deck_context(case: JenikeCase) -> dict:
+    """The rendering context of ``templates/liggghts/jenike.lmp.j2``.
+
+    Contact matrices start at the fill values (``materials``) and are replaced by the test values
+    (``test_materials``) once the lid is in place.
+    """
+    context = _common_context(case)
+    n_types = len(case.materials.names)
+    context["materials"].update(_contact_context(case.fill_contacts, n_types))
+    geometry = case.geometry
+    base_type = PLATE_TYPE if geometry.wall_test else RING_TYPE
+    meshes = {
+        "base": {"file": "deck/meshes/base.stl", "type": base_type},
+        "shear_ring": {"file": "deck/meshes/shear_ring.stl", "type": RING_TYPE},
+        "mould": {"file": "deck/meshes/mould.stl", "type": RING_TYPE},
+    }
+    if case.lid_kind == "rigid":
+        lid_spec = case.rigid_lid
+        lid = {
+            "kind": "rigid",
+            "type": LID_TYPE,
+            "positions": [[float(x), float(y)] for x, y in lid_spec.positions],
+            "sphere_diameter": 2.0 * lid_spec.sphere_radius,
+            "density": lid_spec.density,
+            "n_spheres": lid_spec.n_spheres,
+            "normal_force": lid_spec.normal_force,
+            "sphere_weight": lid_spec.sphere_weight,
+            "share": 1.0 / lid_spec.n_spheres,
+            "height_above_sample": lid_spec.height_above_sample,
+        }
+    else:
+        servo = case.servo_lid
+        meshes["lid"] = {"file": "deck/meshes/lid.stl", "type": LID_TYPE}
+        lid = {
+            "kind": "servo",
+            "type": LID_TYPE,
+            "normal_force": servo.normal_force,
+            "proxy_positions": [[float(x), float(y)] for x, y in servo.proxy_positions],
+            "proxy_diameter": 2.0 * servo.proxy_radius,
+            "proxy_density": servo.proxy_density,
+            "proxy_weight": servo.weight / len(servo.proxy_positions),
+            "proxy_share": 1.0 / len(servo.proxy_positions),
+            "proxy_height": servo.proxy_height,
+            "height_above_sample": servo.height_above_sample,
+        }
+    x0, x1, y0, y1, z0, z1 = case.domain
+    context.update(
+        {
+            "title": f"siloflow-jenike-{case.run_id}",
+            "boundary": ["f", "f", "f"],
+            "domain": {"x": [x0, x1], "y": [y0, y1], "z": [z0, z1]},
+            "test_materials": _contact_context(case.test_contacts, n_types),
+            "shear_plane": geometry.shear_plane,
+            "ring_centre": list(geometry.ring_centre),
+            "clump_sphere_mass": case.clump_sphere_mass,
+            "meshes": meshes,
+            "fill": {
+                "seed": case.seeds[2],
+                "n_clumps": case.fill.n_clumps,
+                "region_centres": list(case.fill.region_centres),
+                "region_radius": case.fill.region_radius,
+                "region_z": list(case.fill.region_z),
+                "steps": case.fill.steps,
+                "level_z": case.fill.level_z,
+                "relax_steps": case.fill.relax_steps,
+            },
+            "lid": lid,
+            "rotation_blocked": case.rotation_blocked,
+            "consolidation": {"ramp_steps": case.ramp_steps, "hold_steps": case.hold_steps},
+            "shear": {"velocity": case.shear_velocity, "steps": case.shear_steps},
+            "output_every": case.output_every,
+            "forces_path": FORCES_NAME,
+            "dump": {"id": "particle_dump", "every": case.dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
+            "contact_dumps": {
+                "pair_path": f"dumps/{PAIR_CONTACT_PREFIX}_*.txt",
+                "wall_path": f"dumps/{WALL_CONTACT_PREFIX}_*.txt",
+                # compute wall/gran/local blocks unfixing the wall, which the servo lid needs to join it
+                "wall": case.lid_kind == "rigid",
+                "columns": len(CONTACT_COLUMNS),
+            },
+            "thermo_every": case.output_every * 10,
+        }
+    )
+    assert context["particle"]["type"] == PARTICLE_TYPE
+    return context
+
+
+def render_jenike_deck(case: JenikeCase) -> str:
+    """The LIGGGHTS deck of a Jenike shear run."""
+    return render_deck("liggghts/jenike.lmp.j2", jenike_deck_context(case))
+
+
+def write_jenike_inputs(case: JenikeCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    deck_dir = Path(deck_dir)
+    for name, mesh in case.geometry.meshes(case.lid_kind).items():
+        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
+    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
+    deck_path = deck_dir / DECK_NAME
+    _write_text_atomic(deck_path, render_jenike_deck(case))
+    return deck_path
+
+
+# ---------------------------------------------------------------------------------------------- reading
+
+
+def read_force_history(path: str | Path) -> dict[str, np.ndarray]:
+    """Read the force history a Jenike deck writes (``fix ave/time ... file forces.txt``).
+
+    Each row averages the preceding output interval; ``time`` is the mean time of that interval.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``step`` and the :data:`FORCE_COLUMNS`: time (s); forces of the particles on the lid, the shear
+        ring and the bottom ring or plate (N); the lid's height (m); the clump mass above the shear plane
+        (kg).
+
+    Raises
+    ------
+    ValueError
+        Naming the file, if it is empty, a row has the wrong number of columns or is not numeric (e.g. a
+        run cut off while writing), or times do not increase.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no force history at {path}")
+    rows = []
+    expected = len(FORCE_COLUMNS) + 1
+    for number, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), start=1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        fields = text.split()
+        if len(fields) != expected:
+            raise ValueError(
+                f"{path}: line {number} has {len(fields)} columns, expected {expected} "
+                f"(step {' '.join(FORCE_COLUMNS)}); the file is malformed or truncated"
+            )
+        try:
+            values = [float(field) for field in fields]
+        except ValueError:
+            raise ValueError(f"{path}: line {number} is not numeric: {text[:80]!r}") from None
+        if not all(np.isfinite(values)):
+            raise ValueError(f"{path}: line {number} holds a non-finite value: {text[:80]!r}")
+        rows.append(values)
+    if not rows:
+        raise ValueError(f"{path}: the force history holds no data rows")
+    table = np.array(rows, dtype=float)
+    history = {"step": table[:, 0]}
+    history.update({name: table[:, i + 1] for i, name in enumerate(FORCE_COLUMNS)})
+    if np.any(np.diff(history["time"]) <= 0):
+        raise ValueError(f"{path}: times do not increase from row to row")
+    return history
+
+
+def read_contact_dump(path: str | Path) -> dict[str, np.ndarray]:
+    """Read one contact dump (``dump local``) into named columns (:data:`CONTACT_COLUMNS`) plus ``step``.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, if the header is incomplete, the entry count disagrees with the rows, or a row
+        has the wrong number of columns.
+    """
+    from engines.liggghts.contacts import parse_local_table
+
+    path = Path(path)
+    step, table = parse_local_table(
+        path.read_text(encoding="utf-8", errors="replace"), len(CONTACT_COLUMNS), str(path)
+    )
+    count = table.shape[0]
+    contacts = {name: table[:, i] for i, name in enumerate(CONTACT_COLUMNS)}
+    contacts["step"] = np.full(count, step)
+    return contacts
+
+
+# ---------------------------------------------------------------------------------------------- running
+
+
+def check_jenike_run(case: JenikeCase, markers: list, run_dir: Path) -> dict:
+    """Check that a finished Jenike run did what the case asked; returns the stage record.
+
+    Raises
+    ------
+    EngineRunError
+        When a stage marker is missing, too few clumps were created, levelling removed nothing (the cell
+        was not filled above the ring top), or clumps were lost after levelling.
+    """
+    by_event: dict[str, list] = {}
+    for marker in markers:
+        by_event.setdefault(marker.event, []).append(marker)
+    for event in STAGES:
+        if event not in by_event:
+            raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
+    stages = {event: by_event[event][-1].values for event in STAGES}
+    created = int(round(stages["filled"]["clumps"]))
+    if created < 0.98 * case.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: only {created} of {case.fill.n_clumps} clumps were created or stayed in the cell"
+        )
+    levelled = int(round(stages["levelled"]["clumps"]))
+    if levelled >= created:
+        raise EngineRunError(
+            f"{run_dir}: levelling removed no clump: the fill (top sphere centre at "
+            f"{stages['filled']['top']:.4g} m) did not reach the top of the shear ring "
+            f"({case.geometry.ring_top:.4g} m); raise jenike.fill.overfill"
+        )
+    final = int(round(stages["sheared"]["clumps"]))
+    if final != levelled:
+        raise EngineRunError(f"{run_dir}: {levelled - final} clumps were lost between levelling and the end of shear")
+    forces = run_dir / FORCES_NAME
+    history = read_force_history(forces)
+    return {
+        "stages": stages,
+        "n_clumps_created": created,
+        "n_clumps": levelled,
+        "timestep_s": case.timestep,
+        "consolidation_start_s": stages["lid_placed"]["time"],
+        "shear_start_s": stages["consolidated"]["time"],
+        "shear_end_s": stages["sheared"]["time"],
+        "force_samples": int(history["time"].size),
+        "forces": FORCES_NAME,
+    }
+
+
+def set_aside_previous_jenike_attempt(run_dir: str | Path) -> Path | None:
+    """Move an earlier attempt's dumps, log, screen output and force history to ``failed_attempts/<UTC time>/``.
+
+    Returns the new location, if anything was moved; nothing is deleted.
+    """
+    return set_aside_previous_attempt(Path(run_dir), RUN_OUTPUTS + (FORCES_NAME,))
+
+
+def run_jenike(
+    case: JenikeCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
+) -> Path:
+    """Run a rendered Jenike deck, check it and write ``run.json``; returns its path.
+
+    Output of an earlier unfinished attempt (dumps, log, screen output, force history) is moved to
+    ``failed_attempts/`` first.
+    """
+    run_dir = Path(run_dir)
+    deck = run_dir / "deck" / DECK_NAME
+    if not deck.exists():
+        raise FileNotFoundError(f"no deck at {deck}; render it first")
+    (run_dir / RUN_RECORD).unlink(missing_ok=True)
+    set_aside_previous_jenike_attempt(run_dir)
+    log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
+    record = check_jenike_run(case, parse_markers(log_text), run_dir)
+    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX,
+                   "output_bytes": output_bytes(run_dir)})
+    return write_run_record(run_dir, record)

@@ -1,0 +1,567 @@
+"""LIGGGHTS: rendering decks for siloflow cases, running the engine, reading its log.
+
+Run directory layout (relative paths are what the deck sees, the engine runs inside the run directory)::
+
+    <run>/deck/in.liggghts     the rendered deck
+    <run>/deck/meshes/*.stl    wall meshes
+    <run>/deck/case.json       derived case quantities (time step, clump count, ...)
+    <run>/dumps/               particle dumps (binary legacy VTK)
+    <run>/log.liggghts         the engine log
+    <run>/engine.out           the engine's screen output
+    <run>/run.json             written last, only after every check passed
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import re
+import shutil
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from engines.cases.geometry import horizontal_rectangle, write_stl
+from engines.cases.silo_flat import SiloCase
+from engines.templating import render_deck
+
+DECK_NAME = "in.liggghts"
+LOG_NAME = "log.liggghts"
+SCREEN_NAME = "engine.out"
+DUMP_PREFIX = "particles"
+CONTACT_PREFIX = "contacts"
+RUN_RECORD = "run.json"
+
+# LIGGGHTS only accepts 5e6 <= E <= 1e9 Pa (SI) unless told otherwise.
+SOFT_LIMIT = 5e6
+HARD_LIMIT = 1e9
+
+
+class EngineNotFound(RuntimeError):
+    """The engine executable is not installed or not on PATH."""
+
+
+class EngineRunError(RuntimeError):
+    """A run failed; the message quotes the relevant log lines and names the run directory."""
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A ``SILOFLOW <event> key=value ...`` line the deck prints at a stage boundary."""
+
+    event: str
+    values: dict
+
+
+_MARKER = re.compile(r"^SILOFLOW (\w+)((?: \w+=\S+)*)\s*$")
+
+
+def parse_markers(log_text: str) -> list[Marker]:
+    """Stage markers in the order the engine printed them (echoed ``print`` commands are skipped)."""
+    markers = []
+    for line in log_text.splitlines():
+        match = _MARKER.match(line.strip())
+        if not match:
+            continue
+        values = {}
+        for item in match.group(2).split():
+            key, _, raw = item.partition("=")
+            try:
+                values[key] = float(raw)
+            except ValueError:
+                values[key] = raw
+        markers.append(Marker(match.group(1), values))
+    return markers
+
+
+def error_lines(log_text: str) -> list[str]:
+    """Lines that report a fatal engine problem (``ERROR``, lost atoms, a crash signal)."""
+    patterns = ("ERROR", "Lost atoms", "Segmentation fault", "received signal", "MPI_ABORT")
+    return [line.rstrip() for line in log_text.splitlines() if any(p in line for p in patterns)]
+
+
+def log_excerpt(log_text: str, lines: int = 15) -> str:
+    """Error lines if there are any, else the last lines of the log, indented for quoting."""
+    selected = error_lines(log_text) or log_text.rstrip().splitlines()[-lines:]
+    return "\n".join("    " + line for line in selected[-lines:])
+
+
+# ---------------------------------------------------------------------------------------------- decks
+
+#: What the silo-type decks dump per sphere: what their analyses read (ids, clump ids, centres, velocities,
+#: radii, masses), in binary. Forces and angular velocities are left out (a third of the volume); contact forces
+#: come from the separate contact dump.
+SILO_DUMP_FIELDS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass")
+
+#: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
+RESTART_DIR = "restart"
+RESTART_PREFIX = "state"
+RESTARTS_PER_STAGE = 20
+
+
+def restart_every(stage_steps: int) -> int:
+    """Steps between restart files of a stage of ``stage_steps`` steps: a killed run loses at most 1/20 of it."""
+    if stage_steps < 1:
+        raise ValueError(f"stage_steps must be >= 1, got {stage_steps!r}")
+    return max(1, -(-stage_steps // RESTARTS_PER_STAGE))
+
+
+
+def _flat(matrix) -> list[float]:
+    return [float(value) for row in matrix for value in row]
+
+
+def _common_context(case: SiloCase) -> dict:
+    table = case.materials
+    moduli = table.youngs_modulus
+    particle = case.particle
+    spheres = [[*map(float, position), float(radius)] for position, radius in zip(particle.sphere_positions, particle.sphere_radii)]
+    return {
+        "materials": {
+            "n_types": len(table.names),
+            "youngs_modulus": list(moduli),
+            "poisson_ratio": list(table.poisson_ratio),
+            "restitution": _flat(table.restitution),
+            "sliding_friction": _flat(table.sliding_friction),
+            "rolling_friction": _flat(table.rolling_friction),
+        },
+        "switches": {
+            "soft_particles": min(moduli) < SOFT_LIMIT,
+            "hard_particles": max(moduli) > HARD_LIMIT,
+        },
+        "timestep": case.timestep,
+        "gravity": 9.81,
+        "neighbor_skin": 0.4 * particle.smallest_radius,
+        "particle": {
+            "name": particle.name,
+            "seed": case.seeds[0],
+            "distribution_seed": case.seeds[1],
+            "type": 1,
+            "density": particle.density,
+            "spheres": spheres,
+            "ntry": 1000000,
+        },
+    }
+
+
+def silo_meshes(case: SiloCase) -> dict:
+    """Floor plates left and right of the outlet and the gate that closes it (z = 0, normals up)."""
+    half_width, half_outlet, depth = 0.5 * case.width, 0.5 * case.outlet_width, case.depth
+    return {
+        "floor_left": horizontal_rectangle(-half_width, -half_outlet, 0.0, depth, 0.0),
+        "floor_right": horizontal_rectangle(half_outlet, half_width, 0.0, depth, 0.0),
+        "outlet_gate": horizontal_rectangle(-half_outlet, half_outlet, 0.0, depth, 0.0),
+    }
+
+
+def silo_deck_context(case: SiloCase) -> dict:
+    """The rendering context of ``templates/liggghts/silo_flat.lmp.j2``."""
+    table = case.materials
+    side, bottom = (table.type_of(case.wall_materials[key]) for key in ("side", "bottom"))
+    front_back_type = table.type_of(case.wall_materials["front_back"]) if case.front_back_walls else None
+    half_width = 0.5 * case.width
+    context = _common_context(case)
+    dump_every = case.dump_every
+    context.update(
+        {
+            "title": f"siloflow-silo_flat-{case.run_id}",
+            # Without front and back walls the depth direction is periodic.
+            "boundary": ["f", "f" if case.front_back_walls else "p", "f"],
+            "domain": {
+                "x": [-half_width, half_width],
+                "y": [0.0, case.depth],
+                "z": [-case.sink_depth, case.domain_top],
+            },
+            "primitive_walls": [
+                {"id": "wall_left", "type": side, "plane": "xplane", "position": -half_width},
+                {"id": "wall_right", "type": side, "plane": "xplane", "position": half_width},
+                *(
+                    [
+                        {"id": "wall_front", "type": front_back_type, "plane": "yplane", "position": 0.0},
+                        {"id": "wall_back", "type": front_back_type, "plane": "yplane", "position": case.depth},
+                    ]
+                    if case.front_back_walls
+                    else []
+                ),
+            ],
+            "meshes": [
+                {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom}
+                for name in ("floor_left", "floor_right", "outlet_gate")
+            ],
+            "closed_floor": ["floor_left", "floor_right", "outlet_gate"],
+            "open_floor": ["floor_left", "floor_right"],
+            "gate_mesh": "outlet_gate",
+            "fill": {
+                "seed": case.seeds[2],
+                "zone": list(case.fill.zone),
+                "n_clumps": case.fill.n_clumps,
+                "particle_rate": case.fill.particle_rate,
+                "insert_every": case.fill.insert_every,
+                "insertion_velocity": case.fill.insertion_velocity,
+                "steps": case.fill.fill_steps,
+                # Crowded insertion events may place fewer clumps than asked: allow as many extra events again.
+                "max_extra_insertions": int(np.ceil(case.fill.n_clumps / case.fill.clumps_per_insertion)) + 10,
+            },
+            "settle": {
+                "threshold": case.settle_threshold,
+                "check_steps": case.settle_check_steps,
+                "max_checks": case.settle_max_checks,
+            },
+            "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
+                     "fields": list(SILO_DUMP_FIELDS)},
+            "contact_dump": f"dumps/{CONTACT_PREFIX}_*.txt",
+            "discharge": {"steps": case.discharge_steps, "upto": False},
+            "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
+            "thermo_every": dump_every,
+        }
+    )
+    return context
+
+
+def render_silo_deck(case: SiloCase) -> str:
+    """The LIGGGHTS deck of a flat-bottom silo run."""
+    return render_deck("liggghts/silo_flat.lmp.j2", silo_deck_context(case))
+
+
+def _write_text_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)
+
+
+def write_case_inputs(meshes: dict, summary: dict, deck_text: str, deck_dir: str | Path) -> Path:
+    """Write wall meshes, ``case.json`` and the deck into ``deck_dir`` (each atomically); returns the deck path."""
+    deck_dir = Path(deck_dir)
+    for name, mesh in meshes.items():
+        write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
+    _write_text_atomic(deck_dir / "case.json", json.dumps(summary, indent=2, sort_keys=True, default=float))
+    deck_path = deck_dir / DECK_NAME
+    _write_text_atomic(deck_path, deck_text)
+    return deck_path
+
+
+def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    return write_case_inputs(silo_meshes(case), case.summary(), render_silo_deck(case), deck_dir)
+
+
+# ---------------------------------------------------------------------------------------------- running
+
+
+def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
+                   log_name: str = LOG_NAME) -> list[str]:
+    """Command line of one engine run, serial or under MPI (no shell involved)."""
+    if shutil.which(executable) is None:
+        raise EngineNotFound(
+            f"LIGGGHTS executable '{executable}' not found on PATH; install it with `make install` "
+            "(Debian package liggghts) or set engine.executable in the config"
+        )
+    command = [executable, "-in", deck, "-log", log_name]
+    if mpi_ranks > 1:
+        if shutil.which(mpirun) is None:
+            raise EngineNotFound(f"MPI launcher '{mpirun}' not found; install openmpi-bin or set engine.mpirun")
+        command = [mpirun, "-np", str(mpi_ranks), "--oversubscribe", *command]
+    return command
+
+
+def _mpi_environment() -> dict:
+    environment = dict(os.environ)
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        # Open MPI refuses to run as root unless told; containers and CI run as root.
+        environment.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        environment.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return environment
+
+
+RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart")
+
+
+def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:
+    """Move the output of an unfinished earlier attempt into ``failed_attempts/<UTC time>/``.
+
+    Nothing is deleted: the user may want to inspect a failed run. ``outputs`` names the files and
+    folders a run writes. Returns the new location, if any.
+    """
+    run_dir = Path(run_dir)
+    leftovers = [run_dir / name for name in outputs if (run_dir / name).exists()]
+    leftovers += sorted(run_dir.glob(f"{RESUME_STEM}*"))
+    if not leftovers:
+        return None
+    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+    target = run_dir / "failed_attempts" / stamp
+    attempt = 1
+    while target.exists():
+        attempt += 1
+        target = run_dir / "failed_attempts" / f"{stamp}-{attempt}"
+    target.mkdir(parents=True)
+    for path in leftovers:
+        shutil.move(str(path), str(target / path.name))
+    return target
+
+
+#: Wall time between progress lines in a run's log (s) and between polls of the engine's output (s).
+PROGRESS_LOG_EVERY = 30.0
+PROGRESS_POLL_EVERY = 1.0
+
+
+def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
+               target_time: float | None = None, deck_name: str = DECK_NAME, log_name: str = LOG_NAME,
+               screen_name: str = SCREEN_NAME) -> str:
+    """Run the deck ``<run_dir>/deck/<deck_name>`` inside ``run_dir`` and return the log text.
+
+    With ``target_time`` (the simulated time the run reaches, s) progress is reported while it runs: simulated
+    time out of the target, clumps and an ETA, every 30 s in the log (``logging``) and, when the job's stderr is a
+    terminal, as a live line there.
+
+    Raises
+    ------
+    EngineRunError
+        On a non-zero exit or an ERROR line, quoting the relevant log lines; the run directory is left as is.
+    """
+    import sys
+
+    from engines.progress import ProgressMonitor
+
+    run_dir = Path(run_dir)
+    command = engine_command(f"deck/{deck_name}", executable, mpi_ranks, mpirun, log_name)
+    (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
+    (run_dir / RESTART_DIR).mkdir(exist_ok=True)
+    terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
+    monitor = (ProgressMonitor(run_dir / screen_name, target_time, run_dir.name, PROGRESS_LOG_EVERY,
+                               logging.getLogger("siloflow"), terminal) if target_time else None)
+    with open(run_dir / screen_name, "w", encoding="utf-8") as screen:
+        process = subprocess.Popen(command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment())
+        while True:
+            try:
+                returncode = process.wait(timeout=PROGRESS_POLL_EVERY)
+                break
+            except subprocess.TimeoutExpired:
+                if monitor is not None:
+                    screen.flush()
+                    monitor.poll()
+    if monitor is not None:
+        monitor.finish()
+    log_path = run_dir / log_name
+    log_text = log_path.read_text(encoding="utf-8", errors="replace") if log_path.exists() else ""
+    screen_text = (run_dir / screen_name).read_text(encoding="utf-8", errors="replace")
+    problems = error_lines(log_text) or error_lines(screen_text)
+    if returncode != 0 or problems:
+        raise EngineRunError(
+            f"LIGGGHTS run in {run_dir} failed (exit code {returncode}); "
+            f"log lines:\n{log_excerpt(log_text or screen_text)}\n"
+            f"The run directory is left for inspection: {run_dir}"
+        )
+    return log_text
+
+
+def check_silo_run(
+    case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged",
+    clumps_conserved: bool = False,
+) -> dict:
+    """Check that a finished silo run did what the case asked; returns the stage record.
+
+    ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
+    drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
+    ``clumps_conserved`` (periodic runs, where nothing may leave) the clump count must be unchanged at its end.
+
+    Raises
+    ------
+    EngineRunError
+        When clumps are missing after filling, the fill did not settle, a stage marker or the dumps
+        are missing.
+    """
+    by_event = {}
+    for marker in markers:
+        by_event.setdefault(marker.event, []).append(marker)
+    for event in ("filled", "settled", "opened", last_stage):
+        if event not in by_event:
+            raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
+    filled = by_event["filled"][-1].values
+    if int(round(filled["clumps"])) != case.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: only {int(filled['clumps'])} of {case.fill.n_clumps} clumps were inserted; "
+            "widen silo_flat.fill.zone_width_fraction or lower silo_flat.fill.volume_fraction"
+        )
+    settled = by_event["settled"][-1].values
+    if not settled["ke_per_clump"] < case.settle_threshold:
+        raise EngineRunError(
+            f"{run_dir}: the fill did not settle: kinetic energy per clump {settled['ke_per_clump']:.3g} J is above "
+            f"the threshold {case.settle_threshold:.3g} J after the longest settling time; raise "
+            "silo_flat.settle.max_time or the threshold"
+        )
+    if len(dump_files) < 2:
+        raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
+    final = int(round(by_event[last_stage][-1].values["clumps"]))
+    if clumps_conserved and final != case.fill.n_clumps:
+        raise EngineRunError(
+            f"{run_dir}: {case.fill.n_clumps} clumps were inserted but {final} remain after the '{last_stage}' stage; "
+            "clumps were lost through a boundary"
+        )
+    opened = by_event["opened"][-1].values
+    return {
+        "filled": filled,
+        "settled": settled,
+        "opened": opened,
+        last_stage: by_event[last_stage][-1].values,
+        "settle_checks": [m.values for m in by_event.get("settle", [])],
+        "open_step": int(round(opened["step"])),
+        "open_time_s": opened["time"],
+        "timestep_s": case.timestep,
+        "n_clumps": case.fill.n_clumps,
+        "n_dumps": len(dump_files),
+    }
+
+
+def write_run_record(run_dir: Path, record: dict) -> Path:
+    """Write ``run.json`` last and atomically: its presence means the run is complete and checked."""
+    from engines.estimates import format_bytes
+
+    path = Path(run_dir) / RUN_RECORD
+    _write_text_atomic(path, json.dumps(record, indent=2, sort_keys=True, default=float))
+    if "output_bytes" in record:
+        logging.getLogger("siloflow").info("run complete: %s; the run wrote %s", path, format_bytes(record["output_bytes"]))
+    return path
+
+
+@dataclass(frozen=True)
+class Resume:
+    """How a silo-type run resumes: the deck template of its case, its rendering context and the steps of its
+    last stage (the one that writes restart files)."""
+
+    template: str
+    context: dict
+    last_stage_steps: int
+
+    def deck(self, restart_file: str, final_step: int) -> str:
+        """The resume deck: the case deck from ``restart_file`` up to ``final_step``."""
+        context = dict(self.context)
+        context.update(
+            case_template=self.template,
+            resume={"restart_file": restart_file},
+            discharge={**self.context["discharge"], "steps": int(final_step), "upto": True},
+            # the dumps go on on the steps of the first attempt (multiples of the interval), none at the restart
+            dump={**self.context["dump"], "first": False},
+        )
+        return render_deck("liggghts/resume.lmp.j2", context)
+
+
+RESUME_STEM = "resume"
+RESUME_DECK = "resume.liggghts"
+_RESTART_STEP = re.compile(rf"^{RESTART_PREFIX}_(\d+)\.restart$")
+
+
+def restart_files(run_dir: str | Path) -> list[Path]:
+    """Restart files of a run, oldest step first."""
+    found = []
+    for path in (Path(run_dir) / RESTART_DIR).glob(f"{RESTART_PREFIX}_*.restart"):
+        match = _RESTART_STEP.match(path.name)
+        if match and path.stat().st_size > 0:
+            found.append((int(match.group(1)), path))
+    return [path for _, path in sorted(found)]
+
+
+def attempt_logs(run_dir: str | Path) -> list[Path]:
+    """The log of the first attempt and those of its resumptions, in order."""
+    run_dir = Path(run_dir)
+    resumed = sorted(run_dir.glob(f"{RESUME_STEM}*.{LOG_NAME}"), key=lambda p: int(p.name.split(".")[0][len(RESUME_STEM):]))
+    return [path for path in [run_dir / LOG_NAME, *resumed] if path.exists()]
+
+
+def _logs_text(run_dir: Path) -> str:
+    return "\n".join(path.read_text(encoding="utf-8", errors="replace") for path in attempt_logs(run_dir))
+
+
+def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> None:
+    """Resume from the newest restart file (the one before it if the newest was cut off by the kill)."""
+    log = logging.getLogger("siloflow")
+    final_step = int(round(opened.values["step"])) + resume.last_stage_steps
+
+    def run_from(restart: Path) -> None:
+        relative = f"{RESTART_DIR}/{restart.name}"
+        _write_text_atomic(run_dir / "deck" / RESUME_DECK, resume.deck(relative, final_step))
+        log.info("resuming %s from restart file %s (the last stage ends at step %d)", run_dir.name, relative, final_step)
+        options = dict(engine)
+        if options.get("target_time"):
+            # LIGGGHTS restarts the clock at zero: progress counts the simulated time still to go
+            restart_step = int(_RESTART_STEP.match(restart.name).group(1))
+            options["target_time"] *= max(final_step - restart_step, 1) / final_step
+        attempt = len(attempt_logs(run_dir))
+        run_engine(run_dir, **options, deck_name=RESUME_DECK, log_name=f"{RESUME_STEM}{attempt}.{LOG_NAME}",
+                   screen_name=f"{RESUME_STEM}{attempt}.{SCREEN_NAME}")
+
+    newest, *older = restart_files(run_dir)[-2:][::-1]
+    try:
+        run_from(newest)
+    except EngineRunError as error:
+        if not older or "restart" not in str(error).lower():
+            raise
+        log.warning("restart file %s is unreadable (%s); trying the one before it", newest.name, error)
+        run_from(older[0])
+
+
+def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None,
+                resume: Resume | None = None) -> Path:
+    """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns its path.
+
+    A run that was killed after its last stage began (it left restart files and its log has the ``opened``
+    marker) resumes from its newest restart file when ``resume`` is given; its logs are then the first attempt's
+    plus one per resumption, checked together. Otherwise the output of an earlier unfinished attempt is moved to
+    ``failed_attempts/`` first, so the dumps of this run are never mixed with older ones. ``check(markers,
+    dump_files)`` raises :class:`EngineRunError` or returns the stage record; ``engine`` holds the
+    :func:`run_engine` options and ``record`` extra entries for ``run.json``. Restart files are deleted once the
+    run is complete and checked: they only serve resumption.
+    """
+    from engines.liggghts.dumps import list_dumps
+
+    run_dir = Path(run_dir)
+    engine = dict(engine or {})
+    deck = run_dir / "deck" / DECK_NAME
+    if not deck.exists():
+        raise FileNotFoundError(f"no deck at {deck}; render it first")
+    (run_dir / RUN_RECORD).unlink(missing_ok=True)
+    earlier = parse_markers(_logs_text(run_dir)) if resume is not None else []
+    opened = [m for m in earlier if m.event == "opened"]
+    resumed = resume is not None and bool(opened) and bool(restart_files(run_dir))
+    if resumed:
+        _resume_run(run_dir, resume, opened[-1], engine)
+    else:
+        set_aside_previous_attempt(run_dir)
+        run_engine(run_dir, **engine)
+    checked = check(parse_markers(_logs_text(run_dir)), list_dumps(run_dir / "dumps", DUMP_PREFIX))
+    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX,
+                    "resumed_attempts": len(attempt_logs(run_dir)) - 1, **(record or {})})
+    shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
+    checked["output_bytes"] = output_bytes(run_dir)
+    return write_run_record(run_dir, checked)
+
+
+def output_bytes(run_dir: str | Path) -> int:
+    """Size of everything a run wrote (dumps, logs, deck, meshes) in bytes; ``run.json`` reports it."""
+    return sum(path.stat().st_size for path in Path(run_dir).rglob("*") if path.is_file())
+
+
+def expected_simulated_time(silo: SiloCase) -> float:
+    """Simulated time a silo-type deck is expected to reach (s): fill, the expected share of the settling time
+    (:class:`engines.estimates.CostModel`), discharge; the target of its progress reports."""
+    from engines.estimates import CostModel, silo_run_steps
+
+    return silo_run_steps(silo, CostModel().settle_fraction) * silo.timestep
+
+
+def run_silo(
+    case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
+) -> Path:
+    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns its path."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case)},
+        {"run_id": case.run_id},
+        Resume("liggghts/silo_flat.lmp.j2", silo_deck_context(case), case.discharge_steps),
+    )

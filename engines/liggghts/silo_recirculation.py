@@ -1,0 +1,99 @@
+"""LIGGGHTS decks and runs of the recirculating silo (blending study).
+
+The run directory has the layout of :mod:`engines.liggghts.run` (``deck/``, ``dumps/``, ``log.liggghts``,
+``engine.out``, ``run.json`` written last). Periodic boundaries and multisphere clumps work together in
+LIGGGHTS 3.8, serially and under MPI with the domain split along the periodic direction: clumps cross the
+bottom boundary whole and re-enter at the top with their ids. The recirculation stage therefore runs with
+``thermo_modify lost error``, and the run is checked for an unchanged clump count.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from engines.cases.silo_recirculation import RecirculationCase
+from engines.cases.geometry import vertical_rectangle_x
+from engines.liggghts.run import (
+    Resume,
+    check_silo_run,
+    expected_simulated_time,
+    run_checked,
+    silo_deck_context,
+    silo_meshes,
+    write_case_inputs,
+)
+from engines.templating import render_deck
+
+CHANNEL_MESHES = ("channel_left", "channel_right")
+
+
+def recirculation_meshes(case: RecirculationCase) -> dict:
+    """The batch silo's floor and gate plus the two channel walls below the outlet (normals into the channel)."""
+    half_outlet, depth, length = 0.5 * case.silo.outlet_width, case.silo.depth, case.channel_length
+    meshes = silo_meshes(case.silo)
+    meshes["channel_left"] = vertical_rectangle_x(-half_outlet, 0.0, depth, -length, 0.0, normal=1)
+    meshes["channel_right"] = vertical_rectangle_x(half_outlet, 0.0, depth, -length, 0.0, normal=-1)
+    return meshes
+
+
+def recirculation_deck_context(case: RecirculationCase) -> dict:
+    """The rendering context of ``templates/liggghts/silo_recirculation.lmp.j2``."""
+    context = silo_deck_context(case.silo)
+    bottom = case.silo.materials.type_of(case.silo.wall_materials["bottom"])
+    context["title"] = f"siloflow-silo_recirculation-{case.run_id}"
+    # The vertical boundary is periodic: what leaves the channel bottom re-enters at the top.
+    context["boundary"] = [context["boundary"][0], context["boundary"][1], "p"]
+    context["meshes"] = context["meshes"] + [
+        {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom} for name in CHANNEL_MESHES
+    ]
+    context["closed_floor"] = context["closed_floor"] + list(CHANNEL_MESHES)
+    context["open_floor"] = context["open_floor"] + list(CHANNEL_MESHES)
+    context["feeder"] = {
+        "zone": list(case.feeder_zone),
+        "velocity": case.feeder_velocity,
+        "spheres_per_clump": case.silo.spheres_per_clump,
+    }
+    return context
+
+
+def render_recirculation_deck(case: RecirculationCase) -> str:
+    """The LIGGGHTS deck of a recirculation run."""
+    return render_deck("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case))
+
+
+def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    return write_case_inputs(recirculation_meshes(case), case.summary(), render_recirculation_deck(case), deck_dir)
+
+
+def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_dir: Path) -> dict:
+    """Check a finished recirculation run: the batch silo's checks, then no clump lost while recirculating.
+
+    Raises
+    ------
+    EngineRunError
+        As :func:`engines.liggghts.run.check_silo_run`, or when the clump count changed during recirculation.
+    """
+    return check_silo_run(case.silo, markers, dump_files, run_dir, last_stage="recirculated", clumps_conserved=True)
+
+
+def run_recirculation(
+    case: RecirculationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
+    mpirun: str = "mpirun",
+) -> Path:
+    """Run a rendered recirculation deck, check it and write ``run.json``; returns its path."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_recirculation_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case.silo)},
+        {
+            "run_id": case.run_id,
+            "flow_pattern": case.pattern,
+            "role": case.role,
+            "estimated_residence_time_s": case.estimated_residence_time,
+            "domain_z": [-case.channel_length, case.silo.domain_top],
+            "outlet_z": 0.0,
+        },
+        Resume("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps),
+    )
