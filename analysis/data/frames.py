@@ -15,6 +15,9 @@ import numpy as np
 
 __all__ = ["ParticleFrame", "ClumpFrame", "clumps_from_frame"]
 
+#: Per-sphere vectors a frame may carry or leave out (dumps of the silo-type decks omit them).
+OPTIONAL_VECTORS = ("angular_velocity", "force")
+
 
 
 def _frozen_array(value, dtype, shape_tail: tuple[int, ...], name: str, n: int | None) -> np.ndarray:

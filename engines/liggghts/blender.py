@@ -14,14 +14,9 @@ from pathlib import Path
 from engines.cases.blender import BlenderCase
 from engines.cases.blender_geometry import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
-from engines.liggghts.run import (
-    Resume,
-    check_silo_run,
-    expected_simulated_time,
-    run_checked,
-    silo_deck_context,
-    write_case_inputs,
-)
+from engines.liggghts.run import Resume, run_checked
+from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context
+from engines.liggghts.inputs import write_case_inputs
 from engines.templating import render_deck
 
 GATE = "outlet_gate"

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from analysis.data.frames import OPTIONAL_VECTORS, ClumpFrame, ParticleFrame, clumps_from_frame
 
 __all__ = [
     "DumpFormatError",
@@ -797,7 +797,6 @@ def list_dumps(dump_dir: str | os.PathLike, prefix: str) -> list[Path]:
 _CACHE_FORMAT = 2  # bump when the cached arrays change meaning (2: angular velocity optional)
 _FRAME_ARRAYS = ("id", "type", "clump_id", "position", "velocity", "radius", "mass")
 #: Per-sphere vectors a dump may leave out (None in the frame).
-OPTIONAL_VECTORS = ("angular_velocity", "force")
 
 
 def _cache_path(dump: Path, cache_dir: Path) -> Path:

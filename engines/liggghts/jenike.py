@@ -22,15 +22,12 @@ import numpy as np
 
 from engines.cases.geometry import write_stl
 from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
+from engines.liggghts.inputs import DECK_NAME, common_context, flat_matrix, write_text_atomic
 from engines.liggghts.run import (
-    DECK_NAME,
     DUMP_PREFIX,
     RUN_OUTPUTS,
     RUN_RECORD,
     EngineRunError,
-    _common_context,
-    _flat,
-    _write_text_atomic,
     parse_markers,
     run_engine,
     set_aside_previous_attempt,
@@ -79,9 +76,9 @@ CONTACT_COLUMNS = (
 def _contact_context(contacts: ContactSet, n_types: int) -> dict:
     return {
         "n_types": n_types,
-        "restitution": _flat(contacts.restitution),
-        "sliding_friction": _flat(contacts.sliding_friction),
-        "rolling_friction": _flat(contacts.rolling_friction),
+        "restitution": flat_matrix(contacts.restitution),
+        "sliding_friction": flat_matrix(contacts.sliding_friction),
+        "rolling_friction": flat_matrix(contacts.rolling_friction),
     }
 
 
@@ -91,7 +88,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
     Contact matrices start at the fill values (``materials``) and are replaced by the test values
     (``test_materials``) once the lid is in place.
     """
-    context = _common_context(case)
+    context = common_context(case)
     n_types = len(case.materials.names)
     context["materials"].update(_contact_context(case.fill_contacts, n_types))
     geometry = case.geometry
@@ -182,9 +179,9 @@ def write_jenike_inputs(case: JenikeCase, deck_dir: str | Path) -> Path:
     deck_dir = Path(deck_dir)
     for name, mesh in case.geometry.meshes(case.lid_kind).items():
         write_stl(mesh, deck_dir / "meshes" / f"{name}.stl")
-    _write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
+    write_text_atomic(deck_dir / "case.json", json.dumps(case.summary(), indent=2, sort_keys=True, default=float))
     deck_path = deck_dir / DECK_NAME
-    _write_text_atomic(deck_path, render_jenike_deck(case))
+    write_text_atomic(deck_path, render_jenike_deck(case))
     return deck_path
 
 

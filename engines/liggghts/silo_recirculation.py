@@ -13,15 +13,9 @@ from pathlib import Path
 
 from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.geometry import vertical_rectangle_x
-from engines.liggghts.run import (
-    Resume,
-    check_silo_run,
-    expected_simulated_time,
-    run_checked,
-    silo_deck_context,
-    silo_meshes,
-    write_case_inputs,
-)
+from engines.liggghts.run import Resume, run_checked
+from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_meshes
+from engines.liggghts.inputs import write_case_inputs
 from engines.templating import render_deck
 
 CHANNEL_MESHES = ("channel_left", "channel_right")

@@ -19,10 +19,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.data.frames import clumps_from_frame
+from engines.liggghts.dumps import read_frames
 from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
 from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.liggghts.run import run_silo, write_silo_inputs
+from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.cases.silo_flat import build_silo_case
 from tests.conftest import TINY_SILO
 

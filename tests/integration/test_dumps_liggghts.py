@@ -14,14 +14,8 @@ import numpy as np
 import pytest
 import pyvista
 
-from engines.liggghts.dumps import (
-    clumps_from_frame,
-    dump_step,
-    list_dumps,
-    parse_legacy_vtk_polydata,
-    read_frame,
-    read_frames,
-)
+from analysis.data.frames import clumps_from_frame
+from engines.liggghts.dumps import dump_step, list_dumps, parse_legacy_vtk_polydata, read_frame, read_frames
 
 from tests.conftest import require_liggghts  # noqa: E402
 

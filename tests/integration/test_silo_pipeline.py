@@ -12,7 +12,8 @@ import pytest
 import yaml
 
 from engines.config import REPO_ROOT
-from engines.liggghts.run import EngineRunError, run_engine, write_silo_inputs, run_silo
+from engines.liggghts.run import EngineRunError, run_engine
+from engines.liggghts.silo_flat import write_silo_inputs, run_silo
 from engines.cases.silo_flat import build_silo_case
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
@@ -142,7 +143,8 @@ def test_two_mpi_ranks_give_the_same_flow_within_noise(tiny_pipeline, tmp_path, 
     record = json.loads((tmp_path / "run.json").read_text())
     assert record["mpi_ranks"] == 2 and record["filled"]["clumps"] == case.fill.n_clumps
 
-    from engines.liggghts.dumps import clumps_from_frame, read_frames
+    from analysis.data.frames import clumps_from_frame
+    from engines.liggghts.dumps import read_frames
     from analysis.studies.silo_flat.metrics import silo_flow_metrics
 
     frames = [

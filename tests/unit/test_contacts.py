@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from engines.liggghts.contacts import ContactDumpError, force_chain_segments, parse_local_dump, read_contacts
+from engines.liggghts.contacts import ContactDumpError, parse_local_dump, read_contacts
+from analysis.numerics.force_chains import force_chain_segments
 
 DUMP = """ITEM: TIMESTEP
 22000

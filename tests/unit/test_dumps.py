@@ -9,12 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis import dumps
+from engines.liggghts import dumps
+from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 from engines.liggghts.dumps import (
-    ClumpFrame,
     DumpFormatError,
-    ParticleFrame,
-    clumps_from_frame,
     dump_step,
     format_legacy_vtk_polydata,
     frame_from_arrays,

@@ -12,15 +12,14 @@ from analysis.numerics.flow import (
     DischargeHistory,
     FlowRateFit,
     beverloo_mass_flow_rate,
-    clump_volume,
     column_surface_heights,
     discharged_mass_history,
-    equivalent_diameter,
     filling_bulk_density,
     mass_in_silo,
     steady_flow_rate,
     volumetric_flow_rate,
 )
+from engines.cases.particles import clump_volume, equivalent_diameter
 
 # --------------------------------------------------------------------------- Beverloo
 

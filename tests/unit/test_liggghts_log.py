@@ -9,12 +9,12 @@ import pytest
 from engines.liggghts.run import (
     EngineNotFound,
     EngineRunError,
-    check_silo_run,
     engine_command,
     error_lines,
     parse_markers,
     set_aside_previous_attempt,
 )
+from engines.liggghts.silo_flat import check_silo_run
 from engines.cases.silo_flat import build_silo_case
 
 LOG = """\

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from engines.progress import Progress, ThermoProgress, ThermoRow, column_name, progress_report
+from engines.liggghts.progress import Progress, ThermoProgress, ThermoRow, column_name, progress_report
 
 # Screen output as LIGGGHTS 3.8 writes it (header names cut to 8 characters, no v_ prefix), with the noise
 # between thermo rows: INFO and WARNING lines, insertion progress, run statistics, blank lines.
@@ -254,7 +254,7 @@ def test_monitor_follows_a_growing_screen_output_logs_when_due_and_keeps_a_live_
     import io
     import logging
 
-    from engines.progress import ProgressMonitor
+    from engines.liggghts.progress import ProgressMonitor
 
     screen = tmp_path / "engine.out"
     screen.write_text("Step Atoms Time n_clumps ke_per_c CPU\n")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from analysis.numerics.coarse_graining import depth_average
-from engines.liggghts.dumps import ClumpFrame
+from analysis.data.frames import ClumpFrame
 from analysis.numerics.profiles import janssen_vertical_stress
 from analysis.studies.silo_flat.fields import (
     FieldSettings,

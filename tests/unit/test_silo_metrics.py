@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from engines.liggghts.dumps import ClumpFrame
+from analysis.data.frames import ClumpFrame
 from analysis.studies.silo_flat.metrics import EscapedParticles, flow_table_row, silo_flow_metrics, vanished_above_outlet
 
 SPACING = 0.004  # m, simple cubic lattice

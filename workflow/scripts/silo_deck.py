@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from calibration.parameters import calibrated_config
-from engines.liggghts.run import write_silo_inputs
+from engines.liggghts.silo_flat import write_silo_inputs
 from engines.logs import logged_to
 from engines.cases.silo_flat import silo_case_for_run
 

@@ -8,8 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from analysis.numerics.coarse_graining import depth_average, front_wall_slice
-from engines.liggghts.contacts import force_chain_segments, read_contacts
-from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.numerics.force_chains import force_chain_segments
+from engines.liggghts.contacts import read_contacts
+from analysis.data.frames import clumps_from_frame
+from engines.liggghts.dumps import read_frames
 from analysis.io.fields import save_fields_npz, write_fields_vti, write_pvd
 from analysis.numerics.flow import column_surface_heights
 from analysis.numerics.profiles import profile_flow_rate, velocity_profile

@@ -3,7 +3,8 @@
 import json
 from pathlib import Path
 
-from engines.liggghts.dumps import clumps_from_frame, read_frames
+from analysis.data.frames import clumps_from_frame
+from engines.liggghts.dumps import read_frames
 from analysis.io.plots import plot_discharge
 from analysis.studies.silo_flat.metrics import flow_table_row, silo_flow_metrics
 from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json

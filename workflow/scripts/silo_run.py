@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from calibration.parameters import calibrated_config
-from engines.liggghts.run import run_silo
+from engines.liggghts.silo_flat import run_silo
 from engines.estimates import estimate_silo_case
 from engines.logs import logged_to
 from engines.planning import cost_model, preflight

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from analysis.studies.silo_recirculation.blending import ClumpTracks, clump_tracks
-from engines.liggghts.dumps import clumps_from_frame, list_dumps, readable_frames
+from analysis.data.frames import clumps_from_frame
+from engines.liggghts.dumps import list_dumps, readable_frames
 from analysis.io.tables import atomic_output
 
 
