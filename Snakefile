@@ -15,7 +15,7 @@ report: "workflow/report/workflow.rst"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
-include: "workflow/rules/blending.smk"
+include: "workflow/rules/silo_recirculation.smk"
 include: "workflow/rules/blender.smk"
 include: "workflow/rules/report.smk"
 
@@ -25,7 +25,7 @@ rule all:
         calibration_targets(),
         silo_flat_targets,
         parametric_targets,
-        blending_targets,
+        recirculation_targets,
         blender_targets,
         f"{RESULTS}/summary/summary.html",
     default_target: True

@@ -1,9 +1,12 @@
 """Loading and validating siloflow configuration.
 
 The schema in ``workflow/schemas/config.schema.yaml`` is the single source of truth: it declares every key
-with a description and a default. Validation fills the defaults (as Snakemake's ``validate`` does) and
-then checks what a JSON schema cannot express: that names refer to defined materials and particle models,
-and that every material pair a case brings into contact has contact parameters.
+with a description and a default. Validation first lets the silo-type case sections (``silo_flat``,
+``silo_recirculation``, ``blender``) inherit, leaf by leaf, every shared key they leave out from the ``defaults``
+section (:data:`SHARED_KEYS`), then fills the schema's defaults (as Snakemake's ``validate`` does) and checks what a
+JSON schema cannot express: that names refer to defined materials and particle models, and that every material pair
+a case brings into contact has contact parameters. Limits of one engine (LIGGGHTS' restitution > 0.05) are not
+checked here but by that engine when it accepts a case (:meth:`engines.interface.Engine.check_case`).
 
 Errors are reported as one :class:`ConfigError` naming the offending key, before any simulation starts.
 """
@@ -18,12 +21,72 @@ from typing import Any, Iterable, Mapping
 import jsonschema
 import yaml
 
+from engines.cases.blender_geometry import INSERT_PRESETS
+
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
 class ConfigError(ValueError):
     """A configuration value is invalid; the message names the key."""
+
+
+#: Keys a silo-type case section inherits from ``defaults`` when it leaves them out.
+SHARED_KEYS = ("particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction", "seed")
+#: The case sections that inherit from ``defaults``.
+INHERITING_SECTIONS = ("silo_flat", "silo_recirculation", "blender")
+
+#: Keys of earlier siloflow versions and where their values went: a config using one is refused with the new name.
+RENAMED_KEYS = {
+    ("blending",): "silo_recirculation",
+    ("engine", "executable"): "engine.liggghts.executable",
+    ("blender", "timestep_fraction"): None,  # only its null ("take silo_flat's") is gone
+}
+
+
+def _deep_merge(base: Mapping, override: Mapping) -> dict:
+    """``override`` over ``base``, leaf by leaf (mappings merge, every other value replaces)."""
+    merged = copy.deepcopy(dict(base))
+    for key, value in override.items():
+        if isinstance(value, Mapping) and isinstance(merged.get(key), Mapping):
+            merged[key] = _deep_merge(merged[key], value)
+        else:
+            merged[key] = copy.deepcopy(value)
+    return merged
+
+
+def inherit_defaults(config: Mapping) -> dict:
+    """A copy of ``config`` in which each silo-type case section carries the shared keys of ``defaults`` it leaves
+    out (leaf by leaf: a section that sets only ``fill.insertion_velocity`` keeps the other fill keys of
+    ``defaults``). Applied to the raw configuration, before the schema fills its defaults."""
+    inherited = copy.deepcopy(dict(config))
+    defaults = inherited.get("defaults") or {}
+    if not isinstance(defaults, Mapping):
+        return inherited  # the schema reports the wrong type
+    shared = {key: value for key, value in defaults.items() if key in SHARED_KEYS}
+    for section in INHERITING_SECTIONS:
+        own = inherited.get(section)
+        if own is None:
+            own = {}
+        if isinstance(own, Mapping):
+            inherited[section] = _deep_merge(shared, own)
+    return inherited
+
+
+def _check_renamed(config: Mapping) -> None:
+    for path, new in RENAMED_KEYS.items():
+        node = config
+        for part in path[:-1]:
+            node = node.get(part) if isinstance(node, Mapping) else None
+        if not (isinstance(node, Mapping) and path[-1] in node):
+            continue
+        old = ".".join(path)
+        if new is None:
+            if node[path[-1]] is None:
+                raise ConfigError(f"config key '{old}': null is no longer accepted; leave the key out to inherit "
+                                  "defaults.timestep_fraction")
+            continue
+        raise ConfigError(f"config key '{old}' was renamed '{new}'; rename it in your config file")
 
 
 def load_schema(path: Path = SCHEMA_PATH) -> dict:
@@ -43,21 +106,25 @@ def load_config_file(path: str | Path) -> dict:
     return loaded
 
 
-def _with_defaults(validator_class):
-    """Extend a jsonschema validator so that ``properties`` fills in declared defaults."""
+def _with_defaults(validator_class, definitions: Mapping):
+    """Extend a jsonschema validator so that ``properties`` fills in declared defaults (also those of a
+    ``#/definitions/...`` reference, which the shared case keys use)."""
     validate_properties = validator_class.VALIDATORS["properties"]
 
     def set_defaults(validator, properties, instance, schema):
         if isinstance(instance, dict):
             for name, subschema in properties.items():
-                if name not in instance and "default" in subschema:
-                    instance[name] = copy.deepcopy(subschema["default"])
+                holder = subschema
+                reference = subschema.get("$ref", "")
+                if "default" not in subschema and reference.startswith("#/definitions/"):
+                    holder = definitions[reference.rsplit("/", 1)[1]]
+                if name not in instance and "default" in holder:
+                    instance[name] = copy.deepcopy(holder["default"])
         yield from validate_properties(validator, properties, instance, schema)
 
     return jsonschema.validators.extend(validator_class, {"properties": set_defaults})
 
 
-_DefaultFillingValidator = _with_defaults(jsonschema.Draft7Validator)
 
 
 def _key_path(path: Iterable[Any]) -> str:
@@ -117,8 +184,9 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
         One message naming the first offending key.
     """
     schema = load_schema() if schema is None else schema
-    filled = copy.deepcopy(dict(config))
-    validator = _DefaultFillingValidator(schema)
+    _check_renamed(config)
+    filled = inherit_defaults(config)
+    validator = _with_defaults(jsonschema.Draft7Validator, schema.get("definitions", {}))(schema)
     errors = sorted(validator.iter_errors(filled), key=_error_depth_key)
     if errors:
         best = errors[0]
@@ -145,21 +213,15 @@ def _check_finite(node: Any, path: tuple) -> None:
 def _check_references(config: dict) -> None:
     materials = config["materials"]
     models = config["particle_models"]
-    silo = config["silo_flat"]
 
     def require(name: str, defined: Mapping, key: str, kind: str) -> None:
         if name not in defined:
             known = ", ".join(sorted(defined)) or "none"
             raise ConfigError(f"config key '{key}': unknown {kind} '{name}'; defined: {known}")
 
-    require(silo["particle_model"], models, "silo_flat.particle_model", "particle model")
-    require(silo["particle_material"], materials, "silo_flat.particle_material", "material")
-    for wall, material in silo["wall_materials"].items():
-        require(material, materials, f"silo_flat.wall_materials.{wall}", "material")
     for index, contact in enumerate(config["contacts"]):
         for material in contact["materials"]:
             require(material, materials, f"contacts[{index}].materials", "material")
-
     seen: dict[frozenset, int] = {}
     for index, contact in enumerate(config["contacts"]):
         pair = frozenset(contact["materials"])
@@ -170,43 +232,53 @@ def _check_references(config: dict) -> None:
             )
         seen[pair] = index
 
+    for section in ("defaults", *INHERITING_SECTIONS):
+        _check_case_materials(config, section, require, seen)
     _check_jenike_references(config, require, seen)
-    _check_blending_references(config, require)
+    _check_recirculation_references(config, require)
     _check_blender_references(config, require)
 
-    particle_material = silo["particle_material"]
+
+def _check_case_materials(config: dict, section: str, require, contact_pairs: dict) -> None:
+    """The particle model, particle material and wall materials of a silo-type section exist, the particle
+    material has a density and every particle-wall pair it uses has contact parameters."""
+    case = config[section]
+    materials = config["materials"]
+    require(case["particle_model"], config["particle_models"], f"{section}.particle_model", "particle model")
+    require(case["particle_material"], materials, f"{section}.particle_material", "material")
+    for wall, material in case["wall_materials"].items():
+        require(material, materials, f"{section}.wall_materials.{wall}", "material")
+    particle_material = case["particle_material"]
     if "density" not in materials[particle_material]:
         raise ConfigError(
             f"config key 'materials.{particle_material}.density': the particle material needs a density"
         )
-    needed = {particle_material, *silo["wall_materials"].values()}
-    for material in sorted(needed):
-        if frozenset((particle_material, material)) not in seen:
+    for material in sorted({particle_material, *case["wall_materials"].values()}):
+        if frozenset((particle_material, material)) not in contact_pairs:
             raise ConfigError(
                 f"config key 'contacts': no contact parameters for the pair "
-                f"[{particle_material}, {material}] used by silo_flat"
+                f"[{particle_material}, {material}] used by {section}"
             )
 
 
-def _check_blending_references(config: dict, require) -> None:
-    blending = config["blending"]
+def _check_recirculation_references(config: dict, require) -> None:
+    blending = config["silo_recirculation"]
     presets = blending["presets"]
     for index, pattern in enumerate(blending["flow_patterns"]):
-        require(pattern, presets, f"blending.flow_patterns[{index}]", "preset")
-    require(blending["verification"]["flow_pattern"], presets, "blending.verification.flow_pattern", "preset")
+        require(pattern, presets, f"silo_recirculation.flow_patterns[{index}]", "preset")
+    require(blending["verification"]["flow_pattern"], presets, "silo_recirculation.verification.flow_pattern", "preset")
     names = [layout["name"] for layout in blending["layouts"]]
     for index, name in enumerate(names):
         if names.index(name) != index:
-            raise ConfigError(f"config key 'blending.layouts[{index}].name': layout name '{name}' is used twice")
+            raise ConfigError(f"config key 'silo_recirculation.layouts[{index}].name': layout name '{name}' is used twice")
     if blending["outlet_width"] >= blending["width"]:
         raise ConfigError(
-            f"config key 'blending.outlet_width': {blending['outlet_width']} m must be smaller than "
-            f"blending.width ({blending['width']} m)"
+            f"config key 'silo_recirculation.outlet_width': {blending['outlet_width']} m must be smaller than "
+            f"silo_recirculation.width ({blending['width']} m)"
         )
 
 
 def _check_blender_references(config: dict, require) -> None:
-    from engines.cases.blender_geometry import INSERT_PRESETS
 
     blender = config["blender"]
     for name in blender["inserts"]:

@@ -20,17 +20,16 @@ import dataclasses
 import math
 import re
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Iterable
+from typing import Iterable
 
-if TYPE_CHECKING:  # the case classes are only read through their attributes
-    from engines.cases.blender import BlenderCase
-    from engines.cases.silo_recirculation import RecirculationCase
-    from engines.cases.jenike import JenikeCase
-    from engines.cases.silo_flat import SiloCase
+from engines.cases.blender import BlenderCase
+from engines.cases.jenike import JenikeCase
+from engines.cases.silo_flat import SiloCase
+from engines.cases.silo_recirculation import RecirculationCase
 
 #: Kinds of run this module estimates.
-SILO_FLAT, BLENDING, BLENDER, JENIKE = "silo_flat", "blending", "blender", "jenike"
-KINDS = (SILO_FLAT, BLENDING, BLENDER, JENIKE)
+SILO_FLAT, RECIRCULATION, BLENDER, JENIKE = "silo_flat", "silo_recirculation", "blender", "jenike"
+KINDS = (SILO_FLAT, RECIRCULATION, BLENDER, JENIKE)
 
 #: The Jenike deck runs one step after ``delete_atoms`` so LIGGGHTS removes the partner spheres of the
 #: deleted clumps (:mod:`engines.cases.jenike`, stage 2).
@@ -356,7 +355,7 @@ def estimate_recirculation_case(
     case: RecirculationCase, mpi_ranks: int = 1, model: CostModel = CostModel()
 ) -> RunEstimate:
     """Estimate a recirculating-silo run of the blending study (its silo's discharge is the recirculation)."""
-    return _estimate_silo_deck(case.run_id, BLENDING, case.silo, mpi_ranks, model)
+    return _estimate_silo_deck(case.run_id, RECIRCULATION, case.silo, mpi_ranks, model)
 
 
 def estimate_blender_case(case: BlenderCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
@@ -536,3 +535,12 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
 def total_dump_bytes(estimates: Iterable[RunEstimate]) -> int:
     """Disk space of all the runs' dumps and caches (bytes), for :func:`check_disk_space`."""
     return sum(estimate.dump_bytes for estimate in estimates)
+
+
+def estimate_case(case, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
+    """Estimate a run of any case kind (dispatch on the case's type)."""
+    for case_type, estimate in ((SiloCase, estimate_silo_case), (RecirculationCase, estimate_recirculation_case),
+                                (BlenderCase, estimate_blender_case), (JenikeCase, estimate_jenike_case)):
+        if isinstance(case, case_type):
+            return estimate(case, mpi_ranks, model)
+    raise TypeError(f"no estimate for a {type(case).__name__}")

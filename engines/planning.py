@@ -11,29 +11,19 @@ import shutil
 import sys
 from pathlib import Path
 
-from calibration.sweep import sweep_points
-from engines.cases.blender import blender_cases
-from engines.cases.silo_recirculation import recirculation_cases
+from engines.cases import CASE_BUILDERS
 from engines.config import load_config
 from engines.estimates import (
     CostModel,
     RunEstimate,
     check_disk_space,
-    estimate_blender_case,
-    estimate_jenike_case,
-    estimate_recirculation_case,
+    estimate_case,
     estimate_rows,
-    estimate_silo_case,
     format_bytes,
     format_duration,
     total_dump_bytes,
 )
-from engines.cases.jenike import build_jenike_case
-from engines.cases.silo_flat import silo_cases
-
-#: Where the runs of each kind live under ``results/`` (as the workflow's rules put them).
-RUN_DIRECTORIES = {"jenike": "calibration/runs", "silo_flat": "silo_flat", "blending": "blending", "blender": "blender"}
-
+from engines.layout import RUN_RECORD, run_dir
 
 def cost_model(config: dict) -> CostModel:
     """The cost model of a validated configuration (``estimates`` section)."""
@@ -46,24 +36,17 @@ def config_estimates(config: dict) -> list[RunEstimate]:
     """Estimates of every engine run a validated configuration defines (calibration sweep, silo runs with their
     parametric variants, recirculation runs, blender runs), in that order."""
     model, ranks = cost_model(config), config["engine"]["mpi_ranks"]
-    estimates = [
-        estimate_jenike_case(build_jenike_case(config, point), ranks, model)
-        for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"])
-    ]
-    estimates += [estimate_silo_case(case, ranks, model) for case in silo_cases(config).values()]
-    estimates += [estimate_recirculation_case(case, ranks, model) for case in recirculation_cases(config).values()]
-    estimates += [estimate_blender_case(case, ranks, model) for case in blender_cases(config).values()]
-    return estimates
+    return [estimate_case(case, ranks, model) for build in CASE_BUILDERS.values() for case in build(config).values()]
 
 
 def run_directory(results: str | Path, estimate: RunEstimate) -> Path:
     """Directory of the run an estimate describes."""
-    return Path(results) / RUN_DIRECTORIES[estimate.kind] / estimate.run_id
+    return Path(run_dir(estimate.kind, estimate.run_id, str(results)))
 
 
 def pending(estimates: list[RunEstimate], results: str | Path) -> list[RunEstimate]:
     """The estimates whose run has not finished yet (no ``run.json``)."""
-    return [e for e in estimates if not (run_directory(results, e) / "run.json").exists()]
+    return [e for e in estimates if not (run_directory(results, e) / RUN_RECORD).exists()]
 
 
 def free_bytes(path: str | Path) -> int:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
 from engines.cases.particles import particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
-from engines.cases.common import GRAVITY, material_table, plan_fill, run_id
+from engines.cases.common import GRAVITY, engine_kind, material_table, plan_fill, run_id
 from engines.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"
@@ -86,6 +86,10 @@ class BlenderCase:
     def time_scale(self) -> float:
         """Factor 1/sqrt(f) applied to the flow times of the run (-)."""
         return 1.0 / math.sqrt(self.gravity_factor)
+
+    def stages(self):
+        """The silo's stages; the discharge is continuous (periodic, no clump may leave) or a batch."""
+        return self.silo.stages(last="discharge")
 
     def summary(self) -> dict:
         """Plain-data summary for ``case.json``."""
@@ -180,12 +184,11 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
     if not gravity_factor > 0:
         raise ValueError(f"gravity factor must be > 0, got {gravity_factor!r}")
     blender = config["blender"]
-    silo_config = config["silo_flat"]
     geometry = geometry_for(config, configuration)
-    material_name = silo_config["particle_material"]
+    material_name = blender["particle_material"]
     material = config["materials"][material_name]
     particle = particle_template(
-        silo_config["particle_model"], config["particle_models"][silo_config["particle_model"]], material["density"]
+        blender["particle_model"], config["particle_models"][blender["particle_model"]], material["density"]
     )
     clump_size = 2.0 * particle.bounding_radius
     narrowest = blender["min_passage_clumps"] * clump_size
@@ -196,19 +199,18 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
                 f"blender.min_passage_clumps = {blender['min_passage_clumps']:g} clump sizes ({narrowest * 1000:.1f} mm); "
                 "widen the silo (blender.width), the outlet or the tube"
             )
-    walls = silo_config["wall_materials"]
+    walls = blender["wall_materials"]
     table = material_table(config, material_name, [walls["side"], walls["front_back"]])
     t_rayleigh = rayleigh_time(
         particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
     )
-    fraction = blender["timestep_fraction"] or silo_config["timestep_fraction"]
-    timestep = fraction * t_rayleigh
+    timestep = blender["timestep_fraction"] * t_rayleigh
     scale = 1.0 / math.sqrt(gravity_factor)
     gravity = GRAVITY * gravity_factor
 
     fill_height = blender["fill_height"]
     fill_area = fill_cross_section_area(geometry, fill_height)
-    fill_config = dict(silo_config["fill"])
+    fill_config = dict(blender["fill"])
     # The pour keeps its insertion velocity: at higher gravity the clumps hit the pile faster anyway, and the
     # soft contacts of the reduced stiffness do not stand much more.
     fill_config.update(zone_width_fraction=blender["fill_zone_width_fraction"])
@@ -223,7 +225,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
             f"{fill.zone[5] + clump_size:.4g} m, above the top of the silo ({geometry.z_top:.4g} m); raise "
             "blender.vertical_height or lower blender.fill_height"
         )
-    settle = silo_config["settle"]
+    settle = blender["settle"]
     settle_check_steps = steps_for(settle["check_interval"] * scale, timestep)
     settle_max_checks = max(1, math.ceil(settle["max_time"] * scale / (settle_check_steps * timestep)))
     discharge = blender["discharge"]
@@ -247,9 +249,10 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
             ({**c, "materials": sorted(c["materials"])} for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
             key=lambda c: c["materials"],
         ),
-        "silo_flat": {k: copy.deepcopy(silo_config[k]) for k in ("fill", "settle", "seed", "timestep_fraction", "wall_materials")},
+        "engine": engine_kind(config, CASE_NAME),
         # the inserts enter through "insert"; the steady and profile windows only steer the analysis
-        "blender": {k: copy.deepcopy(v) for k, v in blender.items() if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge")},
+        "blender": {k: copy.deepcopy(v) for k, v in blender.items()
+                    if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine")},
         "discharge": {"mode": discharge["mode"], "time": discharge["time"]},
     }
     silo = SiloCase(
@@ -271,9 +274,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         dump_every=steps_for(blender["dump_interval"] * scale, timestep),
         sink_depth=blender["sink_depth"],
         domain_top=domain_top,
-        seeds=tuple(engine_seeds(silo_config["seed"], 3)),
-        steady_window=(0.2, 0.8),
-        beverloo=dict(silo_config["beverloo"]),
+        seeds=tuple(engine_seeds(blender["seed"], 3)),
         defining_parameters=defining,
     )
     return BlenderCase(

@@ -169,3 +169,10 @@ def plan_fill(
         particle_rate=particle_rate,
         fill_steps=fill_steps,
     )
+
+
+def engine_kind(config: dict, section: str) -> str:
+    """The engine that runs the cases of config section ``section``: its own ``engine`` key, else ``engine.kind``.
+
+    The engine is part of what defines a run, so it enters every run id."""
+    return config[section].get("engine") or config["engine"]["kind"]

@@ -60,7 +60,9 @@ import numpy as np
 from engines.cases.geometry import TriangleMesh, horizontal_rectangle
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
-from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, run_id
+from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id
+from engines.cases.jenike_sweep import sweep_points
+from engines.cases.stages import Stage
 
 CASE_NAME = "jenike"
 GRAVITY = 9.81
@@ -557,6 +559,20 @@ class JenikeCase:
         """``<shape>-<test>-<hash of every defining parameter>``."""
         return run_id(f"{self.particle.name}-{self.test}", self.defining_parameters)
 
+    def stages(self) -> tuple[Stage, ...]:
+        """Pour into the cell, level it and let it settle, consolidate under the lid, shear; the wall forces
+        (lid, shear ring, base) throughout, frames and contacts during consolidation and shear."""
+        dt = self.timestep
+        return (
+            Stage("fill", {"n_clumps": self.fill.n_clumps, "duration_s": self.fill.steps * dt}),
+            Stage("settle", {"level_z_m": self.fill.level_z, "duration_s": self.fill.relax_steps * dt}),
+            Stage("consolidate", {"normal_force_N": self.normal_force, "lid": self.lid_kind,
+                                  "duration_s": (self.ramp_steps + self.hold_steps) * dt},
+                  ("frames", "wall_forces")),
+            Stage("shear", {"velocity_m_s": self.shear_velocity, "duration_s": self.shear_steps * dt},
+                  ("frames", "wall_forces", "contacts") + (("wall_contacts",) if self.lid_kind == "rigid" else ())),
+        )
+
     @property
     def clump_sphere_mass(self) -> float:
         """Clump mass per sphere (kg): spheres above the shear plane times this is the mass above it."""
@@ -604,35 +620,20 @@ LID_KINDS = ("rigid", "servo")
 POINT_KEYS = ("shape", "test", "sliding_friction", "rolling_friction", "restitution", "rotation_blocked")
 
 
-def _check_point(config: dict, point: dict) -> dict:
+def _check_point(point: dict) -> dict:
+    """The point with exactly :data:`POINT_KEYS`, numbers as floats. Its values come from the validated
+    ``jenike.sweep`` section (:func:`engines.cases.jenike_sweep.sweep_points`): the schema is their one validator."""
     missing = [key for key in POINT_KEYS if key not in point]
     extra = sorted(set(point) - set(POINT_KEYS))
     if missing or extra:
         raise ValueError(f"jenike point: missing keys {missing}, unknown keys {extra}; expected {list(POINT_KEYS)}")
-    if point["shape"] not in config["particle_models"]:
-        raise ValueError(
-            f"jenike point: unknown shape '{point['shape']}'; particle_models defines "
-            f"{', '.join(sorted(config['particle_models']))}"
-        )
-    test = point["test"]
-    if test != "internal" and test not in config["materials"]:
-        raise ValueError(f"jenike point: test '{test}' is neither 'internal' nor a material of the config")
-    for key in ("sliding_friction", "rolling_friction"):
-        value = point[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-            raise ValueError(f"jenike point: {key} must be a number in [0, 1], got {value!r}")
-    restitution = point["restitution"]
-    if isinstance(restitution, bool) or not isinstance(restitution, (int, float)) or not 0.05 < restitution <= 1.0:
-        raise ValueError(f"jenike point: restitution must lie in (0.05, 1] (LIGGGHTS 3.8), got {restitution!r}")
-    if not isinstance(point["rotation_blocked"], bool):
-        raise ValueError(f"jenike point: rotation_blocked must be true or false, got {point['rotation_blocked']!r}")
     return {
         "shape": point["shape"],
-        "test": test,
+        "test": point["test"],
         "sliding_friction": float(point["sliding_friction"]),
         "rolling_friction": float(point["rolling_friction"]),
-        "restitution": float(restitution),
-        "rotation_blocked": point["rotation_blocked"],
+        "restitution": float(point["restitution"]),
+        "rotation_blocked": bool(point["rotation_blocked"]),
     }
 
 
@@ -775,7 +776,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     lid = point.get("lid", config["jenike"]["lid"])
     if lid not in LID_KINDS:
         raise ValueError(f"jenike point: lid must be one of {', '.join(LID_KINDS)}, got {lid!r}")
-    point = _check_point(config, {key: value for key, value in point.items() if key != "lid"})
+    point = _check_point({key: value for key, value in point.items() if key != "lid"})
     jenike = {**config["jenike"], "lid": lid}
     cell = jenike["cell"]
     materials = config["materials"]
@@ -851,6 +852,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
 
     defining = {
         "case": CASE_NAME,
+        "engine": engine_kind(config, CASE_NAME),
         "point": point,
         "lid": jenike["lid"],
         "materials": {name: materials[name] for name in sorted(set(table.names))},
@@ -886,60 +888,19 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     )
 
 
-# ---------------------------------------------------------------------------------------------- analysis input
+def jenike_cases(config: dict) -> dict[str, JenikeCase]:
+    """The Jenike shear tests of the calibration sweep a validated configuration defines, keyed by run id.
 
-
-@dataclass(frozen=True)
-class ShearSignals:
-    """The force histories of the shear stage, signed for :func:`calibration.friction.bulk_friction`.
-
-    Attributes
-    ----------
-    time : numpy.ndarray
-        Sample times (s).
-    lid_force, ring_force : numpy.ndarray
-        Force needed to drive the lid and the shear ring along +x: minus the x force of the particles on
-        them (N).
-    bottom_force : numpy.ndarray
-        x force of the particles on the bottom ring or plate (N); by the force balance of the sample it
-        equals lid_force + ring_force up to the sample's inertia.
-    normal_force : numpy.ndarray
-        Measured upward force of the particles on the lid (N).
-    weight_above : numpy.ndarray
-        Weight of the clumps above the shear plane (N).
+    Raises
+    ------
+    ValueError
+        Naming the sweep point whose cell cannot be built (e.g. a plate too small for the ring's travel).
     """
-
-    time: np.ndarray
-    lid_force: np.ndarray
-    ring_force: np.ndarray
-    bottom_force: np.ndarray
-    normal_force: np.ndarray
-    weight_above: np.ndarray
-
-
-def shear_signals(history: dict, shear_start: float, shear_end: float | None = None) -> ShearSignals:
-    """Cut the shear stage out of a force history and sign its forces for the bulk friction.
-
-    Parameters
-    ----------
-    history : dict of numpy.ndarray
-        Columns ``time, lid_fx, lid_fz, ring_fx, bottom_fx, mass_above`` (as read by
-        :func:`engines.liggghts.jenike.read_force_history`) in s, N, kg.
-    shear_start, shear_end : float
-        Times bounding the shear stage (s); rows whose averaging interval ended after ``shear_start``
-        and no later than ``shear_end`` are kept.
-    """
-    time = np.asarray(history["time"], dtype=float)
-    keep = time > shear_start
-    if shear_end is not None:
-        keep &= time <= shear_end
-    if keep.sum() < 2:
-        raise ValueError(f"the force history holds fewer than 2 samples after t = {shear_start} s")
-    return ShearSignals(
-        time=time[keep],
-        lid_force=-np.asarray(history["lid_fx"], dtype=float)[keep],
-        ring_force=-np.asarray(history["ring_fx"], dtype=float)[keep],
-        bottom_force=np.asarray(history["bottom_fx"], dtype=float)[keep],
-        normal_force=np.asarray(history["lid_fz"], dtype=float)[keep],
-        weight_above=np.asarray(history["mass_above"], dtype=float)[keep] * GRAVITY,
-    )
+    cases = {}
+    for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"]):
+        try:
+            case = build_jenike_case(config, point)
+        except ValueError as error:
+            raise ValueError(f"jenike sweep point {point}: {error}") from None
+        cases[case.run_id] = case
+    return cases

@@ -15,9 +15,10 @@ import copy
 import math
 from dataclasses import asdict, dataclass, field
 
-from engines.cases.common import GRAVITY, FillPlan, MaterialTable, material_table, plan_fill, run_id
+from engines.cases.common import GRAVITY, FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
+from engines.cases.stages import Stage
 
 CASE_NAME = "silo_flat"
 
@@ -48,14 +49,26 @@ class SiloCase:
     sink_depth: float
     domain_top: float
     seeds: tuple[int, ...]
-    steady_window: tuple[float, float]
-    beverloo: dict
     defining_parameters: dict = field(repr=False)
 
     @property
     def run_id(self) -> str:
         """Directory name of the run: particle model plus a hash of every defining parameter."""
         return run_id(self.particle.name, self.defining_parameters)
+
+    def stages(self, last: str = "discharge") -> tuple[Stage, ...]:
+        """Pour, settle (contacts of the settled fill saved), open the outlet, then ``last`` (``discharge``, or
+        ``recirculate`` for the recirculating silo) with frames and restart files; wall forces throughout."""
+        return (
+            Stage("fill", {"n_clumps": self.fill.n_clumps, "insertion_velocity_m_s": self.fill.insertion_velocity,
+                           "duration_s": self.fill.fill_steps * self.timestep}, ("wall_forces",)),
+            Stage("settle", {"kinetic_energy_threshold_J": self.settle_threshold,
+                             "max_duration_s": self.settle_max_checks * self.settle_check_steps * self.timestep},
+                  ("contacts", "wall_forces")),
+            Stage("open", {"gate": "outlet_gate"}),
+            Stage(last, {"duration_s": self.discharge_steps * self.timestep,
+                         "frame_interval_s": self.dump_every * self.timestep}, ("frames", "wall_forces", "restart")),
+        )
 
     @property
     def spheres_per_clump(self) -> int:
@@ -82,15 +95,23 @@ class SiloCase:
             "fill": asdict(self.fill),
             "settle_threshold_J": self.settle_threshold,
             "discharge_time_s": self.discharge_steps * self.timestep,
-            "steady_window": list(self.steady_window),
-            "beverloo": dict(self.beverloo),
             "materials": list(self.materials.names),
             "parameters": self.defining_parameters,
         }
 
 def build_silo_case(config: dict) -> SiloCase:
-    """Derive a :class:`SiloCase` from a validated configuration (see :func:`engines.config.validate_config`)."""
-    silo = config["silo_flat"]
+    """Derive the :class:`SiloCase` of the ``silo_flat`` section of a validated configuration
+    (see :func:`engines.config.validate_config`)."""
+    return silo_case_from_section(config, config["silo_flat"], "silo_flat")
+
+
+def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
+    """Derive a :class:`SiloCase` from a silo-type section ``silo`` (the keys of ``silo_flat``, shared keys
+    inherited from ``defaults``) and the configuration's materials, particle models and contacts.
+
+    ``section`` names the config section in error messages and decides the engine (``<section>.engine`` or
+    ``engine.kind``), which is part of the defining parameters and so of the run id.
+    """
     material_name = silo["particle_material"]
     material = config["materials"][material_name]
     particle = particle_template(
@@ -98,11 +119,11 @@ def build_silo_case(config: dict) -> SiloCase:
     )
     if silo["outlet_width"] >= silo["width"]:
         raise ValueError(
-            f"silo_flat.outlet_width ({silo['outlet_width']} m) must be smaller than silo_flat.width ({silo['width']} m)"
+            f"{section}.outlet_width ({silo['outlet_width']} m) must be smaller than {section}.width ({silo['width']} m)"
         )
     if silo["depth"] < 2.0 * particle.bounding_radius:
         raise ValueError(
-            f"silo_flat.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"
+            f"{section}.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"
         )
     walls = silo["wall_materials"]
     used_walls = [walls["side"], walls["bottom"]] + ([walls["front_back"]] if silo["front_back_walls"] else [])
@@ -118,18 +139,19 @@ def build_silo_case(config: dict) -> SiloCase:
     sink_depth = silo["sink_depth"]
     if sink_depth < 2.0 * particle.bounding_radius:
         raise ValueError(
-            f"silo_flat.sink_depth ({sink_depth} m) must exceed one clump size ({2 * particle.bounding_radius:.4g} m)"
+            f"{section}.sink_depth ({sink_depth} m) must exceed one clump size ({2 * particle.bounding_radius:.4g} m)"
         )
 
     defining = {
         "case": CASE_NAME,
+        "engine": engine_kind(config, section),
         "materials": {name: config["materials"][name] for name in table.names},
         "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
         "contacts": sorted(
             (c for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
             key=lambda c: sorted(c["materials"]),
         ),
-        "silo": {k: v for k, v in silo.items() if k not in ANALYSIS_ONLY_KEYS},
+        "silo": {k: v for k, v in silo.items() if k not in (*ANALYSIS_ONLY_KEYS, "engine")},
     }
     # Normalise the contact pair order so [a, b] and [b, a] key the same run.
     defining["contacts"] = [{**c, "materials": sorted(c["materials"])} for c in defining["contacts"]]
@@ -154,8 +176,6 @@ def build_silo_case(config: dict) -> SiloCase:
         sink_depth=sink_depth,
         domain_top=fill.zone[5] + 2.0 * particle.bounding_radius,
         seeds=tuple(engine_seeds(silo["seed"], 3)),
-        steady_window=tuple(silo["steady_window"]),
-        beverloo=dict(silo["beverloo"]),
         defining_parameters=defining,
     )
 
@@ -173,6 +193,7 @@ def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
     study = silo["parametric"]
     particle = silo["particle_material"]
     front_back = silo["wall_materials"]["front_back"]
+    silo_materials = {particle, *silo["wall_materials"].values()}
 
     def variant(edit) -> dict:
         changed = copy.deepcopy(config)
@@ -183,8 +204,8 @@ def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
         for contact in changed["contacts"]:
             if particle in contact["materials"]:
                 partner = [m for m in contact["materials"] if m != particle] or [particle]
-                if partner[0] == config["jenike"]["lid_material"]:
-                    continue
+                if partner[0] not in silo_materials:
+                    continue  # a contact this silo never has (e.g. the Jenike lid's)
                 if "sliding_friction" in values and partner[0] != particle:
                     continue  # particle-particle sliding friction only
                 contact.update(values)

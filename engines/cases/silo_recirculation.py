@@ -10,7 +10,7 @@ Stages: pour and settle exactly as the batch silo (the gate closes the outlet, t
 outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times
 (:func:`estimated_residence_time`).
 
-A flow pattern is a named preset of friction coefficients (``blending.presets``); it replaces the particle-
+A flow pattern is a named preset of friction coefficients (``silo_recirculation.presets``); it replaces the particle-
 particle and particle-wall friction of the contacts for this run. The front and back walls get their own copy
 of their material (``<material>_front_back``), so that their friction can differ from the side walls' even
 when both are made of the same material.
@@ -22,9 +22,15 @@ import copy
 from dataclasses import dataclass, field
 
 from engines.cases.common import run_id
-from engines.cases.silo_flat import SiloCase, build_silo_case
+from engines.cases.silo_flat import SiloCase, silo_case_from_section
 
 CASE_NAME = "silo_recirculation"
+#: The config section of the case.
+SECTION = "silo_recirculation"
+#: The silo keys the recirculating silo takes from its own section (the shared ones inherited from ``defaults``);
+#: geometry, sink and discharge are set from the channel and the feeder. The settings of the batch silo's
+#: analysis (steady window, Beverloo) keep their schema defaults.
+SILO_KEYS = ("engine", "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction", "seed")
 
 #: Roles of a recirculation run: the blending study proper, or the one-particle-thick verification silo.
 ROLES = ("blending", "verification")
@@ -71,6 +77,10 @@ class RecirculationCase:
         prefix = self.pattern if self.role == "blending" else f"thin-{self.pattern}"
         return run_id(prefix, self.defining_parameters)
 
+    def stages(self):
+        """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`)."""
+        return self.silo.stages(last="recirculate")
+
     def summary(self) -> dict:
         """Plain-data summary for ``case.json``."""
         summary = self.silo.summary()
@@ -108,7 +118,7 @@ def estimated_residence_time(
     return width * fill_height / (outlet_width * feeder_velocity * channel_density_ratio)
 
 
-def apply_flow_pattern(config: dict, preset: dict) -> dict:
+def apply_flow_pattern(config: dict, preset: dict, section: str = "silo_recirculation") -> dict:
     """A copy of ``config`` whose particle contacts carry the friction of a flow-pattern preset.
 
     Particle-particle: ``sliding_friction``, ``rolling_friction``. Particle with the side and bottom wall materials:
@@ -117,7 +127,7 @@ def apply_flow_pattern(config: dict, preset: dict) -> dict:
     ``wall_rolling_friction``. Restitution is kept from the particle's contact with the original material.
     """
     changed = copy.deepcopy(config)
-    silo = changed["silo_flat"]
+    silo = changed[section]
     particle = silo["particle_material"]
     walls = silo["wall_materials"]
     contacts = changed["contacts"]
@@ -151,36 +161,37 @@ def apply_flow_pattern(config: dict, preset: dict) -> dict:
 def build_recirculation_case(config: dict, pattern: str, role: str = "blending") -> RecirculationCase:
     """Derive the :class:`RecirculationCase` of flow pattern ``pattern`` from a validated configuration.
 
-    ``role="blending"`` takes the geometry from ``blending``; ``role="verification"`` the thin silo of
-    ``blending.verification`` (same outlet, channel and feeder).
+    Everything comes from the ``silo_recirculation`` section (its shared keys inherited from ``defaults``):
+    ``role="blending"`` takes the geometry from the section, ``role="verification"`` the thin silo of
+    ``silo_recirculation.verification`` (same outlet, channel and feeder).
     """
     if role not in ROLES:
         raise ValueError(f"role must be one of {ROLES}, got {role!r}")
-    blending = config["blending"]
-    if pattern not in blending["presets"]:
-        known = ", ".join(sorted(blending["presets"]))
-        raise KeyError(f"unknown flow pattern '{pattern}'; blending.presets defines: {known}")
-    geometry = blending if role == "blending" else blending["verification"]
+    section = config[SECTION]
+    if pattern not in section["presets"]:
+        known = ", ".join(sorted(section["presets"]))
+        raise KeyError(f"unknown flow pattern '{pattern}'; {SECTION}.presets defines: {known}")
+    geometry = section if role == "blending" else section["verification"]
     recirculations = geometry["recirculations"]
     t_res = estimated_residence_time(
-        geometry["width"], geometry["fill_height"], blending["outlet_width"], blending["feeder_velocity"],
-        blending["channel_density_ratio"],
+        geometry["width"], geometry["fill_height"], section["outlet_width"], section["feeder_velocity"],
+        section["channel_density_ratio"],
     )
-    changed = apply_flow_pattern(config, blending["presets"][pattern])
-    silo = changed["silo_flat"]
+    changed = apply_flow_pattern(config, section["presets"][pattern], SECTION)
+    silo = {key: copy.deepcopy(changed[SECTION][key]) for key in SILO_KEYS}
     silo.update(
         width=geometry["width"],
         depth=geometry["depth"],
         fill_height=geometry["fill_height"],
-        outlet_width=blending["outlet_width"],
+        outlet_width=section["outlet_width"],
         front_back_walls=True,
-        sink_depth=blending["channel_length"],
+        sink_depth=section["channel_length"],
         discharge_time=recirculations * t_res,
-        dump_interval=blending["dump_interval"],
+        dump_interval=section["dump_interval"],
     )
-    silo_case = build_silo_case(changed)
-    half_outlet = 0.5 * blending["outlet_width"]
-    channel = blending["channel_length"]
+    silo_case = silo_case_from_section(changed, silo, SECTION)
+    half_outlet = 0.5 * section["outlet_width"]
+    channel = section["channel_length"]
     feeder_zone = (-half_outlet, half_outlet, -channel, -0.5 * channel)
     defining = {
         "case": CASE_NAME,
@@ -188,14 +199,14 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         "pattern": pattern,
         "silo": silo_case.defining_parameters,
         "channel_length": channel,
-        "feeder_velocity": blending["feeder_velocity"],
+        "feeder_velocity": section["feeder_velocity"],
     }
     return RecirculationCase(
         pattern=pattern,
         role=role,
         silo=silo_case,
         channel_length=channel,
-        feeder_velocity=blending["feeder_velocity"],
+        feeder_velocity=section["feeder_velocity"],
         feeder_zone=feeder_zone,
         estimated_residence_time=t_res,
         recirculation_time=silo_case.discharge_steps * silo_case.timestep,
@@ -205,13 +216,13 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
 
 def recirculation_cases(config: dict) -> dict[str, RecirculationCase]:
     """The recirculation runs a validated configuration defines (one per flow pattern, plus the thin silo when
-    ``blending.verification.enabled``), keyed by run id; empty when ``blending.enabled`` is false."""
-    blending = config["blending"]
-    if not blending["enabled"]:
+    ``silo_recirculation.verification.enabled``), keyed by run id; empty when ``silo_recirculation.enabled`` is false."""
+    section = config[SECTION]
+    if not section["enabled"]:
         return {}
-    cases = [build_recirculation_case(config, pattern) for pattern in blending["flow_patterns"]]
-    if blending["verification"]["enabled"]:
-        cases.append(build_recirculation_case(config, blending["verification"]["flow_pattern"], "verification"))
+    cases = [build_recirculation_case(config, pattern) for pattern in section["flow_patterns"]]
+    if section["verification"]["enabled"]:
+        cases.append(build_recirculation_case(config, section["verification"]["flow_pattern"], "verification"))
     return {case.run_id: case for case in cases}
 
 

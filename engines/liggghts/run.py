@@ -19,70 +19,28 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from analysis.data.record import RunRecord
+from engines.estimates import format_bytes
+from engines.interface import EngineNotFound, EngineRunError
+from engines.layout import RUN_RECORD
+from engines.liggghts.dumps import list_dumps
 from engines.liggghts.inputs import DECK_NAME, write_text_atomic
+from engines.liggghts.markers import Marker, error_lines, log_excerpt, parse_markers
+from engines.liggghts.progress import ProgressMonitor
 from engines.templating import render_deck
 
 LOG_NAME = "log.liggghts"
 SCREEN_NAME = "engine.out"
 DUMP_PREFIX = "particles"
 CONTACT_PREFIX = "contacts"
-RUN_RECORD = "run.json"
 
-
-
-class EngineNotFound(RuntimeError):
-    """The engine executable is not installed or not on PATH."""
-
-
-class EngineRunError(RuntimeError):
-    """A run failed; the message quotes the relevant log lines and names the run directory."""
-
-
-@dataclass(frozen=True)
-class Marker:
-    """A ``SILOFLOW <event> key=value ...`` line the deck prints at a stage boundary."""
-
-    event: str
-    values: dict
-
-
-_MARKER = re.compile(r"^SILOFLOW (\w+)((?: \w+=\S+)*)\s*$")
-
-
-def parse_markers(log_text: str) -> list[Marker]:
-    """Stage markers in the order the engine printed them (echoed ``print`` commands are skipped)."""
-    markers = []
-    for line in log_text.splitlines():
-        match = _MARKER.match(line.strip())
-        if not match:
-            continue
-        values = {}
-        for item in match.group(2).split():
-            key, _, raw = item.partition("=")
-            try:
-                values[key] = float(raw)
-            except ValueError:
-                values[key] = raw
-        markers.append(Marker(match.group(1), values))
-    return markers
-
-
-def error_lines(log_text: str) -> list[str]:
-    """Lines that report a fatal engine problem (``ERROR``, lost atoms, a crash signal)."""
-    patterns = ("ERROR", "Lost atoms", "Segmentation fault", "received signal", "MPI_ABORT")
-    return [line.rstrip() for line in log_text.splitlines() if any(p in line for p in patterns)]
-
-
-def log_excerpt(log_text: str, lines: int = 15) -> str:
-    """Error lines if there are any, else the last lines of the log, indented for quoting."""
-    selected = error_lines(log_text) or log_text.rstrip().splitlines()[-lines:]
-    return "\n".join("    " + line for line in selected[-lines:])
 
 
 #: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
@@ -173,10 +131,6 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     EngineRunError
         On a non-zero exit or an ERROR line, quoting the relevant log lines; the run directory is left as is.
     """
-    import sys
-
-    from engines.liggghts.progress import ProgressMonitor
-
     run_dir = Path(run_dir)
     command = engine_command(f"deck/{deck_name}", executable, mpi_ranks, mpirun, log_name)
     (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
@@ -209,14 +163,11 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     return log_text
 
 
-def write_run_record(run_dir: Path, record: dict) -> Path:
+def write_run_record(run_dir: Path, record: RunRecord) -> Path:
     """Write ``run.json`` last and atomically: its presence means the run is complete and checked."""
-    from engines.estimates import format_bytes
-
     path = Path(run_dir) / RUN_RECORD
-    write_text_atomic(path, json.dumps(record, indent=2, sort_keys=True, default=float))
-    if "output_bytes" in record:
-        logging.getLogger("siloflow").info("run complete: %s; the run wrote %s", path, format_bytes(record["output_bytes"]))
+    write_text_atomic(path, record.to_json())
+    logging.getLogger("siloflow").info("run complete: %s; the run wrote %s", path, format_bytes(record.output_bytes))
     return path
 
 
@@ -296,20 +247,19 @@ def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> 
         run_from(older[0])
 
 
-def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: dict | None = None,
-                resume: Resume | None = None) -> Path:
-    """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns its path.
+def run_checked(run_dir: str | Path, check, engine: dict | None = None, to_record=None,
+                resume: Resume | None = None) -> RunRecord:
+    """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns the record.
 
     A run that was killed after its last stage began (it left restart files and its log has the ``opened``
     marker) resumes from its newest restart file when ``resume`` is given; its logs are then the first attempt's
     plus one per resumption, checked together. Otherwise the output of an earlier unfinished attempt is moved to
     ``failed_attempts/`` first, so the dumps of this run are never mixed with older ones. ``check(markers,
-    dump_files)`` raises :class:`EngineRunError` or returns the stage record; ``engine`` holds the
-    :func:`run_engine` options and ``record`` extra entries for ``run.json``. Restart files are deleted once the
-    run is complete and checked: they only serve resumption.
+    dump_files)`` raises :class:`EngineRunError` or returns what it checked (a dict); ``engine`` holds the
+    :func:`run_engine` options and ``to_record(checked)`` turns the checked dict, with ``mpi_ranks``,
+    ``resumed_attempts`` and ``output_bytes`` added, into the :class:`RunRecord`. Restart files are deleted once
+    the run is complete and checked: they only serve resumption.
     """
-    from engines.liggghts.dumps import list_dumps
-
     run_dir = Path(run_dir)
     engine = dict(engine or {})
     deck = run_dir / "deck" / DECK_NAME
@@ -325,11 +275,12 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, record: 
         set_aside_previous_attempt(run_dir)
         run_engine(run_dir, **engine)
     checked = check(parse_markers(_logs_text(run_dir)), list_dumps(run_dir / "dumps", DUMP_PREFIX))
-    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "dump_prefix": DUMP_PREFIX,
-                    "resumed_attempts": len(attempt_logs(run_dir)) - 1, **(record or {})})
+    checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "resumed_attempts": len(attempt_logs(run_dir)) - 1})
     shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
     checked["output_bytes"] = output_bytes(run_dir)
-    return write_run_record(run_dir, checked)
+    record = to_record(checked)
+    write_run_record(run_dir, record)
+    return record
 
 
 def output_bytes(run_dir: str | Path) -> int:

@@ -7,14 +7,20 @@ import copy
 import pytest
 import yaml
 
+from engines.cases.silo_flat import build_silo_case
 from engines.config import SCHEMA_PATH, ConfigError, load_config, validate_config
+from engines.interface import CaseNotSupported, engine_for
 
 
-def _schema_properties(node, path=""):
-    """Yield (path, subschema) for every declared property of the schema."""
+def _schema_properties(node, path="", definitions=None):
+    """Yield (path, subschema) for every declared property of the schema (a ``$ref`` resolved to its definition)."""
+    definitions = node.get("definitions", {}) if definitions is None else definitions
     for name, sub in node.get("properties", {}).items():
+        reference = sub.get("$ref", "")
+        if reference.startswith("#/definitions/"):
+            sub = {**definitions[reference.rsplit("/", 1)[1]], **{k: v for k, v in sub.items() if k != "$ref"}}
         yield f"{path}{name}", sub
-        yield from _schema_properties(sub, f"{path}{name}.")
+        yield from _schema_properties(sub, f"{path}{name}.", definitions)
 
 
 def test_every_schema_key_has_description_and_default():
@@ -26,7 +32,8 @@ def test_every_schema_key_has_description_and_default():
 
 def test_empty_config_gets_every_default():
     config = validate_config({})
-    assert config["engine"] == {"executable": "liggghts", "mpi_ranks": 1, "mpirun": "mpirun"}
+    assert config["engine"] == {"kind": "liggghts", "mpi_ranks": 1, "mpirun": "mpirun",
+                                "liggghts": {"executable": "liggghts"}}
     assert config["silo_flat"]["width"] == 0.15
     assert config["silo_flat"]["settle"]["kinetic_energy_threshold"] == 1e-12
     assert config["silo_flat"]["beverloo"] == {
@@ -85,11 +92,48 @@ def test_friction_outside_unit_interval_is_rejected(raw_default_config, field, v
         validate_config(config)
 
 
-def test_restitution_below_engine_limit_is_rejected(raw_default_config):
+def test_restitution_below_an_engines_limit_is_the_engines_to_refuse(raw_default_config):
     config = copy.deepcopy(raw_default_config)
     config["contacts"][0]["restitution"] = 1e-4
-    with pytest.raises(ConfigError, match=r"contacts\[0\]\.restitution': 0.0001 is less than or equal to the minimum of 0.05"):
+    validated = validate_config(config)  # the schema only asks for 0 < e <= 1
+    case = build_silo_case(validated)
+    with pytest.raises(CaseNotSupported, match=r"config key 'contacts': restitution 0.0001 of the pair \[hdpe, hdpe\] "
+                                               r"is not accepted by LIGGGHTS 3.8, which requires 0.05 < e <= 1"):
+        engine_for(validated, "silo_flat").check_case(case)
+    config["contacts"][0]["restitution"] = 0.0
+    with pytest.raises(ConfigError, match=r"contacts\[0\]\.restitution': 0.0 is less than or equal to the minimum of 0"):
         validate_config(config)
+
+
+def test_renamed_keys_are_refused_with_their_new_name(raw_default_config):
+    old = copy.deepcopy(raw_default_config)
+    old["blending"] = old.pop("silo_recirculation")
+    with pytest.raises(ConfigError, match="config key 'blending' was renamed 'silo_recirculation'"):
+        validate_config(old)
+    old = copy.deepcopy(raw_default_config)
+    old["engine"]["executable"] = "liggghts"
+    with pytest.raises(ConfigError, match="config key 'engine.executable' was renamed 'engine.liggghts.executable'"):
+        validate_config(old)
+
+
+def test_case_sections_inherit_shared_keys_from_defaults_leaf_by_leaf(raw_default_config):
+    raw = copy.deepcopy(raw_default_config)
+    raw["defaults"]["fill"]["insertion_velocity"] = 0.5
+    raw["blender"]["fill"] = {"heap_angle": 35.0}
+    raw["silo_recirculation"]["particle_model"] = "sphere4"
+    config = validate_config(raw)
+    assert config["silo_flat"]["fill"]["insertion_velocity"] == 0.5
+    assert config["blender"]["fill"]["insertion_velocity"] == 0.5 and config["blender"]["fill"]["heap_angle"] == 35.0
+    assert config["silo_flat"]["fill"]["heap_angle"] == raw["defaults"]["fill"]["heap_angle"]
+    assert config["silo_recirculation"]["particle_model"] == "sphere4"
+    assert config["silo_flat"]["particle_model"] == config["blender"]["particle_model"] == "sphere2"
+
+
+def test_a_case_section_naming_an_unknown_material_is_refused(raw_default_config):
+    raw = copy.deepcopy(raw_default_config)
+    raw["blender"]["wall_materials"] = {"side": "steel", "bottom": "aluminium", "front_back": "perspex"}
+    with pytest.raises(ConfigError, match="config key 'blender.wall_materials.side': unknown material 'steel'"):
+        validate_config(raw)
 
 
 def test_yaml_exponent_without_sign_gets_a_hint(raw_default_config):

@@ -235,12 +235,12 @@ def test_changing_a_silo_case_changes_its_estimate_exactly(config):
 
 def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
     cases = recirculation_cases(config)
-    assert cases, "the default config defines blending runs"
+    assert cases, "the default config defines recirculating-silo runs"
     for run_id, case in cases.items():
         estimate = estimate_recirculation_case(case, model=WORST_CASE)
         silo = case.silo
         assert estimate.run_id == run_id != silo.run_id
-        assert estimate.kind == "blending"
+        assert estimate.kind == "silo_recirculation"
         assert estimate.steps == silo.fill.fill_steps + silo.settle_max_checks * silo.settle_check_steps + silo.discharge_steps
         assert estimate.dump_frames == 1 + math.ceil(silo.discharge_steps / silo.dump_every)
         assert estimate.spheres == silo.fill.n_clumps * silo.particle.n_spheres
@@ -297,7 +297,7 @@ def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
 
 
 def test_kinds_are_the_four_run_kinds():
-    assert KINDS == ("silo_flat", "blending", "blender", "jenike")
+    assert KINDS == ("silo_flat", "silo_recirculation", "blender", "jenike")
 
 
 # ---------------------------------------------------------------------------------------------- disk

@@ -27,7 +27,7 @@ def estimates():
 def test_every_run_of_the_default_config_is_estimated(estimates):
     kinds = [e.kind for e in estimates]
     assert kinds.count("jenike") == 15 and kinds.count("silo_flat") == 1
-    assert kinds.count("blending") == 3 and kinds.count("blender") == 3
+    assert kinds.count("silo_recirculation") == 3 and kinds.count("blender") == 3
     assert all(e.dump_bytes > 0 and e.wall_time_s > 0 for e in estimates)
 
 

@@ -1,26 +1,15 @@
 # Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
 
-from calibration.sweep import diagnostic_points, sweep_points
-from engines.cases.jenike import build_jenike_case
+from calibration.sweep import diagnostic_points
 
-
-def _jenike_points():
-    points = {}
-    for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"]):
-        try:
-            case = build_jenike_case(config, point)
-        except ValueError as error:
-            raise WorkflowError(f"Invalid jenike configuration for sweep point {point}: {error}") from None
-        points[case.run_id] = point
-    return points
-
-
-JENIKE_POINTS = _jenike_points()
+JENIKE_CASES = cases_of(config, "jenike")
 CALIBRATION = f"{RESULTS}/calibration"
 
 
-def jenike_dir(run_id):
-    return f"{CALIBRATION}/runs/{run_id}"
+def jenike_point(run):
+    """The sweep point of a Jenike run, with the lid it ran with."""
+    case = JENIKE_CASES[run]
+    return {**case.point, "lid": case.lid_kind}
 
 
 def calibration_chart_names():
@@ -35,10 +24,18 @@ def lid_comparison_targets():
     return [f"{CALIBRATION}/lid_comparison.csv", f"{CALIBRATION}/charts/lid_comparison.png"]
 
 
+def _sweep_point(run):
+    """The point as the sweep designed it (the lid only where it differs from jenike.lid)."""
+    point = dict(JENIKE_CASES[run].point)
+    if JENIKE_CASES[run].lid_kind != config["jenike"]["lid"]:
+        point["lid"] = JENIKE_CASES[run].lid_kind
+    return point
+
+
 def diagnostic_targets():
-    points = diagnostic_points(list(JENIKE_POINTS.values()), config["jenike"]["sweep"], config["jenike"]["lid"])
-    chosen = [run_id for run_id, point in JENIKE_POINTS.items() if point in points]
-    return [f"{jenike_dir(run_id)}/plots/{name}.png" for run_id in chosen for name in ("mobilised_friction", "angular_velocity")]
+    points = diagnostic_points([_sweep_point(run) for run in JENIKE_CASES], config["jenike"]["sweep"], config["jenike"]["lid"])
+    chosen = [run for run in JENIKE_CASES if _sweep_point(run) in points]
+    return [run_path("jenike", f"plots/{name}.png", run) for run in chosen for name in ("mobilised_friction", "angular_velocity")]
 
 
 def calibration_targets():
@@ -53,31 +50,31 @@ def calibration_targets():
 
 rule jenike_deck:
     output:
-        deck=f"{CALIBRATION}/runs/{{point}}/deck/in.liggghts",
-        case=f"{CALIBRATION}/runs/{{point}}/deck/case.json",
+        case=deck_rule_output("jenike"),
     params:
-        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+        case="jenike",
+        defining=lambda wildcards: JENIKE_CASES[wildcards.run].defining_parameters,
     log:
-        f"{CALIBRATION}/runs/{{point}}/logs/deck.log",
+        run_path("jenike", "logs/deck.log"),
     script:
-        "../scripts/jenike_deck.py"
+        "../scripts/case_deck.py"
 
 
 rule jenike_run:
     input:
-        deck=rules.jenike_deck.output.deck,
+        case=rules.jenike_deck.output.case,
     output:
-        record=f"{CALIBRATION}/runs/{{point}}/run.json",
+        record=run_rule_output("jenike"),
     params:
-        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
+        case="jenike",
         engine=config["engine"],
     resources:
         tasks=config["engine"]["mpi_ranks"],
     threads: config["engine"]["mpi_ranks"]
     log:
-        f"{CALIBRATION}/runs/{{point}}/logs/run.log",
+        run_path("jenike", "logs/run.log"),
     script:
-        "../scripts/jenike_run.py"
+        "../scripts/case_run.py"
 
 
 rule jenike_friction:
@@ -85,20 +82,19 @@ rule jenike_friction:
         record=rules.jenike_run.output.record,
         case=rules.jenike_deck.output.case,
     output:
-        summary=f"{CALIBRATION}/runs/{{point}}/metrics/bulk_friction.json",
-        plot=report(f"{CALIBRATION}/runs/{{point}}/plots/forces.png", caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{point}"}),
+        summary=run_path("jenike", "metrics/bulk_friction.json"),
+        plot=report(run_path("jenike", "plots/forces.png"), caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{run}"}),
     params:
-        point=lambda wildcards: JENIKE_POINTS[wildcards.point],
-        lid=config["jenike"]["lid"],
+        point=lambda wildcards: jenike_point(wildcards.run),
     log:
-        f"{CALIBRATION}/runs/{{point}}/logs/friction.log",
+        run_path("jenike", "logs/friction.log"),
     script:
         "../scripts/jenike_friction.py"
 
 
 rule calibration_table:
     input:
-        summaries=expand(f"{CALIBRATION}/runs/{{point}}/metrics/bulk_friction.json", point=sorted(JENIKE_POINTS)),
+        summaries=[run_path("jenike", "metrics/bulk_friction.json", run) for run in sorted(JENIKE_CASES)],
     output:
         table=f"{CALIBRATION}/bulk_friction.csv",
     log:
@@ -160,10 +156,10 @@ rule jenike_diagnostics:
         record=rules.jenike_run.output.record,
         case=rules.jenike_deck.output.case,
     output:
-        friction=report(f"{CALIBRATION}/runs/{{point}}/plots/mobilised_friction.png", caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{point}"}),
-        rotation=report(f"{CALIBRATION}/runs/{{point}}/plots/angular_velocity.png", caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{point}"}),
-        summary=f"{CALIBRATION}/runs/{{point}}/metrics/diagnostics.json",
+        friction=report(run_path("jenike", "plots/mobilised_friction.png"), caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
+        rotation=report(run_path("jenike", "plots/angular_velocity.png"), caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
+        summary=run_path("jenike", "metrics/diagnostics.json"),
     log:
-        f"{CALIBRATION}/runs/{{point}}/logs/diagnostics.log",
+        run_path("jenike", "logs/diagnostics.log"),
     script:
         "../scripts/jenike_diagnostics.py"

@@ -1,4 +1,5 @@
-# Shared set-up: validate the configuration first thing and derive the runs it defines.
+# Shared set-up: validate the configuration first thing, build every case it defines, let each case's engine accept
+# it (or refuse it, naming the key) before anything runs, and derive the targets from the one results layout.
 
 import sys
 from pathlib import Path
@@ -6,12 +7,14 @@ from pathlib import Path
 sys.path.insert(0, workflow.basedir)
 
 from calibration.parameters import calibrated_config
+from engines.cases import CASE_BUILDERS, cases_of
+from engines.cases.silo_flat import build_silo_case, parametric_variants
+from engines.cases.silo_recirculation import SECTION as RECIRCULATION
 from engines.config import ConfigError, validate_config
 from engines.estimates import InsufficientDiskSpace, format_bytes
+from engines.interface import CaseNotSupported, engine_for
+from engines.layout import CASE_SUMMARY, RESULTS, RUN_RECORD, case_root, run_dir, run_path
 from engines.planning import config_estimates, ensure_disk_space
-from engines.cases.blender import blender_case_for_run, blender_cases
-from engines.cases.silo_recirculation import recirculation_case_for_run, recirculation_cases
-from engines.cases.silo_flat import build_silo_case, parametric_variants, silo_case_for_run, silo_cases
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.
@@ -19,21 +22,22 @@ try:
 except ConfigError as error:
     raise WorkflowError(f"Invalid configuration: {error}") from None
 
-RESULTS = "results"
 
-try:
-    # Geometry and sizing errors surface before anything runs, whatever the parameter source.
-    silo_cases(config)
-except ValueError as error:
-    raise WorkflowError(f"Invalid silo_flat configuration: {error}") from None
-try:
-    recirculation_cases(config)
-except ValueError as error:
-    raise WorkflowError(f"Invalid blending configuration: {error}") from None
-try:
-    blender_cases(config)
-except (ValueError, KeyError) as error:
-    raise WorkflowError(f"Invalid blender configuration: {error}") from None
+def check_cases(configuration):
+    """Build every case and let its engine accept it: geometry, sizing and engine limits fail here, first."""
+    for kind in CASE_BUILDERS:
+        try:
+            cases = cases_of(configuration, kind)
+            engine = engine_for(configuration, kind)
+            for case in cases.values():
+                engine.check_case(case)
+        except CaseNotSupported as error:
+            raise WorkflowError(f"The {kind} runs cannot run on their engine: {error}") from None
+        except (ValueError, KeyError) as error:
+            raise WorkflowError(f"Invalid {kind} configuration: {error}") from None
+
+
+check_cases(config)
 
 
 def check_disk_for_pending_runs():
@@ -65,29 +69,28 @@ def silo_config():
     return calibrated_config(config, calibrated_parameters_file())
 
 
+def run_ids(kind):
+    """Run ids of case ``kind`` (the flat-bottom silo's with calibrated parameters applied when asked for)."""
+    return list(cases_of(silo_config() if kind == "silo_flat" else config, kind))
+
+
 def silo_dir(run_id):
-    return f"{RESULTS}/silo_flat/{run_id}"
+    return run_dir("silo_flat", run_id)
 
 
 def silo_flat_targets(wildcards=None):
     return [
-        path
-        for run_id in silo_cases(silo_config())
-        for path in (
-            f"{silo_dir(run_id)}/metrics/flow.csv",
-            f"{silo_dir(run_id)}/plots/discharge.png",
-            f"{silo_dir(run_id)}/fields/fields.pvd",
-            f"{silo_dir(run_id)}/metrics/profiles.csv",
-            f"{silo_dir(run_id)}/plots/profiles.png",
-            *measured_comparison_targets(run_id),
-        )
+        run_path("silo_flat", name, run)
+        for run in run_ids("silo_flat")
+        for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
+                     "plots/profiles.png", *measured_comparison_names())
     ]
 
 
-def measured_comparison_targets(run_id):
+def measured_comparison_names():
     if config["silo_flat"]["fields"]["measured_profiles"] is None:
         return []
-    return [f"{silo_dir(run_id)}/metrics/measured_comparison.csv", f"{silo_dir(run_id)}/plots/measured_comparison.png"]
+    return ["metrics/measured_comparison.csv", "plots/measured_comparison.png"]
 
 
 def parametric_studies():
@@ -102,66 +105,65 @@ def parametric_studies():
 
 def parametric_targets(wildcards=None):
     return [
-        path
-        for study in parametric_studies()
-        for path in (f"{RESULTS}/silo_flat/parametric/{study}.csv", f"{RESULTS}/silo_flat/parametric/{study}.png")
+        f"{case_root('silo_flat')}/parametric/{study}.{ext}" for study in parametric_studies() for ext in ("csv", "png")
     ]
 
 
-def blending_dir(run_id):
-    return f"{RESULTS}/blending/{run_id}"
+def recirculation_runs(role="blending"):
+    """Run ids of the recirculating-silo runs with the given role (the blending study or the thin verification silo)."""
+    return [run for run, case in cases_of(config, RECIRCULATION).items() if case.role == role]
 
 
-def blending_runs(role="blending"):
-    """Run ids of the recirculation runs with the given role (the blending study or the thin verification silo)."""
-    return [run for run, case in recirculation_cases(config).items() if case.role == role]
-
-
-def blending_targets(wildcards=None):
-    runs = blending_runs()
+def recirculation_targets(wildcards=None):
+    runs = recirculation_runs()
     targets = [
-        f"{blending_dir(run)}/{name}"
+        run_path(RECIRCULATION, name, run)
         for run in runs
         for name in ("metrics/blending.json", "plots/concentration.png", "plots/vrr.png", "plots/rtd.png",
                      "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png", "plots/snapshots")
     ]
     if runs:
-        targets += [f"{RESULTS}/blending/summary/blending.csv", f"{RESULTS}/blending/summary/vrr.png"]
+        targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
     targets += [
-        f"{blending_dir(run)}/verification/{name}"
-        for run in blending_runs("verification")
+        run_path(RECIRCULATION, f"verification/{name}", run)
+        for run in recirculation_runs("verification")
         for name in ("verification.json", "paths.png", "residence_times.png")
     ]
     return targets
 
 
-def blender_dir(run_id):
-    return f"{RESULTS}/blender/{run_id}"
-
-
 def blender_runs():
     """Run ids of the blender runs (configurations x gravity factors)."""
-    return list(blender_cases(config))
+    return run_ids("blender")
 
 
 def blender_targets(wildcards=None):
     runs = blender_runs()
     targets = [
-        f"{blender_dir(run)}/{name}"
+        run_path("blender", name, run)
         for run in runs
         for name in ("metrics/blender.json", "plots/profiles.png", "plots/insert_velocities.png",
                      "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png", "plots/discontinuous.png",
                      "plots/vrr_period.png")
     ]
     if runs:
-        targets += [f"{RESULTS}/blender/comparison/{name}"
+        targets += [f"{case_root('blender')}/comparison/{name}"
                     for name in ("configurations.csv", "configurations.md", "configurations.png", "rtd.png")]
     if len(config["blender"]["gravity_factors"]) > 1:
-        targets += [f"{RESULTS}/blender/gravity/scaling.csv", f"{RESULTS}/blender/gravity/scaling.png"]
+        targets += [f"{case_root('blender')}/gravity/scaling.csv", f"{case_root('blender')}/gravity/scaling.png"]
     return targets
 
 
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *blending_targets(),
+    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *recirculation_targets(),
                  *blender_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")
+
+
+# The deck and run steps of every case: the engine writes deck/case.json last, and run.json last of a run.
+def deck_rule_output(kind):
+    return run_path(kind, CASE_SUMMARY)
+
+
+def run_rule_output(kind):
+    return run_path(kind, RUN_RECORD)

@@ -5,11 +5,11 @@
 rule report_summary:
     input:
         parameters=f"{RESULTS}/calibration/parameters.yaml",
-        flows=lambda wildcards: [f"{silo_dir(run)}/metrics/flow.json" for run in silo_cases(silo_config())],
-        measured=lambda wildcards: [path for run in silo_cases(silo_config()) for path in measured_comparison_targets(run)
-                                    if path.endswith(".csv")],
-        blending=lambda wildcards: [f"{RESULTS}/blending/summary/blending.csv"] if blending_runs() else [],
-        blender=lambda wildcards: [f"{RESULTS}/blender/comparison/configurations.csv"] if blender_runs() else [],
+        flows=lambda wildcards: [run_path("silo_flat", "metrics/flow.json", run) for run in run_ids("silo_flat")],
+        measured=lambda wildcards: [run_path("silo_flat", name, run) for run in run_ids("silo_flat")
+                                    for name in measured_comparison_names() if name.endswith(".csv")],
+        blending=lambda wildcards: [f"{case_root(RECIRCULATION)}/summary/blending.csv"] if recirculation_runs() else [],
+        blender=lambda wildcards: [f"{case_root('blender')}/comparison/configurations.csv"] if blender_runs() else [],
     output:
         page=report(f"{RESULTS}/summary/summary.html", caption="../report/summary.rst", category="0 Summary",
                     labels={"figure": "figures of merit"}),

@@ -3,8 +3,8 @@
 import json
 from pathlib import Path
 
-from analysis.studies.blender.blender import BlenderField
-from analysis.studies.blender.fields_io import read_planar_fields
+from analysis.studies.blender.steady_field import BlenderField
+from analysis.studies.blender.window_fields_io import read_planar_fields
 from analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_continuous_mode,
@@ -23,14 +23,14 @@ from analysis.studies.blender.study import (
     study_summary,
 )
 from analysis.io.tables import write_flow_table, write_json
-from engines.cases.blender import blender_case_for_run
+from engines.cases import case_for_run
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     blender = snakemake.params.blender
     case = json.loads(Path(snakemake.input.case).read_text())
     flow = json.loads(Path(snakemake.input.flow).read_text())
-    geometry = blender_case_for_run(snakemake.config, case["run_id"]).geometry
+    geometry = case_for_run(snakemake.config, "blender", case["run_id"]).geometry
     steady, windows = read_planar_fields(snakemake.input.fields)
     settings = BlenderSettings.from_config(blender)
     heights = key_heights(case["geometry"], blender["bin_size"], blender["fill_height"], blender["profile_heights_above"])

@@ -3,7 +3,7 @@
 import json
 from pathlib import Path
 
-from analysis.studies.blender.blender import best_blender, comparison_table
+from analysis.studies.blender.comparison import best_blender, comparison_table
 from analysis.studies.blender.plots import plot_configuration_comparison, plot_rtd_theta
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
 from analysis.io.tables import markdown_table, write_flow_table, write_text
@@ -17,7 +17,7 @@ with logged_to(snakemake.log[0]) as log:
     rows = comparison_table(metrics)
     best = best_blender(metrics)
     write_flow_table(snakemake.output.table, rows)
-    tolerance = snakemake.params.blender["discontinuous"]["tolerance"]
+    tolerance = snakemake.params.tolerance
     write_text(snakemake.output.markdown, f"# Insert configurations at {lowest:g} g\n\n{markdown_table(rows)}\n"
                f"Best blender: **{best}** (fewest recirculations to homogenise within +-{tolerance:.0%}, ties broken "
                "by the highest VRR at the shortest period).\n")

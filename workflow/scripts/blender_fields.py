@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.blender.fields import discharged_mass_history, mean_velocity_history, window_average_field
-from analysis.studies.blender.fields_io import write_planar_fields
+from analysis.studies.blender.window_fields import discharged_mass_history, mean_velocity_history, window_average_field
+from analysis.studies.blender.window_fields_io import write_planar_fields
 from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks
 from analysis.numerics.eulerian_rtd import silo_bins
 from analysis.numerics.flow import steady_flow_rate

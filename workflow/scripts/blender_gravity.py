@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.blender.blender import gravity_scaling
+from analysis.studies.blender.gravity import gravity_scaling
 from analysis.studies.blender.plots import plot_gravity_scaling
 from analysis.io.tables import write_flow_table
 from engines.logs import logged_to

@@ -7,11 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.numerics.coarse_graining import depth_average, front_wall_slice
+from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.force_chains import force_chain_segments
-from engines.liggghts.contacts import read_contacts
 from analysis.data.frames import clumps_from_frame
-from engines.liggghts.dumps import read_frames
+from analysis.data.record import read_run_record
 from analysis.io.fields import save_fields_npz, write_fields_vti, write_pvd
 from analysis.numerics.flow import column_surface_heights
 from analysis.numerics.profiles import profile_flow_rate, velocity_profile
@@ -36,12 +35,13 @@ from analysis.studies.silo_flat.plots import (
     plot_velocity_contour,
 )
 from analysis.io.tables import write_flow_table, write_json
-from engines.liggghts.run import CONTACT_PREFIX
+from engines.interface import engine_named
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
-    record = json.loads(Path(snakemake.input.record).read_text())
+    record = read_run_record(snakemake.input.record)
+    engine = engine_named(record.engine)
     case = json.loads(Path(snakemake.input.case).read_text())
     flow = json.loads(Path(snakemake.input.flow).read_text())
     options = snakemake.params.settings
@@ -51,9 +51,8 @@ with logged_to(snakemake.log[0]) as log:
                              options["cutoff"])
 
     frames = [clumps_from_frame(frame) for frame in
-              read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames",
-                              on_damaged=snakemake.config["dumps"]["on_damaged"])
-              if frame.step >= record["open_step"]]
+              engine.read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
+              if frame.step >= record.open_step]
     settled = frames[0]
     surface = column_surface_heights(settled.position[:, 0], settled.position[:, 2], radius, width,
                                      max(1, int(width / (4 * 2 * radius))))
@@ -121,7 +120,7 @@ with logged_to(snakemake.log[0]) as log:
     bulk_rate = profile_flow_rate(profiles.x, profiles.v_z[0], flow["filling_bulk_density_kg_m3"], depth)
 
     # Janssen: mean vertical contact stress of the settled fill against the formula.
-    contacts = read_contacts(sorted((run_dir / "dumps").glob(f"{CONTACT_PREFIX}_*.txt"))[-1])
+    contacts = engine.contacts(run_dir, record, "pair")[-1]
     stress = contact_stress_field(contacts, grid, settings)
     # The settled fill with its contact stress (compression positive), for ParaView.
     write_fields_vti(fields_dir / "settled_stress.vti", grid, fields[0], time=0.0,

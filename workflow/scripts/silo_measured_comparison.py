@@ -1,6 +1,6 @@
 """Snakemake adapter: compare the simulated time-averaged profiles with measured ones (e.g. PIV)."""
 
-from analysis.numerics.coarse_graining import depth_average, front_wall_slice
+from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.io.fields import load_fields_npz
 from analysis.studies.silo_flat.measured import compare_with_measurement, read_measured_profiles
 from analysis.numerics.profiles import velocity_profile

@@ -4,23 +4,23 @@ import json
 from pathlib import Path
 
 from analysis.data.frames import clumps_from_frame
-from engines.liggghts.dumps import read_frames
-from analysis.io.plots import plot_discharge
+from analysis.data.record import read_run_record
+from analysis.studies.silo_flat.plots import plot_discharge
 from analysis.studies.silo_flat.metrics import flow_table_row, silo_flow_metrics
 from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json
+from engines.interface import engine_named
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
-    record = json.loads(Path(snakemake.input.record).read_text())
+    record = read_run_record(snakemake.input.record)
     case = json.loads(Path(snakemake.input.case).read_text())
     analysis = snakemake.params.analysis
     beverloo = analysis["beverloo"]
 
-    frames = read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"], cache_dir=run_dir / "frames",
-                              on_damaged=snakemake.config["dumps"]["on_damaged"])
-    discharge = [clumps_from_frame(frame) for frame in frames if frame.step >= record["open_step"]]
-    log.info("%d discharge frames from %s", len(discharge), run_dir / "dumps")
+    frames = engine_named(record.engine).read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
+    discharge = [clumps_from_frame(frame) for frame in frames if frame.step >= record.open_step]
+    log.info("%d discharge frames of %s", len(discharge), run_dir)
 
     metrics = silo_flow_metrics(
         discharge,

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.numerics.coarse_graining import depth_average
+from analysis.numerics.field_ops import depth_average
 from analysis.io.fields import load_fields_npz
 from analysis.numerics.profiles import velocity_profile
 from analysis.studies.silo_flat.plots import plot_parametric_study

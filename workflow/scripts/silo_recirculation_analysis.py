@@ -5,16 +5,18 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.silo_recirculation.blending import sampling_noise_vrr_limit
+from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
-    plot_lti_comparison,
     plot_outlet_concentration,
+    plot_vrr_versus_recirculations,
+)
+from analysis.studies.silo_recirculation.rtd_plots import (
+    plot_lti_comparison,
     plot_recirculation_model,
     plot_rtd_comparison,
     plot_vrr_versus_period,
-    plot_vrr_versus_recirculations,
 )
 from analysis.studies.silo_recirculation.study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
 from analysis.numerics.rtd import johanson_rtd

@@ -4,7 +4,8 @@ import json
 from pathlib import Path
 
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
-from analysis.studies.silo_recirculation.plots import plot_paths_comparison, plot_residence_time_comparison
+from analysis.studies.silo_recirculation.plots import plot_paths_comparison
+from analysis.studies.silo_recirculation.rtd_plots import plot_residence_time_comparison
 from analysis.studies.silo_recirculation.study import residence_summary, verify_eulerian_rtd
 from analysis.io.tables import write_flow_table, write_json
 from engines.logs import logged_to

@@ -1,0 +1,82 @@
+"""Design of the calibration sweep: the Jenike shear-cell runs a configuration asks for.
+
+A sweep point is a plain dict (it keys the run and travels through Snakemake unchanged)::
+
+    {"shape": "sphere2", "test": "internal" | <wall material>, "sliding_friction": 0.3,
+     "rolling_friction": 0.1, "restitution": 0.1, "rotation_blocked": False}
+"""
+
+from __future__ import annotations
+
+INTERNAL = "internal"
+
+
+def other_lid(lid: str) -> str:
+    """The lid a comparison runs against: servo for rigid and rigid for servo."""
+    return "servo" if lid == "rigid" else "rigid"
+
+
+def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
+    """Expand the ``jenike.sweep`` section into the list of distinct sweep points.
+
+    The grid is every shape x test x sliding friction x rolling friction at the base restitution. The
+    restitution sensitivity adds, per shape and test, the middle sliding friction at the first rolling
+    friction for each extra restitution; the rotation-blocked reference adds every sliding friction at the
+    first rolling friction with particle rotation blocked. The lid comparison adds, per shape, the internal
+    test at every sliding friction and the first rolling friction with the other lid (key ``"lid"``).
+    Duplicates are dropped, order is stable.
+
+    Parameters
+    ----------
+    sweep : dict
+        The validated ``jenike.sweep`` configuration section.
+    lid : str
+        The configured lid (``jenike.lid``); the comparison uses the other one.
+
+    Returns
+    -------
+    list of dict
+        Sweep points (friction coefficients and restitution are dimensionless).
+    """
+    sliding = list(sweep["sliding_friction"])
+    rolling = list(sweep["rolling_friction"])
+    base_restitution = sweep["restitution"]
+    points: list[dict] = []
+
+    def add(shape, test, mu, mu_r, restitution, blocked=False):
+        point = {
+            "shape": shape,
+            "test": test,
+            "sliding_friction": float(mu),
+            "rolling_friction": float(mu_r),
+            "restitution": float(restitution),
+            "rotation_blocked": bool(blocked),
+        }
+        if point not in points:
+            points.append(point)
+
+    for shape in sweep["shapes"]:
+        for test in sweep["tests"]:
+            for mu_r in rolling:
+                for mu in sliding:
+                    add(shape, test, mu, mu_r, base_restitution)
+            middle = sorted(sliding)[len(sliding) // 2]
+            for restitution in sweep["restitution_sensitivity"]:
+                add(shape, test, middle, rolling[0], restitution)
+            if sweep["rotation_blocked"]:
+                for mu in sliding:
+                    add(shape, test, mu, rolling[0], base_restitution, blocked=True)
+        if sweep["lid_comparison"] and INTERNAL in sweep["tests"]:
+            for mu in sliding:
+                point = {
+                    "shape": shape,
+                    "test": INTERNAL,
+                    "sliding_friction": float(mu),
+                    "rolling_friction": float(rolling[0]),
+                    "restitution": float(base_restitution),
+                    "rotation_blocked": False,
+                    "lid": other_lid(lid),
+                }
+                if point not in points:
+                    points.append(point)
+    return points

@@ -1,0 +1,175 @@
+"""The seam between a case and the engine that runs it: one small interface and a registry of engines by name.
+
+A case (:mod:`engines.cases`) is engine-neutral data. An engine turns it into input files, runs them and reads the
+outputs back into neutral objects (:mod:`analysis.data`): particle frames, the force and torque each wall exerts on
+the particles, contact forces at saved instants, and the typed run record. Nothing outside an engine's own package
+(``engines/<name>/``) and templates (``templates/<name>/``) knows its file names or formats.
+
+Each engine is a subclass of :class:`Engine` in the package ``engines.<name>`` that decorates itself with
+:func:`register`; :func:`engine_named` imports that package on first use (the engine kinds are listed in
+:data:`ENGINE_KINDS`, as the configuration schema's ``engine.kind`` enumerates them). As in signac-flow, each engine
+class names its own base template, and its case templates extend it with blocks.
+
+Adding an engine: create ``engines/<name>/`` with an :class:`Engine` subclass, its templates under
+``templates/<name>/``, add the name to :data:`ENGINE_KINDS` and to the schema's ``engine.kind`` enum.
+"""
+
+from __future__ import annotations
+
+import importlib
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Mapping
+
+from engines.cases.common import engine_kind
+
+if TYPE_CHECKING:  # the neutral types appear in signatures only
+    from analysis.data.contacts import ContactFrame
+    from analysis.data.forces import WallForceHistory
+    from analysis.data.frames import ParticleFrame
+    from analysis.data.record import RunRecord
+
+__all__ = [
+    "ENGINE_KINDS",
+    "CaseNotSupported",
+    "Engine",
+    "EngineError",
+    "EngineNotFound",
+    "EngineOptions",
+    "EngineRunError",
+    "engine_for",
+    "engine_named",
+    "register",
+]
+
+#: Engines siloflow can drive, by registry name (the package ``engines.<name>`` implements each).
+ENGINE_KINDS = ("liggghts",)
+
+#: Config sections of the cases, each of which may name its own engine (``<section>.engine``).
+CASE_SECTIONS = ("jenike", "silo_flat", "silo_recirculation", "blender")
+
+
+class EngineError(RuntimeError):
+    """Base of the errors an engine raises while running a case."""
+
+
+class EngineNotFound(EngineError):
+    """The engine's executable or launcher is not installed or not on PATH."""
+
+
+class EngineRunError(EngineError):
+    """A run failed; the message quotes the relevant log lines and names the run directory."""
+
+
+class CaseNotSupported(ValueError):
+    """The engine cannot run this case as configured; the message names the config key and the engine's limit."""
+
+
+@dataclass(frozen=True)
+class EngineOptions:
+    """How an engine is started (the validated ``engine`` config section).
+
+    Attributes
+    ----------
+    mpi_ranks : int
+        MPI ranks per run; 1 runs serially without a launcher.
+    mpirun : str
+        MPI launcher used when ``mpi_ranks > 1``.
+    settings : dict
+        The engine's own settings (``engine.<kind>``, e.g. the LIGGGHTS executable).
+    """
+
+    mpi_ranks: int = 1
+    mpirun: str = "mpirun"
+    settings: Mapping[str, Any] | None = None
+
+    @classmethod
+    def from_config(cls, config: Mapping, kind: str) -> "EngineOptions":
+        """Options of engine ``kind`` from a validated configuration."""
+        section = config["engine"]
+        return cls(mpi_ranks=int(section["mpi_ranks"]), mpirun=str(section["mpirun"]),
+                   settings=dict(section.get(kind, {})))
+
+
+class Engine(ABC):
+    """What every DEM engine does for siloflow. Subclasses set :attr:`name` and :attr:`base_template`."""
+
+    #: Registry name (``engine.kind`` in the config).
+    name: ClassVar[str]
+    #: The engine's base template under ``templates/``; each case template extends it.
+    base_template: ClassVar[str]
+
+    @abstractmethod
+    def check_case(self, case) -> None:
+        """Refuse a case the engine cannot run as configured, before anything runs.
+
+        Raises
+        ------
+        CaseNotSupported
+            Naming the config key and the engine's limit.
+        """
+
+    @abstractmethod
+    def write_inputs(self, case, run_dir: str | Path) -> Path:
+        """Render the case into ``<run_dir>/deck/``; the neutral case summary ``deck/case.json`` is written last.
+
+        Returns the path of ``deck/case.json``.
+        """
+
+    @abstractmethod
+    def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:
+        """Run rendered inputs (serial or MPI, with progress, failure detection and resume), check that the run did
+        what the case asked and write ``<run_dir>/run.json`` last.
+
+        Raises
+        ------
+        EngineNotFound, EngineRunError
+        """
+
+    @abstractmethod
+    def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
+        """The particle frames a run saved, oldest first (``on_damaged``: ``error`` or ``skip`` a damaged one)."""
+
+    @abstractmethod
+    def wall_forces(self, run_dir: str | Path, record: RunRecord) -> WallForceHistory:
+        """The force and torque each wall exerted on the particles, as a time series."""
+
+    @abstractmethod
+    def contacts(self, run_dir: str | Path, record: RunRecord, kind: str = "pair") -> list[ContactFrame]:
+        """Contact forces at the saved instants, oldest first: ``pair`` (particle-particle) or ``wall``."""
+
+
+_REGISTERED: dict[str, type[Engine]] = {}
+
+
+def register(engine_class: type[Engine]) -> type[Engine]:
+    """Class decorator: make an :class:`Engine` subclass available under its :attr:`Engine.name`."""
+    name = engine_class.name
+    if name not in ENGINE_KINDS:
+        raise ValueError(f"engine name {name!r} is not one of ENGINE_KINDS {ENGINE_KINDS}")
+    _REGISTERED[name] = engine_class
+    return engine_class
+
+
+def engine_named(name: str) -> Engine:
+    """The engine registered as ``name`` (its package is imported on first use).
+
+    Raises
+    ------
+    KeyError
+        When siloflow has no engine of that name.
+    """
+    if name not in ENGINE_KINDS:
+        raise KeyError(f"unknown engine {name!r}; siloflow has: {', '.join(ENGINE_KINDS)}")
+    if name not in _REGISTERED:
+        # the engine's package registers its class when imported
+        importlib.import_module(f"{__package__}.{name}")
+    return _REGISTERED[name]()
+
+
+def engine_for(config: Mapping, section: str) -> Engine:
+    """The engine that runs the cases of config section ``section``."""
+    if section not in CASE_SECTIONS:
+        raise KeyError(f"unknown case section {section!r}; the cases are {', '.join(CASE_SECTIONS)}")
+    return engine_named(engine_kind(config, section))

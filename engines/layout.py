@@ -1,0 +1,57 @@
+"""The results tree, defined once: where each case's runs live and what a run directory holds.
+
+The workflow's rules, the run planning (estimates, disk checks) and the tests all build paths here::
+
+    results/<case root>/<run id>/
+        deck/            the engine's input files; deck/case.json (the neutral case summary) is written last
+        run.json         the typed run record (analysis.data.record), written last, only when the run passed its checks
+        logs/            one log per workflow step
+        metrics/ fields/ plots/ tracks.npz ...   analysis products
+        failed_attempts/ output of unfinished earlier attempts, moved aside, never deleted
+
+The engine's own files (dumps, logs, restart files) also live in the run directory, under names only the engine knows.
+"""
+
+from __future__ import annotations
+
+from pathlib import PurePosixPath
+
+__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_RECORD", "case_root", "run_dir", "run_path"]
+
+#: The results folder, relative to the working directory of the workflow.
+RESULTS = "results"
+
+#: Folder of each case's runs under :data:`RESULTS`.
+CASE_ROOTS = {
+    "jenike": "calibration/runs",
+    "silo_flat": "silo_flat",
+    "silo_recirculation": "silo_recirculation",
+    "blender": "blender",
+}
+
+#: The neutral case summary an engine writes last into ``deck/`` (the product of a deck step).
+CASE_SUMMARY = "deck/case.json"
+#: The typed run record (the product of a run step).
+RUN_RECORD = "run.json"
+
+#: The wildcard rules use for a run id.
+RUN_WILDCARD = "{run}"
+
+
+def case_root(case: str, results: str = RESULTS) -> str:
+    """``results/<case root>``: the folder that holds every run of case kind ``case``."""
+    if case not in CASE_ROOTS:
+        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_ROOTS)}")
+    return str(PurePosixPath(results) / CASE_ROOTS[case])
+
+
+def run_dir(case: str, run: str = RUN_WILDCARD, results: str = RESULTS) -> str:
+    """The directory of run ``run`` of case ``case`` (with the default ``{run}``: the rules' wildcard pattern)."""
+    return f"{case_root(case, results)}/{run}"
+
+
+def run_path(case: str, relative: str, run: str = RUN_WILDCARD, results: str = RESULTS) -> str:
+    """A file of a run: ``run_path("silo_flat", "metrics/flow.csv")`` is ``results/silo_flat/{run}/metrics/flow.csv``."""
+    if relative.startswith("/") or ".." in PurePosixPath(relative).parts:
+        raise ValueError(f"run paths are relative and stay inside the run directory, got {relative!r}")
+    return f"{run_dir(case, run, results)}/{relative}"

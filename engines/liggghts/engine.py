@@ -1,0 +1,199 @@
+"""LIGGGHTS (LIGGGHTS-PUBLIC 3.8, Debian ``liggghts``) behind the engine interface.
+
+:class:`LiggghtsEngine` dispatches each case kind to its deck module (:mod:`engines.liggghts.silo_flat`,
+:mod:`~engines.liggghts.silo_recirculation`, :mod:`~engines.liggghts.blender`, :mod:`~engines.liggghts.jenike`) and
+reads the engine's files back into the neutral objects of :mod:`analysis.data`. Its templates live in
+``templates/liggghts/``; every case template extends :attr:`LiggghtsEngine.base_template`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from analysis.data.contacts import ContactFrame, WallContactFrame
+from analysis.data.forces import WallForceHistory
+from analysis.data.frames import ParticleFrame
+from analysis.data.record import RunRecord
+from engines.cases.blender import BlenderCase
+from engines.cases.jenike import JenikeCase
+from engines.cases.silo_flat import SiloCase
+from engines.cases.silo_recirculation import RecirculationCase
+from engines.interface import CaseNotSupported, Engine, EngineOptions, register
+from engines.layout import CASE_SUMMARY
+from engines.liggghts.blender import run_blender, write_blender_inputs
+from engines.liggghts.contacts import read_contacts
+from engines.liggghts.dumps import read_frames
+from engines.liggghts.forces import read_jenike_forces, read_wall_forces
+from engines.liggghts.inputs import ENGINE_NAME
+from engines.liggghts.jenike import (
+    PAIR_CONTACT_PREFIX,
+    WALL_CONTACT_PREFIX,
+    WALL_MESHES,
+    read_contact_dump,
+    run_jenike,
+    write_jenike_inputs,
+)
+from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
+from engines.liggghts.silo_flat import run_silo, write_silo_inputs
+from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
+
+__all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]
+
+#: LIGGGHTS 3.8 refuses a coefficient of restitution at or below this value (it requires 0.05 < e <= 1).
+MIN_RESTITUTION = 0.05
+
+#: The stage sequences the decks implement, per case kind.
+_STAGES = {
+    "silo_flat": ("fill", "settle", "open", "discharge"),
+    "silo_recirculation": ("fill", "settle", "open", "recirculate"),
+    "blender": ("fill", "settle", "open", "discharge"),
+    "jenike": ("fill", "settle", "consolidate", "shear"),
+}
+
+
+@dataclass(frozen=True)
+class _Adapter:
+    """How one case kind is rendered and run."""
+
+    kind: str
+    write: Callable
+    run: Callable
+
+
+_ADAPTERS = {
+    SiloCase: _Adapter("silo_flat", write_silo_inputs, run_silo),
+    RecirculationCase: _Adapter("silo_recirculation", write_recirculation_inputs, run_recirculation),
+    BlenderCase: _Adapter("blender", write_blender_inputs, run_blender),
+    JenikeCase: _Adapter("jenike", write_jenike_inputs, run_jenike),
+}
+
+
+def _adapter(case) -> _Adapter:
+    try:
+        return _ADAPTERS[type(case)]
+    except KeyError:
+        raise TypeError(f"LIGGGHTS cannot run a {type(case).__name__}; it runs {', '.join(c.__name__ for c in _ADAPTERS)}") from None
+
+
+def _restitution_pairs(case) -> list[tuple[str, str, float, str]]:
+    """(material a, material b, restitution, config key) of every pair with a particle in it."""
+    if isinstance(case, JenikeCase):
+        names = case.materials.names
+        found = []
+        # the sweep point sets the restitution of both contact sets: name its key first
+        for contacts, key in ((case.test_contacts, "jenike.sweep.restitution"), (case.fill_contacts, "contacts")):
+            for j, value in enumerate(contacts.restitution[0]):
+                found.append((names[0], names[j], float(value), key))
+        return found
+    table = case.silo.materials if isinstance(case, (RecirculationCase, BlenderCase)) else case.materials
+    return [(table.names[0], table.names[j], float(value), "contacts") for j, value in enumerate(table.restitution[0])]
+
+
+@register
+class LiggghtsEngine(Engine):
+    """LIGGGHTS-PUBLIC 3.8: decks from ``templates/liggghts/``, run serially or under MPI, read back."""
+
+    name = ENGINE_NAME
+    base_template = "liggghts/base.lmp.j2"
+
+    def check_case(self, case) -> None:
+        """Refuse a case LIGGGHTS cannot run: a restitution at or below 0.05, a stage sequence it has no deck for.
+
+        Raises
+        ------
+        CaseNotSupported
+            Naming the config key, the value and the limit.
+        """
+        adapter = _adapter(case)
+        kinds = tuple(stage.kind for stage in case.stages())
+        if kinds != _STAGES[adapter.kind]:
+            raise CaseNotSupported(f"{adapter.kind} run {case.run_id}: LIGGGHTS has no deck for the stages {kinds}; "
+                                   f"it runs {_STAGES[adapter.kind]}")
+        for a, b, value, key in _restitution_pairs(case):
+            if not value > MIN_RESTITUTION:
+                raise CaseNotSupported(
+                    f"config key '{key}': restitution {value:g} of the pair [{a}, {b}] is not accepted by LIGGGHTS 3.8, "
+                    f"which requires {MIN_RESTITUTION} < e <= 1 ({adapter.kind} run {case.run_id}); raise it (the study "
+                    "found bulk behaviour insensitive to restitution) or run this case on another engine"
+                )
+
+    def write_inputs(self, case, run_dir: str | Path) -> Path:
+        self.check_case(case)
+        _adapter(case).write(case, Path(run_dir) / "deck")
+        return Path(run_dir) / CASE_SUMMARY
+
+    def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:
+        self.check_case(case)
+        settings = dict(options.settings or {})
+        return _adapter(case).run(case, Path(run_dir), executable=settings.get("executable", "liggghts"),
+                                  mpi_ranks=options.mpi_ranks, mpirun=options.mpirun)
+
+    def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
+        return list(read_frames(Path(run_dir) / "dumps", DUMP_PREFIX, record.timestep_s, on_damaged=on_damaged))
+
+    def wall_forces(self, run_dir: str | Path, record: RunRecord) -> WallForceHistory:
+        if record.case == "jenike":
+            return read_jenike_forces(run_dir)
+        return read_wall_forces(run_dir)
+
+    def contacts(self, run_dir: str | Path, record: RunRecord, kind: str = "pair") -> list:
+        if kind not in ("pair", "wall"):
+            raise ValueError(f"contact kind must be 'pair' or 'wall', got {kind!r}")
+        dumps = Path(run_dir) / "dumps"
+        if record.case != "jenike":
+            if kind == "wall":
+                raise ValueError(f"{record.case} runs save no particle-wall contacts")
+            return [read_contacts(path) for path in _numbered(dumps, CONTACT_PREFIX)]
+        if kind == "pair":
+            return [_pair_frame(read_contact_dump(path)) for path in _numbered(dumps, PAIR_CONTACT_PREFIX)]
+        return [_wall_frame(read_contact_dump(path)) for path in _numbered(dumps, WALL_CONTACT_PREFIX)]
+
+
+def _numbered(folder: Path, prefix: str) -> list[Path]:
+    """The contact dumps ``<prefix>_<step>.txt`` of a folder, by step."""
+    found = []
+    for path in folder.glob(f"{prefix}_*.txt"):
+        step = path.stem[len(prefix) + 1:]
+        if step.isdigit():
+            found.append((int(step), path))
+    return [path for _, path in sorted(found)]
+
+
+def _columns(table: dict, *names: str) -> np.ndarray:
+    return np.column_stack([table[name] for name in names]) if names else np.empty((0, 3))
+
+
+def _step(table: dict) -> int:
+    return int(table["step"][0]) if table["step"].size else 0
+
+
+def _pair_frame(table: dict) -> ContactFrame:
+    """A Jenike pair-contact dump (both centres, both ids, normal and tangential force on the first) as a frame."""
+    return ContactFrame(
+        step=_step(table),
+        position_i=_columns(table, "x1", "y1", "z1"),
+        position_j=_columns(table, "x2", "y2", "z2"),
+        id_i=table["id1"].astype(np.int64),
+        id_j=table["id2"].astype(np.int64),
+        force=_columns(table, "fn_x", "fn_y", "fn_z") + _columns(table, "ft_x", "ft_y", "ft_z"),
+    )
+
+
+def _wall_frame(table: dict) -> WallContactFrame:
+    """A Jenike wall-contact dump (contact point, centre, mesh index, triangle, atom id, forces) as a frame."""
+    mesh = table["id1"].astype(int)
+    if mesh.size and (mesh.min() < 0 or mesh.max() >= len(WALL_MESHES)):
+        raise ValueError(f"wall contact dump at step {_step(table)}: mesh index outside 0..{len(WALL_MESHES) - 1}")
+    return WallContactFrame(
+        step=_step(table),
+        point=_columns(table, "x1", "y1", "z1"),
+        centre=_columns(table, "x2", "y2", "z2"),
+        wall=np.array(WALL_MESHES, dtype=object)[mesh] if mesh.size else np.empty(0, dtype=object),
+        particle_id=table["id3"].astype(np.int64),
+        normal_force=_columns(table, "fn_x", "fn_y", "fn_z"),
+        tangential_force=_columns(table, "ft_x", "ft_y", "ft_z"),
+    )

@@ -1,0 +1,114 @@
+# Blending in the recirculating flat-bottom silo: engine inputs -> engine run -> clump tracks -> direct measurement,
+# RTDs and LTI predictions per flow pattern; the one-particle-thick verification of the Eulerian RTD; a summary.
+
+
+rule silo_recirculation_deck:
+    output:
+        case=deck_rule_output(RECIRCULATION),
+    params:
+        case=RECIRCULATION,
+        defining=lambda wildcards: cases_of(config, RECIRCULATION)[wildcards.run].defining_parameters,
+    log:
+        run_path(RECIRCULATION, "logs/deck.log"),
+    script:
+        "../scripts/case_deck.py"
+
+
+rule silo_recirculation_run:
+    input:
+        case=rules.silo_recirculation_deck.output.case,
+    output:
+        record=run_rule_output(RECIRCULATION),
+    params:
+        case=RECIRCULATION,
+        engine=config["engine"],
+    resources:
+        tasks=config["engine"]["mpi_ranks"],
+    threads: config["engine"]["mpi_ranks"]
+    # long runs: start them early, after the batch silo
+    priority: 5
+    log:
+        run_path(RECIRCULATION, "logs/run.log"),
+    script:
+        "../scripts/case_run.py"
+
+
+rule silo_recirculation_tracks:
+    input:
+        record=rules.silo_recirculation_run.output.record,
+        case=rules.silo_recirculation_deck.output.case,
+    output:
+        tracks=f"{run_dir(RECIRCULATION)}/tracks.npz",
+    params:
+        on_damaged=config["dumps"]["on_damaged"],
+    log:
+        f"{run_dir(RECIRCULATION)}/logs/tracks.log",
+    script:
+        "../scripts/silo_recirculation_tracks.py"
+
+
+rule silo_recirculation_analysis:
+    input:
+        tracks=rules.silo_recirculation_tracks.output.tracks,
+        case=rules.silo_recirculation_deck.output.case,
+    output:
+        summary=f"{run_dir(RECIRCULATION)}/metrics/blending.json",
+        concentration=f"{run_dir(RECIRCULATION)}/metrics/concentration.csv",
+        vrr=f"{run_dir(RECIRCULATION)}/metrics/vrr.csv",
+        rtd=f"{run_dir(RECIRCULATION)}/metrics/rtd.csv",
+        vrr_period=f"{run_dir(RECIRCULATION)}/metrics/vrr_period.csv",
+        model=f"{run_dir(RECIRCULATION)}/metrics/recirculation_model.csv",
+        concentration_plot=report(f"{run_dir(RECIRCULATION)}/plots/concentration.png", caption="../report/silo_recirculation_concentration.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "concentration"}),
+        vrr_plot=report(f"{run_dir(RECIRCULATION)}/plots/vrr.png", caption="../report/silo_recirculation_vrr.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR"}),
+        rtd_plot=report(f"{run_dir(RECIRCULATION)}/plots/rtd.png", caption="../report/silo_recirculation_rtd.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "RTD"}),
+        lti_plot=report(f"{run_dir(RECIRCULATION)}/plots/lti.png", caption="../report/silo_recirculation_lti.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "LTI"}),
+        vrr_period_plot=report(f"{run_dir(RECIRCULATION)}/plots/vrr_period.png", caption="../report/silo_recirculation_vrr_period.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR vs period"}),
+        model_plot=report(f"{run_dir(RECIRCULATION)}/plots/recirculation_model.png", caption="../report/silo_recirculation_model.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "recirculation model"}),
+        snapshots=report(directory(f"{run_dir(RECIRCULATION)}/plots/snapshots"), patterns=["{layout}.png"],
+                         caption="../report/silo_recirculation_snapshots.rst", category="3 Recirculating silo", subcategory="{run}",
+                         labels={"figure": "snapshots {layout}"}),
+        per_layout=directory(f"{run_dir(RECIRCULATION)}/plots/layouts"),
+    params:
+        blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
+                                    ("layouts", "lti", "concentration_window", "tracer", "eulerian", "snapshots")},
+    log:
+        f"{run_dir(RECIRCULATION)}/logs/analysis.log",
+    script:
+        "../scripts/silo_recirculation_analysis.py"
+
+
+rule silo_recirculation_verification:
+    input:
+        tracks=rules.silo_recirculation_tracks.output.tracks,
+        case=rules.silo_recirculation_deck.output.case,
+    output:
+        table=f"{run_dir(RECIRCULATION)}/verification/residence_times.csv",
+        summary=f"{run_dir(RECIRCULATION)}/verification/verification.json",
+        paths_plot=report(f"{run_dir(RECIRCULATION)}/verification/paths.png", caption="../report/silo_recirculation_paths.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "paths"}),
+        residence_plot=report(f"{run_dir(RECIRCULATION)}/verification/residence_times.png", caption="../report/silo_recirculation_residence.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "residence times"}),
+    params:
+        blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in ("verification", "tracer", "eulerian")},
+    log:
+        f"{run_dir(RECIRCULATION)}/logs/verification.log",
+    script:
+        "../scripts/silo_recirculation_verification.py"
+
+
+rule silo_recirculation_summary:
+    input:
+        summaries=lambda wildcards: [f"{run_dir(RECIRCULATION, run)}/metrics/blending.json" for run in recirculation_runs()],
+        vrr=lambda wildcards: [f"{run_dir(RECIRCULATION, run)}/metrics/vrr.csv" for run in recirculation_runs()],
+    output:
+        table=f"{case_root(RECIRCULATION)}/summary/blending.csv",
+        vrr_plot=report(f"{case_root(RECIRCULATION)}/summary/vrr.png", caption="../report/silo_recirculation_summary.rst", category="3 Recirculating silo", subcategory="Summary", labels={"figure": "VRR all"}),
+    params:
+        runs=lambda wildcards: recirculation_runs(),
+    log:
+        f"{case_root(RECIRCULATION)}/summary/summary.log",
+    script:
+        "../scripts/silo_recirculation_summary.py"
+
+
+rule silo_recirculation_all:
+    input:
+        recirculation_targets,
