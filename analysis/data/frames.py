@@ -47,7 +47,7 @@ class ParticleFrame:
     type : numpy.ndarray of int32, shape (n,)
         Material (atom) type [-].
     clump_id : numpy.ndarray of int64, shape (n,)
-        Id of the rigid clump the sphere belongs to (LIGGGHTS ``id_multisphere``); a free
+        Id of the rigid clump the sphere belongs to (the engine's clump id); a free
         sphere carries its own sphere id [-].
     position : numpy.ndarray of float64, shape (n, 3)
         Sphere centre [m].
@@ -93,7 +93,8 @@ class ParticleFrame:
         for name in OPTIONAL_VECTORS:
             if getattr(self, name) is not None:
                 set_field(self, name, _frozen_array(getattr(self, name), np.float64, (3,), name, n))
-        sorted_ids = np.sort(ids)
+        # engines write spheres in ascending id order: checking that first spares the sort (a third of a read)
+        sorted_ids = ids if np.all(ids[1:] > ids[:-1]) else np.sort(ids)
         if np.any(sorted_ids[1:] == sorted_ids[:-1]):
             raise ValueError("sphere ids in a frame must be unique")
 

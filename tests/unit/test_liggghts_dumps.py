@@ -1,47 +1,29 @@
-"""Unit tests for engines.liggghts.dumps: exact round trips, malformed files, clumps, file lists, cache."""
+"""Unit tests for engines.liggghts.dumps: exact round trips, the strict layout, damaged files, clumps, file lists.
+
+Every dump here is written with pyvista (tests/dump_fixtures.py), in the layout LIGGGHTS writes.
+"""
 
 from __future__ import annotations
 
-import os
-import struct
 from pathlib import Path
 
 import numpy as np
 import pytest
+import pyvista
 
-from engines.liggghts import dumps
 from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 from engines.liggghts.dumps import (
     DumpFormatError,
     dump_step,
-    format_legacy_vtk_polydata,
     frame_from_arrays,
     list_dumps,
     parse_legacy_vtk_polydata,
     read_frame,
     read_frames,
-    write_legacy_vtk_polydata,
 )
+from tests.dump_fixtures import dump_mesh, liggghts_dump_bytes, liggghts_like_fields, write_liggghts_dump
 
 TIMESTEP = 1e-5  # [s]
-
-
-def liggghts_like_fields(n_clumps: int, seed: int = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Points and fields with the names, dtypes and order LIGGGHTS writes for two-sphere clumps."""
-    rng = np.random.default_rng(seed)
-    n = 2 * n_clumps
-    points = rng.uniform(-0.02, 0.06, size=(n, 3)).astype(np.float32)
-    fields = {
-        "id": np.arange(1, n + 1, dtype=np.int32),
-        "id_multisphere": np.repeat(np.arange(1, n_clumps + 1, dtype=np.int32), 2),
-        "type": np.ones(n, dtype=np.int32),
-        "mass": np.repeat(rng.uniform(1e-5, 2e-5, n_clumps), 2),
-        "v": rng.normal(size=(n, 3)),
-        "f": rng.normal(scale=1e-3, size=(n, 3)),
-        "radius": np.full(n, 0.0015),
-        "omega": rng.normal(scale=10.0, size=(n, 3)),
-    }
-    return points, fields
 
 
 def header_length(content: bytes) -> int:
@@ -49,22 +31,19 @@ def header_length(content: bytes) -> int:
     return content.index(b"\n", content.index(b"POINTS")) + 1
 
 
-# --------------------------------------------------------------------------- round trips
+# --------------------------------------------------------------------------- round trips and the layout
 
 
-@pytest.mark.parametrize("binary", [True, False], ids=["binary", "ascii"])
-@pytest.mark.parametrize("points_dtype", [np.float32, np.float64])
-def test_round_trip_is_exact(binary, points_dtype):
+def test_round_trip_is_exact(tmp_path):
     points, fields = liggghts_like_fields(20)
-    points = np.random.default_rng(1).uniform(-1, 1, size=points.shape).astype(points_dtype)
-    fields["big_id"] = np.arange(len(points), dtype=np.int64) * 10**12
-    fields["radius32"] = fields["radius"].astype(np.float32) / 3
-    fields["tiny"] = np.full(len(points), 5e-324)  # smallest subnormal survives ASCII too
+    points = np.random.default_rng(1).uniform(-1, 1, size=points.shape).astype(np.float32)
+    fields["big_id"] = np.arange(len(points), dtype=np.int32) * 10**8
+    fields["tiny"] = np.full(len(points), 5e-324)  # the smallest subnormal survives
 
-    parsed = parse_legacy_vtk_polydata(format_legacy_vtk_polydata(points, fields, binary=binary))
+    parsed = parse_legacy_vtk_polydata(liggghts_dump_bytes(points, fields, tmp_path))
 
     assert list(parsed) == ["points", *fields]
-    assert parsed["points"].dtype == points_dtype
+    assert parsed["points"].dtype == np.float32
     np.testing.assert_array_equal(parsed["points"], points)
     for name, values in fields.items():
         assert parsed[name].dtype == values.dtype, name
@@ -72,38 +51,33 @@ def test_round_trip_is_exact(binary, points_dtype):
         np.testing.assert_array_equal(parsed[name], values, err_msg=name)
 
 
-def test_float64_points_written_as_float32_equal_the_float32_cast(tmp_path):
-    points = np.array([[0.1, 0.2, 0.3], [1 / 3, 2 / 3, 1.0]])
-    path = write_legacy_vtk_polydata(tmp_path / "p_0.vtk", points.astype(np.float32), {})
-    parsed = parse_legacy_vtk_polydata(path.read_bytes(), str(path))
-    np.testing.assert_array_equal(parsed["points"], points.astype(np.float32))
-
-
-def test_writer_layout_matches_liggghts():
+def test_fixture_layout_matches_liggghts(tmp_path):
+    # The layout of tests/dump_fixtures.py, line by line, as LIGGGHTS writes it (module docstring of
+    # engines.liggghts.dumps); tests/integration/test_dumps_liggghts.py compares it with the real engine.
     points, fields = liggghts_like_fields(2)
-    content = format_legacy_vtk_polydata(points, fields, binary=True)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     lines = [line for line in content.split(b"\n") if line[:1].isalpha() or line.startswith(b"#")]
     assert lines[:4] == [b"# vtk DataFile Version 5.1", lines[1], b"BINARY", b"DATASET POLYDATA"]
     assert b"POINTS 4 float\n" in content
     assert b"VERTICES 5 4\nOFFSETS vtktypeint64\n" in content
     assert b"POINT_DATA 4\nFIELD FieldData 8\nid 1 4 int\n" in content
     assert b"\nv 3 4 double\n" in content
+    assert b"SCALARS" not in content and b"LOOKUP_TABLE" not in content
 
 
-def test_vtk_reads_what_the_writer_writes(tmp_path):
-    pyvista = pytest.importorskip("pyvista")
+def test_parser_agrees_with_pyvista_on_the_fixture(tmp_path):
     points, fields = liggghts_like_fields(5)
-    for binary in (True, False):
-        path = write_legacy_vtk_polydata(tmp_path / f"w_{int(binary)}.vtk", points, fields, binary=binary)
-        mesh = pyvista.read(path)
-        np.testing.assert_array_equal(np.asarray(mesh.points), points)
-        assert mesh.n_verts == len(points)
-        for name, values in fields.items():
-            np.testing.assert_array_equal(np.asarray(mesh.point_data[name]), values, err_msg=name)
+    path = write_liggghts_dump(tmp_path / "w_1.vtk", points, fields)
+    mesh = pyvista.read(path)
+    parsed = parse_legacy_vtk_polydata(path.read_bytes(), str(path))
+    np.testing.assert_array_equal(parsed["points"], np.asarray(mesh.points))
+    assert mesh.n_verts == len(points)
+    for name in fields:
+        np.testing.assert_array_equal(parsed[name], np.asarray(mesh.point_data[name]), err_msg=name)
 
 
-def test_empty_liggghts_dump_gives_empty_frame():
-    # What LIGGGHTS writes before the first insertion.
+def test_empty_liggghts_dump_gives_empty_frame(tmp_path):
+    # What LIGGGHTS writes before the first insertion (the integration test compares it with the real file).
     content = b"# vtk DataFile Version 5.1\nGenerated by LIGGGHTS\nBINARY\nDATASET POLYDATA\nPOINTS 0 float\n\n"
     parsed = parse_legacy_vtk_polydata(content)
     assert parsed["points"].shape == (0, 3)
@@ -111,44 +85,52 @@ def test_empty_liggghts_dump_gives_empty_frame():
     assert len(frame) == 0 and frame.position.shape == (0, 3) and frame.force is None
     clumps = clumps_from_frame(frame)
     assert len(clumps) == 0 and clumps.position.shape == (0, 3)
+    # pyvista writes an empty point cloud the same way, but for its title line
+    empty = liggghts_dump_bytes(np.empty((0, 3), dtype=np.float32), {}, tmp_path)
+    assert empty.split(b"\n")[2:] == content.split(b"\n")[2:]
 
 
-def vtk42(binary: bool) -> bytes:
-    """A VTK 4.2 POLYDATA file by hand: VERTICES n 2n with pairs '1 i', long and double fields."""
-    head = b"# vtk DataFile Version 4.2\nvtk output\n" + (b"BINARY\n" if binary else b"ASCII\n")
-    head += b"DATASET POLYDATA\nPOINTS 2 double\n"
-    if binary:
-        return (
-            head
-            + struct.pack(">6d", 0.5, 1.5, 2.5, -0.25, 0.0, 1e-3) + b"\n"
-            + b"VERTICES 2 4\n" + struct.pack(">4i", 1, 0, 1, 1) + b"\n"
-            + b"POINT_DATA 2\nFIELD FieldData 2\nid 1 2 long\n" + struct.pack(">2q", 7, 9) + b"\n"
-            + b"v 3 2 double\n" + struct.pack(">6d", 1, 2, 3, 4, 5, 6) + b"\n"
-        )
-    return head + (
-        b"0.5 1.5 2.5 -0.25 0 0.001 \n\nVERTICES 2 4\n1 0 \n1 1 \n\n"
-        b"POINT_DATA 2\nFIELD FieldData 2\nid 1 2 long\n7 9 \nv 3 2 double\n1 2 3 4 5 6 \n\n"
-    )
+# --------------------------------------------------------------------------- layouts LIGGGHTS does not write
 
 
-@pytest.mark.parametrize("binary", [True, False], ids=["binary", "ascii"])
-def test_vtk42_layout(binary):
-    parsed = parse_legacy_vtk_polydata(vtk42(binary))
-    np.testing.assert_array_equal(parsed["points"], [[0.5, 1.5, 2.5], [-0.25, 0.0, 1e-3]])
-    assert parsed["id"].dtype == np.int64
-    np.testing.assert_array_equal(parsed["id"], [7, 9])
-    np.testing.assert_array_equal(parsed["v"], [[1, 2, 3], [4, 5, 6]])
+def test_layouts_no_deck_writes_are_rejected_naming_file_and_finding(tmp_path):
+    points, fields = liggghts_like_fields(2)
+    source = "results/x/dumps/silo_4000.vtk"
 
+    def rejection(content: bytes) -> str:
+        with pytest.raises(DumpFormatError) as error:
+            parse_legacy_vtk_polydata(content, source)
+        assert str(error.value).startswith(f"{source}: ")
+        return str(error.value)
 
-def test_scalars_and_vectors_sections():
-    content = (
-        b"# vtk DataFile Version 5.1\nx\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1 1\n"
-        b"POINT_DATA 2\nSCALARS radius double\nLOOKUP_TABLE default\n0.5 0.25\n"
-        b"VECTORS v double\n1 2 3 4 5 6\n"
-    )
-    parsed = parse_legacy_vtk_polydata(content)
-    np.testing.assert_array_equal(parsed["radius"], [0.5, 0.25])
-    np.testing.assert_array_equal(parsed["v"], [[1, 2, 3], [4, 5, 6]])
+    ascii_path = tmp_path / "ascii_1.vtk"
+    dump_mesh(points, fields).save(ascii_path, binary=False)
+    assert "file format 'ASCII'" in rejection(ascii_path.read_bytes())
+
+    # pyvista leaves the first array as the active scalars unless told otherwise: a SCALARS section
+    scalars_path = tmp_path / "scalars_1.vtk"
+    mesh = dump_mesh(points, fields)
+    mesh.point_data.active_scalars_name = "radius"
+    mesh.save(scalars_path, binary=True)
+    assert "unknown or unsupported section 'SCALARS'" in rejection(scalars_path.read_bytes())
+
+    cell_path = tmp_path / "cells_1.vtk"
+    mesh = dump_mesh(points, fields)
+    mesh.cell_data["c"] = np.arange(mesh.n_cells, dtype=np.int32)
+    mesh.save(cell_path, binary=True)
+    assert "unknown or unsupported section 'CELL_DATA'" in rejection(cell_path.read_bytes())
+
+    content = liggghts_dump_bytes(points, fields, tmp_path)
+    old_version = content.replace(b"Version 5.1", b"Version 4.2", 1)
+    assert "'# vtk DataFile Version 4.2': LIGGGHTS writes" in rejection(old_version)
+
+    double_points = liggghts_dump_bytes(points.astype(np.float64), fields, tmp_path)
+    assert "POINTS have type 'double'" in rejection(double_points)
+
+    fields64 = {**fields, "id": fields["id"].astype(np.int64)}  # pyvista writes int64 as "long"
+    assert "field 'id' has unknown data type 'long'" in rejection(liggghts_dump_bytes(points, fields64, tmp_path))
+
+    assert "unexpected content at byte" in rejection(content + b"METADATA\nINFORMATION 0\n\n")
 
 
 # --------------------------------------------------------------------------- malformed files
@@ -156,7 +138,7 @@ def test_scalars_and_vectors_sections():
 
 def test_truncated_binary_points_names_file_and_counts(tmp_path):
     points, fields = liggghts_like_fields(800)  # 1600 spheres
-    content = format_legacy_vtk_polydata(points, fields, binary=True)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     cut = header_length(content) + 812 * 12 + 5  # 812 whole float32 points, then part of one
     path = tmp_path / "silo_4000.vtk"
     path.write_bytes(content[:cut])
@@ -168,7 +150,7 @@ def test_truncated_binary_points_names_file_and_counts(tmp_path):
 
 def test_truncated_binary_field_names_file_and_field(tmp_path):
     points, fields = liggghts_like_fields(10)
-    content = format_legacy_vtk_polydata(points, fields, binary=True)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     path = tmp_path / "silo_100.vtk"
     header = b"omega 3 20 double\n"
     path.write_bytes(content[: content.index(header) + len(header) + 24 + 5])  # 1 tuple and a bit
@@ -177,39 +159,27 @@ def test_truncated_binary_field_names_file_and_field(tmp_path):
         read_frame(path, TIMESTEP)
 
 
-def test_garbled_ascii_number_names_file_and_field(tmp_path):
-    points, fields = liggghts_like_fields(3)
-    fields["v"][1, 2] = 0.5
-    content = format_legacy_vtk_polydata(points, fields, binary=False)
-    start = content.index(b"v 3 6 double\n")
-    garbled = content[:start] + content[start:].replace(b"0.5", b"1.2.3", 1)
-    path = tmp_path / "silo_7.vtk"
-    path.write_bytes(garbled)
-
-    with pytest.raises(DumpFormatError) as error:
-        read_frame(path, TIMESTEP)
-    message = str(error.value)
-    assert message.startswith(f"{path}: ")
-    assert "field 'v'" in message and "'1.2.3'" in message
+def test_truncated_vertex_cells_name_the_counts(tmp_path):
+    points, fields = liggghts_like_fields(5)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
+    header = b"OFFSETS vtktypeint64\n"
+    cut = content.index(header) + len(header) + 3 * 8 + 1  # 3 of the 11 offsets and a bit
+    expected = r"^c_1\.vtk: VERTICES OFFSETS declares 11 values but the file ends after 3$"
+    with pytest.raises(DumpFormatError, match=expected):
+        parse_legacy_vtk_polydata(content[:cut], "c_1.vtk")
 
 
-@pytest.mark.parametrize("binary", [True, False], ids=["binary", "ascii"])
 @pytest.mark.parametrize("field", ["v", "points"])
-def test_non_finite_values_are_rejected(binary, field):
+def test_non_finite_values_are_rejected(field, tmp_path):
     points, fields = liggghts_like_fields(3)
     if field == "points":
         points[4, 1] = np.nan
     else:
         fields["v"][4, 1] = np.inf
-    content = format_legacy_vtk_polydata(points, fields, binary=binary)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     expected = "POINTS" if field == "points" else "field 'v'"
     with pytest.raises(DumpFormatError, match=rf"^dump_1\.vtk: {expected} contains a non-finite value .* at point 4$"):
         parse_legacy_vtk_polydata(content, "dump_1.vtk")
-
-
-def liggghts_ascii() -> bytes:
-    points, fields = liggghts_like_fields(2)
-    return format_legacy_vtk_polydata(points, fields, binary=False)
 
 
 MALFORMED = {
@@ -221,66 +191,63 @@ MALFORMED = {
     "keyword": (b"POINTS 4 float", b"POINTZ 4 float", "unknown or unsupported section 'POINTZ'"),
     "dataset": (b"DATASET POLYDATA", b"DATASET RECTILINEAR_GRID", "not POLYDATA"),
     "magic": (b"# vtk DataFile", b"# xyz DataFile", "not a legacy VTK file"),
-    "int": (b"\nid 1 4 int\n1 2 3 4", b"\nid 1 4 int\n1 2 3.0 4", "field 'id': '3.0' (value 2) is not a valid int"),
-    "extra": (
-        b"\nid 1 4 int\n1 2 3 4", b"\nid 1 4 int\n1 2 3 4 5",
-        "field 'id' declares 4 tuples but its last line holds 1 more values",
-    ),
+    "vertices": (b"VERTICES 5 4", b"VERTICES 4 3", "expected 'VERTICES 5 4' (one vertex per point)"),
+    "n-arrays": (b"FIELD FieldData 8", b"FIELD FieldData 9", "the file ends where a FIELD array line"),
 }
 
 
 @pytest.mark.parametrize("case", MALFORMED)
-def test_malformed_files_raise_with_source(case):
+def test_malformed_files_raise_with_source(case, tmp_path):
     old, new, message = MALFORMED[case]
-    content = liggghts_ascii()
-    assert old in content
+    points, fields = liggghts_like_fields(2)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
+    assert content.count(old) == 1
     with pytest.raises(DumpFormatError) as error:
         parse_legacy_vtk_polydata(content.replace(old, new, 1), "results/x/dumps/silo_4000.vtk")
     assert str(error.value).startswith("results/x/dumps/silo_4000.vtk: ")
     assert message in str(error.value)
 
 
-def test_missing_points_raise_with_source():
-    content = liggghts_ascii()
+def test_missing_points_raise_with_source(tmp_path):
+    points, fields = liggghts_like_fields(2)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     with pytest.raises(DumpFormatError, match=r"^s_1\.vtk: no POINTS section$"):
         parse_legacy_vtk_polydata(content[: content.index(b"POINTS")], "s_1.vtk")
 
 
-def test_wrong_count_in_binary_is_reported_not_misread():
+def test_wrong_count_in_binary_is_reported_not_misread(tmp_path):
     points, fields = liggghts_like_fields(2)
-    content = format_legacy_vtk_polydata(points, fields, binary=True)
-    # Declaring 3 tuples of 'type' leaves the reader 4 bytes early, inside binary data.
+    content = liggghts_dump_bytes(points, fields, tmp_path)
+    # Declaring 3 tuples of 'type' would leave the reader 4 bytes early, inside binary data.
     content = content.replace(b"type 1 4 int", b"type 1 3 int")
     with pytest.raises(DumpFormatError, match="^f.vtk: field 'type' has 3 tuples but the data section declares 4"):
         parse_legacy_vtk_polydata(content, "f.vtk")
 
 
-def test_missing_fields_are_named():
+def test_missing_fields_are_named(tmp_path):
     points, fields = liggghts_like_fields(2)
     del fields["v"], fields["mass"]
-    parsed = parse_legacy_vtk_polydata(format_legacy_vtk_polydata(points, fields), "d_1.vtk")
+    parsed = parse_legacy_vtk_polydata(liggghts_dump_bytes(points, fields, tmp_path), "d_1.vtk")
     with pytest.raises(DumpFormatError, match=r"^d_1\.vtk: missing fields mass, v \(or vx vy vz\)"):
         frame_from_arrays(parsed, step=1, time=1e-5, source="d_1.vtk")
 
 
-def test_a_dump_without_forces_and_angular_velocities_reads_and_caches(tmp_path):
+def test_a_dump_without_forces_and_angular_velocities_reads(tmp_path):
+    # the silo-type decks dump neither
     points, fields = liggghts_like_fields(3)
     del fields["omega"], fields["f"]
-    path = tmp_path / "particles_10.vtk"
-    path.write_bytes(format_legacy_vtk_polydata(points, fields, binary=True))
-    frame = read_frame(path, TIMESTEP, tmp_path / "cache")
+    path = write_liggghts_dump(tmp_path / "particles_10.vtk", points, fields)
+    frame = read_frame(path, TIMESTEP)
     assert frame.angular_velocity is None and frame.force is None and len(frame) == 6  # 3 two-sphere clumps
-    cached = read_frame(path, TIMESTEP, tmp_path / "cache")
-    assert cached.angular_velocity is None
-    np.testing.assert_array_equal(cached.velocity, frame.velocity)
+    np.testing.assert_array_equal(frame.velocity, fields["v"])
 
 
 # --------------------------------------------------------------------------- frames and clumps
 
 
-def test_frame_from_liggghts_arrays():
+def test_frame_from_liggghts_arrays(tmp_path):
     points, fields = liggghts_like_fields(4)
-    frame = frame_from_arrays(parse_legacy_vtk_polydata(format_legacy_vtk_polydata(points, fields)), 300, 3e-3)
+    frame = frame_from_arrays(parse_legacy_vtk_polydata(liggghts_dump_bytes(points, fields, tmp_path)), 300, 3e-3)
     assert (frame.step, frame.time) == (300, 3e-3)
     assert frame.id.dtype == np.int64 and frame.type.dtype == np.int32 and frame.clump_id.dtype == np.int64
     np.testing.assert_array_equal(frame.position, points.astype(np.float64))
@@ -293,15 +260,16 @@ def test_frame_from_liggghts_arrays():
         frame.position[0, 0] = 1.0  # frames are read-only
 
 
-def test_frame_from_split_components_and_free_spheres():
+def test_frame_with_free_spheres():
     arrays = {
-        "x": np.array([0.0, 1.0, 2.0]), "y": np.zeros(3), "z": np.array([0.5, 0.5, 0.5]),
-        "id": np.array([10, 11, 12]), "type": np.array([1, 2, 1]),
+        "points": np.array([[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [2.0, 0.0, 0.5]], dtype=np.float32),
+        "id": np.array([10, 11, 12], dtype=np.int32), "type": np.array([1, 2, 1], dtype=np.int32),
         # LIGGGHTS writes -1 for a free sphere; 0 or absence also means free
-        "id_multisphere": np.array([3, 3, -1]),
-        "vx": np.array([1.0, 2.0, 3.0]), "vy": np.zeros(3), "vz": np.zeros(3),
-        "omegax": np.zeros(3), "omegay": np.zeros(3), "omegaz": np.array([1.0, 1.0, 0.0]),
-        "radius": np.full(3, 0.001), "mass": np.array([2e-5, 2e-5, 1e-5]),
+        "id_multisphere": np.array([3, 3, -1], dtype=np.int32),
+        "mass": np.array([2e-5, 2e-5, 1e-5]),
+        "v": np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]]),
+        "radius": np.full(3, 0.001),
+        "omega": np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]]),
     }
     frame = frame_from_arrays(arrays, step=5, time=5e-5)
     np.testing.assert_array_equal(frame.clump_id, [3, 3, -12])
@@ -325,6 +293,15 @@ def test_free_sphere_never_shares_a_clump_id():
     clumps = clumps_from_frame(frame)
     np.testing.assert_array_equal(clumps.clump_id, [-3, 3])
     np.testing.assert_array_equal(clumps.n_spheres, [1, 2])
+
+
+def test_ids_must_be_integers():
+    arrays = {
+        "points": np.zeros((2, 3)), "id": np.array([1.0, 2.0]), "type": np.ones(2, dtype=np.int32),
+        "v": np.zeros((2, 3)), "radius": np.ones(2), "mass": np.ones(2),
+    }
+    with pytest.raises(DumpFormatError, match=r"^i_0\.vtk: field 'id' must hold integers, got dtype float64$"):
+        frame_from_arrays(arrays, 0, 0.0, source="i_0.vtk")
 
 
 def three_clump_frame() -> ParticleFrame:
@@ -410,115 +387,25 @@ def test_list_dumps_ignores_bounding_boxes_and_sorts_numerically(tmp_path):
     assert [path.name for path in list_dumps(tmp_path, "silo_x")] == ["silo_x_300.vtk"]
 
 
-# --------------------------------------------------------------------------- cache
+# --------------------------------------------------------------------------- reading folders
 
 
 def write_dump(path: Path, seed: int = 0) -> dict[str, np.ndarray]:
     points, fields = liggghts_like_fields(3, seed=seed)
-    write_legacy_vtk_polydata(path, points, fields)
+    write_liggghts_dump(path, points, fields)
     return {"points": points, **fields}
-
-
-def forbid_parsing(monkeypatch):
-    def refuse(content, source="<bytes>"):
-        raise AssertionError(f"{source} was parsed again instead of read from the cache")
-
-    monkeypatch.setattr(dumps, "parse_legacy_vtk_polydata", refuse)
-
-
-def assert_frames_equal(a: ParticleFrame, b: ParticleFrame) -> None:
-    assert (a.step, a.time) == (b.step, b.time)
-    for name in ("id", "type", "clump_id", "position", "velocity", "angular_velocity", "radius", "mass", "force"):
-        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
-        assert getattr(a, name).dtype == getattr(b, name).dtype, name
-
-
-def test_cache_is_used_on_second_read(tmp_path, monkeypatch):
-    dump = tmp_path / "dumps" / "silo_4000.vtk"
-    dump.parent.mkdir()
-    write_dump(dump)
-    cache_dir = tmp_path / "frames"
-
-    first = read_frame(dump, TIMESTEP, cache_dir)
-    assert sorted(p.name for p in cache_dir.iterdir()) == ["silo_4000.npz"]  # no temporary left
-
-    forbid_parsing(monkeypatch)
-    second = read_frame(dump, TIMESTEP, cache_dir)
-    assert_frames_equal(first, second)
-    assert second.time == 4000 * TIMESTEP
-
-    # the cache stores no time: another time step gives another time
-    assert read_frame(dump, 2 * TIMESTEP, cache_dir).time == 4000 * 2 * TIMESTEP
-
-
-def test_changed_dump_invalidates_cache(tmp_path, monkeypatch):
-    dump = tmp_path / "silo_10.vtk"
-    write_dump(dump, seed=0)
-    cache_dir = tmp_path / "frames"
-    read_frame(dump, TIMESTEP, cache_dir)
-    # age the entry so the rewritten dump is newer even on a coarse-clock filesystem
-    entry = cache_dir / "silo_10.npz"
-    old = entry.stat().st_mtime_ns - 10 * 10**9
-    os.utime(entry, ns=(old, old))
-
-    new = write_dump(dump, seed=1)  # a rerun: same size, other values, later mtime
-    frame = read_frame(dump, TIMESTEP, cache_dir)
-    np.testing.assert_array_equal(frame.velocity, new["v"])
-
-    forbid_parsing(monkeypatch)  # and the refreshed entry is used again
-    np.testing.assert_array_equal(read_frame(dump, TIMESTEP, cache_dir).velocity, new["v"])
-
-
-def test_cache_with_other_recorded_mtime_is_not_used(tmp_path):
-    dump = tmp_path / "silo_10.vtk"
-    write_dump(dump, seed=0)
-    cache_dir = tmp_path / "frames"
-    read_frame(dump, TIMESTEP, cache_dir)
-    # an older dump copied in place, with an mtime before the cache entry
-    new = write_dump(dump, seed=2)
-    stat = dump.stat()
-    os.utime(dump, ns=(stat.st_atime_ns, stat.st_mtime_ns - 10**9))
-    np.testing.assert_array_equal(read_frame(dump, TIMESTEP, cache_dir).velocity, new["v"])
-
-
-def test_half_written_cache_is_ignored_and_replaced(tmp_path, monkeypatch):
-    dump = tmp_path / "silo_20.vtk"
-    expected = write_dump(dump)
-    cache_dir = tmp_path / "frames"
-    cache_dir.mkdir()
-    entry = cache_dir / "silo_20.npz"
-    read_frame(dump, TIMESTEP, cache_dir)
-    entry.write_bytes(entry.read_bytes()[:100])  # as if a non-atomic writer had been killed
-
-    frame = read_frame(dump, TIMESTEP, cache_dir)
-    np.testing.assert_array_equal(frame.mass, expected["mass"])
-    forbid_parsing(monkeypatch)
-    read_frame(dump, TIMESTEP, cache_dir)
-
-
-def test_failed_cache_write_leaves_no_entry(tmp_path, monkeypatch):
-    dump = tmp_path / "silo_30.vtk"
-    write_dump(dump)
-    cache_dir = tmp_path / "frames"
-
-    def killed(*args, **kwargs):
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(dumps.np, "savez", killed)
-    with pytest.raises(KeyboardInterrupt):
-        read_frame(dump, TIMESTEP, cache_dir)
-    assert list(cache_dir.iterdir()) == []
 
 
 def test_read_frames_in_step_order(tmp_path):
     dump_dir = tmp_path / "dumps"
     dump_dir.mkdir()
-    for step in (10000, 2000, 0):
-        write_dump(dump_dir / f"silo_{step}.vtk", seed=step)
+    written = {step: write_dump(dump_dir / f"silo_{step}.vtk", seed=step) for step in (10000, 2000, 0)}
     (dump_dir / "silo_boundingBox_2000.vtk").write_bytes(b"not a dump")
-    frames = read_frames(dump_dir, "silo", TIMESTEP, cache_dir=tmp_path / "frames")
+    frames = read_frames(dump_dir, "silo", TIMESTEP)
     assert [f.step for f in frames] == [0, 2000, 10000]
     assert [f.time for f in frames] == [0.0, 2000 * TIMESTEP, 10000 * TIMESTEP]
+    for frame in frames:
+        np.testing.assert_array_equal(frame.velocity, written[frame.step]["v"])
 
 
 def test_read_frame_rejects_bad_timestep(tmp_path):
@@ -530,10 +417,8 @@ def test_read_frame_rejects_bad_timestep(tmp_path):
 
 
 def test_a_damaged_dump_among_good_ones_raises_naming_it_or_is_skipped_with_a_warning(tmp_path):
-    from engines.liggghts.dumps import read_frames
-
     points, fields = liggghts_like_fields(5)
-    content = format_legacy_vtk_polydata(points, fields, binary=True)
+    content = liggghts_dump_bytes(points, fields, tmp_path)
     for step in (100, 200, 300):
         (tmp_path / f"particles_{step}.vtk").write_bytes(content)
     damaged = tmp_path / "particles_200.vtk"
