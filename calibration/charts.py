@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -20,9 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.io.plots import save_png  # noqa: E402
-
-if TYPE_CHECKING:
-    from calibration.inversion import CalibrationCurve
+from calibration.inversion import CalibrationCurve  # noqa: E402
 
 __all__ = ["plot_calibration_chart", "plot_polar_histogram"]
 
@@ -34,7 +31,7 @@ _X_LABELS = {
 
 
 
-def _curve_label(curve: "CalibrationCurve", several_shapes: bool, several_materials: bool) -> str:
+def _curve_label(curve: CalibrationCurve, several_shapes: bool, several_materials: bool) -> str:
     parts = []
     if several_shapes:
         parts.append(curve.shape)
@@ -45,7 +42,7 @@ def _curve_label(curve: "CalibrationCurve", several_shapes: bool, several_materi
 
 
 def plot_calibration_chart(
-    curves: "list[CalibrationCurve]",
+    curves: list[CalibrationCurve],
     path: str | os.PathLike,
     title: str,
     target_angle_deg: float | None = None,

@@ -431,8 +431,8 @@ def curves_from_table(rows: list[dict]) -> list[CalibrationCurve]:
     Each row is one simulated shear test with the keys ``shape``, ``test``
     ("internal" or "wall"), ``wall_material`` (empty, None or NaN for internal
     friction), ``rolling_friction``, ``particle_friction``, ``bulk_friction``
-    and, optionally, ``bulk_friction_stderr``. Values may be strings (as read
-    from CSV). Rows are grouped by (shape, test, wall material, rolling
+    and, optionally, ``bulk_friction_stderr``. Values may be strings (as
+    read from CSV). Rows are grouped by (shape, test, wall material, rolling
     friction); each curve is sorted by particle friction.
 
     Parameters

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ContactFrame"]
+__all__ = ["ContactFrame", "WallContactFrame"]
 
 
 @dataclass(frozen=True)
@@ -50,3 +50,35 @@ class ContactFrame:
         length = np.linalg.norm(branch, axis=1)
         safe = np.where(length > 0, length, 1.0)
         return -np.einsum("ij,ij->i", self.force, branch) / safe
+
+
+@dataclass(frozen=True)
+class WallContactFrame:
+    """Particle-wall contacts at one time step.
+
+    Attributes
+    ----------
+    step : int
+        Time step.
+    point : numpy.ndarray
+        (n, 3) contact points on the walls (m).
+    centre : numpy.ndarray
+        (n, 3) centres of the spheres in contact (m).
+    wall : numpy.ndarray
+        (n,) name of the wall each contact is on (str).
+    particle_id : numpy.ndarray
+        (n,) sphere ids.
+    normal_force, tangential_force : numpy.ndarray
+        (n, 3) normal and tangential parts of the contact force on the sphere (N), as the engine reports them.
+    """
+
+    step: int
+    point: np.ndarray
+    centre: np.ndarray
+    wall: np.ndarray
+    particle_id: np.ndarray
+    normal_force: np.ndarray
+    tangential_force: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.particle_id.shape[0])

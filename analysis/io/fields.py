@@ -40,7 +40,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from analysis.numerics.coarse_graining import Fields, Grid
+from analysis.numerics.grid import Fields, Grid
 from analysis.io.tables import atomic_output
 
 __all__ = [

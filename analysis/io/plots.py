@@ -1,24 +1,35 @@
-"""Plots of silo discharge (PNG, matplotlib Agg backend, no display needed)."""
+"""What every plot writer shares: the headless backend, atomic PNG output, the silo outline and argument checks.
+
+The study plots (:mod:`analysis.studies.silo_flat.plots`, :mod:`analysis.studies.silo_recirculation.plots`,
+:mod:`analysis.studies.silo_recirculation.rtd_plots`, :mod:`analysis.studies.blender.plots`,
+:mod:`calibration.charts`) draw with matplotlib's Agg backend (no display needed) and save through
+:func:`save_png`. Lengths drawn in the x-z plane follow the project convention: x across the width with
+x = 0 on the silo axis, z up with the floor and outlet plane at z = 0.
+"""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import matplotlib
 
 matplotlib.use("Agg")  # headless: runs on clusters and in CI
 
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from analysis.checks import finite_array  # noqa: E402
 from analysis.io.tables import atomic_output  # noqa: E402
 
-if TYPE_CHECKING:
-    from analysis.numerics.flow import DischargeHistory, FlowRateFit
-
-__all__ = ["plot_discharge"]
+__all__ = [
+    "save_png",
+    "silo_outline",
+    "non_empty_list",
+    "tuple_entry",
+    "finite_abscissa",
+    "matching_ordinate",
+    "positive_finite_points",
+]
 
 
 def save_png(figure, path: str | os.PathLike, tight: bool = False) -> Path:
@@ -29,72 +40,66 @@ def save_png(figure, path: str | os.PathLike, tight: bool = False) -> Path:
     return Path(path)
 
 
-def plot_discharge(
-    history: "DischargeHistory",
-    fit: "FlowRateFit",
-    beverloo_rate: float | None,
-    path: str | os.PathLike,
-    title: str,
-) -> Path:
-    """Plot discharged mass against time with the fitted and Beverloo flow rates.
-
-    Draws the discharged mass, the least-squares line over the steady window
-    (shaded), and, for comparison, a line of the Beverloo slope through the
-    fitted line at the window midpoint (so only the slopes are compared).
+def silo_outline(axes, width: float, outlet_width: float, top: float) -> None:
+    """Draw the walls and floor of a flat-bottom silo with a centred slot outlet, in the units given.
 
     Parameters
     ----------
-    history : analysis.numerics.flow.DischargeHistory
-        Time since opening [s] and discharged mass [kg].
-    fit : analysis.numerics.flow.FlowRateFit
-        Steady flow rate fit [kg/s] and its window [s].
-    beverloo_rate : float or None
-        Beverloo mass flow rate [kg/s]; None to omit the line.
-    path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
-    title : str
-        Figure title.
-
-    Returns
-    -------
-    pathlib.Path
-        The written path.
+    axes : matplotlib.axes.Axes
+        Axes in the x-z plane.
+    width : float
+        Silo width W; the walls stand at x = +-W/2.
+    outlet_width : float
+        Slot width B0, centred on x = 0 in the floor z = 0.
+    top : float
+        Height up to which the walls are drawn.
     """
-    time = np.asarray(history.time, dtype=float)
-    mass = np.asarray(history.discharged_mass, dtype=float)
+    half, slot = 0.5 * width, 0.5 * outlet_width
+    outline = dict(color="black", linewidth=1.5)
+    axes.plot([-half, -half, -slot], [top, 0.0, 0.0], **outline)
+    axes.plot([half, half, slot], [top, 0.0, 0.0], **outline)
 
-    figure, axes = plt.subplots(figsize=(6.4, 4.4))
+
+def non_empty_list(name: str, items) -> list:
+    """``items`` as a list; a ValueError naming ``name`` when it is empty."""
+    items = list(items)
+    if not items:
+        raise ValueError(f"{name} must not be empty")
+    return items
+
+
+def tuple_entry(name: str, index: int, item, size: int) -> tuple:
+    """``item`` (entry ``index`` of the argument ``name``) as a tuple of ``size`` items, else a ValueError."""
     try:
-        axes.plot(time, mass, ".", markersize=3, color="0.35", label="DEM discharged mass")
-        axes.axvspan(fit.t_start, fit.t_end, color="tab:blue", alpha=0.08, label="steady window")
+        entry = tuple(item)
+    except TypeError:
+        entry = ()
+    if len(entry) != size:
+        raise ValueError(f"{name}[{index}] must be a tuple of {size} items")
+    return entry
 
-        window_time = np.array([fit.t_start, fit.t_end])
-        axes.plot(
-            window_time,
-            fit.intercept + fit.mass_flow_rate * window_time,
-            "-",
-            color="tab:blue",
-            linewidth=2,
-            label=f"fit: {fit.mass_flow_rate:.4g} ± {fit.standard_error:.2g} kg/s",
-        )
-        if beverloo_rate is not None:
-            midpoint_time = 0.5 * (fit.t_start + fit.t_end)
-            midpoint_mass = fit.intercept + fit.mass_flow_rate * midpoint_time
-            axes.plot(
-                window_time,
-                midpoint_mass + beverloo_rate * (window_time - midpoint_time),
-                "--",
-                color="tab:red",
-                linewidth=1.5,
-                label=f"Beverloo: {beverloo_rate:.4g} kg/s",
-            )
 
-        axes.set_xlabel("time since opening [s]")
-        axes.set_ylabel("discharged mass [kg]")
-        axes.set_title(title)
-        axes.grid(True, alpha=0.3)
-        axes.legend(loc="upper left", fontsize="small")
-        figure.tight_layout()
-        return save_png(figure, path)
-    finally:
-        plt.close(figure)
+def finite_abscissa(name: str, values) -> np.ndarray:
+    """A non-empty, finite 1-D array (the x values of a curve)."""
+    array = finite_array(name, values)
+    if array.size == 0:
+        raise ValueError(f"{name} must not be empty")
+    return array
+
+
+def matching_ordinate(name: str, values, length: int, reference: str) -> np.ndarray:
+    """A 1-D float array of ``length`` entries, the y values over the abscissa ``reference``.
+
+    NaN is allowed (drawn as a gap or skipped).
+    """
+    array = np.asarray(values, dtype=float)
+    if array.ndim != 1 or array.size != length:
+        raise ValueError(f"{name} must be a 1-D array of the same length as {reference} ({length}), "
+                         f"got shape {array.shape}")
+    return array
+
+
+def positive_finite_points(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The points with finite x and y and ``y > 0`` (what a log y axis can show)."""
+    keep = np.isfinite(x) & np.isfinite(y) & (y > 0.0)
+    return x[keep], y[keep]

@@ -7,17 +7,16 @@ A particle of mass m at x_p contributes to the field at a grid node x_n through 
 - momentum density   ``p(n)       = sum_p m_p v_p phi_pn / V_cell``                      [kg/(m2 s)]
 - velocity           ``V(n)       = p(n) / rho(n)``                                      [m/s]
 - kinetic stress     ``sigma_k(n) = sum_p m_p v'_pn (x) v'_pn phi_pn / V_cell``          [Pa]
-- contact stress     ``sigma_c(n) = -sum_c f_ij (x) r_ij  int_0^1 phi(x_n - x_i - s r_ij) ds / V_cell`` [Pa]
+
+(the contact stress, deposited with the same kernels, is :mod:`analysis.numerics.contact_stress`)
 
 where ``phi_pn`` are discrete weights (below) that sum to one over the nodes for every particle,
 so every field integrates over the grid (sum times cell volume) to the exact particle total.
 
 Conventions
 -----------
-* SI units; coordinates x across the width (x = 0 on the axis), y front-to-back depth
-  (y = 0 the front wall, the camera side), z up (z = 0 at the outlet plane).
-* Nodes are cell centres: the cells of a :class:`Grid` tile a box (normally the silo
-  interior) and node (i, j, k) sits at ``origin + (i + 0.5, j + 0.5, k + 0.5) * spacing``.
+* SI units and the grid of :mod:`analysis.numerics.grid` (:class:`~analysis.numerics.grid.Grid`: nodes at
+  the cell centres, coordinates x across, y depth, z up).
 * Stress is **compression positive** (soil-mechanics sign) for both the kinetic and the
   contact part, so they add: ``sigma = sigma_k + sigma_c``, and a static column under gravity
   has ``sigma_zz > 0``. (Goldhirsch's tension-positive forms carry the opposite sign:
@@ -72,327 +71,56 @@ weights still sum to one.
 
 Particles whose centre lies outside the grid box ``[lower, upper]`` (faces included) are
 ignored: e.g. discharged particles below the outlet plane. The same holds for the quadrature
-points of a contact branch (see :func:`contact_stress`).
+points of a contact branch (see :func:`analysis.numerics.contact_stress.contact_stress`).
 
 Backends
 --------
-The deposition runs in a compiled loop (numba ``@njit``) when numba is installed, else in a
-vectorised numpy fallback that evaluates the same kernel with the same normalisation (slower,
-same results to round-off). ``backend="numpy"`` forces the fallback.
+The deposition runs in a compiled loop (numba ``@njit``, a declared dependency) or, with
+``backend="numpy"``, in a vectorised numpy fallback that evaluates the same kernel with the same
+normalisation (slower, same results to round-off). The loops are hand-written because no library
+deposits with per-particle discrete normalisation at walls (scipy.ndimage filters a binned field,
+which loses the exact conservation at walls described above).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
 
+import numba
 import numpy as np
 
-from analysis.checks import compute_backend, finite_array, per_particle_values, points3, positive_number, vector3
-
-try:  # pragma: no cover - exercised through both branches in the tests when numba is present
-    import numba
-
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover
-    numba = None
-    HAVE_NUMBA = False
+from analysis.checks import compute_backend, finite_array, per_particle_values, points3, positive_number
+from analysis.numerics.grid import DEFAULT_DENSITY_THRESHOLD, Fields, Grid, checked_density_threshold
 
 __all__ = [
-    "DEFAULT_SPACING",
     "DEFAULT_CUTOFF",
-    "DEFAULT_DENSITY_THRESHOLD",
     "HAVE_NUMBA",
     "KERNELS",
-    "Grid",
-    "Fields",
     "default_width",
     "kernel_support_radius",
     "kernel_shift",
     "coarse_grain",
-    "contact_stress",
     "deposit",
-    "average_fields",
-    "depth_average",
-    "front_wall_slice",
 ]
 
-DEFAULT_SPACING: tuple[float, float, float] = (0.006, 0.004, 0.006)
-"""Grid spacing of the study (dx, dy, dz) [m]: 6 mm across, 4 mm in depth, 6 mm vertically."""
+HAVE_NUMBA = True
+"""numba is a declared dependency; kept so callers can list the backends they may ask for."""
 
 DEFAULT_CUTOFF = 3.0
 """Gaussian cut-off radius in standard deviations [-]."""
 
-DEFAULT_DENSITY_THRESHOLD = 1.0e-6
-"""Nodes with density at or below this fraction of the maximum density are masked out [-]."""
-
 KERNELS = ("gaussian", "gaussian_shifted", "lucy")
 
 _LUCY_SUPPORT_PER_WIDTH = 2.0 * math.sqrt(3.0)  # h / w so that the per-axis std is w
-_REL_TILE_TOLERANCE = 1.0e-9
 
-
-# --------------------------------------------------------------------------- validation
-
-
-
-
-def _triple(name: str, values, positive: bool) -> tuple[float, float, float]:
-    return tuple(float(v) for v in vector3(name, values, positive))
-
-
-
-
+# Columns 4..9 of the deposited values: m vx vx, m vy vy, m vz vz, m vx vy, m vx vz, m vy vz.
+_SECOND_MOMENT_COLUMNS = {(0, 0): 4, (1, 1): 5, (2, 2): 6, (0, 1): 7, (0, 2): 8, (1, 2): 9}
 
 
 def _kernel_name(kernel: str) -> str:
     if kernel not in KERNELS:
         raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
     return kernel
-
-
-
-
-def _threshold(value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or not 0.0 <= value < 1.0:
-        raise ValueError(f"density_threshold must be a number in [0, 1), got {value!r}")
-    return value
-
-
-# --------------------------------------------------------------------------- grid
-
-
-@dataclass(frozen=True, kw_only=True)
-class Grid:
-    """A Cartesian grid of cells tiling a box; the field nodes are the cell centres.
-
-    Attributes
-    ----------
-    origin : tuple of 3 float
-        Lower corner of the box (of cell (0, 0, 0)) [m].
-    spacing : tuple of 3 float
-        Cell size (dx, dy, dz) [m]; default (6, 4, 6) mm, the grid of the study.
-    shape : tuple of 3 int
-        Number of cells (nx, ny, nz), each >= 1.
-
-    Notes
-    -----
-    Node (i, j, k) sits at ``origin + (i + 0.5, j + 0.5, k + 0.5) * spacing``. Arrays of a
-    field on the grid have shape ``(nx, ny, nz, ...)`` (x index first). All arguments are
-    keyword-only: ``Grid(origin=..., spacing=..., shape=...)``.
-    """
-
-    origin: tuple[float, float, float]
-    spacing: tuple[float, float, float] = DEFAULT_SPACING
-    shape: tuple[int, int, int]
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "origin", _triple("origin", self.origin, positive=False))
-        object.__setattr__(self, "spacing", _triple("spacing", self.spacing, positive=True))
-        shape = tuple(self.shape) if isinstance(self.shape, (tuple, list, np.ndarray)) else None
-        if (
-            shape is None
-            or len(shape) != 3
-            or any(isinstance(n, (bool, np.bool_)) or int(n) != n or int(n) < 1 for n in shape)
-        ):
-            raise ValueError(f"shape must be 3 integers >= 1 (nx, ny, nz), got {self.shape!r}")
-        object.__setattr__(self, "shape", (int(shape[0]), int(shape[1]), int(shape[2])))
-
-    @classmethod
-    def covering(
-        cls,
-        lower,
-        upper,
-        spacing=DEFAULT_SPACING,
-        adjust_spacing: bool = False,
-    ) -> "Grid":
-        """The grid whose cells exactly tile the box ``[lower, upper]``.
-
-        Parameters
-        ----------
-        lower, upper : array_like, shape (3,)
-            Opposite corners of the box, e.g. the silo interior
-            ``(-W/2, 0, 0)`` and ``(W/2, T, H)`` [m]; ``upper > lower`` in every component.
-        spacing : array_like, shape (3,), optional
-            Wanted cell size (dx, dy, dz) [m]; default (6, 4, 6) mm.
-        adjust_spacing : bool, optional
-            What to do when a side of the box is not a whole number of cells (within a
-            relative 1e-9). False (default): raise ``ValueError``. True: use the nearest whole
-            number of cells ``n = max(1, round(L / d))`` and stretch the spacing to ``L / n``,
-            so the cells still tile the box exactly (the returned ``spacing`` then differs
-            from the one asked for; compare it).
-
-        Returns
-        -------
-        Grid
-            ``origin = lower``, ``shape = (L / d)`` per axis, ``spacing = L / shape``.
-        """
-        lower = _triple("lower", lower, positive=False)
-        upper = _triple("upper", upper, positive=False)
-        spacing = _triple("spacing", spacing, positive=True)
-        shape = []
-        exact_spacing = []
-        for axis, (lo, hi, d) in enumerate(zip(lower, upper, spacing)):
-            length = hi - lo
-            if length <= 0.0:
-                raise ValueError(
-                    f"upper must exceed lower in every component; axis {'xyz'[axis]}: "
-                    f"lower {lo!r}, upper {hi!r}"
-                )
-            cells = length / d
-            n = max(1, int(round(cells)))
-            if abs(cells - n) > _REL_TILE_TOLERANCE * max(cells, 1.0) and not adjust_spacing:
-                raise ValueError(
-                    f"spacing: the box side along {'xyz'[axis]} ({length!r} m) is {cells:.9g} cells of "
-                    f"{d!r} m, not a whole number; choose another spacing or pass adjust_spacing=True "
-                    f"(it would use {n} cells of {length / n!r} m)"
-                )
-            shape.append(n)
-            exact_spacing.append(length / n)
-        return cls(origin=lower, spacing=tuple(exact_spacing), shape=tuple(shape))
-
-    @property
-    def lower(self) -> np.ndarray:
-        """Lower corner of the box [m]."""
-        return np.array(self.origin)
-
-    @property
-    def upper(self) -> np.ndarray:
-        """Upper corner of the box, ``origin + shape * spacing`` [m]."""
-        return np.array(self.origin) + np.array(self.shape) * np.array(self.spacing)
-
-    @property
-    def cell_volume(self) -> float:
-        """Volume of one cell ``dx dy dz`` [m3]."""
-        return float(self.spacing[0] * self.spacing[1] * self.spacing[2])
-
-    @property
-    def n_nodes(self) -> int:
-        """Number of nodes (cells) ``nx ny nz``."""
-        return int(self.shape[0] * self.shape[1] * self.shape[2])
-
-    def axis(self, index: int) -> np.ndarray:
-        """Node coordinates along one axis (0 = x, 1 = y, 2 = z) [m]."""
-        if index not in (0, 1, 2):
-            raise ValueError(f"index must be 0, 1 or 2, got {index!r}")
-        return self.origin[index] + (np.arange(self.shape[index]) + 0.5) * self.spacing[index]
-
-    @property
-    def x(self) -> np.ndarray:
-        """Node x coordinates, shape (nx,) [m]."""
-        return self.axis(0)
-
-    @property
-    def y(self) -> np.ndarray:
-        """Node y coordinates, shape (ny,) [m]."""
-        return self.axis(1)
-
-    @property
-    def z(self) -> np.ndarray:
-        """Node z coordinates, shape (nz,) [m]."""
-        return self.axis(2)
-
-    def node_positions(self) -> np.ndarray:
-        """All node positions, shape (nx, ny, nz, 3) [m]."""
-        xs, ys, zs = np.meshgrid(self.x, self.y, self.z, indexing="ij")
-        return np.stack([xs, ys, zs], axis=-1)
-
-    def contains(self, points) -> np.ndarray:
-        """Whether each point lies in the closed box ``[lower, upper]``; shape (n,) bool."""
-        points = points3("points", points)
-        return np.all((points >= self.lower) & (points <= self.upper), axis=1)
-
-
-# --------------------------------------------------------------------------- fields
-
-
-def _frozen(name: str, values, shape: tuple[int, ...], dtype) -> np.ndarray:
-    array = np.array(values, dtype=dtype, copy=True)
-    if array.shape != shape:
-        raise ValueError(f"{name} must have shape {shape}, got {array.shape}")
-    if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must contain only finite numbers")
-    array.setflags(write=False)
-    return array
-
-
-@dataclass(frozen=True, eq=False)
-class Fields:
-    """Coarse-grained continuum fields on the nodes of a grid.
-
-    Arrays are copied on construction and read-only. No entry is ever NaN.
-
-    Attributes
-    ----------
-    grid : Grid
-        The grid; arrays have shape ``grid.shape + (...)``.
-    density : numpy.ndarray, shape (nx, ny, nz)
-        Mass density [kg/m3].
-    momentum_density : numpy.ndarray, shape (nx, ny, nz, 3)
-        Momentum density [kg/(m2 s)].
-    velocity : numpy.ndarray, shape (nx, ny, nz, 3)
-        ``momentum_density / density`` where :attr:`mask` is set, 0 elsewhere [m/s].
-    kinetic_stress : numpy.ndarray, shape (nx, ny, nz, 3, 3)
-        Kinetic (streaming) stress, compression positive, symmetric [Pa].
-    mask : numpy.ndarray of bool, shape (nx, ny, nz)
-        Nodes with particles: density above ``density_threshold`` times the maximum density.
-    density_threshold : float
-        Relative threshold used for :attr:`mask` [-].
-    """
-
-    grid: Grid
-    density: np.ndarray
-    momentum_density: np.ndarray
-    velocity: np.ndarray
-    kinetic_stress: np.ndarray
-    mask: np.ndarray
-    density_threshold: float = DEFAULT_DENSITY_THRESHOLD
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.grid, Grid):
-            raise ValueError(f"grid must be a Grid, got {type(self.grid).__name__}")
-        shape = self.grid.shape
-        set_field = object.__setattr__
-        set_field(self, "density", _frozen("density", self.density, shape, np.float64))
-        set_field(self, "momentum_density", _frozen("momentum_density", self.momentum_density, shape + (3,), np.float64))
-        set_field(self, "velocity", _frozen("velocity", self.velocity, shape + (3,), np.float64))
-        set_field(self, "kinetic_stress", _frozen("kinetic_stress", self.kinetic_stress, shape + (3, 3), np.float64))
-        set_field(self, "mask", _frozen("mask", self.mask, shape, bool))
-        set_field(self, "density_threshold", _threshold(self.density_threshold))
-
-    @property
-    def total_mass(self) -> float:
-        """Integral of density over the grid, ``sum(density) * cell volume`` [kg]."""
-        return float(self.density.sum() * self.grid.cell_volume)
-
-    @property
-    def total_momentum(self) -> np.ndarray:
-        """Integral of momentum density over the grid [kg m/s]."""
-        return self.momentum_density.sum(axis=(0, 1, 2)) * self.grid.cell_volume
-
-
-def _mask_and_velocity(density: np.ndarray, momentum: np.ndarray, threshold: float):
-    peak = float(density.max()) if density.size else 0.0
-    mask = density > threshold * peak if peak > 0.0 else np.zeros(density.shape, dtype=bool)
-    velocity = np.zeros(momentum.shape)
-    velocity[mask] = momentum[mask] / density[mask][:, None]
-    return mask, velocity
-
-
-def _assemble_fields(grid, density, momentum, kinetic, threshold) -> Fields:
-    """Fields from density, momentum density and kinetic stress; velocity and mask derived here."""
-    mask, velocity = _mask_and_velocity(density, momentum, threshold)
-    return Fields(
-        grid=grid,
-        density=density,
-        momentum_density=momentum,
-        velocity=velocity,
-        kinetic_stress=kinetic,
-        mask=mask,
-        density_threshold=threshold,
-    )
 
 
 def _fields_from_sums(grid: Grid, sums: np.ndarray, threshold: float) -> Fields:
@@ -411,11 +139,8 @@ def _fields_from_sums(grid: Grid, sums: np.ndarray, threshold: float) -> Fields:
     p = momentum[occupied]
     kinetic[occupied] -= p[:, :, None] * p[:, None, :] / density[occupied][:, None, None]
     kinetic[~occupied] = 0.0
-    return _assemble_fields(grid, density, momentum, kinetic, threshold)
+    return Fields.from_moments(grid, density, momentum, kinetic, threshold)
 
-
-# Columns 4..9 of the deposited values: m vx vx, m vy vy, m vz vz, m vx vy, m vx vz, m vy vz.
-_SECOND_MOMENT_COLUMNS = {(0, 0): 4, (1, 1): 5, (2, 2): 6, (0, 1): 7, (0, 2): 8, (1, 2): 9}
 
 
 # --------------------------------------------------------------------------- kernels
@@ -467,116 +192,116 @@ def kernel_shift(width: float, cutoff: float = DEFAULT_CUTOFF, kernel: str = "ga
     return 0.0
 
 
-if HAVE_NUMBA:
 
-    @numba.njit(cache=True, nogil=True)
-    def _axis_weights(d, h, n, inv_two_w2, step, direct, q, g):  # pragma: no cover
-        """Squared offsets ``q`` and 1-D Gaussians ``g`` of n nodes at offsets d, d + h, ...
 
-        By recurrence (two exp per axis instead of n): ``g(d + h) = g(d) r(d)`` with
-        ``r(d) = exp(-(2 d h + h^2) / (2 w^2))`` and ``r(d + h) = r(d) exp(-h^2 / w^2)``;
-        relative error about n * 1e-16. ``direct``: one exp per node.
-        """
-        if direct:
-            for a in range(n):
-                q[a] = d * d
-                g[a] = math.exp(-d * d * inv_two_w2)
-                d += h
-            return
-        value = math.exp(-d * d * inv_two_w2)
-        ratio = math.exp(-(2.0 * d * h + h * h) * inv_two_w2)
+@numba.njit(cache=True, nogil=True)
+def _axis_weights(d, h, n, inv_two_w2, step, direct, q, g):  # pragma: no cover
+    """Squared offsets ``q`` and 1-D Gaussians ``g`` of n nodes at offsets d, d + h, ...
+
+    By recurrence (two exp per axis instead of n): ``g(d + h) = g(d) r(d)`` with
+    ``r(d) = exp(-(2 d h + h^2) / (2 w^2))`` and ``r(d + h) = r(d) exp(-h^2 / w^2)``;
+    relative error about n * 1e-16. ``direct``: one exp per node.
+    """
+    if direct:
         for a in range(n):
             q[a] = d * d
-            g[a] = value
+            g[a] = math.exp(-d * d * inv_two_w2)
             d += h
-            value *= ratio
-            ratio *= step
+        return
+    value = math.exp(-d * d * inv_two_w2)
+    ratio = math.exp(-(2.0 * d * h + h * h) * inv_two_w2)
+    for a in range(n):
+        q[a] = d * d
+        g[a] = value
+        d += h
+        value *= ratio
+        ratio *= step
 
-    @numba.njit(cache=True, fastmath=False, nogil=True)
-    def _deposit_compiled(positions, values, origin, spacing, shape, width, radius, lucy, shift, out):  # pragma: no cover
-        """Compiled deposition; see :func:`deposit`. ``out`` (n_nodes, n_values) is incremented."""
-        nx, ny, nz = shape[0], shape[1], shape[2]
-        ox, oy, oz = origin[0], origin[1], origin[2]
-        dx, dy, dz = spacing[0], spacing[1], spacing[2]
-        n_values = values.shape[1]
-        radius2 = radius * radius
-        inv_two_w2 = 0.5 / (width * width)
-        inv_radius = 1.0 / radius
-        step_x = math.exp(-dx * dx * 2.0 * inv_two_w2)
-        step_y = math.exp(-dy * dy * 2.0 * inv_two_w2)
-        step_z = math.exp(-dz * dz * 2.0 * inv_two_w2)
-        # The recurrence is used only where none of its factors can overflow or underflow
-        # (exponents below 600); otherwise each weight is evaluated directly.
-        direct_x = (radius + 3.0 * dx) ** 2 * inv_two_w2 > 600.0
-        direct_y = (radius + 3.0 * dy) ** 2 * inv_two_w2 > 600.0
-        direct_z = (radius + 3.0 * dz) ** 2 * inv_two_w2 > 600.0
-        mx = min(nx, int(2.0 * radius / dx) + 3)
-        my = min(ny, int(2.0 * radius / dy) + 3)
-        mz = min(nz, int(2.0 * radius / dz) + 3)
-        gx = np.empty(mx)
-        gy = np.empty(my)
-        gz = np.empty(mz)
-        qx = np.empty(mx)
-        qy = np.empty(my)
-        qz = np.empty(mz)
-        nodes = np.empty(mx * my * mz + 1, dtype=np.int64)
-        weights = np.empty(mx * my * mz + 1)
-        for p in range(positions.shape[0]):
-            x = positions[p, 0]
-            y = positions[p, 1]
-            z = positions[p, 2]
-            i0 = max(0, int(math.floor((x - radius - ox) / dx - 0.5)))
-            i1 = min(nx - 1, int(math.floor((x + radius - ox) / dx - 0.5)) + 1)
-            j0 = max(0, int(math.floor((y - radius - oy) / dy - 0.5)))
-            j1 = min(ny - 1, int(math.floor((y + radius - oy) / dy - 0.5)) + 1)
-            k0 = max(0, int(math.floor((z - radius - oz) / dz - 0.5)))
-            k1 = min(nz - 1, int(math.floor((z + radius - oz) / dz - 0.5)) + 1)
-            na = i1 - i0 + 1
-            nb = j1 - j0 + 1
-            nc = k1 - k0 + 1
-            _axis_weights(ox + (i0 + 0.5) * dx - x, dx, na, inv_two_w2, step_x, direct_x, qx, gx)
-            _axis_weights(oy + (j0 + 0.5) * dy - y, dy, nb, inv_two_w2, step_y, direct_y, qy, gy)
-            _axis_weights(oz + (k0 + 0.5) * dz - z, dz, nc, inv_two_w2, step_z, direct_z, qz, gz)
-            count = 0
-            total = 0.0
-            for a in range(na):
-                for b in range(nb):
-                    qab = qx[a] + qy[b]
-                    if qab > radius2:
-                        continue
-                    gab = gx[a] * gy[b]
-                    base = ((i0 + a) * ny + (j0 + b)) * nz + k0
-                    # Branch-free: every node of the column is written to the next free slot,
-                    # which only advances (count += inside) when the node is inside the sphere.
-                    for c in range(nc):
-                        q = qab + qz[c]
-                        inside = q <= radius2
-                        if lucy:
-                            s = math.sqrt(q) * inv_radius
-                            t = 1.0 - s
-                            w = (1.0 + 3.0 * s) * t * t * t
-                        else:
-                            w = gab * gz[c] - shift
-                        w = max(w, 0.0) * inside
-                        nodes[count] = base + c
-                        weights[count] = w
-                        total += w
-                        count += inside
-            if total > 0.0:
-                scale = 1.0 / total
-                for e in range(count):
-                    node = nodes[e]
-                    w = weights[e] * scale
-                    for v in range(n_values):
-                        out[node, v] += w * values[p, v]
-            else:
-                # Kernel narrower than the grid: bin into the containing cell.
-                i = min(nx - 1, max(0, int(math.floor((x - ox) / dx))))
-                j = min(ny - 1, max(0, int(math.floor((y - oy) / dy))))
-                k = min(nz - 1, max(0, int(math.floor((z - oz) / dz))))
-                node = (i * ny + j) * nz + k
+@numba.njit(cache=True, fastmath=False, nogil=True)
+def _deposit_compiled(positions, values, origin, spacing, shape, width, radius, lucy, shift, out):  # pragma: no cover
+    """Compiled deposition; see :func:`deposit`. ``out`` (n_nodes, n_values) is incremented."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    dx, dy, dz = spacing[0], spacing[1], spacing[2]
+    n_values = values.shape[1]
+    radius2 = radius * radius
+    inv_two_w2 = 0.5 / (width * width)
+    inv_radius = 1.0 / radius
+    step_x = math.exp(-dx * dx * 2.0 * inv_two_w2)
+    step_y = math.exp(-dy * dy * 2.0 * inv_two_w2)
+    step_z = math.exp(-dz * dz * 2.0 * inv_two_w2)
+    # The recurrence is used only where none of its factors can overflow or underflow
+    # (exponents below 600); otherwise each weight is evaluated directly.
+    direct_x = (radius + 3.0 * dx) ** 2 * inv_two_w2 > 600.0
+    direct_y = (radius + 3.0 * dy) ** 2 * inv_two_w2 > 600.0
+    direct_z = (radius + 3.0 * dz) ** 2 * inv_two_w2 > 600.0
+    mx = min(nx, int(2.0 * radius / dx) + 3)
+    my = min(ny, int(2.0 * radius / dy) + 3)
+    mz = min(nz, int(2.0 * radius / dz) + 3)
+    gx = np.empty(mx)
+    gy = np.empty(my)
+    gz = np.empty(mz)
+    qx = np.empty(mx)
+    qy = np.empty(my)
+    qz = np.empty(mz)
+    nodes = np.empty(mx * my * mz + 1, dtype=np.int64)
+    weights = np.empty(mx * my * mz + 1)
+    for p in range(positions.shape[0]):
+        x = positions[p, 0]
+        y = positions[p, 1]
+        z = positions[p, 2]
+        i0 = max(0, int(math.floor((x - radius - ox) / dx - 0.5)))
+        i1 = min(nx - 1, int(math.floor((x + radius - ox) / dx - 0.5)) + 1)
+        j0 = max(0, int(math.floor((y - radius - oy) / dy - 0.5)))
+        j1 = min(ny - 1, int(math.floor((y + radius - oy) / dy - 0.5)) + 1)
+        k0 = max(0, int(math.floor((z - radius - oz) / dz - 0.5)))
+        k1 = min(nz - 1, int(math.floor((z + radius - oz) / dz - 0.5)) + 1)
+        na = i1 - i0 + 1
+        nb = j1 - j0 + 1
+        nc = k1 - k0 + 1
+        _axis_weights(ox + (i0 + 0.5) * dx - x, dx, na, inv_two_w2, step_x, direct_x, qx, gx)
+        _axis_weights(oy + (j0 + 0.5) * dy - y, dy, nb, inv_two_w2, step_y, direct_y, qy, gy)
+        _axis_weights(oz + (k0 + 0.5) * dz - z, dz, nc, inv_two_w2, step_z, direct_z, qz, gz)
+        count = 0
+        total = 0.0
+        for a in range(na):
+            for b in range(nb):
+                qab = qx[a] + qy[b]
+                if qab > radius2:
+                    continue
+                gab = gx[a] * gy[b]
+                base = ((i0 + a) * ny + (j0 + b)) * nz + k0
+                # Branch-free: every node of the column is written to the next free slot,
+                # which only advances (count += inside) when the node is inside the sphere.
+                for c in range(nc):
+                    q = qab + qz[c]
+                    inside = q <= radius2
+                    if lucy:
+                        s = math.sqrt(q) * inv_radius
+                        t = 1.0 - s
+                        w = (1.0 + 3.0 * s) * t * t * t
+                    else:
+                        w = gab * gz[c] - shift
+                    w = max(w, 0.0) * inside
+                    nodes[count] = base + c
+                    weights[count] = w
+                    total += w
+                    count += inside
+        if total > 0.0:
+            scale = 1.0 / total
+            for e in range(count):
+                node = nodes[e]
+                w = weights[e] * scale
                 for v in range(n_values):
-                    out[node, v] += values[p, v]
+                    out[node, v] += w * values[p, v]
+        else:
+            # Kernel narrower than the grid: bin into the containing cell.
+            i = min(nx - 1, max(0, int(math.floor((x - ox) / dx))))
+            j = min(ny - 1, max(0, int(math.floor((y - oy) / dy))))
+            k = min(nz - 1, max(0, int(math.floor((z - oz) / dz))))
+            node = (i * ny + j) * nz + k
+            for v in range(n_values):
+                out[node, v] += values[p, v]
 
 
 def _deposit_numpy(positions, values, origin, spacing, shape, width, radius, lucy, shift, out, chunk_entries=2_000_000):
@@ -664,7 +389,8 @@ def deposit(
 ) -> np.ndarray:
     """Spread per-point values onto the grid nodes with discretely normalised kernel weights.
 
-    This is the building block of :func:`coarse_grain` and :func:`contact_stress`: node n
+    This is the building block of :func:`coarse_grain` and
+    :func:`analysis.numerics.contact_stress.contact_stress`: node n
     receives ``sum_p phi_pn values[p]`` where, for every point p, the weights ``phi_pn`` over
     the nodes sum to exactly 1 (see the module notes on normalisation and walls). Divide by
     the cell volume to get a density.
@@ -684,7 +410,7 @@ def deposit(
     kernel : {"gaussian", "gaussian_shifted", "lucy"}, optional
         Kernel (see the module notes).
     backend : {"auto", "numba", "numpy"}, optional
-        Compiled loop (default when numba is installed) or the numpy fallback.
+        Compiled loop (the default) or the numpy fallback.
 
     Returns
     -------
@@ -784,7 +510,7 @@ def coarse_grain(
     velocities = finite_array("velocities", velocities, ndim=2)
     if velocities.shape != (n, 3):
         raise ValueError(f"velocities must have shape ({n}, 3), got {velocities.shape}")
-    density_threshold = _threshold(density_threshold)
+    density_threshold = checked_density_threshold(density_threshold)
     if not isinstance(grid, Grid):
         raise ValueError(f"grid must be a Grid, got {type(grid).__name__}")
 
@@ -796,200 +522,3 @@ def coarse_grain(
     sums = deposit(positions, values, grid, width, cutoff, kernel, backend)
     return _fields_from_sums(grid, sums, density_threshold)
 
-
-def _gauss_legendre_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
-    nodes, weights = np.polynomial.legendre.leggauss(n)
-    return 0.5 * (nodes + 1.0), 0.5 * weights
-
-
-def contact_stress(
-    grid: Grid,
-    contact_positions_i,
-    contact_positions_j,
-    forces_ij,
-    width: float,
-    cutoff: float = DEFAULT_CUTOFF,
-    kernel: str = "gaussian",
-    n_quadrature: int = 3,
-    backend: str = "auto",
-) -> np.ndarray:
-    """Contact stress field from pair forces and branch vectors, compression positive.
-
-    ``sigma_c(n) = -sum_c f_ij (x) r_ij  int_0^1 phi(x_n - x_i - s r_ij) ds / V_cell``
-
-    with ``r_ij = x_j - x_i`` the branch vector from particle i to particle j and ``f_ij``
-    the force **on i exerted by j**. A repulsive (compressive) contact has ``f_ij`` pointing
-    from j to i, against ``r_ij``, so ``-f_ij (x) r_ij`` has a positive trace: compression is
-    positive. (Goldhirsch's tension-positive form is ``+1/2 sum_ij f_ij (x) r_ij ...`` over
-    ordered pairs with ``r_ij = x_i - x_j``; here each contact is listed once.)
-
-    Parameters
-    ----------
-    grid : Grid
-        Target grid.
-    contact_positions_i, contact_positions_j : array_like, shape (c, 3)
-        Centres of the two particles of each contact [m] (for clumps: the centres of the
-        touching spheres, or the clump centres for a clump-level branch).
-    forces_ij : array_like, shape (c, 3)
-        Force on particle i by particle j [N].
-    width : float
-        Kernel standard deviation w [m].
-    cutoff : float, optional
-        Gaussian cut-off in units of w (default 3).
-    kernel : {"gaussian", "gaussian_shifted", "lucy"}, optional
-        Kernel.
-    n_quadrature : int, optional
-        Gauss-Legendre points along each branch (default 3, exact for the part of the
-        kernel that is a polynomial of degree 5 along the branch; branches are about one
-        particle diameter, shorter than the kernel support, so 3 points are ample).
-    backend : {"auto", "numba", "numpy"}, optional
-        Compiled loop or numpy fallback.
-
-    Returns
-    -------
-    numpy.ndarray, shape (nx, ny, nz, 3, 3)
-        Contact stress [Pa]; ``[..., a, b] = -sum f_a r_b ...``. Not symmetric in general
-        (tangential forces); symmetrise if needed.
-
-    Notes
-    -----
-    The line integral is evaluated with ``n_quadrature`` points ``x_i + s_q r_ij`` and weights
-    ``omega_q`` (summing to 1); each point is deposited with the discretely normalised kernel,
-    so ``sum(sigma_c) * V_cell = -sum_c f_ij (x) r_ij`` exactly for contacts inside the box.
-    Quadrature points outside the grid box are dropped (their share of the branch is lost),
-    e.g. contacts across the outlet plane.
-    """
-    if not isinstance(grid, Grid):
-        raise ValueError(f"grid must be a Grid, got {type(grid).__name__}")
-    first = points3("contact_positions_i", contact_positions_i)
-    second = points3("contact_positions_j", contact_positions_j)
-    forces = points3("forces_ij", forces_ij)
-    if second.shape != first.shape or forces.shape != first.shape:
-        raise ValueError(
-            "contact_positions_i, contact_positions_j and forces_ij must have the same shape, got "
-            f"{first.shape}, {second.shape} and {forces.shape}"
-        )
-    if isinstance(n_quadrature, bool) or int(n_quadrature) != n_quadrature or n_quadrature < 1:
-        raise ValueError(f"n_quadrature must be an integer >= 1, got {n_quadrature!r}")
-    n_quadrature = int(n_quadrature)
-
-    branch = second - first
-    tensor = -(forces[:, :, None] * branch[:, None, :]).reshape(-1, 9)
-    s, omega = _gauss_legendre_unit(n_quadrature)
-    points = (first[None, :, :] + s[:, None, None] * branch[None, :, :]).reshape(-1, 3)
-    values = (omega[:, None, None] * tensor[None, :, :]).reshape(-1, 9)
-    sums = deposit(points, values, grid, width, cutoff, kernel, backend)
-    return sums.reshape(grid.shape + (3, 3)) / grid.cell_volume
-
-
-# --------------------------------------------------------------------------- averages and slices
-
-
-def average_fields(fields: Sequence[Fields], density_threshold: float | None = None) -> Fields:
-    """Time average of fields on the same grid.
-
-    Density, momentum density and kinetic stress are arithmetic means over the frames; the
-    velocity is the mass-weighted mean ``mean(p) / mean(rho)`` (not the mean of the frame
-    velocities), masked as in :func:`coarse_grain`. The kinetic stress is the mean of the
-    instantaneous kinetic stresses (fluctuations about each frame's own node velocity);
-    velocity fluctuations between frames are not added to it.
-
-    Parameters
-    ----------
-    fields : sequence of Fields
-        At least one frame, all on the same grid.
-    density_threshold : float, optional
-        Mask threshold of the result; default: that of the first frame.
-
-    Returns
-    -------
-    Fields
-    """
-    fields = list(fields)
-    if not fields:
-        raise ValueError("fields must contain at least one Fields")
-    if not all(isinstance(item, Fields) for item in fields):
-        raise ValueError("fields must contain only Fields")
-    grid = fields[0].grid
-    for index, item in enumerate(fields):
-        if item.grid != grid:
-            raise ValueError(f"fields: frame {index} is on a different grid ({item.grid}) than frame 0 ({grid})")
-    threshold = fields[0].density_threshold if density_threshold is None else _threshold(density_threshold)
-    count = len(fields)
-    density = sum(item.density for item in fields) / count
-    momentum = sum(item.momentum_density for item in fields) / count
-    kinetic = sum(item.kinetic_stress for item in fields) / count
-    return _assemble_fields(grid, density, momentum, kinetic, threshold)
-
-
-def depth_average(fields: Fields) -> Fields:
-    """Average over the depth (y): one layer of nodes, shape (nx, 1, nz).
-
-    Density, momentum density and kinetic stress are means over the y nodes; the velocity is
-    density-weighted, ``sum_y p / sum_y rho``, masked as in :func:`coarse_grain`. The returned
-    grid spans the same box with one cell in y (``spacing_y = T``), so its single node lies at
-    mid-depth.
-    """
-    if not isinstance(fields, Fields):
-        raise ValueError(f"fields must be a Fields, got {type(fields).__name__}")
-    grid = fields.grid
-    ny = grid.shape[1]
-    flat = Grid(
-        origin=grid.origin,
-        spacing=(grid.spacing[0], grid.spacing[1] * ny, grid.spacing[2]),
-        shape=(grid.shape[0], 1, grid.shape[2]),
-    )
-    density = fields.density.mean(axis=1, keepdims=True)
-    momentum = fields.momentum_density.mean(axis=1, keepdims=True)
-    kinetic = fields.kinetic_stress.mean(axis=1, keepdims=True)
-    mask, velocity = _mask_and_velocity(density, momentum, fields.density_threshold)
-    return Fields(
-        grid=flat,
-        density=density,
-        momentum_density=momentum,
-        velocity=velocity,
-        kinetic_stress=kinetic,
-        mask=mask,
-        density_threshold=fields.density_threshold,
-    )
-
-
-def front_wall_slice(fields: Fields, wall_y: float = 0.0) -> Fields:
-    """The layer of nodes nearest the front wall (y = 0, the camera side), shape (nx, 1, nz).
-
-    Parameters
-    ----------
-    fields : Fields
-        Fields on a grid with any number of y layers.
-    wall_y : float, optional
-        y of the front wall [m] (default 0).
-
-    Returns
-    -------
-    Fields
-        The node layer nearest ``wall_y`` (the first layer when the grid starts at the wall,
-        i.e. the nodes at ``y = dy / 2``), values unchanged; its grid is that single cell
-        layer, so the node keeps its y coordinate.
-    """
-    if not isinstance(fields, Fields):
-        raise ValueError(f"fields must be a Fields, got {type(fields).__name__}")
-    wall_y = float(wall_y)
-    if not math.isfinite(wall_y):
-        raise ValueError(f"wall_y must be finite, got {wall_y!r}")
-    grid = fields.grid
-    layer = int(np.argmin(np.abs(grid.y - wall_y)))
-    sliced = Grid(
-        origin=(grid.origin[0], grid.origin[1] + layer * grid.spacing[1], grid.origin[2]),
-        spacing=grid.spacing,
-        shape=(grid.shape[0], 1, grid.shape[2]),
-    )
-    pick = slice(layer, layer + 1)
-    return Fields(
-        grid=sliced,
-        density=fields.density[:, pick],
-        momentum_density=fields.momentum_density[:, pick],
-        velocity=fields.velocity[:, pick],
-        kinetic_stress=fields.kinetic_stress[:, pick],
-        mask=fields.mask[:, pick],
-        density_threshold=fields.density_threshold,
-    )

@@ -4,13 +4,13 @@ Pure computation on numpy arrays; no file I/O. SI units: m, m/s, s, kg.
 
 The method of SEED_DIGEST section 4 ("RTD from Eulerian fields"):
 
-1. Split the silo into bins (a regular grid, :class:`analysis.numerics.coarse_graining.Grid`) and take, at every
+1. Split the silo into bins (a regular grid, :class:`analysis.numerics.grid.Grid`) and take, at every
    saved instant, the mass-weighted mean velocity of the clumps whose centres lie in each bin
    (:func:`bin_velocity_series`). A bin that is empty at an instant (a dilute falling stream, the
    free surface) takes its mass-weighted velocity over all instants; a bin that is never occupied gets
    zero velocity, so a tracer there stays put.
 2. Place virtual tracers on a lattice in the inlet bins, the top row of bins above the outlet
-   (:func:`inlet_bins`, :func:`analysis.numerics.pathlines.lattice_seeds`); in the recirculating silo the
+   (:func:`inlet_bins`, :func:`analysis.numerics.tracer_seeds.lattice_seeds`); in the recirculating silo the
    re-entering clumps fall through them.
 3. Integrate ``x(t + dt) = x(t) + v(x, t) dt`` with the velocity interpolated trilinearly between bin
    centres and linearly in time (:func:`analysis.numerics.pathlines.integrate_pathlines`), and take the time to
@@ -24,8 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.checks import finite_array, positive_number
-from analysis.numerics.coarse_graining import Grid
-from analysis.numerics.pathlines import PathlineResult, integrate_pathlines, lattice_seeds
+from analysis.numerics.grid import Grid
+from analysis.numerics.pathlines import PathlineResult, integrate_pathlines
+from analysis.numerics.tracer_seeds import lattice_seeds
 
 __all__ = ["silo_bins", "bin_sums", "bin_velocity_series", "inlet_bins", "EulerianRTD", "eulerian_residence_times"]
 

@@ -31,6 +31,8 @@ Discontinuous (recirculation) mode
     The output of pass n is the input of pass n + 1 (:func:`recirculate`); the number of
     recirculations until the outlet concentration stays within +-10 % of its mean
     (:func:`recirculations_to_homogenise`).
+Recycle of a measured first pass (Carson and Royal)
+    The outflow of each pass of a unit pulse, by repeated convolution (:func:`carson_royal_recycle`).
 """
 
 from __future__ import annotations
@@ -39,8 +41,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import convolve
 
 from analysis.checks import finite_array, finite_number, non_negative_number, positive_number, uniform_step
+from analysis.numerics.rtd import rtd_moments
 
 __all__ = [
     "VRRTable",
@@ -53,11 +57,8 @@ __all__ = [
     "vrr_versus_period",
     "recirculate",
     "recirculations_to_homogenise",
+    "carson_royal_recycle",
 ]
-
-_DIRECT_LIMIT = 4_000_000
-"""Largest ``len(c_in) * len(E)`` convolved directly in ``method="auto"``; larger use FFT."""
-
 
 
 # --------------------------------------------------------------------------- results
@@ -141,18 +142,12 @@ class Recirculation:
 # --------------------------------------------------------------------------- validation
 
 
-
-
-
-
 def _count(name: str, value, minimum: int = 1) -> int:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer, float)) or int(value) != value:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
     if int(value) < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(value)
-
-
 
 
 def _unit_area(e: np.ndarray, dt: float) -> np.ndarray:
@@ -167,15 +162,6 @@ def _method(method: str) -> str:
     if method not in ("auto", "direct", "fft"):
         raise ValueError(f"method must be 'auto', 'direct' or 'fft', got {method!r}")
     return method
-
-
-def _full_convolution(a: np.ndarray, b: np.ndarray, method: str) -> np.ndarray:
-    """``np.convolve(a, b)`` (length ``len(a) + len(b) - 1``), directly or by FFT."""
-    if method == "direct" or (method == "auto" and a.size * b.size <= _DIRECT_LIMIT):
-        return np.convolve(a, b)
-    from scipy.signal import fftconvolve
-
-    return fftconvolve(a, b)
 
 
 # --------------------------------------------------------------------------- convolution
@@ -203,8 +189,8 @@ def convolve_with_rtd(time, c_in, E, c_before: float = 0.0, method: str = "auto"
         Input concentration before ``time[0]``; default 0 (the silo holds only material of
         concentration 0 at the start).
     method : {"auto", "direct", "fft"}, optional
-        Direct sum (exact to round-off) or FFT (``scipy.signal.fftconvolve``; error about
-        1e-16 of the largest term). ``"auto"`` (default) sums directly when ``n * m <= 4e6``.
+        Passed to :func:`scipy.signal.convolve`: the direct sum (exact to round-off), FFT (error
+        about 1e-16 of the largest term) or ``"auto"`` (default), scipy's choice of the faster one.
 
     Returns
     -------
@@ -221,7 +207,7 @@ def convolve_with_rtd(time, c_in, E, c_before: float = 0.0, method: str = "auto"
         raise ValueError("E must have at least 1 sample")
     c_before = finite_number("c_before", c_before)
     method = _method(method)
-    out = dt * _full_convolution(c, e, method)[: c.size]
+    out = dt * convolve(c, e, method=method)[: c.size]
     if c_before != 0.0:
         # sum_{k=n+1}^{m-1} E[k] for n = 0 .. N-1 (zero once n >= m - 1)
         tail = np.cumsum(e[::-1])[::-1]  # tail[j] = sum_{k>=j} E[k]
@@ -416,8 +402,6 @@ def vrr_versus_period(
     -------
     VRRTable
     """
-    from analysis.numerics.rtd import rtd_moments
-
     t = finite_array("time", time, ndim=1)
     dt = uniform_step("time", t)
     if abs(t[0]) > 1.0e-9 * dt:
@@ -516,7 +500,7 @@ def recirculate(c_first_input, E, time, passes: int, normalise: bool = True, met
     outputs = []
     current = c
     for _ in range(passes + 1):
-        current = dt * _full_convolution(current, e, method)
+        current = dt * convolve(current, e, method=method)
         outputs.append(current)
     next_pass_full = outputs.pop()
     length = outputs[-1].size
@@ -575,3 +559,50 @@ def recirculations_to_homogenise(c, mean=None, tolerance: float = 0.10, per_pass
     hits = np.flatnonzero(outside)
     start = 0 if hits.size == 0 else int(hits[-1]) + 1
     return start / per_pass_length
+
+
+# --------------------------------------------------------------------------- recycle of a measured first pass
+
+
+def carson_royal_recycle(first_pass_E, time, passes: int) -> np.ndarray:
+    """Carson and Royal's recycle blending: the outflow after each pass from a measured first-pass curve.
+
+    Material recycled from the outlet back to the inlet makes a second, third, ... pass through
+    the bin. With a linear, time-invariant bin whose single-pass RTD is the measured first-pass
+    curve ``E1``, the outflow of a unit tracer pulse injected at t = 0 is, for its n-th pass, the
+    n-fold convolution ``E_n = E1 * E1 * ... * E1`` (n factors), and the outlet concentration of the
+    closed recycle loop is ``sum_n E_n``. Each convolution is the discrete rule of
+    :func:`convolve_with_rtd`: ``E_{n+1}[j] = dt sum_k E_n[j - k] E1[k]``.
+
+    Parameters
+    ----------
+    first_pass_E : array_like, shape (m,)
+        First-pass RTD sampled at residence times ``time`` [1/s].
+    time : array_like, shape (m,)
+        Uniform residence-time axis starting at 0: ``time[k] = k dt`` [s]. (For a histogram from
+        :func:`analysis.numerics.rtd.rtd_from_exit_times` with equal bins starting at 0, use its left edges
+        ``rtd.edges[:-1]``.)
+    passes : int
+        Number of passes, >= 1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (passes, m)
+        Row ``n - 1`` is the outflow of the n-th pass ``E_n`` on ``time`` [1/s] (row 0 is the input
+        curve). Parts of ``E_n`` beyond ``time[-1]`` are cut off, so the axis must be long enough for
+        the passes wanted (``sum(E_n) dt`` falls below ``sum(E1) dt`` when it is not).
+        ``rows.sum(axis=0)`` is the outlet concentration of the recycle loop after a unit pulse.
+    """
+    t = finite_array("time", time, ndim=1)
+    dt = uniform_step("time", t)
+    if abs(t[0]) > 1.0e-9 * dt:
+        raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
+    e1 = finite_array("first_pass_E", first_pass_E, ndim=1)
+    if e1.shape != t.shape:
+        raise ValueError(f"first_pass_E must have the shape of time {t.shape}, got {e1.shape}")
+    passes = _count("passes", passes)
+    rows = np.empty((passes, t.size))
+    rows[0] = e1
+    for n in range(1, passes):
+        rows[n] = convolve_with_rtd(t, rows[n - 1], e1)
+    return rows

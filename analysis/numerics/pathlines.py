@@ -5,14 +5,15 @@ times in s.
 
 The method of SEED_DIGEST section 4 ("RTD from Eulerian fields"): bin-averaged (coarse-grained)
 velocities are saved at instants ``t_k``; virtual tracers seeded on a lattice
-(:func:`lattice_seeds`) are integrated through the interpolated field, and the residence time of a
-tracer is the time it takes to cross the outlet plane ``z = outlet_z``. The residence times feed
-:func:`analysis.numerics.rtd.rtd_from_exit_times` (NaN marks tracers that never left).
+(:func:`analysis.numerics.tracer_seeds.lattice_seeds`) are integrated through the interpolated field,
+and the residence time of a tracer is the time it takes to cross the outlet plane ``z = outlet_z``.
+The residence times feed :func:`analysis.numerics.rtd.rtd_from_exit_times` (NaN marks tracers that
+never left).
 
 Fields and interpolation
 ------------------------
 ``velocities`` has shape ``(n_times, nx, ny, nz, 3)``: the velocity at the cell centres of a regular
-lattice (the nodes of :class:`analysis.numerics.coarse_graining.Grid`), node (i, j, k) at
+lattice (the nodes of :class:`analysis.numerics.grid.Grid`), node (i, j, k) at
 ``origin + (i + 0.5, j + 0.5, k + 0.5) * spacing``, at the strictly increasing instants ``times``.
 
 - In space the velocity is **trilinear** between the 8 surrounding nodes. Outside the hull of
@@ -42,9 +43,9 @@ moving with the clamped boundary velocity.
 
 Backends
 --------
-The inner loop (tracers x steps) runs compiled with numba (``@njit``, single-threaded) when numba
-is installed, else in a vectorised numpy fallback with the same interpolation and scheme (same
-results to round-off). ``backend="numpy"`` forces the fallback. The compiled loop advances a few
+The inner loop (tracers x steps) runs compiled with numba (``@njit``, single-threaded), or with
+``backend="numpy"`` in a vectorised numpy fallback with the same interpolation and scheme (same
+results to round-off). The compiled loop advances a few
 tracers in turn, one step each, so that the CPU overlaps their independent work; every tracer
 still goes through exactly the operations it would alone. On the benchmark of
 ``tests/bench/bench_pathlines.py`` (127 x 107 x 31 grid, 5 time levels, RK2) it makes about 1.5e7
@@ -57,17 +58,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from analysis.checks import compute_backend, finite_array, finite_number, points3, positive_number, vector3
 
-try:  # pragma: no cover - exercised through both branches in the tests when numba is present
-    import numba
-
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover
-    numba = None
-    HAVE_NUMBA = False
 
 __all__ = [
     "HAVE_NUMBA",
@@ -77,7 +72,6 @@ __all__ = [
     "METHODS",
     "PathlineResult",
     "integrate_pathlines",
-    "lattice_seeds",
     "time_levels",
     "interpolate_velocity",
 ]
@@ -90,6 +84,9 @@ OUTSIDE = 2
 """Status of a seed outside the grid box or at/below the outlet plane (not integrated)."""
 
 METHODS = ("rk2", "euler")
+
+HAVE_NUMBA = True
+"""numba is a declared dependency; kept so callers can list the backends they may ask for."""
 
 
 # --------------------------------------------------------------------------- result
@@ -163,14 +160,6 @@ class PathlineResult:
 # --------------------------------------------------------------------------- validation
 
 
-
-
-
-
-
-
-
-
 def _velocity_series(velocities, times) -> tuple[np.ndarray, np.ndarray]:
     v = np.asarray(velocities)
     if v.ndim != 5 or v.shape[-1] != 3 or min(v.shape[:4]) < 1:
@@ -184,8 +173,6 @@ def _velocity_series(velocities, times) -> tuple[np.ndarray, np.ndarray]:
     if np.any(np.diff(t) <= 0.0):
         raise ValueError("times must be strictly increasing")
     return v, t
-
-
 
 
 # --------------------------------------------------------------------------- interpolation
@@ -285,159 +272,157 @@ def interpolate_velocity(points, t: float, velocities, times, origin, spacing) -
     return _interpolate_numpy(v, int(k[0]), float(w[0]), origin, 1.0 / spacing, pts)
 
 
-if HAVE_NUMBA:
+@numba.njit(cache=True, nogil=True, inline="always")
+def _blend(f, b, sx, sy, sz, fx, fy, fz, gx, gy, gz):  # pragma: no cover
+    """Trilinear blend of the 8 values ``f[b + {0, sx} + {0, sy} + {0, sz}]`` (flat field, node strides)."""
+    c00 = f[b] * gx + f[b + sx] * fx
+    c10 = f[b + sy] * gx + f[b + sx + sy] * fx
+    c01 = f[b + sz] * gx + f[b + sx + sz] * fx
+    c11 = f[b + sy + sz] * gx + f[b + sx + sy + sz] * fx
+    c0 = c00 * gy + c10 * fy
+    c1 = c01 * gy + c11 * fy
+    return c0 * gz + c1 * fz
 
-    @numba.njit(cache=True, nogil=True, inline="always")
-    def _blend(f, b, sx, sy, sz, fx, fy, fz, gx, gy, gz):  # pragma: no cover
-        """Trilinear blend of the 8 values ``f[b + {0, sx} + {0, sy} + {0, sz}]`` (flat field, node strides)."""
-        c00 = f[b] * gx + f[b + sx] * fx
-        c10 = f[b + sy] * gx + f[b + sx + sy] * fx
-        c01 = f[b + sz] * gx + f[b + sx + sz] * fx
-        c11 = f[b + sy + sz] * gx + f[b + sx + sy + sz] * fx
-        c0 = c00 * gy + c10 * fy
-        c1 = c01 * gy + c11 * fy
-        return c0 * gz + c1 * fz
+@numba.njit(cache=True, nogil=True, inline="always")
+def _sample(f, shape, k, w, ox, oy, oz, ix, iy, iz, x, y, z):  # pragma: no cover
+    """Velocity at (x, y, z) for time level k with weight w (same operations as :func:`_interpolate_numpy`).
 
-    @numba.njit(cache=True, nogil=True, inline="always")
-    def _sample(f, shape, k, w, ox, oy, oz, ix, iy, iz, x, y, z):  # pragma: no cover
-        """Velocity at (x, y, z) for time level k with weight w (same operations as :func:`_interpolate_numpy`).
+    ``f`` is the flattened field of shape (nx, ny, nz, n_times, 3): the time axis sits next to the
+    components so that both time levels of a node share cache lines. Offsets are unsigned, so
+    the compiled code does no negative-index wraparound.
+    """
+    nx = shape[0]
+    ny = shape[1]
+    nz = shape[2]
+    nt = shape[3]
+    sx = min(max((x - ox) * ix - 0.5, 0.0), nx - 1.0)
+    sy = min(max((y - oy) * iy - 0.5, 0.0), ny - 1.0)
+    sz = min(max((z - oz) * iz - 0.5, 0.0), nz - 1.0)
+    x0 = min(int(sx), max(nx - 2, 0))
+    y0 = min(int(sy), max(ny - 2, 0))
+    z0 = min(int(sz), max(nz - 2, 0))
+    fx = sx - x0
+    fy = sy - y0
+    fz = sz - z0
+    gx = 1.0 - fx
+    gy = 1.0 - fy
+    gz = 1.0 - fz
+    step_z = np.uint64(3 * nt)
+    step_y = np.uint64(nz) * step_z
+    step_x = np.uint64(ny) * step_y
+    dx = step_x if nx > 1 else np.uint64(0)
+    dy = step_y if ny > 1 else np.uint64(0)
+    dz = step_z if nz > 1 else np.uint64(0)
+    b = np.uint64(x0) * step_x + np.uint64(y0) * step_y + np.uint64(z0) * step_z + np.uint64(3 * k)
+    ux = _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz)
+    uy = _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz)
+    uz = _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz)
+    if w != 0.0:
+        rest = 1.0 - w
+        b += np.uint64(3)
+        ux = ux * rest + _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
+        uy = uy * rest + _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
+        uz = uz * rest + _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
+    return ux, uy, uz
 
-        ``f`` is the flattened field of shape (nx, ny, nz, n_times, 3): the time axis sits next to the
-        components so that both time levels of a node share cache lines. Offsets are unsigned, so
-        the compiled code does no negative-index wraparound.
-        """
-        nx = shape[0]
-        ny = shape[1]
-        nz = shape[2]
-        nt = shape[3]
-        sx = min(max((x - ox) * ix - 0.5, 0.0), nx - 1.0)
-        sy = min(max((y - oy) * iy - 0.5, 0.0), ny - 1.0)
-        sz = min(max((z - oz) * iz - 0.5, 0.0), nz - 1.0)
-        x0 = min(int(sx), max(nx - 2, 0))
-        y0 = min(int(sy), max(ny - 2, 0))
-        z0 = min(int(sz), max(nz - 2, 0))
-        fx = sx - x0
-        fy = sy - y0
-        fz = sz - z0
-        gx = 1.0 - fx
-        gy = 1.0 - fy
-        gz = 1.0 - fz
-        step_z = np.uint64(3 * nt)
-        step_y = np.uint64(nz) * step_z
-        step_x = np.uint64(ny) * step_y
-        dx = step_x if nx > 1 else np.uint64(0)
-        dy = step_y if ny > 1 else np.uint64(0)
-        dz = step_z if nz > 1 else np.uint64(0)
-        b = np.uint64(x0) * step_x + np.uint64(y0) * step_y + np.uint64(z0) * step_z + np.uint64(3 * k)
-        ux = _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz)
-        uy = _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz)
-        uz = _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz)
-        if w != 0.0:
-            rest = 1.0 - w
-            b += np.uint64(3)
-            ux = ux * rest + _blend(f, b, dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
-            uy = uy * rest + _blend(f, b + np.uint64(1), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
-            uz = uz * rest + _blend(f, b + np.uint64(2), dx, dy, dz, fx, fy, fz, gx, gy, gz) * w
-        return ux, uy, uz
+_LANES = 8
+"""Tracers advanced in lockstep by the compiled loop (independent work for the CPU to overlap)."""
 
-    _LANES = 8
-    """Tracers advanced in lockstep by the compiled loop (independent work for the CPU to overlap)."""
+@numba.njit(cache=True, nogil=True)
+def _integrate_compiled(
+    seeds, v, origin, inv_spacing, k_steps, w_steps, dt, outlet_z, euler, record_every,
+    active, history, residence, exit_position, status, n_steps,
+):  # pragma: no cover
+    """Compiled integration loop; see :func:`integrate_pathlines`. Outputs are filled in place.
 
-    @numba.njit(cache=True, nogil=True)
-    def _integrate_compiled(
-        seeds, v, origin, inv_spacing, k_steps, w_steps, dt, outlet_z, euler, record_every,
-        active, history, residence, exit_position, status, n_steps,
-    ):  # pragma: no cover
-        """Compiled integration loop; see :func:`integrate_pathlines`. Outputs are filled in place.
-
-        ``v`` has shape (nx, ny, nz, n_times, 3). A step of one tracer depends on its previous step,
-        so a single tracer leaves the CPU waiting on memory and arithmetic latency; ``_LANES``
-        tracers are therefore advanced one step each in turn, and a lane whose tracer has finished
-        takes the next tracer. Every tracer goes through exactly the same operations as alone.
-        """
-        ox, oy, oz = origin[0], origin[1], origin[2]
-        ix, iy, iz = inv_spacing[0], inv_spacing[1], inv_spacing[2]
-        shape = v.shape
-        flat = v.ravel()
-        total_steps = k_steps.size - 1
-        n_seeds = seeds.shape[0]
-        lane_p = np.full(_LANES, -1, dtype=np.int64)
-        lane_n = np.zeros(_LANES, dtype=np.int64)
-        lane_x = np.zeros(_LANES)
-        lane_y = np.zeros(_LANES)
-        lane_z = np.zeros(_LANES)
-        following = 0
-        busy = 0
-        while True:
-            # fill idle lanes with the next active seeds
-            for lane in range(_LANES):
-                if lane_p[lane] >= 0:
-                    continue
-                while following < n_seeds and not active[following]:
-                    following += 1
-                if following >= n_seeds:
-                    continue
-                p = following
+    ``v`` has shape (nx, ny, nz, n_times, 3). A step of one tracer depends on its previous step,
+    so a single tracer leaves the CPU waiting on memory and arithmetic latency; ``_LANES``
+    tracers are therefore advanced one step each in turn, and a lane whose tracer has finished
+    takes the next tracer. Every tracer goes through exactly the same operations as alone.
+    """
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    ix, iy, iz = inv_spacing[0], inv_spacing[1], inv_spacing[2]
+    shape = v.shape
+    flat = v.ravel()
+    total_steps = k_steps.size - 1
+    n_seeds = seeds.shape[0]
+    lane_p = np.full(_LANES, -1, dtype=np.int64)
+    lane_n = np.zeros(_LANES, dtype=np.int64)
+    lane_x = np.zeros(_LANES)
+    lane_y = np.zeros(_LANES)
+    lane_z = np.zeros(_LANES)
+    following = 0
+    busy = 0
+    while True:
+        # fill idle lanes with the next active seeds
+        for lane in range(_LANES):
+            if lane_p[lane] >= 0:
+                continue
+            while following < n_seeds and not active[following]:
                 following += 1
-                lane_p[lane] = p
-                lane_n[lane] = 0
-                lane_x[lane] = seeds[p, 0]
-                lane_y[lane] = seeds[p, 1]
-                lane_z[lane] = seeds[p, 2]
-                busy += 1
-                if record_every > 0:
-                    history[0, p, 0] = seeds[p, 0]
-                    history[0, p, 1] = seeds[p, 1]
-                    history[0, p, 2] = seeds[p, 2]
-            if busy == 0:
-                break
-            for lane in range(_LANES):
-                p = lane_p[lane]
-                if p < 0:
-                    continue
-                n = lane_n[lane]
-                x = lane_x[lane]
-                y = lane_y[lane]
-                z = lane_z[lane]
-                ux, uy, uz = _sample(flat, shape, k_steps[n], w_steps[n], ox, oy, oz, ix, iy, iz, x, y, z)
-                if euler:
-                    xn = x + dt * ux
-                    yn = y + dt * uy
-                    zn = z + dt * uz
-                else:
-                    px = x + dt * ux
-                    py = y + dt * uy
-                    pz = z + dt * uz
-                    vx, vy, vz = _sample(flat, shape, k_steps[n + 1], w_steps[n + 1], ox, oy, oz, ix, iy, iz, px, py, pz)
-                    xn = x + 0.5 * dt * (ux + vx)
-                    yn = y + 0.5 * dt * (uy + vy)
-                    zn = z + 0.5 * dt * (uz + vz)
-                if zn <= outlet_z:
-                    frac = (z - outlet_z) / (z - zn)
-                    residence[p] = (n + frac) * dt
-                    exit_position[p, 0] = x + frac * (xn - x)
-                    exit_position[p, 1] = y + frac * (yn - y)
-                    exit_position[p, 2] = outlet_z
-                    status[p] = 0
-                    n_steps[p] = n + 1
-                    lane_p[lane] = -1
-                    busy -= 1
-                    continue
-                n += 1
-                lane_n[lane] = n
-                lane_x[lane] = xn
-                lane_y[lane] = yn
-                lane_z[lane] = zn
-                if record_every > 0 and n % record_every == 0:
-                    row = n // record_every
-                    history[row, p, 0] = xn
-                    history[row, p, 1] = yn
-                    history[row, p, 2] = zn
-                if n == total_steps:
-                    status[p] = 1
-                    n_steps[p] = total_steps
-                    lane_p[lane] = -1
-                    busy -= 1
+            if following >= n_seeds:
+                continue
+            p = following
+            following += 1
+            lane_p[lane] = p
+            lane_n[lane] = 0
+            lane_x[lane] = seeds[p, 0]
+            lane_y[lane] = seeds[p, 1]
+            lane_z[lane] = seeds[p, 2]
+            busy += 1
+            if record_every > 0:
+                history[0, p, 0] = seeds[p, 0]
+                history[0, p, 1] = seeds[p, 1]
+                history[0, p, 2] = seeds[p, 2]
+        if busy == 0:
+            break
+        for lane in range(_LANES):
+            p = lane_p[lane]
+            if p < 0:
+                continue
+            n = lane_n[lane]
+            x = lane_x[lane]
+            y = lane_y[lane]
+            z = lane_z[lane]
+            ux, uy, uz = _sample(flat, shape, k_steps[n], w_steps[n], ox, oy, oz, ix, iy, iz, x, y, z)
+            if euler:
+                xn = x + dt * ux
+                yn = y + dt * uy
+                zn = z + dt * uz
+            else:
+                px = x + dt * ux
+                py = y + dt * uy
+                pz = z + dt * uz
+                vx, vy, vz = _sample(flat, shape, k_steps[n + 1], w_steps[n + 1], ox, oy, oz, ix, iy, iz, px, py, pz)
+                xn = x + 0.5 * dt * (ux + vx)
+                yn = y + 0.5 * dt * (uy + vy)
+                zn = z + 0.5 * dt * (uz + vz)
+            if zn <= outlet_z:
+                frac = (z - outlet_z) / (z - zn)
+                residence[p] = (n + frac) * dt
+                exit_position[p, 0] = x + frac * (xn - x)
+                exit_position[p, 1] = y + frac * (yn - y)
+                exit_position[p, 2] = outlet_z
+                status[p] = 0
+                n_steps[p] = n + 1
+                lane_p[lane] = -1
+                busy -= 1
+                continue
+            n += 1
+            lane_n[lane] = n
+            lane_x[lane] = xn
+            lane_y[lane] = yn
+            lane_z[lane] = zn
+            if record_every > 0 and n % record_every == 0:
+                row = n // record_every
+                history[row, p, 0] = xn
+                history[row, p, 1] = yn
+                history[row, p, 2] = zn
+            if n == total_steps:
+                status[p] = 1
+                n_steps[p] = total_steps
+                lane_p[lane] = -1
+                busy -= 1
 
 
 def _integrate_numpy(
@@ -504,7 +489,7 @@ def integrate_pathlines(
     Parameters
     ----------
     seeds : array_like, shape (n, 3)
-        Release positions [m] (e.g. :func:`lattice_seeds`).
+        Release positions [m] (e.g. :func:`analysis.numerics.tracer_seeds.lattice_seeds`).
     t0 : float
         Release time [s] (on the clock of ``times``).
     velocities : array_like, shape (n_times, nx, ny, nz, 3)
@@ -527,7 +512,7 @@ def integrate_pathlines(
         Record positions every this many steps (0, the default: no history). The history holds
         ``ceil(max_time / dt) // record_every + 1`` rows of ``n`` positions: mind the memory.
     backend : {"auto", "numba", "numpy"}, optional
-        Compiled loop (default when numba is installed) or the numpy fallback.
+        Compiled loop (the default) or the numpy fallback.
 
     Returns
     -------
@@ -601,64 +586,3 @@ def integrate_pathlines(
         history_time=history_time,
         history=history if record_every > 0 else None,
     )
-
-
-# --------------------------------------------------------------------------- seeds
-
-
-def lattice_seeds(region_lower, region_upper, count=None, spacing=None) -> np.ndarray:
-    """Virtual tracers on a regular lattice filling a box region (e.g. an inlet bin).
-
-    The region is split into ``n_x x n_y x n_z`` equal cells and a tracer is put at each cell
-    centre ``lower + (i + 0.5) (upper - lower) / n`` per axis. A flat axis (``upper == lower``)
-    gets one tracer at that coordinate.
-
-    Parameters
-    ----------
-    region_lower, region_upper : array_like, shape (3,)
-        Opposite corners of the region, ``upper >= lower`` per axis [m].
-    count : int or array_like of 3 int, optional
-        Three ints: tracers per axis (exact). One int ``N``: an approximately cubic lattice with
-        about ``N`` tracers, ``n_a = max(1, round(L_a / h))`` with ``h = (prod L / N)^(1/d)`` over the
-        ``d`` non-flat axes (the product is close to ``N`` but not always equal; pass three ints
-        for an exact count, e.g. from bulk density and tracer volume).
-    spacing : float or array_like of 3 float, optional
-        Wanted lattice spacing [m]: ``n_a = max(1, round(L_a / spacing_a))``. Give exactly one of
-        ``count`` and ``spacing``.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n_x n_y n_z, 3)
-        Positions [m], x index slowest and z fastest.
-    """
-    lower = vector3("region_lower", region_lower, positive=False, scalar_to_all=True)
-    upper = vector3("region_upper", region_upper, positive=False, scalar_to_all=True)
-    if np.any(upper < lower):
-        raise ValueError(f"region_upper must be >= region_lower per axis, got {lower.tolist()} and {upper.tolist()}")
-    if (count is None) == (spacing is None):
-        raise ValueError("give exactly one of count and spacing")
-    lengths = upper - lower
-    flat = lengths == 0.0
-    if count is not None:
-        counts = np.asarray(count)
-        if counts.ndim == 0:
-            if isinstance(count, (bool, np.bool_)) or not np.issubdtype(counts.dtype, np.number) or int(count) != count or int(count) < 1:
-                raise ValueError(f"count must be an integer >= 1 or 3 integers >= 1, got {count!r}")
-            total = int(count)
-            dims = int(np.count_nonzero(~flat))
-            per_axis = np.ones(3, dtype=np.int64)
-            if dims:
-                h = (float(np.prod(lengths[~flat])) / total) ** (1.0 / dims)
-                per_axis[~flat] = np.maximum(1, np.round(lengths[~flat] / h)).astype(np.int64)
-        else:
-            if counts.shape != (3,) or counts.dtype == bool or not np.issubdtype(counts.dtype, np.number) or np.any(counts != np.round(counts)) or np.any(counts < 1):
-                raise ValueError(f"count must be an integer >= 1 or 3 integers >= 1, got {count!r}")
-            per_axis = counts.astype(np.int64)
-            if np.any(per_axis[flat] != 1):
-                raise ValueError("count must be 1 along a flat axis of the region (upper == lower)")
-    else:
-        step = vector3("spacing", spacing, positive=True, scalar_to_all=True)
-        per_axis = np.maximum(1, np.round(lengths / step)).astype(np.int64)
-    axes = [lower[a] + (np.arange(per_axis[a]) + 0.5) * lengths[a] / per_axis[a] for a in range(3)]
-    grids = np.meshgrid(*axes, indexing="ij")
-    return np.stack([g.ravel() for g in grids], axis=1)

@@ -1,7 +1,8 @@
-"""Velocity profiles across the silo, flow channel boundary, kinematic model, flow rate, Janssen.
+"""Velocity profiles across the silo: profiles at a height, flow channel boundary, flow rate, comparison.
 
-Pure functions on numpy arrays and :class:`analysis.numerics.coarse_graining.Fields`; no file I/O.
-All quantities are SI: lengths in m, velocities in m/s, densities in kg/m3, stresses in Pa.
+Pure functions on numpy arrays and :class:`analysis.numerics.grid.Fields`; no file I/O. All
+quantities are SI: lengths in m, velocities in m/s, densities in kg/m3. The kinematic model fitted to
+the profiles is :mod:`analysis.numerics.kinematic`, Janssen's stress :mod:`analysis.numerics.janssen`.
 
 Coordinates follow the project convention: x across the silo width (x = 0 on the axis),
 y front-to-back depth (y = 0 the front wall), z up with z = 0 at the outlet plane. A
@@ -14,24 +15,19 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import trapezoid
 
-from analysis.checks import finite_array, non_negative_number, positive_number
-from analysis.numerics.coarse_graining import Fields
+from analysis.checks import finite_array, positive_number
+from analysis.numerics.grid import Fields
 
 __all__ = [
     "VelocityProfile",
     "FlowChannelBoundary",
-    "KinematicFit",
     "ProfileErrors",
+    "checked_profile",
     "velocity_profile",
     "flow_channel_boundary",
-    "fit_kinematic_constant",
-    "kinematic_velocity",
-    "kinematic_horizontal_velocity",
     "profile_flow_rate",
-    "janssen_coefficient",
-    "janssen_characteristic_depth",
-    "janssen_vertical_stress",
     "profile_errors",
 ]
 
@@ -39,11 +35,8 @@ __all__ = [
 # --------------------------------------------------------------------------- validation
 
 
-
-
-
-
-def _profile(x, v, v_name: str = "v_z", min_points: int = 2) -> tuple[np.ndarray, np.ndarray]:
+def checked_profile(x, v, v_name: str = "v_z", min_points: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A profile ``v(x)`` as float arrays: finite, of equal shape, ``x`` strictly increasing, enough points."""
     x = finite_array("x", x)
     v = finite_array(v_name, v)
     if x.shape != v.shape:
@@ -111,31 +104,6 @@ class FlowChannelBoundary:
 
 
 @dataclass(frozen=True)
-class KinematicFit:
-    """Least-squares fit of ``v_z(x) = A exp(-x^2 / (4 B z))`` at one height.
-
-    Attributes
-    ----------
-    B : float
-        Kinematic constant (diffusion length) [m], corrected for the kernel width if asked.
-    A : float
-        Centreline velocity of the fit [m/s] (negative for downward flow).
-    z : float
-        Height above the outlet used in the model [m].
-    B_standard_error : float
-        Standard error of B from the fit covariance [m].
-    rms_residual : float
-        Root-mean-square residual of the fit [m/s].
-    """
-
-    B: float
-    A: float
-    z: float
-    B_standard_error: float
-    rms_residual: float
-
-
-@dataclass(frozen=True)
 class ProfileErrors:
     """Differences between a simulated and a measured profile sampled at the same points.
 
@@ -175,9 +143,9 @@ def velocity_profile(fields_or_2d, z_value: float, method: str = "linear") -> Ve
     Parameters
     ----------
     fields_or_2d : Fields or tuple
-        Either a :class:`~analysis.numerics.coarse_graining.Fields` with one node layer in y (from
-        :func:`~analysis.numerics.coarse_graining.depth_average` or
-        :func:`~analysis.numerics.coarse_graining.front_wall_slice`), or a tuple
+        Either a :class:`~analysis.numerics.grid.Fields` with one node layer in y (from
+        :func:`~analysis.numerics.field_ops.depth_average` or
+        :func:`~analysis.numerics.field_ops.front_wall_slice`), or a tuple
         ``(x, z, v_x, v_z)`` with node coordinates x (nx,), z (nz,) [m] and velocity
         components of shape (nx, nz) [m/s].
     z_value : float
@@ -290,7 +258,7 @@ def flow_channel_boundary(
     ``f |v_z(0)|``, found by linear interpolation between the last node above and the first
     node at or below that level (the centreline point counts as the first node).
     """
-    x, v = _profile(x, v_z)
+    x, v = checked_profile(x, v_z)
     fractions = finite_array("fractions", np.atleast_1d(np.asarray(fractions, dtype=float)))
     if fractions.size == 0 or np.any((fractions <= 0.0) | (fractions >= 1.0)):
         raise ValueError(f"fractions must be non-empty and each in (0, 1), got {fractions.tolist()}")
@@ -313,137 +281,6 @@ def flow_channel_boundary(
     return FlowChannelBoundary(
         fractions=fractions, left=left, right=right, centreline_speed=centre, wall_velocity=float(wall_velocity)
     )
-
-
-# --------------------------------------------------------------------------- kinematic model
-
-
-def kinematic_velocity(x, z: float, A: float, B: float) -> np.ndarray:
-    """Kinematic-model profile ``v_z(x) = A exp(-x^2 / (4 B z))`` [m/s].
-
-    Parameters
-    ----------
-    x : array_like
-        Horizontal position from the axis [m].
-    z : float
-        Height above the outlet plane [m], > 0 (the model's virtual origin is the outlet).
-    A : float
-        Centreline velocity [m/s].
-    B : float
-        Kinematic constant [m], > 0.
-    """
-    x = np.asarray(x, dtype=float)
-    z = positive_number("z", z)
-    B = positive_number("B", B)
-    return float(A) * np.exp(-(x**2) / (4.0 * B * z))
-
-
-def fit_kinematic_constant(x, v_z, z: float, kernel_width: float = 0.0) -> KinematicFit:
-    """Fit the kinematic model ``v_z(x) = A exp(-x^2 / (4 B z))`` to a profile.
-
-    In the kinematic model (Nedderman and Tuzun 1979) the vertical velocity obeys the
-    diffusion equation ``d v_z / d z = B d^2 v_z / d x^2`` with the height above the outlet
-    playing the role of time; for a point outlet the solution is a Gaussian of variance
-    ``2 B z`` across the width. Here ``z`` is the distance above the outlet plane (z = 0,
-    the virtual origin placed at the outlet; a finite slot shifts the true origin a little
-    below it, which the fitted B absorbs).
-
-    Parameters
-    ----------
-    x : array_like, shape (n,)
-        Node x coordinates, strictly increasing [m]; the profile is centred on x = 0.
-    v_z : array_like, shape (n,)
-        Vertical velocity [m/s].
-    z : float
-        Height of the profile above the outlet plane [m], > 0.
-    kernel_width : float, optional
-        Standard deviation w of a Gaussian coarse-graining kernel the profile was smoothed
-        with [m] (default 0: no correction). Smoothing convolves the Gaussian profile, so
-        its variance becomes ``2 B z + w^2``; with ``kernel_width`` given the fitted variance
-        is corrected, ``B = (sigma_fit^2 - w^2) / (2 z)``.
-
-    Returns
-    -------
-    KinematicFit
-
-    Notes
-    -----
-    Nonlinear least squares on ``v_z`` itself (scipy ``curve_fit``, unweighted), started
-    from the moments of ``|v_z|``. The fit is over all given points; pass a slice of the
-    profile to restrict it (e.g. to leave out wall slip).
-    """
-    from scipy.optimize import curve_fit
-
-    x, v = _profile(x, v_z, min_points=3)
-    z = positive_number("z", z)
-    kernel_width = non_negative_number("kernel_width", kernel_width)
-    speed = np.abs(v)
-    if not np.any(speed > 0.0):
-        raise ValueError("v_z is zero everywhere; nothing to fit")
-
-    peak = int(np.argmax(speed))
-    amplitude0 = float(v[peak])
-    variance0 = float(np.sum(x**2 * speed) / np.sum(speed))
-    if variance0 <= 0.0:
-        variance0 = float(np.min(np.diff(x))) ** 2
-    scale = float(np.max(speed))
-
-    def model(xs, a, log_variance):
-        return a * np.exp(-(xs**2) / (2.0 * np.exp(log_variance)))
-
-    try:
-        parameters, covariance = curve_fit(
-            model, x, v / scale, p0=(amplitude0 / scale, math.log(variance0)), maxfev=10_000
-        )
-    except RuntimeError as error:  # no convergence
-        raise ValueError(f"v_z: the Gaussian fit did not converge ({error})") from None
-    a_scaled, log_variance = (float(p) for p in parameters)
-    variance = math.exp(log_variance)
-    corrected = variance - kernel_width**2
-    if corrected <= 0.0:
-        raise ValueError(
-            f"kernel_width = {kernel_width!r} m: the fitted profile variance {variance:.6g} m2 is not larger "
-            "than the kernel variance; the profile is no wider than the smoothing"
-        )
-    B = corrected / (2.0 * z)
-    log_variance_error = math.sqrt(max(float(covariance[1, 1]), 0.0)) if np.all(np.isfinite(covariance)) else math.inf
-    B_error = variance * log_variance_error / (2.0 * z)
-    residual = v - scale * model(x, a_scaled, log_variance)
-    return KinematicFit(
-        B=B,
-        A=a_scaled * scale,
-        z=z,
-        B_standard_error=B_error,
-        rms_residual=float(np.sqrt(np.mean(residual**2))),
-    )
-
-
-def kinematic_horizontal_velocity(x, v_z, B: float) -> np.ndarray:
-    """Horizontal velocity of the kinematic model, ``u = -B d v_z / d x``.
-
-    With ``v_z`` signed (negative downward) and z up, ``u = -B dv_z/dx`` points toward the
-    axis above an outlet: it is the relation that, with continuity
-    ``du/dx + dv_z/dz = 0``, gives the diffusion equation ``dv_z/dz = B d^2 v_z/dx^2``.
-
-    Parameters
-    ----------
-    x : array_like, shape (n,)
-        Node x coordinates, strictly increasing [m] (uniform or not).
-    v_z : array_like, shape (n,)
-        Vertical velocity [m/s].
-    B : float
-        Kinematic constant [m], > 0.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n,)
-        Horizontal velocity [m/s]. ``dv_z/dx`` is the second-order central difference at
-        interior nodes (``numpy.gradient``; ``(v[i+1] - v[i-1]) / (2 dx)`` on a uniform grid)
-        and one-sided first-order differences at the two end nodes.
-    """
-    x, v = _profile(x, v_z)
-    B = positive_number("B", B)
-    return -B * np.gradient(v, x, edge_order=1)
 
 
 # --------------------------------------------------------------------------- flow rate
@@ -476,7 +313,7 @@ def profile_flow_rate(x, v_z, bulk_density: float, depth: float, bounds: tuple[f
     float
         Mass flow rate [kg/s], positive for net downward flow.
     """
-    x, v = _profile(x, v_z, min_points=1 if bounds is not None else 2)
+    x, v = checked_profile(x, v_z, min_points=1 if bounds is not None else 2)
     bulk_density = positive_number("bulk_density", bulk_density)
     depth = positive_number("depth", depth)
     if bounds is not None:
@@ -488,97 +325,8 @@ def profile_flow_rate(x, v_z, bulk_density: float, depth: float, bounds: tuple[f
             raise ValueError(f"bounds must be finite and enclose the nodes [{x[0]!r}, {x[-1]!r}], got {bounds!r}")
         x = np.concatenate([[left], x, [right]])
         v = np.concatenate([[v[0]], v, [v[-1]]])
-    integral = float(np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(x)))
+    integral = float(trapezoid(v, x))
     return -bulk_density * depth * integral
-
-
-# --------------------------------------------------------------------------- Janssen
-
-
-def janssen_coefficient(internal_friction_angle_deg: float) -> float:
-    """Janssen's (Rankine active) stress ratio ``K = (1 - sin phi) / (1 + sin phi)`` [-]."""
-    phi = float(internal_friction_angle_deg)
-    if not math.isfinite(phi) or not 0.0 <= phi < 90.0:
-        raise ValueError(f"internal_friction_angle_deg must be in [0, 90), got {phi!r}")
-    s = math.sin(math.radians(phi))
-    return (1.0 - s) / (1.0 + s)
-
-
-def janssen_characteristic_depth(
-    width: float,
-    depth: float,
-    wall_friction_side: float,
-    wall_friction_front: float,
-    internal_friction_angle_deg: float,
-) -> float:
-    """Janssen depth ``z_c = W T / (2 K (T mu_sw + W mu_fw))`` of a W x T rectangle [m].
-
-    Infinite when both wall friction coefficients are 0 (no wall support: hydrostatic).
-    """
-    width = positive_number("width", width)
-    depth = positive_number("depth", depth)
-    mu_side = non_negative_number("wall_friction_side", wall_friction_side)
-    mu_front = non_negative_number("wall_friction_front", wall_friction_front)
-    k = janssen_coefficient(internal_friction_angle_deg)
-    support = 2.0 * k * (depth * mu_side + width * mu_front)
-    return math.inf if support == 0.0 else width * depth / support
-
-
-def janssen_vertical_stress(
-    depth_below_surface,
-    bulk_density: float,
-    width: float,
-    depth: float,
-    wall_friction_side: float,
-    wall_friction_front: float,
-    internal_friction_angle_deg: float,
-    gravity: float = 9.81,
-):
-    """Mean vertical stress in a rectangular silo by Janssen's method.
-
-    ``sigma_v(h) = gamma z_c (1 - exp(-h / z_c))``, ``gamma = rho_b g``,
-    ``z_c = W T / (2 K (T mu_sw + W mu_fw))``, ``K = (1 - sin phi) / (1 + sin phi)``.
-
-    A slice of the W x T cross-section carries its weight ``gamma W T dh`` partly by the
-    wall shear ``mu K sigma_v`` on the two side walls (area ``2 T dh``, friction mu_sw) and the
-    front and back walls (area ``2 W dh``, friction mu_fw).
-
-    Parameters
-    ----------
-    depth_below_surface : float or array_like
-        Depth h below the free surface [m], >= 0.
-    bulk_density : float
-        Bulk density rho_b [kg/m3].
-    width : float
-        Silo width W (between the side walls) [m].
-    depth : float
-        Silo depth T (between front and back walls) [m].
-    wall_friction_side : float
-        Bulk wall friction coefficient mu_sw = tan(wall friction angle) of the side walls
-        [-] (aluminium in the study); the bulk value from the calibration chart, not the
-        particle-wall one.
-    wall_friction_front : float
-        Bulk wall friction coefficient mu_fw of the front and back walls [-] (perspex).
-    internal_friction_angle_deg : float
-        Bulk internal friction angle phi [deg].
-    gravity : float, optional
-        g [m/s2] (default 9.81).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Vertical stress [Pa], compression positive; the shape of ``depth_below_surface``.
-        Without wall friction it is the hydrostatic ``gamma h``.
-    """
-    h = np.asarray(depth_below_surface, dtype=float)
-    if not np.all(np.isfinite(h)) or np.any(h < 0.0):
-        raise ValueError("depth_below_surface must contain finite numbers >= 0")
-    bulk_density = positive_number("bulk_density", bulk_density)
-    gravity = positive_number("gravity", gravity)
-    z_c = janssen_characteristic_depth(width, depth, wall_friction_side, wall_friction_front, internal_friction_angle_deg)
-    gamma = bulk_density * gravity
-    stress = gamma * h if math.isinf(z_c) else gamma * z_c * -np.expm1(-h / z_c)
-    return float(stress) if stress.ndim == 0 else stress
 
 
 # --------------------------------------------------------------------------- comparison

@@ -15,9 +15,9 @@ A tracer of ``N0`` particles (or virtual tracers) enters at ``t_entry``; particl
 - ``t_s / t_d``: first appearance ``t_s`` (shortest residence time) over the time ``t_d`` needed to
   discharge all of the tracer (longest residence time). 1 for plug flow, 0 for a perfect mixer.
 
-Models: the perfect mixer ``E = exp(-t/tau)/tau``, plug flow (a narrow pulse at ``tau``),
-a triangular reading of Johanson's two-parameter blending model, and Carson and Royal's
-recycling of a measured first-pass curve (repeated convolution).
+Models: the perfect mixer ``E = exp(-t/tau)/tau``, plug flow (a narrow pulse at ``tau``) and
+a triangular reading of Johanson's two-parameter blending model. Carson and Royal's recycling of a
+measured first-pass curve (repeated convolution) is :func:`analysis.numerics.lti.carson_royal_recycle`.
 """
 
 from __future__ import annotations
@@ -26,8 +26,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import trapezoid
 
-from analysis.checks import finite_array, positive_number, uniform_step
+from analysis.checks import finite_array, positive_number
 
 __all__ = [
     "RTD",
@@ -37,7 +38,6 @@ __all__ = [
     "perfect_mixer_rtd",
     "plug_flow_rtd",
     "johanson_rtd",
-    "carson_royal_recycle",
 ]
 
 
@@ -136,17 +136,6 @@ class RTDMoments:
     def sigma_theta2(self) -> float:
         """Dimensionless variance ``variance / mean^2`` [-]."""
         return self.variance / self.mean**2
-
-
-# --------------------------------------------------------------------------- validation
-
-
-
-
-def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
-    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
-
-
 
 
 # --------------------------------------------------------------------------- measured RTD
@@ -279,11 +268,11 @@ def rtd_moments(time, E) -> RTDMoments:
         raise ValueError(f"E must have the shape of time {t.shape}, got {e.shape}")
     if t.size < 2 or np.any(np.diff(t) <= 0.0):
         raise ValueError("time must have at least 2 strictly increasing samples")
-    area = _trapezoid(e, t)
+    area = float(trapezoid(e, t))
     if not area > 0.0:
         raise ValueError(f"E must have a positive area, got {area!r}")
-    mean = _trapezoid(t * e, t) / area
-    variance = _trapezoid((t - mean) ** 2 * e, t) / area
+    mean = float(trapezoid(t * e, t)) / area
+    variance = float(trapezoid((t - mean) ** 2 * e, t)) / area
     return RTDMoments(area=area, mean=mean, variance=variance)
 
 
@@ -316,7 +305,7 @@ def plug_flow_rtd(t, tau: float, width: float | None = None) -> np.ndarray:
     Ideal plug flow is a Dirac pulse ``delta(t - tau)``; on a time grid it is represented by the
     Gaussian ``exp(-(t - tau)^2 / (2 width^2)) / (sqrt(2 pi) width)``, normalised analytically
     (unit area over the real line). Sampled with a step ``dt <= width`` and ``tau`` several widths
-    from the ends of the grid, the discrete sum ``sum(E) dt`` is 1 to better than 1e-8 (Poisson
+    away from the ends of the grid, the discrete sum ``sum(E) dt`` is 1 to better than 1e-8 (Poisson
     summation: the error is about ``2 exp(-2 pi^2 width^2 / dt^2)``). As a filter it damps a sine of
     angular frequency ``w`` by ``exp(-w^2 width^2 / 2)``.
 
@@ -404,50 +393,3 @@ def johanson_rtd(t, tau: float, V1: float, P: float) -> np.ndarray:
         falling = (theta >= p) & (theta <= end)
         e_theta[falling] = 2.0 * (end - theta[falling]) / (base * (end - p))
     return e_theta / tau
-
-
-def carson_royal_recycle(first_pass_E, time, passes: int) -> np.ndarray:
-    """Carson and Royal's recycle blending: the outflow after each pass from a measured first-pass curve.
-
-    Material recycled from the outlet back to the inlet makes a second, third, ... pass through
-    the bin. With a linear, time-invariant bin whose single-pass RTD is the measured first-pass
-    curve ``E1``, the outflow of a unit tracer pulse injected at t = 0 is, for its n-th pass, the
-    n-fold convolution ``E_n = E1 * E1 * ... * E1`` (n factors), and the outlet concentration of the
-    closed recycle loop is ``sum_n E_n``. Each convolution is the discrete rule of
-    :func:`analysis.numerics.lti.convolve_with_rtd`: ``E_{n+1}[j] = dt sum_k E_n[j - k] E1[k]``.
-
-    Parameters
-    ----------
-    first_pass_E : array_like, shape (m,)
-        First-pass RTD sampled at residence times ``time`` [1/s].
-    time : array_like, shape (m,)
-        Uniform residence-time axis starting at 0: ``time[k] = k dt`` [s]. (For a histogram from
-        :func:`rtd_from_exit_times` with equal bins starting at 0, use its left edges
-        ``rtd.edges[:-1]``.)
-    passes : int
-        Number of passes, >= 1.
-
-    Returns
-    -------
-    numpy.ndarray, shape (passes, m)
-        Row ``n - 1`` is the outflow of the n-th pass ``E_n`` on ``time`` [1/s] (row 0 is the input
-        curve). Parts of ``E_n`` beyond ``time[-1]`` are cut off, so the axis must be long enough for
-        the passes wanted (``sum(E_n) dt`` falls below ``sum(E1) dt`` when it is not).
-        ``rows.sum(axis=0)`` is the outlet concentration of the recycle loop after a unit pulse.
-    """
-    from analysis.numerics.lti import convolve_with_rtd
-
-    t = finite_array("time", time, ndim=1)
-    dt = uniform_step("time", t)
-    if abs(t[0]) > 1.0e-9 * dt:
-        raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
-    e1 = finite_array("first_pass_E", first_pass_E, ndim=1)
-    if e1.shape != t.shape:
-        raise ValueError(f"first_pass_E must have the shape of time {t.shape}, got {e1.shape}")
-    if isinstance(passes, (bool, np.bool_)) or int(passes) != passes or int(passes) < 1:
-        raise ValueError(f"passes must be an integer >= 1, got {passes!r}")
-    rows = np.empty((int(passes), t.size))
-    rows[0] = e1
-    for n in range(1, int(passes)):
-        rows[n] = convolve_with_rtd(t, rows[n - 1], e1)
-    return rows

@@ -32,8 +32,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from analysis.numerics.coarse_graining import HAVE_NUMBA, Grid, coarse_grain
+from analysis.numerics.coarse_graining import HAVE_NUMBA, coarse_grain
+from analysis.numerics.grid import Grid
 
 N_PARTICLES = 100_000
 N_LARGE = 500_000
@@ -73,8 +75,6 @@ def coarse_grain_ckdtree(positions, masses, velocities, grid: Grid, width: float
         ``(density (nx, ny, nz), momentum_density (nx, ny, nz, 3), kinetic_stress (nx, ny, nz, 3, 3),
         number of (node, particle) pairs within the cut-off)``.
     """
-    from scipy.spatial import cKDTree
-
     positions = np.asarray(positions, float)
     masses = np.broadcast_to(np.asarray(masses, float), (positions.shape[0],))
     velocities = np.asarray(velocities, float)

@@ -20,23 +20,19 @@ import time
 from pathlib import Path
 
 from analysis.data.frames import clumps_from_frame
-from engines.liggghts.dumps import read_frames
 from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.cases.silo_flat import build_silo_case
+from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.interface import EngineOptions, engine_for
 from tests.conftest import TINY_SILO
 
 SILO = {**TINY_SILO, "width": 0.12, "fill_height": 0.06, "discharge_time": 0.5}
 
 
-def flow_rate(run_dir: Path, case) -> tuple[float, float]:
+def flow_rate(engine, run_dir: Path, record, case) -> tuple[float, float]:
     """Steady mass flow rate (kg/s) and its counting noise (3 sigma, kg/s) of a finished run."""
-    import json
-
-    record = json.loads((run_dir / "run.json").read_text())
-    frames = [clumps_from_frame(f) for f in read_frames(run_dir / "dumps", record["dump_prefix"], record["timestep_s"])]
-    times = [f.time - record["open_time_s"] for f in frames]
+    frames = [clumps_from_frame(f) for f in engine.read_frames(run_dir, record)]
+    times = [f.time - record.open_time_s for f in frames]
     history = discharged_mass_history(times, [mass_in_silo(f.position[:, 2], f.mass) for f in frames])
     fit = steady_flow_rate(history.time, history.discharged_mass)
     counted = fit.mass_flow_rate * (fit.t_end - fit.t_start) / case.particle.mass
@@ -47,16 +43,18 @@ def main(argv: list[str]) -> int:
     output = Path(argv[1] if len(argv) > 1 else "results/bench/mpi.csv")
     raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
     raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(SILO)}
-    case = build_silo_case(validate_config(raw))
+    config = validate_config(raw)
+    case = build_silo_case(config)
+    engine = engine_for(config, "silo_flat")
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
         for ranks in (1, 2):
             run_dir = Path(scratch) / f"ranks{ranks}"
-            write_silo_inputs(case, run_dir / "deck")
+            engine.write_inputs(case, run_dir)
             start = time.perf_counter()
-            run_silo(case, run_dir, mpi_ranks=ranks)
+            record = engine.run(case, run_dir, EngineOptions(mpi_ranks=ranks))
             wall = time.perf_counter() - start
-            rate, noise = flow_rate(run_dir, case)
+            rate, noise = flow_rate(engine, run_dir, record, case)
             rows.append({"mpi_ranks": ranks, "clumps": case.fill.n_clumps, "wall_time_s": wall,
                          "mass_flow_rate_kg_s": rate, "flow_rate_noise_3sigma_kg_s": noise})
     serial = rows[0]

@@ -38,8 +38,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.interpolate import RegularGridInterpolator
 
-from analysis.numerics.pathlines import HAVE_NUMBA, EXITED, NOT_EXITED, OUTSIDE, integrate_pathlines, lattice_seeds, time_levels
+from analysis.numerics.pathlines import HAVE_NUMBA, EXITED, NOT_EXITED, OUTSIDE, integrate_pathlines, time_levels
+from analysis.numerics.tracer_seeds import lattice_seeds
 
 SHAPE = (127, 107, 31)
 SPACING = (0.006, 0.004, 0.006)
@@ -82,8 +84,6 @@ def integrate_with_scipy(seeds, t0, velocities, times, origin, spacing, dt, outl
     tuple
         ``(residence_time (n,), status (n,), tracer steps integrated)``.
     """
-    from scipy.interpolate import RegularGridInterpolator
-
     seeds = np.asarray(seeds, float)
     velocities = np.asarray(velocities, float)
     origin = np.asarray(origin, float)

@@ -1,4 +1,5 @@
-"""Unit tests for analysis.studies.blender.blender: exact answers on uniform, linear and closed-form cases."""
+"""Unit tests for the blender analysis (steady field, profiles, tracers, modes, gravity, comparison): exact answers on
+uniform, linear and closed-form cases."""
 
 from __future__ import annotations
 
@@ -7,27 +8,18 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.blender.blender import (
-    BlenderField,
-    BlenderMetrics,
-    best_blender,
-    comparison_table,
-    continuous_mode,
-    discontinuous_mode,
+from analysis.numerics.grid import Fields, Grid
+from analysis.studies.blender.comparison import BlenderMetrics, best_blender, comparison_table
+from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity, gravity_scaling
+from analysis.studies.blender.modes import continuous_mode, discontinuous_mode
+from analysis.studies.blender.profiles import (
     flow_channel_boundary_over_height,
-    gravity_normalised_time,
-    gravity_normalised_velocity,
-    gravity_scaling,
     height_profile,
-    layer_rtd,
     passage_velocities,
     profiles_over_time,
-    tabulated_rtd,
-    tracer_layer,
-    tracer_pathlines,
-    virtual_tracer_rtd,
 )
-from analysis.numerics.coarse_graining import Fields, Grid
+from analysis.studies.blender.steady_field import BlenderField
+from analysis.studies.blender.tracers import layer_rtd, tabulated_rtd, tracer_layer, tracer_pathlines, virtual_tracer_rtd
 
 SPEED = 0.5  # m/s, downward
 DX = 0.01

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import copy
+import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +52,11 @@ def test_continuous_deck_is_periodic_and_loses_no_clump_batch_deck_drains(golden
             in continuous)
     opened = continuous[continuous.index("# --- open the outlet"):]
     assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right\n" in opened
+    # every wall writes its force and torque on the particles: the front and back planes, then each mesh
+    forces = next(line for line in continuous.splitlines() if line.startswith("fix wall_forces all ave/time"))
+    assert re.findall(r" v_(\w+)_fx", forces) == ["wall_front", "wall_back", "hopper_left", "hopper_right", "insert_left",
+                                                "insert_right", "tube_left", "tube_right", "outlet_gate"]
+    assert opened.index("variable outlet_gate_fx equal 0.0") < opened.index("unfix outlet_gate")
 
 
 def test_gravity_factor_scales_gravity_and_flow_times_not_the_time_step(golden_config):
@@ -98,7 +105,6 @@ def test_meshes_are_closed_walls_plus_the_gate(golden_config):
 
 
 def test_written_inputs_record_the_achieved_area_ratios(tmp_path, golden_config):
-    import json
     case = build_blender_case(golden_config, "straight")
     deck = write_blender_inputs(case, tmp_path / "deck")
     summary = json.loads((deck.parent / "case.json").read_text())

@@ -3,8 +3,16 @@
 import numpy as np
 import pytest
 
-from analysis.studies.blender.fields import discharged_mass_history, frames_in_window, window_average_field
-from analysis.studies.silo_recirculation.blending import ClumpTracks
+from analysis.numerics.grid import Grid
+from analysis.studies.blender.window_fields import (
+    PlanarField,
+    discharged_mass_history,
+    frames_in_window,
+    mean_velocity_history,
+    window_average_field,
+)
+from analysis.studies.blender.window_fields_io import read_planar_fields, write_planar_fields
+from analysis.studies.silo_recirculation.tracks import ClumpTracks
 from analysis.numerics.eulerian_rtd import silo_bins
 
 
@@ -46,7 +54,6 @@ def test_a_bin_no_clump_entered_is_nan_and_a_grid_with_depth_bins_is_refused():
     positions = np.array([[[-0.005, 0.005, 0.005]]])
     field = window_average_field(positions, np.zeros((1, 1, 3)), [1.0], [0.0, ], grid, (0.0, 1.0), 1000.0)
     assert np.isnan(field.v_z[1, 0]) and field.solid_fraction[1, 0] == 0.0
-    from analysis.numerics.coarse_graining import Grid
     with pytest.raises(ValueError, match="one bin across the depth"):
         window_average_field(positions, np.zeros((1, 1, 3)), [1.0], [0.0], Grid(origin=(0, 0, 0), spacing=(0.01, 0.005, 0.01), shape=(2, 2, 1)),
                              (0.0, 1.0), 1000.0)
@@ -81,9 +88,6 @@ def test_continuous_discharged_mass_counts_outlet_crossings():
 
 
 def test_planar_fields_round_trip(tmp_path):
-    from analysis.studies.blender.fields import PlanarField
-    from analysis.studies.blender.fields_io import read_planar_fields, write_planar_fields
-
     def field(value, window):
         return PlanarField(x=np.array([-0.5, 0.5]), z=np.array([0.1, 0.2, 0.3]), v_x=np.full((2, 3), value),
                            v_z=np.arange(6.0).reshape(2, 3) * value, solid_fraction=np.full((2, 3), 0.6),
@@ -98,7 +102,6 @@ def test_planar_fields_round_trip(tmp_path):
 
 
 def test_mean_velocity_history_weights_the_clumps_above_the_outlet_by_mass():
-    from analysis.studies.blender.fields import mean_velocity_history
     times = np.array([0.0, 1.0])
     position = np.zeros((2, 3, 3))
     position[:, :, 2] = [[0.1, 0.2, -0.01], [np.nan, 0.1, 0.3]]

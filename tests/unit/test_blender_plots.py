@@ -1,4 +1,5 @@
-"""Unit tests for analysis.studies.blender.plots: PNGs are written and the plotted data are the input (files under tmp_path)."""
+"""Unit tests for analysis.studies.blender.plots: PNGs are written and the plotted data are the input (files under
+tmp_path)."""
 
 from __future__ import annotations
 
@@ -8,18 +9,12 @@ import numpy as np
 import pytest
 
 import analysis.studies.blender.plots as blender_plots
-import analysis.studies.silo_recirculation.plots as blending_plots
-from analysis.studies.blender.blender import (
-    BlenderField,
-    comparison_table,
-    continuous_mode,
-    discontinuous_mode,
-    flow_channel_boundary_over_height,
-    layer_rtd,
-    passage_velocities,
-    profiles_over_time,
-    tracer_pathlines,
-)
+import analysis.studies.silo_recirculation.rtd_plots as rtd_plots
+from analysis.studies.blender.comparison import comparison_table
+from analysis.studies.blender.modes import continuous_mode, discontinuous_mode
+from analysis.studies.blender.profiles import flow_channel_boundary_over_height, passage_velocities, profiles_over_time
+from analysis.studies.blender.steady_field import BlenderField
+from analysis.studies.blender.tracers import layer_rtd, tracer_pathlines
 from analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_configuration_comparison,
@@ -47,7 +42,7 @@ def figures(monkeypatch):
         return save_png(figure, path, tight=tight)
 
     monkeypatch.setattr(blender_plots, "save_png", keep)
-    monkeypatch.setattr(blending_plots, "save_png", keep)
+    monkeypatch.setattr(rtd_plots, "save_png", keep)
     return saved
 
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.blender.blender import BlenderField
+from analysis.studies.blender.steady_field import BlenderField
 from analysis.studies.blender.study import (
     BlenderSettings,
     analyse_blender,

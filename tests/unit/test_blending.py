@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.blending (passes, batch layers, outlet concentration) on exact cases.
+"""Unit tests for analysis.studies.silo_recirculation (tracks, concentration, vrr, tracers) on exact cases.
 
 Most tests use a "conveyor": N clumps evenly spaced along z, all moving down at a constant speed
 through the periodic domain, so every crossing, re-entry and pass is known in closed form.
@@ -11,28 +11,32 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.silo_recirculation.blending import (
-    ClumpTracks,
+from analysis.data.frames import ClumpFrame, ParticleFrame
+from analysis.numerics.rtd import rtd_from_exit_times
+from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
-    RecirculationEvents,
-    RecirculationVRR,
-    TracerPasses,
     batch_inlet_signal,
-    clump_tracks,
-    clumps_above_outlet,
     first_pass_concentration,
-    holdup_residence_time,
     layer_colours,
     outlet_concentration,
     predicted_concentration_from_first_pass,
+)
+from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_count, tracer_passes
+from analysis.studies.silo_recirculation.tracks import (
+    ClumpTracks,
+    RecirculationEvents,
+    clump_tracks,
+    clumps_above_outlet,
     recirculation_events,
+    recirculation_tracks,
+)
+from analysis.studies.silo_recirculation.vrr import (
+    RecirculationVRR,
+    holdup_residence_time,
     recirculation_number,
     sampling_noise_vrr_limit,
-    tracer_count,
-    tracer_passes,
     vrr_by_recirculation,
 )
-from analysis.numerics.rtd import rtd_from_exit_times
 
 # --------------------------------------------------------------------------- the conveyor
 
@@ -528,3 +532,49 @@ def test_tracer_count():
         tracer_count(-1.0, 0.1, 600.0, 0.001)
     with pytest.raises(ValueError, match="clump_mass must be a finite number > 0"):
         tracer_count(1.0, 0.1, 600.0, 0.0)
+
+
+# --------------------------------------------------------------------------- tracks from frames
+
+
+def _spheres(time, clump_id, position, velocity, mass):
+    """A frame of spheres (sphere ids 0, 1, ...); ``mass`` is the clump mass carried by each sphere."""
+    n = len(clump_id)
+    return ParticleFrame(time=time, step=int(round(time * 1000)), id=np.arange(n), type=np.ones(n),
+                         clump_id=clump_id, position=position, velocity=velocity, angular_velocity=None,
+                         radius=np.full(n, 0.001), mass=mass)
+
+
+def test_recirculation_tracks_join_straddling_clumps_and_lay_out_velocities_and_masses():
+    # Domain periodic in z over [-0.25, 0.75) (L = 1 m). Clump 5 has two spheres; at t = 1 s it straddles the
+    # periodic boundary (spheres at z = 0.74 and -0.24, i.e. 0.76 unwrapped): its centre is 0.75 -> wrapped to
+    # -0.25. Clump 9 is a single sphere, absent from the last frame.
+    frames = [
+        _spheres(0.0, [5, 5, 9], [[0.0, 0.0, 0.10], [0.0, 0.0, 0.12], [0.02, 0.0, 0.5]],
+                 [[0.0, 0.0, -1.0], [0.0, 0.0, -3.0], [1.0, 0.0, 0.0]], [2.0, 2.0, 1.0]),
+        _spheres(1.0, [9, 5, 5], [[0.02, 0.0, 0.4], [0.0, 0.0, 0.74], [0.0, 0.0, -0.24]],
+                 [[0.0, 0.0, -0.5], [0.0, 0.0, -2.0], [0.0, 0.0, -2.0]], [1.0, 2.0, 2.0]),
+        _spheres(2.0, [5, 5], [[0.0, 0.0, 0.3], [0.0, 0.0, 0.4]], [[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]], [2.0, 2.0]),
+    ]
+    result = recirculation_tracks(frames, (BOTTOM, TOP))
+    np.testing.assert_array_equal(result.tracks.times, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(result.tracks.clump_id, [5, 9])
+    np.testing.assert_allclose(result.tracks.z[:, 0], [0.11, -0.25, 0.35], atol=1e-12)
+    np.testing.assert_allclose(result.tracks.z[:2, 1], [0.5, 0.4])
+    assert np.isnan(result.tracks.z[2, 1])
+    np.testing.assert_allclose(result.velocity[:, 0, 2], [-2.0, -2.0, -1.0])
+    np.testing.assert_allclose(result.velocity[:2, 1], [[1.0, 0.0, 0.0], [0.0, 0.0, -0.5]])
+    assert np.all(np.isnan(result.velocity[2, 1]))
+    np.testing.assert_array_equal(result.mass, [2.0, 1.0])
+
+
+def test_recirculation_tracks_take_clump_frames_as_they_are_and_need_two_frames():
+    clumps = [ClumpFrame(time=t, step=k, clump_id=[3], position=[[0.0, 0.0, z]], velocity=[[0.0, 0.0, -0.1]],
+                         mass=[0.5], n_spheres=[4]) for k, (t, z) in enumerate([(0.0, 0.2), (0.5, 0.15)])]
+    result = recirculation_tracks(iter(clumps), (BOTTOM, TOP))
+    np.testing.assert_array_equal(result.tracks.z[:, 0], [0.2, 0.15])
+    np.testing.assert_array_equal(result.mass, [0.5])
+    with pytest.raises(ValueError, match="at least 2 frames, got 1"):
+        recirculation_tracks(clumps[:1], (BOTTOM, TOP))
+    with pytest.raises(ValueError, match="domain_z must be"):
+        recirculation_tracks(clumps, (TOP, BOTTOM))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +47,11 @@ def test_deck_is_periodic_in_z_with_feeder_and_no_lost_clumps(golden_config):
     recirculation = deck[deck.index("# --- recirculate"):]
     assert "thermo_modify lost error" in recirculation
     assert "meshes floor_left floor_right channel_left channel_right" in deck
+    # every wall, the channel walls included, writes its force and torque on the particles
+    forces = next(line for line in deck.splitlines() if line.startswith("fix wall_forces all ave/time"))
+    walls = re.findall(r" v_(\w+)_fx", forces)
+    assert walls == ["wall_left", "wall_right", "wall_front", "wall_back", "floor_left", "floor_right",
+                     "outlet_gate", "channel_left", "channel_right"]
 
 
 def test_presets_set_the_study_friction_and_a_dedicated_front_back_material(golden_config):
@@ -64,7 +70,7 @@ def test_presets_set_the_study_friction_and_a_dedicated_front_back_material(gold
 
 def test_apply_flow_pattern_leaves_its_input_alone(golden_config):
     before = copy.deepcopy(golden_config)
-    apply_flow_pattern(golden_config, golden_config["blending"]["presets"]["internal_flow"])
+    apply_flow_pattern(golden_config, golden_config["silo_recirculation"]["presets"]["internal_flow"])
     assert golden_config == before
 
 
@@ -95,16 +101,16 @@ def test_channel_meshes_face_into_the_channel(golden_config):
 
 def test_runs_are_keyed_by_pattern_and_role(golden_config):
     raw = copy.deepcopy(golden_config)
-    raw["blending"]["flow_patterns"] = ["internal_flow", "semi_mass_flow"]
-    raw["blending"]["verification"]["enabled"] = True
+    raw["silo_recirculation"]["flow_patterns"] = ["internal_flow", "semi_mass_flow"]
+    raw["silo_recirculation"]["verification"]["enabled"] = True
     cases = recirculation_cases(raw)
     prefixes = sorted(run.rsplit("-", 1)[0] for run in cases)
     assert prefixes == ["internal_flow", "semi_mass_flow", "thin-semi_mass_flow"]
     thin = next(case for case in cases.values() if case.role == "verification")
-    assert thin.silo.depth == raw["blending"]["verification"]["depth"]
+    assert thin.silo.depth == raw["silo_recirculation"]["verification"]["depth"]
     with pytest.raises(KeyError, match="it defines"):
         recirculation_case_for_run(raw, "internal_flow-0000000000")
-    raw["blending"]["enabled"] = False
+    raw["silo_recirculation"]["enabled"] = False
     assert recirculation_cases(raw) == {}
 
 
@@ -121,16 +127,16 @@ def test_write_inputs_writes_deck_meshes_and_case(tmp_path, golden_config):
 @pytest.mark.parametrize(
     "edit, message",
     [
-        (lambda b: b.update(flow_patterns=["funnel"]), "blending.flow_patterns\\[0\\]': unknown preset 'funnel'"),
-        (lambda b: b["verification"].update(flow_pattern="nope"), "blending.verification.flow_pattern"),
-        (lambda b: b.update(outlet_width=0.2), "blending.outlet_width"),
+        (lambda b: b.update(flow_patterns=["funnel"]), "silo_recirculation.flow_patterns\\[0\\]': unknown preset 'funnel'"),
+        (lambda b: b["verification"].update(flow_pattern="nope"), "silo_recirculation.verification.flow_pattern"),
+        (lambda b: b.update(outlet_width=0.2), "silo_recirculation.outlet_width"),
         (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 0.2}, {"name": "a", "blue_fraction": 0.3}]),
          "used twice"),
-        (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 1.0}]), "blending.layouts"),
+        (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 1.0}]), "silo_recirculation.layouts"),
     ],
 )
-def test_bad_blending_config_is_named(golden_config, edit, message):
+def test_bad_recirculation_config_is_named(golden_config, edit, message):
     raw = copy.deepcopy(golden_config)
-    edit(raw["blending"])
+    edit(raw["silo_recirculation"])
     with pytest.raises(ConfigError, match=message):
         validate_config(raw)

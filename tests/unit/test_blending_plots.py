@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.plots (files under tmp_path only)."""
+"""Unit tests for analysis.studies.silo_recirculation.plots and .rtd_plots (files under tmp_path only)."""
 
 from __future__ import annotations
 
@@ -7,14 +7,16 @@ import pytest
 
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
-    plot_lti_comparison,
     plot_outlet_concentration,
     plot_paths_comparison,
+    plot_vrr_versus_recirculations,
+)
+from analysis.studies.silo_recirculation.rtd_plots import (
+    plot_lti_comparison,
     plot_recirculation_model,
     plot_residence_time_comparison,
     plot_rtd_comparison,
     plot_vrr_versus_period,
-    plot_vrr_versus_recirculations,
 )
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from calibration.charts import plot_calibration_chart, plot_polar_histogram
-from calibration.friction import angular_histogram
+from calibration.contact_diagnostics import angular_histogram
 from calibration.inversion import CalibrationCurve
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -1,22 +1,23 @@
-"""Unit tests for calibration.friction on synthetic force histories with exact answers."""
+"""Unit tests for calibration.friction and calibration.contact_diagnostics on synthetic input with exact answers."""
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from calibration.contact_diagnostics import angular_histogram, mobilised_friction_by_azimuth, mobilised_friction_histogram
 from calibration.friction import (
     BulkFriction,
     SteadyWindow,
-    angular_histogram,
     bulk_friction,
+    bulk_friction_of_shear,
     detect_steady_window,
     friction_angle,
     friction_coefficient,
     mean_and_standard_error,
-    mobilised_friction_histogram,
 )
 
 N_SAMPLES = 101  # default running mean: 5 samples (h = 2)
@@ -325,10 +326,6 @@ def test_angular_histogram_rejects_bad_arguments():
 
 
 def test_bulk_friction_of_shear_uses_the_plateau_or_the_second_half():
-    from types import SimpleNamespace
-
-    from calibration.friction import bulk_friction_of_shear
-
     time = np.linspace(0.0, 1.0, 201)
     load = 52.0
     plateau = np.where(time < 0.2, 0.6 * load * time / 0.2, 0.6 * load)
@@ -350,8 +347,6 @@ def test_bulk_friction_of_shear_uses_the_plateau_or_the_second_half():
 
 
 def test_mobilised_friction_by_azimuth_exact_sectors():
-    from calibration.friction import mobilised_friction_by_azimuth
-
     points = [[1.0, 0.0, 0.0], [1.0, 0.1, 0.0], [-1.0, 0.01, 0.0], [0.0, 1.0, 0.0]]
     normal = [[-2.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     tangential = [[0.0, 1.0, 0.0], [0.0, 0.0, 0.5], [0.0, 1.0, 0.0], [0.0, 3.0, 0.0]]

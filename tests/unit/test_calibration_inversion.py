@@ -252,16 +252,12 @@ def test_curves_from_table_errors():
 
 
 def test_unreachable_targets_can_be_recorded_instead_of_raised():
-    import math as _math
-
-    from calibration.inversion import CalibrationCurve, invert_calibration
-
     particle = np.array([0.0, 0.5, 1.0])
     curves = [
         CalibrationCurve("sphere2", "internal", 0.1, particle, 0.2 + 0.5 * particle),
         CalibrationCurve("sphere2", "wall", 0.1, particle, 0.1 + 0.2 * particle, wall_material="aluminium"),
     ]
-    target = _math.degrees(_math.atan(0.45))
+    target = math.degrees(math.atan(0.45))
     result = invert_calibration(curves, {"internal": target, "aluminium": 45.0}, 0.5, shape="sphere2",
                                 rolling_friction=0.1, record_unreachable=True)
     assert result["particle_particle"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)

@@ -1,6 +1,7 @@
 """Expansion of the calibration sweep grid."""
 
-from calibration.sweep import is_chart_point, sweep_points
+from calibration.sweep import chart_rows, diagnostic_points, is_chart_point, lid_comparison
+from engines.cases.jenike_sweep import sweep_points
 from engines.config import validate_config
 
 
@@ -57,8 +58,6 @@ def test_lid_comparison_runs_the_internal_points_with_the_other_lid():
 
 
 def test_lid_comparison_pairs_rows_of_both_lids():
-    from calibration.sweep import chart_rows, lid_comparison
-
     base = {"shape": "sphere2", "test": "internal", "rolling_friction": "0.0", "restitution": "0.1",
             "rotation_blocked": "False"}
     rows = [
@@ -74,8 +73,6 @@ def test_lid_comparison_pairs_rows_of_both_lids():
 
 
 def test_diagnostic_points_are_the_middle_friction_of_each_curve():
-    from calibration.sweep import diagnostic_points
-
     sweep = validate_config({})["jenike"]["sweep"]
     points = sweep_points(sweep, lid="rigid")
     chosen = diagnostic_points(points, sweep, "rigid")

@@ -10,18 +10,15 @@ import pytest
 from analysis.numerics.coarse_graining import (
     HAVE_NUMBA,
     KERNELS,
-    Fields,
-    Grid,
-    average_fields,
     coarse_grain,
-    contact_stress,
     default_width,
     deposit,
-    depth_average,
-    front_wall_slice,
     kernel_shift,
     kernel_support_radius,
 )
+from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.field_ops import average_fields, depth_average, front_wall_slice
+from analysis.numerics.contact_stress import contact_stress
 
 BACKENDS = ["numpy"] + (["numba"] if HAVE_NUMBA else [])
 WIDTH = 0.0045  # 3 radii of a 3 mm sphere, the study's kernel width [m]

@@ -17,7 +17,6 @@ from engines.estimates import (
     CostModel,
     InsufficientDiskSpace,
     RunEstimate,
-    calibrate_cost_model,
     check_disk_space,
     dump_frames,
     estimate_blender_case,
@@ -35,6 +34,7 @@ from engines.estimates import (
     wall_time,
 )
 from engines.cases.jenike import build_jenike_case
+from engines.liggghts.cost import calibrate_cost_model
 from engines.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {

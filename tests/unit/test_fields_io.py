@@ -5,7 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.numerics.coarse_graining import Grid, coarse_grain, contact_stress, depth_average
+from analysis.numerics.grid import Grid
+from analysis.numerics.coarse_graining import coarse_grain
+from analysis.numerics.contact_stress import contact_stress
+from analysis.numerics.field_ops import depth_average
 from analysis.io.fields import (
     load_fields_npz,
     read_fields_vti,

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from engines.interface import CaseNotSupported, engine_named
 from scipy.spatial import cKDTree
 
 from engines.config import load_config, validate_config
@@ -29,9 +31,9 @@ from engines.cases.jenike import (
     disk,
     lid_sphere_layout,
     segments_for_chord,
-    shear_signals,
 )
-from engines.liggghts.run import EngineRunError, Marker
+from engines.interface import EngineRunError
+from engines.liggghts.markers import Marker
 from engines.liggghts.jenike import (
     CONTACT_COLUMNS,
     FORCE_COLUMNS,
@@ -40,6 +42,7 @@ from engines.liggghts.jenike import (
     jenike_deck_context,
     read_force_history,
     render_jenike_deck,
+    set_aside_previous_jenike_attempt,
     write_jenike_inputs,
 )
 from engines.cases.physics import rayleigh_time
@@ -331,19 +334,11 @@ def test_sweep_settings_other_than_the_point_do_not_change_the_run_id():
     assert build_jenike_case(config, POINT).run_id == build_jenike_case(other, POINT).run_id
 
 
-@pytest.mark.parametrize(
-    "change, message",
-    [
-        ({"shape": "cube"}, "unknown shape 'cube'"),
-        ({"test": "steel"}, "neither 'internal' nor a material"),
-        ({"restitution": 0.05}, r"restitution must lie in \(0.05, 1\]"),
-        ({"sliding_friction": 1.5}, r"sliding_friction must be a number in \[0, 1\]"),
-        ({"rotation_blocked": "no"}, "rotation_blocked must be true or false"),
-    ],
-)
-def test_bad_points_are_refused_with_the_key(change, message):
-    with pytest.raises(ValueError, match=message):
-        _case(change)
+def test_a_point_below_the_engines_restitution_limit_is_refused_by_the_engine_naming_the_key():
+    # The sweep's values are validated by the schema alone (0 < e <= 1); LIGGGHTS' own limit is the engine's check.
+    case = _case({"restitution": 0.05})
+    with pytest.raises(CaseNotSupported, match=r"config key 'jenike.sweep.restitution': restitution 0.05 .* LIGGGHTS 3.8"):
+        engine_named("liggghts").check_case(case)
 
 
 def test_missing_point_key_and_missing_contact_pair_are_named():
@@ -500,24 +495,6 @@ def test_force_history_reader_names_the_file_on_bad_content(tmp_path, content, m
         read_force_history(path)
 
 
-def test_shear_signals_cut_the_shear_and_sign_the_forces():
-    time = np.array([0.1, 0.2, 0.3, 0.4])
-    history = {
-        "time": time,
-        "lid_fx": np.array([0.0, -1.0, -2.0, -3.0]),
-        "ring_fx": np.array([0.0, -0.5, -0.5, -0.5]),
-        "bottom_fx": np.array([0.0, 1.5, 2.5, 3.5]),
-        "lid_fz": np.full(4, 5.0),
-        "mass_above": np.full(4, 0.01),
-    }
-    signals = shear_signals(history, 0.15)
-    np.testing.assert_array_equal(signals.time, [0.2, 0.3, 0.4])
-    np.testing.assert_array_equal(signals.lid_force + signals.ring_force, signals.bottom_force)
-    np.testing.assert_allclose(signals.weight_above, 0.01 * 9.81)
-    with pytest.raises(ValueError, match="fewer than 2 samples"):
-        shear_signals(history, 0.35)
-
-
 def _markers(created=815, levelled=655, final=655):
     values = lambda clumps, time: {"step": 1.0, "time": time, "clumps": float(clumps), "top": 0.02}  # noqa: E731
     return [
@@ -575,8 +552,6 @@ def test_contact_dump_reader(tmp_path):
 
 
 def test_an_earlier_attempt_is_set_aside_with_its_force_history(tmp_path):
-    from engines.liggghts.jenike import set_aside_previous_jenike_attempt
-
     assert set_aside_previous_jenike_attempt(tmp_path) is None
     (tmp_path / "dumps").mkdir()
     (tmp_path / "dumps" / "particles_1.vtk").write_text("x")

@@ -6,14 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from engines.liggghts.run import (
-    EngineNotFound,
-    EngineRunError,
-    engine_command,
-    error_lines,
-    parse_markers,
-    set_aside_previous_attempt,
-)
+from engines.interface import EngineNotFound, EngineRunError
+from engines.liggghts.run import engine_command, set_aside_previous_attempt
+from engines.liggghts.markers import error_lines, parse_markers
 from engines.liggghts.silo_flat import check_silo_run
 from engines.cases.silo_flat import build_silo_case
 

@@ -13,10 +13,11 @@ from analysis.numerics.pathlines import (
     PathlineResult,
     integrate_pathlines,
     interpolate_velocity,
-    lattice_seeds,
     time_levels,
 )
 from analysis.numerics.rtd import rtd_from_exit_times
+from analysis.numerics.tracer_seeds import lattice_seeds
+from tests.bench.bench_pathlines import integrate_with_scipy, max_relative_difference
 
 BACKENDS = ["numba", "numpy"] if HAVE_NUMBA else ["numpy"]
 METHODS = ["rk2", "euler"]
@@ -189,8 +190,6 @@ def smooth_series(n_times=3):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_backends_and_the_scipy_peer_agree(method):
-    from tests.bench.bench_pathlines import integrate_with_scipy, max_relative_difference
-
     series = smooth_series()
     times = [0.0, 0.7, 1.5]
     seeds = lattice_seeds((-0.4, 0.01, 0.35), (0.4, 0.39, 0.59), count=(9, 4, 3))  # x = +-0.356 outside the box

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.io.plots and analysis.io.tables (files under tmp_path only)."""
+"""Unit tests for the discharge plot (analysis.studies.silo_flat.plots) and analysis.io.tables (files under tmp_path only)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 
 from analysis.numerics.flow import DischargeHistory, discharged_mass_history, steady_flow_rate
-from analysis.io.plots import plot_discharge
-from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json
+from analysis.studies.silo_flat.plots import plot_discharge
+from analysis.io.tables import markdown_table, write_discharge_history_csv, write_flow_table, write_json, write_text
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -111,8 +111,6 @@ def test_write_discharge_history_csv_round_trip(tmp_path):
 
 
 def test_markdown_table_writes_columns_of_the_first_row_with_significant_digits(tmp_path):
-    from analysis.io.tables import markdown_table, write_text
-
     text = markdown_table([{"name": "a", "rate": 0.0123456, "n": 3}, {"name": "b", "rate": float("nan")}], digits=3)
     assert text == "| name | rate | n |\n|---|---|---|\n| a | 0.0123 | 3 |\n| b | nan |  |\n"
     path = write_text(tmp_path / "table.md", text)

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.profiles on synthetic profiles with exact answers."""
+"""Unit tests for analysis.numerics.profiles, .kinematic and .janssen on synthetic profiles with exact answers."""
 
 from __future__ import annotations
 
@@ -7,18 +7,20 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.coarse_graining import Fields, Grid, coarse_grain, depth_average
-from analysis.numerics.profiles import (
-    FlowChannelBoundary,
+from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.coarse_graining import coarse_grain
+from analysis.numerics.field_ops import depth_average
+from analysis.numerics.janssen import janssen_characteristic_depth, janssen_coefficient, janssen_vertical_stress
+from analysis.numerics.kinematic import (
     KinematicFit,
-    ProfileErrors,
     fit_kinematic_constant,
-    flow_channel_boundary,
-    janssen_characteristic_depth,
-    janssen_coefficient,
-    janssen_vertical_stress,
     kinematic_horizontal_velocity,
     kinematic_velocity,
+)
+from analysis.numerics.profiles import (
+    FlowChannelBoundary,
+    ProfileErrors,
+    flow_channel_boundary,
     profile_errors,
     profile_flow_rate,
     velocity_profile,

@@ -29,6 +29,9 @@ def _check_common(deck: str) -> None:
     assert "dump_modify particle_dump binary yes first no" in deck
     assert "outlet_gate" not in deck.split("fix floor_wall", 1)[1].splitlines()[0]
     assert deck.index("run 0") < deck.index("SILOFLOW resumed")
+    # wall forces from the restart on, in a second file named by the restart step; the gate's columns are zeros
+    assert " file resume_wall_forces_$(step).txt title1 " in deck
+    assert "variable outlet_gate_fz equal 0.0" in deck and "f_outlet_gate[" not in deck
 
 
 def test_silo_resume_deck_reads_the_restart_and_runs_up_to_the_end():

@@ -10,7 +10,6 @@ import pytest
 from analysis.numerics.rtd import (
     RTD,
     RTDMoments,
-    carson_royal_recycle,
     johanson_rtd,
     perfect_mixer_rtd,
     plug_flow_rtd,
@@ -205,46 +204,3 @@ def test_johanson_symmetric_case_by_hand():
 def test_johanson_rejects_bad_parameters(v1, p, match):
     with pytest.raises(ValueError, match=match):
         johanson_rtd([0.0, 1.0], 1.0, v1, p)
-
-
-def test_carson_royal_delay_passes_shift_exactly():
-    dt = 0.125
-    t = np.arange(40) * dt
-    delay = np.zeros(40)
-    delay[3] = 1.0 / dt  # plug flow of 3 dt
-    rows = carson_royal_recycle(delay, t, passes=4)
-    assert rows.shape == (4, 40)
-    for n in range(4):
-        expected = np.zeros(40)
-        expected[3 * (n + 1)] = 1.0 / dt
-        np.testing.assert_array_equal(rows[n], expected)
-
-
-def test_carson_royal_perfect_mixer_gives_erlang_curves():
-    tau = 1.0
-    dt = 1e-3
-    t = np.arange(0, 40001) * dt
-    e1 = perfect_mixer_rtd(t, tau)
-    rows = carson_royal_recycle(e1, t, passes=4)
-    area = float(np.sum(e1) * dt)
-    for n in range(1, 5):
-        # the rectangle rule (first order) shifts the n-th pass by (n - 1) dt and scales by O(dt)
-        shifted = t + (n - 1) * dt
-        erlang = shifted ** (n - 1) * np.exp(-shifted / tau) / (tau**n * math.factorial(n - 1))
-        np.testing.assert_allclose(rows[n - 1], erlang, atol=2.5e-3 * erlang.max())
-        # discrete convolution multiplies the areas; the axis holds the whole curve
-        assert float(np.sum(rows[n - 1]) * dt) == pytest.approx(area**n, rel=1e-9)
-    total = rows.sum(axis=0)
-    assert total[-1] < 1e-9
-
-
-def test_carson_royal_rejects_bad_input():
-    t = np.arange(5) * 0.1
-    with pytest.raises(ValueError, match="passes"):
-        carson_royal_recycle(np.ones(5), t, 0)
-    with pytest.raises(ValueError, match="time"):
-        carson_royal_recycle(np.ones(5), t + 0.05, 2)
-    with pytest.raises(ValueError, match="first_pass_E"):
-        carson_royal_recycle(np.ones(4), t, 2)
-    with pytest.raises(ValueError, match="time"):
-        carson_royal_recycle(np.ones(5), [0.0, 0.1, 0.3, 0.4, 0.5], 2)

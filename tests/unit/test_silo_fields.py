@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.coarse_graining import depth_average
+from analysis.numerics.field_ops import depth_average
 from analysis.data.frames import ClumpFrame
-from analysis.numerics.profiles import janssen_vertical_stress
+from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.studies.silo_flat.fields import (
     FieldSettings,
     analyse_profiles,

@@ -1,6 +1,6 @@
 """The report's summary page."""
 
-from analysis.report.summary import format_cell, summary_html
+from analysis.report.summary import calibration_rows, format_cell, summary_html
 
 
 def test_cells_are_formatted_and_escaped():
@@ -23,8 +23,6 @@ def test_summary_page_has_one_table_per_section_with_the_union_of_columns():
 
 
 def test_calibration_rows_cover_chosen_unreachable_and_untested_contacts():
-    from analysis.report.summary import calibration_rows
-
     rows = calibration_rows({
         "particle_particle": {"sliding_friction": 0.27, "lower": 0.25, "upper": 0.3},
         "particle_wall": {"aluminium": {"sliding_friction": 0.17}},

@@ -47,6 +47,25 @@ def test_every_contact_uses_hertz_with_cdt_rolling_friction():
         assert "model hertz tangential history rolling_friction cdt" in line, line
 
 
+def test_every_wall_writes_its_force_and_the_gate_leaves_zeros():
+    deck = render_silo_deck(_golden_case())
+    lines = deck.splitlines()
+    primitive = [line for line in lines if " primitive type " in line]
+    meshes = [line for line in lines if re.match(r"^fix \S+ all mesh/surface", line)]
+    assert len(primitive) == 4 and all(line.endswith(" store_force yes") for line in primitive)
+    assert len(meshes) == 3
+    assert all("mesh/surface/stress" in line and line.endswith(" reference_point 0.0 0.0 0.0") for line in meshes)
+    # torque of the left wall's force taken at the contact point on the plane x = -0.04
+    assert "variable wall_left_torque_y atom z*f_force_wall_left[1]-(-0.04)*f_force_wall_left[3]" in lines
+    assert "variable floor_left_fz equal -f_floor_left[3]" in lines
+    assert "variable floor_left_tz equal -f_floor_left[6]" in lines
+    # one sample file through every stage, defined before the fill; the gate's columns become zeros before it goes
+    assert deck.index("fix wall_forces all ave/time 434 1 434 ") < deck.index("fix pour")
+    assert deck.count("fix wall_forces ") == 1
+    opened = deck.split("# --- open the outlet")[1]
+    assert opened.index("variable outlet_gate_fz equal 0.0") < opened.index("unfix outlet_gate")
+
+
 def test_material_matrices_are_rendered_row_major():
     deck = render_silo_deck(_golden_case())
     rolling = next(line for line in deck.splitlines() if "coefficientRollingFriction" in line)

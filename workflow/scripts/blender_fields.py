@@ -7,21 +7,22 @@ import numpy as np
 
 from analysis.studies.blender.window_fields import discharged_mass_history, mean_velocity_history, window_average_field
 from analysis.studies.blender.window_fields_io import write_planar_fields
-from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks
+from analysis.data.record import read_run_record
+from analysis.studies.silo_recirculation.tracks import recirculation_tracks
 from analysis.numerics.eulerian_rtd import silo_bins
 from analysis.numerics.flow import steady_flow_rate
 from analysis.io.tables import write_json
+from engines.interface import engine_named
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
-    record = json.loads(Path(snakemake.input.record).read_text())
+    record = read_run_record(snakemake.input.record)
     case = json.loads(Path(snakemake.input.case).read_text())
-    recorded = read_recirculation_tracks(run_dir / "dumps", record["dump_prefix"], record["timestep_s"],
-                                         record["domain_z"], cache_dir=run_dir / "frames",
-                                       on_damaged=snakemake.config["dumps"]["on_damaged"])
+    frames = engine_named(record.engine).read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
+    recorded = recirculation_tracks(frames, record.domain_z)
     tracks = recorded.tracks
-    since_open = tracks.times - record["open_time_s"]
+    since_open = tracks.times - record.open_time_s
     grid = silo_bins(case["width_m"], case["depth_m"], case["fill_height_m"], snakemake.params.bin_size)
     density = case["clump_mass_kg"] / case["clump_volume_m3"]
     steady_window = tuple(case["steady_window"])
@@ -35,12 +36,12 @@ with logged_to(snakemake.log[0]) as log:
     write_planar_fields(snakemake.output.fields, steady, windows)
 
     time, discharged = discharged_mass_history(tracks, recorded.mass, case["mode"], case["outlet_z"], case["domain_z"])
-    fit = steady_flow_rate(time - record["open_time_s"], discharged, window=steady_window)
+    fit = steady_flow_rate(time - record.open_time_s, discharged, window=steady_window)
     write_json(snakemake.output.flow, {
         "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
         "mode": case["mode"], "n_clumps": case["n_clumps"], "mass_flow_rate_kg_s": fit.mass_flow_rate,
         "mass_flow_rate_standard_error_kg_s": fit.standard_error, "steady_window_s": list(steady_window),
-        "time_since_open_s": (time - record["open_time_s"]).tolist(), "discharged_mass_kg": discharged.tolist(),
+        "time_since_open_s": (time - record.open_time_s).tolist(), "discharged_mass_kg": discharged.tolist(),
         "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case["outlet_z"]).tolist(),
     })
     log.info("%s: %d frames, steady window %s s (%d frames), mass flow rate %.5g +- %.2g kg/s", case["run_id"],

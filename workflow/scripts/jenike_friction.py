@@ -1,32 +1,32 @@
 """Snakemake adapter: bulk friction of one Jenike sweep point from its force histories."""
 
-import json
 from pathlib import Path
 
 from analysis.io.tables import write_json
 from calibration.charts import plot_force_history
 from calibration.friction import bulk_friction_of_shear
-from engines.cases.jenike import shear_signals
-from engines.liggghts.jenike import read_force_history
+from analysis.data.record import read_run_record
+from calibration.shear import shear_signals
+from engines.interface import engine_named
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
-    record = json.loads(Path(snakemake.input.record).read_text())
+    record = read_run_record(snakemake.input.record)
     point = snakemake.params.point
-    history = read_force_history(run_dir / record["forces"])
-    signals = shear_signals(history, record["shear_start_s"], record["shear_end_s"])
+    history = engine_named(record.engine).wall_forces(run_dir, record)
+    signals = shear_signals(history, record.labels["shear_start_s"], record.labels["shear_end_s"])
     friction, window_method = bulk_friction_of_shear(signals)
     test = "internal" if point["test"] == "internal" else "wall"
     summary = {
-        "run_id": record["run_id"],
+        "run_id": record.run_id,
         "shape": point["shape"],
         "test": test,
         "wall_material": "" if test == "internal" else point["test"],
         "rolling_friction": point["rolling_friction"],
         "restitution": point["restitution"],
         "rotation_blocked": point["rotation_blocked"],
-        "lid": point.get("lid", snakemake.params.lid),
+        "lid": point["lid"],
         "particle_friction": point["sliding_friction"],
         "bulk_friction": friction.coefficient,
         "bulk_friction_stderr": friction.standard_error,
@@ -36,7 +36,7 @@ with logged_to(snakemake.log[0]) as log:
         "window_start_s": friction.window.t_start,
         "window_end_s": friction.window.t_end,
         "window_method": window_method,
-        "n_clumps": record["n_clumps"],
+        "n_clumps": record.n_clumps,
     }
     write_json(snakemake.output.summary, summary)
     plot_force_history(signals, friction, snakemake.output.plot,

@@ -1,9 +1,9 @@
-"""Plots of the multi-flow blender analysis (:mod:`analysis.studies.blender.blender`).
+"""Plots of the multi-flow blender analysis (the modules of :mod:`analysis.studies.blender`).
 
-Each writer takes the results of :mod:`analysis.studies.blender.blender` (or plain arrays), a path and a title, draws
-one figure and saves it atomically as a 150 dpi PNG with :func:`analysis.io.plots.save_png`; nothing is
-read from files. Lengths are given in m and drawn in mm; x = 0 is the silo axis and z = 0 the outlet
-plane. The RTD and the discontinuous mode are drawn by the writers of :mod:`analysis.studies.silo_recirculation.plots`.
+Each writer takes the results of the blender analysis (or plain arrays), a path and a title, draws one figure
+and saves it atomically as a 150 dpi PNG with :func:`analysis.io.plots.save_png`; nothing is read from files.
+Lengths are given in m and drawn in mm; x = 0 is the silo axis and z = 0 the outlet plane. The RTD and the
+discontinuous mode are drawn by the writers of :mod:`analysis.studies.silo_recirculation.rtd_plots`.
 """
 
 from __future__ import annotations
@@ -20,28 +20,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.studies.blender.blender import (  # noqa: E402
-    BlenderField,
-    ChannelBoundary,
-    ContinuousMode,
-    DiscontinuousMode,
-    PassageVelocities,
-    ProfilesOverTime,
-    TracerPathlines,
-    VirtualTracerRTD,
-    gravity_normalised_time,
-    gravity_normalised_velocity,
-)
-from analysis.studies.silo_recirculation.plots import (  # noqa: E402
-    _entry,
-    _non_empty,
-    _positive_finite,
-    plot_recirculation_model,
-    plot_rtd_comparison,
-)
 from analysis.checks import finite_array, positive_number  # noqa: E402
-from analysis.io.plots import save_png  # noqa: E402
+from analysis.io.plots import non_empty_list, positive_finite_points, save_png, tuple_entry  # noqa: E402
 from analysis.numerics.rtd import RTD  # noqa: E402
+from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity  # noqa: E402
+from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode  # noqa: E402
+from analysis.studies.blender.profiles import ChannelBoundary, PassageVelocities, ProfilesOverTime  # noqa: E402
+from analysis.studies.blender.steady_field import BlenderField  # noqa: E402
+from analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD  # noqa: E402
+from analysis.studies.silo_recirculation.rtd_plots import plot_recirculation_model, plot_rtd_comparison  # noqa: E402
 
 __all__ = [
     "plot_profiles_over_time",
@@ -69,7 +56,7 @@ def _labelled(name: str, items, kind) -> list[tuple[str, object]]:
     """Checked non-empty mapping label -> instance of ``kind``, as a list of pairs."""
     if not isinstance(items, Mapping):
         raise ValueError(f"{name} must be a mapping label -> {kind.__name__}")
-    pairs = _non_empty(name, items.items())
+    pairs = non_empty_list(name, items.items())
     return [(str(label), _instance(f"{name}[{label!r}]", value, kind)) for label, value in pairs]
 
 
@@ -84,7 +71,7 @@ def plot_profiles_over_time(profiles: ProfilesOverTime, path: str | os.PathLike,
 
     Parameters
     ----------
-    profiles : analysis.studies.blender.blender.ProfilesOverTime
+    profiles : analysis.studies.blender.profiles.ProfilesOverTime
         Profiles at key heights for several windows.
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
@@ -131,7 +118,7 @@ def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelociti
 
     Parameters
     ----------
-    inlet, outlet : analysis.studies.blender.blender.PassageVelocities
+    inlet, outlet : analysis.studies.blender.profiles.PassageVelocities
         Profiles and passage means at the two heights.
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
@@ -176,10 +163,10 @@ def plot_channel_boundary(field: BlenderField, boundary: ChannelBoundary, path: 
 
     Parameters
     ----------
-    field : analysis.studies.blender.blender.BlenderField
+    field : analysis.studies.blender.steady_field.BlenderField
         The steady field (bins without particles are left blank).
-    boundary : analysis.studies.blender.blender.ChannelBoundary
-        Boundary per row (:func:`analysis.studies.blender.blender.flow_channel_boundary_over_height` of ``field``).
+    boundary : analysis.studies.blender.profiles.ChannelBoundary
+        Boundary per row (:func:`analysis.studies.blender.profiles.flow_channel_boundary_over_height` of ``field``).
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
     title : str
@@ -230,7 +217,7 @@ def plot_tracer_pathlines(pathlines: TracerPathlines, path: str | os.PathLike, t
 
     Parameters
     ----------
-    pathlines : analysis.studies.blender.blender.TracerPathlines
+    pathlines : analysis.studies.blender.tracers.TracerPathlines
         Released tracers and their paths.
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
@@ -270,7 +257,7 @@ def plot_tracer_pathlines(pathlines: TracerPathlines, path: str | os.PathLike, t
 def plot_rtd_theta(rtds: Mapping, path: str | os.PathLike, title: str) -> Path:
     """RTDs of several configurations as ``E(theta)`` against ``theta = t / t_m`` on one axes.
 
-    Drawn by :func:`analysis.studies.silo_recirculation.plots.plot_rtd_comparison`.
+    Drawn by :func:`analysis.studies.silo_recirculation.rtd_plots.plot_rtd_comparison`.
 
     Parameters
     ----------
@@ -295,11 +282,12 @@ def plot_rtd_theta(rtds: Mapping, path: str | os.PathLike, title: str) -> Path:
 def plot_discontinuous_mode(result: DiscontinuousMode, path: str | os.PathLike, title: str) -> Path:
     """Outlet tracer concentration of the two-layer fill over the passes, with the homogenisation band.
 
-    Drawn by :func:`analysis.studies.silo_recirculation.plots.plot_recirculation_model` (the tracer is the "blue" batch).
+    Drawn by :func:`analysis.studies.silo_recirculation.rtd_plots.plot_recirculation_model` (the tracer is the
+    "blue" batch).
 
     Parameters
     ----------
-    result : analysis.studies.blender.blender.DiscontinuousMode
+    result : analysis.studies.blender.modes.DiscontinuousMode
         The recirculated two-layer fill.
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
@@ -324,7 +312,7 @@ def plot_continuous_mode(results: Mapping, path: str | os.PathLike, title: str) 
 
     Parameters
     ----------
-    results : mapping label -> analysis.studies.blender.blender.ContinuousMode
+    results : mapping label -> analysis.studies.blender.modes.ContinuousMode
         One result per configuration.
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
@@ -344,7 +332,7 @@ def plot_continuous_mode(results: Mapping, path: str | os.PathLike, title: str) 
         right.set_xscale("log")
         left.axhline(1.0, color="black", linewidth=0.9, label="VRR = 1 (no blending)")
         for label, result in checked:
-            x, y = _positive_finite(result.period_over_tm, result.vrr)
+            x, y = positive_finite_points(result.period_over_tm, result.vrr)
             (line,) = left.plot(x, y, "o-", markersize=4, linewidth=1.2, label=label)
             resonant = np.isin(result.period_over_tm, result.resonant_periods_over_tm)
             left.plot(result.period_over_tm[resonant], result.vrr[resonant], "o", markersize=10, fillstyle="none",
@@ -391,8 +379,8 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         The written path.
     """
     checked = []
-    for i, item in enumerate(_non_empty("runs", runs)):
-        label, factor, time, velocity = _entry("runs", i, item, 4)
+    for i, item in enumerate(non_empty_list("runs", runs)):
+        label, factor, time, velocity = tuple_entry("runs", i, item, 4)
         factor = positive_number(f"runs[{i}] gravity_factor", factor)
         time = finite_array(f"runs[{i}] time", time)
         velocity = np.asarray(velocity, dtype=float)
@@ -421,7 +409,7 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     Parameters
     ----------
     rows : list of dict
-        :func:`analysis.studies.blender.blender.comparison_table` rows (key ``"configuration"`` and the metrics).
+        :func:`analysis.studies.blender.comparison.comparison_table` rows (key ``"configuration"`` and the metrics).
     columns : sequence of str
         Metric columns to draw, each a key of every row; NaN values leave the bar out.
     path : str or os.PathLike
@@ -429,7 +417,7 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     title : str
         Figure title.
     best : str, optional
-        Configuration to outline in black (e.g. :func:`analysis.studies.blender.blender.best_blender`); it must be one of
+        Configuration to outline in black (e.g. :func:`analysis.studies.blender.comparison.best_blender`); it must be one of
         the rows.
 
     Returns
@@ -437,8 +425,8 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     pathlib.Path
         The written path.
     """
-    rows = _non_empty("rows", rows)
-    columns = [str(column) for column in _non_empty("columns", columns)]
+    rows = non_empty_list("rows", rows)
+    columns = [str(column) for column in non_empty_list("columns", columns)]
     names = []
     for i, row in enumerate(rows):
         if not isinstance(row, Mapping) or "configuration" not in row:

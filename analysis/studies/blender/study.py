@@ -1,8 +1,8 @@
 """The blender study of one run: profiles, passage velocities, flow channel, pathlines, RTD and blending modes.
 
-Composes :mod:`analysis.studies.blender.blender` on the steady field and the window fields of one run. Pure computation: the
-geometry comes in as plain numbers and two functions of height (the clear passages and the inner wall
-position), so nothing here reads files or knows the engine.
+Composes the modules of :mod:`analysis.studies.blender` (profiles, tracers, modes) on the steady field and the
+window fields of one run. Pure computation: the geometry comes in as plain numbers and two functions of height
+(the clear passages and the inner wall position), so nothing here reads files or knows the engine.
 """
 
 from __future__ import annotations
@@ -13,26 +13,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.studies.blender.blender import (
-    BlenderField,
-    BlenderMetrics,
+from analysis.checks import positive_number
+from analysis.numerics.rtd import RTD
+from analysis.studies.blender.comparison import BlenderMetrics
+from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode, continuous_mode, discontinuous_mode
+from analysis.studies.blender.profiles import (
     ChannelBoundary,
-    ContinuousMode,
-    DiscontinuousMode,
     PassageVelocities,
     ProfilesOverTime,
-    TracerPathlines,
-    VirtualTracerRTD,
-    continuous_mode,
-    discontinuous_mode,
     flow_channel_boundary_over_height,
     passage_velocities,
     profiles_over_time,
-    tracer_pathlines,
-    virtual_tracer_rtd,
 )
-from analysis.checks import positive_number
-from analysis.numerics.rtd import RTD
+from analysis.studies.blender.steady_field import BlenderField
+from analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD, tracer_pathlines, virtual_tracer_rtd
 
 __all__ = ["BlenderSettings", "BlenderStudy", "key_heights", "analyse_blender", "study_metrics", "study_summary",
            "metrics_from_summary", "rtd_from_summary"]

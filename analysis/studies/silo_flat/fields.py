@@ -1,6 +1,6 @@
 """Continuum view of a flat-bottom silo run: coarse-grained fields and the quantities compared with PIV.
 
-Pure computation on clump frames and contact frames (see :mod:`engines.liggghts.dumps`, :mod:`engines.liggghts.contacts`);
+Pure computation on clump frames and contact frames (:mod:`analysis.data.frames`, :mod:`analysis.data.contacts`);
 writers live in :mod:`analysis.io.fields` and :mod:`analysis.studies.silo_flat.plots`. Coordinates as everywhere in
 siloflow: x across the width (0 on the axis), y front to back (0 at the front wall), z up (0 at the outlet).
 """
@@ -13,21 +13,13 @@ from typing import Sequence
 
 import numpy as np
 
-from analysis.numerics.coarse_graining import (
-    Fields,
-    Grid,
-    average_fields,
-    coarse_grain,
-    contact_stress,
-    depth_average,
-)
-from analysis.numerics.profiles import (
-    fit_kinematic_constant,
-    flow_channel_boundary,
-    janssen_vertical_stress,
-    kinematic_horizontal_velocity,
-    velocity_profile,
-)
+from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.field_ops import average_fields, depth_average
+from analysis.numerics.coarse_graining import coarse_grain
+from analysis.numerics.contact_stress import contact_stress
+from analysis.numerics.janssen import janssen_vertical_stress
+from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity
+from analysis.numerics.profiles import flow_channel_boundary, velocity_profile
 
 
 @dataclass(frozen=True)

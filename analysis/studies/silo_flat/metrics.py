@@ -1,6 +1,6 @@
 """Discharge metrics of a flat-bottom silo run from a sequence of clump frames.
 
-Pure computation: the frames come in as :class:`engines.liggghts.dumps.ClumpFrame` objects (or anything with
+Pure computation: the frames come in as :class:`analysis.data.frames.ClumpFrame` objects (or anything with
 ``time``, ``clump_id``, ``position`` and ``mass``), the results go out as dataclasses.
 """
 
@@ -67,7 +67,7 @@ class SiloFlowMetrics:
 def vanished_above_outlet(previous_ids, previous_z, current_ids, outlet_plane: float = 0.0) -> np.ndarray:
     """Ids of clumps that disappeared between two frames while last seen at or above the outlet plane.
 
-    Discharged clumps leave the domain only after falling below the outlet plane, and between two dumps
+    Discharged clumps leave the domain only after falling below the outlet plane, and between two frames
     none can travel from the silo to the bottom of the domain, so a clump that vanishes from above the
     outlet plane has escaped through a wall (lost atoms).
     """

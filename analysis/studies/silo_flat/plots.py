@@ -1,5 +1,7 @@
-"""Plots of the flat-bottom silo flow in the study's style. Each writer takes arrays or dataclasses and a path,
-draws one figure and saves it atomically as a 150 dpi PNG."""
+"""Plots of the flat-bottom silo flow in the study's style: discharge, velocity profiles and fields, stresses.
+
+Each writer takes arrays or dataclasses and a path, draws one figure and saves it atomically as a 150 dpi
+PNG (:func:`analysis.io.plots.save_png`)."""
 
 from __future__ import annotations
 
@@ -14,16 +16,79 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
-from analysis.io.plots import save_png  # noqa: E402
+from analysis.io.plots import save_png, silo_outline  # noqa: E402
+from analysis.numerics.flow import DischargeHistory, FlowRateFit  # noqa: E402
 
 
+def plot_discharge(
+    history: DischargeHistory,
+    fit: FlowRateFit,
+    beverloo_rate: float | None,
+    path: str | os.PathLike,
+    title: str,
+) -> Path:
+    """Plot discharged mass against time with the fitted and Beverloo flow rates.
 
+    Draws the discharged mass, the least-squares line over the steady window
+    (shaded), and, for comparison, a line of the Beverloo slope through the
+    fitted line at the window midpoint (so only the slopes are compared).
 
-def _silo_outline(axes, width: float, outlet_width: float, top: float) -> None:
-    half, slot = 0.5 * width, 0.5 * outlet_width
-    outline = dict(color="black", linewidth=1.5)
-    axes.plot([-half, -half, -slot], [top, 0.0, 0.0], **outline)
-    axes.plot([half, half, slot], [top, 0.0, 0.0], **outline)
+    Parameters
+    ----------
+    history : analysis.numerics.flow.DischargeHistory
+        Time since opening [s] and discharged mass [kg].
+    fit : analysis.numerics.flow.FlowRateFit
+        Steady flow rate fit [kg/s] and its window [s].
+    beverloo_rate : float or None
+        Beverloo mass flow rate [kg/s]; None to omit the line.
+    path : str or os.PathLike
+        Destination PNG file (written atomically, 150 dpi).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    pathlib.Path
+        The written path.
+    """
+    time = np.asarray(history.time, dtype=float)
+    mass = np.asarray(history.discharged_mass, dtype=float)
+
+    figure, axes = plt.subplots(figsize=(6.4, 4.4))
+    try:
+        axes.plot(time, mass, ".", markersize=3, color="0.35", label="DEM discharged mass")
+        axes.axvspan(fit.t_start, fit.t_end, color="tab:blue", alpha=0.08, label="steady window")
+
+        window_time = np.array([fit.t_start, fit.t_end])
+        axes.plot(
+            window_time,
+            fit.intercept + fit.mass_flow_rate * window_time,
+            "-",
+            color="tab:blue",
+            linewidth=2,
+            label=f"fit: {fit.mass_flow_rate:.4g} ± {fit.standard_error:.2g} kg/s",
+        )
+        if beverloo_rate is not None:
+            midpoint_time = 0.5 * (fit.t_start + fit.t_end)
+            midpoint_mass = fit.intercept + fit.mass_flow_rate * midpoint_time
+            axes.plot(
+                window_time,
+                midpoint_mass + beverloo_rate * (window_time - midpoint_time),
+                "--",
+                color="tab:red",
+                linewidth=1.5,
+                label=f"Beverloo: {beverloo_rate:.4g} kg/s",
+            )
+
+        axes.set_xlabel("time since opening [s]")
+        axes.set_ylabel("discharged mass [kg]")
+        axes.set_title(title)
+        axes.grid(True, alpha=0.3)
+        axes.legend(loc="upper left", fontsize="small")
+        figure.tight_layout()
+        return save_png(figure, path)
+    finally:
+        plt.close(figure)
 
 
 def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
@@ -41,7 +106,7 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
     x_mm = 1e3 * profiles.x
     figure, axes = plt.subplots(figsize=(5.0, 6.0))
     try:
-        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
         for i, z in enumerate(heights):
             axes.axhline(1e3 * z, color="0.8", linewidth=0.6)
             axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
@@ -68,7 +133,7 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
         filled = axes.contourf(1e3 * np.asarray(x), 1e3 * np.asarray(z), np.asarray(v_z).T, levels=levels,
                                cmap="viridis")
         figure.colorbar(filled, ax=axes, label="v_z [m/s]")
-        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * np.max(z))
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * np.max(z))
         axes.set_aspect("equal")
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
@@ -134,7 +199,7 @@ def plot_force_chains(segments, width: float, outlet_width: float, top: float, p
         collection.set_clim(0.0, segments.cap)
         axes.add_collection(collection)
         figure.colorbar(collection, ax=axes, shrink=0.6, label=f"normal force [N] (capped at {segments.cap:.3g} N)")
-        _silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
         axes.set_xlim(-0.55e3 * width, 0.55e3 * width)
         axes.set_ylim(-2.0, 1e3 * top)
         axes.set_aspect("equal")

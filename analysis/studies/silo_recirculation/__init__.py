@@ -1,1 +1,10 @@
-"""analysis.studies.silo_recirculation."""
+"""The blending study in the recirculating silo.
+
+- ``tracks``: clump tracks from the engine's frames, outlet crossings, re-entries and passes;
+  ``tracks_io``: their ``.npz`` store.
+- ``concentration``: batch layers, outlet concentration measured and predicted (renewal equation).
+- ``vrr``: recirculation number, holdup residence time, VRR per recirculation.
+- ``tracers``: the tracer passes of the particle RTD. ``validation``: argument checks they share.
+- ``study``: the composed study of one run; ``plots`` and ``rtd_plots``: its figures (``rtd_plots`` is shared
+  with the blender).
+"""

@@ -1,11 +1,13 @@
-"""The blending study of one recirculation run, composed from :mod:`analysis.studies.silo_recirculation.blending`, :mod:`analysis.numerics.rtd`,
+"""The blending study of one recirculation run, composed from the modules of
+:mod:`analysis.studies.silo_recirculation` (tracks, concentration, vrr, tracers), :mod:`analysis.numerics.rtd`,
 :mod:`analysis.numerics.lti` and :mod:`analysis.numerics.eulerian_rtd`.
 
 Pure computation on arrays; the workflow scripts read the tracks and write tables and plots. SI units.
 
 Steps (SEED_DIGEST section 4):
 
-1. Events: re-entries at the top and outlet crossings of every clump (:func:`analysis.studies.silo_recirculation.blending.recirculation_events`);
+1. Events: re-entries at the top and outlet crossings of every clump
+   (:func:`analysis.studies.silo_recirculation.tracks.recirculation_events`);
    the mean residence time ``t_res`` = holdup / throughput over the steady part of the run (after the first
    ``startup_fraction`` of it).
 2. Direct measurement, per batch layout: colours from the heights at the opening, outlet concentration in windows
@@ -27,26 +29,30 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from analysis.studies.silo_recirculation.blending import (
-    ClumpTracks,
+from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
+from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
+from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
+from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
-    RecirculationEvents,
-    RecirculationVRR,
-    TracerPasses,
     batch_inlet_signal,
-    clumps_above_outlet,
     first_pass_concentration,
-    holdup_residence_time,
     layer_colours,
     outlet_concentration,
     predicted_concentration_from_first_pass,
+)
+from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_passes
+from analysis.studies.silo_recirculation.tracks import (
+    ClumpTracks,
+    RecirculationEvents,
+    clumps_above_outlet,
     recirculation_events,
+)
+from analysis.studies.silo_recirculation.vrr import (
+    RecirculationVRR,
+    holdup_residence_time,
     recirculation_number,
-    tracer_passes,
     vrr_by_recirculation,
 )
-from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
-from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
 
 
 @dataclass(frozen=True)
@@ -423,8 +429,6 @@ def verify_eulerian_rtd(tracks: ClumpTracks, velocity, mass, width: float, depth
     The particle side takes the passes re-entering after ``Nr = tracer_start`` (as many as ``tracer_fraction`` of
     the holdup); the Eulerian side seeds the same number of virtual tracers in the inlet bins at the same time.
     """
-    from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
-
     events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
     timing = loop_timing(tracks, events, outlet_z)
     start = timing.t_open + tracer_start * timing.residence_time
@@ -457,8 +461,6 @@ def main_run_eulerian_rtd(tracks: ClumpTracks, velocity, mass, result: BlendingR
                           domain_top: float, inlet_width: float, bin_size: float, dt: float,
                           max_recirculations: float, bins: int, outlet_z: float = 0.0) -> RTD:
     """The Eulerian RTD of a blending run: as many virtual tracers as the particle tracer, released when it starts."""
-    from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
-
     grid = silo_bins(width, depth, domain_top, bin_size)
     eulerian = eulerian_residence_times(
         tracks.times, tracks.position, velocity, mass, grid, inlet_width, result.rtd.n_tracer, result.rtd.start_time,

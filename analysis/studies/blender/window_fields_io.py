@@ -1,6 +1,7 @@
-"""Readers and writers of the blender analysis: planar fields as ``.npz``.
+"""Reader and writer of the blender's window-averaged planar fields as ``.npz``.
 
-The only place the blender analysis touches files besides :mod:`analysis.studies.silo_recirculation.tracks_io` (clump tracks).
+The only place the blender analysis touches files besides :mod:`analysis.studies.silo_recirculation.tracks_io`
+(clump tracks).
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.blender.fields import PlanarField
 from analysis.io.tables import atomic_output
+from analysis.studies.blender.window_fields import PlanarField
 
 
 def write_planar_fields(path: str | os.PathLike, steady: PlanarField, windows: list[PlanarField]) -> Path:

@@ -1,7 +1,8 @@
-"""Steady depth-averaged fields and the discharge rate of a blender run, from clump tracks.
+"""Window-averaged planar fields and the discharge history of a blender run, from clump tracks.
 
-Pure functions on numpy arrays; no file I/O (:mod:`analysis.studies.silo_recirculation.tracks_io` reads the tracks). SI units: positions
-in m, velocities in m/s, masses in kg, times in s.
+Pure functions on numpy arrays; no file I/O (:func:`analysis.studies.silo_recirculation.tracks.recirculation_tracks`
+builds the tracks from the engine's frames, :mod:`analysis.studies.blender.window_fields_io` stores the
+fields). SI units: positions in m, velocities in m/s, masses in kg, times in s.
 
 Fields are mass-weighted bin averages over all frames of a time window: for bin b,
 ``v_b = sum_k sum_{i in b at k} m_i v_i / sum_k sum_{i in b at k} m_i`` (clumps of many frames pooled, so a bin
@@ -19,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.studies.silo_recirculation.blending import ClumpTracks, recirculation_events
 from analysis.checks import finite_number, positive_number
-from analysis.numerics.coarse_graining import Grid
 from analysis.numerics.eulerian_rtd import bin_sums
+from analysis.numerics.grid import Grid
+from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events
 
 __all__ = ["PlanarField", "window_average_field", "discharged_mass_history", "frames_in_window", "mean_velocity_history"]
 
@@ -124,7 +125,7 @@ def discharged_mass_history(tracks: ClumpTracks, masses, mode: str, outlet_z: fl
         Clump masses [kg].
     mode : {"batch", "continuous"}
         Batch: mass above the outlet at the first frame minus that at each frame. Continuous: mass of the outlet
-        crossings up to each frame (:func:`analysis.studies.silo_recirculation.blending.recirculation_events`, which needs ``domain_z``).
+        crossings up to each frame (:func:`analysis.studies.silo_recirculation.tracks.recirculation_events`, which needs ``domain_z``).
     outlet_z : float
         Height of the outlet plane [m].
     domain_z : tuple of float, optional

@@ -1,0 +1,186 @@
+"""The layout holds: layers point one way, no import circles, no function-local imports, and only the LIGGGHTS
+package and templates know LIGGGHTS (its code, file names and formats).
+
+Layers (../shared/design/ARCHITECTURE.md): workflow -> engines, analysis, calibration; calibration -> analysis;
+engines -> the neutral bottom of analysis only (``analysis.data``, ``analysis.checks``); analysis -> nothing else.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+from engines.config import REPO_ROOT
+from engines.interface import ENGINE_KINDS, engine_named
+
+PACKAGES = ("engines", "analysis", "calibration")
+#: What engines may take from analysis: the neutral types and the argument checks.
+NEUTRAL_ANALYSIS = ("analysis.data", "analysis.checks")
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(REPO_ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _python_files(*folders: str) -> list[Path]:
+    return sorted(p for folder in folders for p in (REPO_ROOT / folder).rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def _is_type_checking(node: ast.If) -> bool:
+    test = node.test
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def _imports(path: Path) -> tuple[list[tuple[int, str]], list[tuple[int, str]]]:
+    """(runtime imports, imports inside functions or classes) of a file as (line, module)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    runtime, local = [], []
+
+    def modules(node) -> list[str]:
+        if isinstance(node, ast.Import):
+            return [alias.name for alias in node.names]
+        if node.level:  # relative imports are not used in this project; resolve them anyway
+            base = _module_name(path).rsplit(".", node.level)[0]
+            return [f"{base}.{node.module}" if node.module else base]
+        return [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
+
+    def visit(nodes, inside_code: bool, type_only: bool) -> None:
+        for node in nodes:
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                for module in modules(node):
+                    (local if inside_code else runtime if not type_only else []).append((node.lineno, module))
+            elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                visit(node.body, True, type_only)
+            elif isinstance(node, ast.If):
+                visit(node.body, inside_code, type_only or _is_type_checking(node))
+                visit(node.orelse, inside_code, type_only)
+            elif isinstance(node, (ast.Try, ast.With)):
+                for block in (getattr(node, "body", []), getattr(node, "orelse", []), getattr(node, "finalbody", [])):
+                    visit(block, inside_code, type_only)
+                for handler in getattr(node, "handlers", []):
+                    visit(handler.body, inside_code, type_only)
+            elif hasattr(node, "body") and isinstance(node.body, list):
+                visit(node.body, inside_code, type_only)
+
+    visit(tree.body, False, False)
+    return runtime, local
+
+
+def _internal(module: str, known: set[str]) -> str | None:
+    """The project module an imported name refers to (``from a.b import c`` may name module a.b.c or a name in a.b)."""
+    while module and module not in known:
+        module = module.rpartition(".")[0]
+    return module or None
+
+
+def _graph() -> dict[str, set[str]]:
+    files = _python_files(*PACKAGES)
+    known = {_module_name(p) for p in files}
+    graph = {}
+    for path in files:
+        name = _module_name(path)
+        runtime, _ = _imports(path)
+        graph[name] = {target for _, module in runtime if (target := _internal(module, known)) and target != name}
+    return graph
+
+
+def test_no_function_local_imports():
+    found = [f"{path.relative_to(REPO_ROOT)}:{line} imports {module}"
+             for path in _python_files(*PACKAGES, "workflow/scripts", "tests")
+             for line, module in _imports(path)[1]]
+    assert not found, "imports belong at the top of a module:\n" + "\n".join(found)
+
+
+def test_layers_point_one_way():
+    wrong = []
+    for module, targets in _graph().items():
+        top = module.split(".")[0]
+        for target in targets:
+            other = target.split(".")[0]
+            if top == "analysis" and other != "analysis":
+                wrong.append(f"{module} -> {target} (analysis imports nothing from {other})")
+            if top == "calibration" and other not in ("calibration", "analysis"):
+                wrong.append(f"{module} -> {target} (calibration may use analysis only)")
+            if top == "engines" and other == "analysis" and not target.startswith(NEUTRAL_ANALYSIS):
+                wrong.append(f"{module} -> {target} (engines take only the neutral types from analysis)")
+            if top == "engines" and other == "calibration":
+                wrong.append(f"{module} -> {target} (engines import nothing from calibration)")
+            if module.startswith("analysis.data") and not target.startswith(NEUTRAL_ANALYSIS):
+                wrong.append(f"{module} -> {target} (the neutral types depend on nothing above them)")
+            if module.startswith("engines.cases") and target.startswith(("engines.liggghts", "engines.interface")):
+                wrong.append(f"{module} -> {target} (the case model knows no engine)")
+    assert not wrong, "\n".join(sorted(wrong))
+
+
+def test_no_import_circles():
+    graph = _graph()
+    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
+
+    def strongly_connected(node):  # Tarjan
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in graph.get(node, ()):
+            if target not in index:
+                strongly_connected(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for node in graph:
+        if node not in index:
+            strongly_connected(node)
+    # a package importing its own submodules in __init__ is not a circle of concern unless a submodule imports back
+    # the package's __init__ names; those appear as components too, so none may exist
+    assert not cycles, f"import circles: {cycles}"
+
+
+#: What names LIGGGHTS' code, file names or formats; only engines/liggghts/ and templates/liggghts/ may say these.
+LIGGGHTS_NAMES = re.compile(
+    r"engines\.liggghts|engines/liggghts|liggghts/\w+\.(?:lmp\.)?j2|in\.liggghts|log\.liggghts|\.lmp\b|custom/vtk|"
+    r"wall/gran|pair/gran|mesh/surface|dump_prefix|CONTACT_PREFIX|read_force_history|forces\.txt|wall_forces\.txt|"
+    r"id_multisphere|particles_\*|boundingBox"
+)
+
+
+@pytest.mark.parametrize("folder", ["engines", "analysis", "calibration", "workflow", "Snakefile"])
+def test_only_the_liggghts_package_names_liggghts_files_and_formats(folder):
+    root = REPO_ROOT / folder
+    paths = [root] if root.is_file() else [p for p in root.rglob("*") if p.is_file() and p.suffix in (".py", ".smk", ".yaml", ".rst")]
+    found = []
+    for path in paths:
+        relative = path.relative_to(REPO_ROOT)
+        if relative.parts[:2] == ("engines", "liggghts") or "__pycache__" in relative.parts:
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            match = LIGGGHTS_NAMES.search(line)
+            if match:
+                found.append(f"{relative}:{number}: {match.group(0)!r} in {line.strip()[:100]}")
+    assert not found, "LIGGGHTS names outside engines/liggghts/:\n" + "\n".join(found)
+
+
+def test_every_engine_kind_is_registered_and_names_its_base_template():
+    from_registry = []
+    for name in ENGINE_KINDS:
+        engine = engine_named(name)
+        assert engine.name == name
+        assert (REPO_ROOT / "templates" / engine.base_template).is_file()
+        from_registry.append(name)
+    assert from_registry == ["liggghts"]
