@@ -33,7 +33,8 @@ from engines.layout import RUN_RECORD
 from engines.liggghts.dumps import list_dumps
 from engines.liggghts.inputs import DECK_NAME, write_text_atomic
 from engines.liggghts.markers import Marker, error_lines, log_excerpt, parse_markers
-from engines.liggghts.progress import ProgressMonitor
+from engines.liggghts.thermo import ThermoProgress
+from engines.progress import ProgressMonitor
 from engines.templating import render_deck
 
 LOG_NAME = "log.liggghts"
@@ -123,8 +124,8 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     """Run the deck ``<run_dir>/deck/<deck_name>`` inside ``run_dir`` and return the log text.
 
     With ``target_time`` (the simulated time the run reaches, s) progress is reported while it runs: simulated
-    time out of the target, clumps and an ETA, every 30 s in the log (``logging``) and, when the job's stderr is a
-    terminal, as a live line there.
+    time out of the target, clumps and an ETA, every 30 s and at the end, in the log (``logging``) and, when the
+    job's stderr is a terminal, as one whole line naming the run there (runs Snakemake starts at once share it).
 
     Raises
     ------
@@ -136,7 +137,7 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
     (run_dir / RESTART_DIR).mkdir(exist_ok=True)
     terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
-    monitor = (ProgressMonitor(run_dir / screen_name, target_time, run_dir.name, PROGRESS_LOG_EVERY,
+    monitor = (ProgressMonitor(run_dir / screen_name, ThermoProgress(), target_time, run_dir.name, PROGRESS_LOG_EVERY,
                                logging.getLogger("siloflow"), terminal) if target_time else None)
     with open(run_dir / screen_name, "w", encoding="utf-8") as screen:
         process = subprocess.Popen(command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment())
