@@ -4,8 +4,8 @@ Pure computation: callers pass case objects (:mod:`engines.cases.silo_flat`, :mo
 :mod:`engines.cases.blender`, :mod:`engines.cases.jenike`), log text and numbers; nothing here reads or writes files.
 
 The cost model (:class:`CostModel`) is linear in the work: a run of S steps over N spheres costs
-``N S c`` seconds on one core, with c measured on this machine (:func:`calibrate_cost_model` measures it from
-the ``Loop time`` lines of a LIGGGHTS log). MPI ranks divide that by ``ranks * efficiency^log2(ranks)``.
+``N S c`` seconds on one core, with c measured on this machine (each engine package can fit it to the timing
+lines of its own logs). MPI ranks divide that by ``ranks * efficiency^log2(ranks)``.
 Every estimate is a worst case: the settling stage counts all its checks, the sphere count is the largest the
 run holds, and a dumped stage counts the largest number of dump frames its length allows.
 
@@ -16,9 +16,7 @@ text contact dumps (``contact_bytes_per_sphere_per_dump``).
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import re
 from dataclasses import dataclass
 from typing import Iterable
 
@@ -88,56 +86,6 @@ class CostModel:
 
 def _finite(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-_LOOP_TIME = re.compile(
-    r"Loop time of\s+([-+0-9.eE]+)\s+on\s+(\d+)\s+procs\s+for\s+(\d+)\s+steps\s+with\s+(\d+)\s+atoms"
-)
-
-
-def calibrate_cost_model(log_text: str, base: CostModel = CostModel()) -> CostModel:
-    """A cost model whose CPU time per sphere-step is measured from a LIGGGHTS log.
-
-    Every line ``Loop time of <seconds> on <procs> procs for <steps> steps with <atoms> atoms`` with
-    steps > 0 and atoms > 0 counts: c = sum(seconds * procs) / sum(steps * atoms). LIGGGHTS reports the
-    atoms at the end of each ``run``, so a run whose sphere count changes (a filling or draining silo) is
-    measured against its final count.
-
-    Parameters
-    ----------
-    log_text : str
-        Text of one or more engine logs or screen outputs (concatenate several runs to average them).
-    base : CostModel
-        Model whose other values are kept.
-
-    Returns
-    -------
-    CostModel
-        ``base`` with ``seconds_per_sphere_step`` replaced (s).
-
-    Raises
-    ------
-    ValueError
-        When the text holds no such line with steps > 0 and atoms > 0.
-    """
-    cpu_seconds = 0.0
-    sphere_steps = 0
-    for match in _LOOP_TIME.finditer(log_text):
-        try:
-            seconds = float(match.group(1))
-        except ValueError:
-            continue
-        procs, steps, atoms = (int(match.group(i)) for i in (2, 3, 4))
-        if steps > 0 and atoms > 0 and math.isfinite(seconds) and seconds >= 0:
-            cpu_seconds += seconds * procs
-            sphere_steps += steps * atoms
-    if sphere_steps == 0 or cpu_seconds <= 0:
-        raise ValueError(
-            "the log holds no 'Loop time of <s> on <procs> procs for <steps> steps with <atoms> atoms' line "
-            "with steps > 0 and atoms > 0; pass the log.liggghts or engine.out of a run that got past its "
-            "first stage"
-        )
-    return dataclasses.replace(base, seconds_per_sphere_step=cpu_seconds / sphere_steps)
 
 
 # ---------------------------------------------------------------------------------------------- time

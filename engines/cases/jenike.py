@@ -16,20 +16,16 @@ Wall friction test (``test = <wall material>``)
     (its bottom annulus at z = 0) and holds the whole sample, so the shear plane is the plate surface
     (z = 0) and every clump lies above it. ``bottom_ring_height`` is not used.
 
-Stages (the deck, see ``templates/liggghts/jenike.lmp.j2``):
+Stages (:meth:`JenikeCase.stages`; how an engine carries them out is that engine's business):
 
-1. fill: clumps are created at once (``insert/pack``) in a loose column inside both rings and a mould
+1. fill: clumps are created at once in a loose column inside both rings and a mould
    ring stacked on the shear ring (as in the real test), at the fill friction (low, for a dense
    packing), fall and settle for ``fill.settle_time``. The clump count fills the cell to
    ``1 + fill.overfill`` times the sample height at an estimated solid fraction
    (:data:`FILL_SOLID_FRACTION`).
-2. level: every clump with a sphere centre above ``ring top - largest sphere radius`` is deleted
-   (``delete_atoms region``; LIGGGHTS removes the partner spheres of a deleted sphere's clump at the
-   start of the next run, so a one-step run follows), so no sphere reaches above the top of the shear
-   ring; the sample relaxes. The mould stays (now empty) and moves with the shear ring during the shear,
-   a collar that keeps clumps from escaping past the lid's edge: removing it would mean re-creating the
-   single mesh wall, which LIGGGHTS refuses while ``compute wall/gran/local`` (the wall-contact
-   diagnostics, to be defined before the first run) exists.
+2. level: every clump with a sphere centre above ``ring top - largest sphere radius`` is deleted, so no
+   sphere reaches above the top of the shear ring; the sample relaxes. The mould stays (now empty) and moves
+   with the shear ring during the shear, a collar that keeps clumps from escaping past the lid's edge.
 3. lid: placed just above the highest sphere of the sample (its centre height is measured in the deck).
 4. test contact parameters replace the fill values; consolidation under F_N = sigma pi D^2 / 4, ramped
    from 0 over the first :data:`LOAD_RAMP_FRACTION` of ``consolidation.time``, then held.
@@ -42,12 +38,10 @@ Lids
     body that translates vertically and may tilt and rotate, loaded by a constant vertical force F_N
     with its weight cancelled. Its spheres have the radius of the smallest particle sphere and the
     particle density (the lid material has no density in the configuration).
-    ``servo``: a flat disk mesh that cannot tilt or rotate, loaded by the same constant force. LIGGGHTS'
-    own servo mesh (``mesh/surface/stress/servo``) cannot be moved horizontally, and a lid held still
-    while the shear ring moves away turns the test into a wall-friction test of the ring against the
-    sample; so the lid mesh is moved with ``move/mesh linear/variable``: x at the shear velocity (with
-    the ring), z with a proxy atom of the lid's mass driven by the particles' force on the mesh minus
-    F_N (:class:`ServoLid`).
+    ``servo``: a flat disk mesh that cannot tilt or rotate, loaded by the same constant force. A lid held
+    still while the shear ring moves away would turn the test into a wall-friction test of the ring against
+    the sample; so the lid mesh moves along x at the shear velocity (with the ring) and along z with a proxy
+    body of the lid's mass driven by the particles' force on the mesh minus F_N (:class:`ServoLid`).
 """
 
 from __future__ import annotations
@@ -426,12 +420,10 @@ class RigidLid:
 class ServoLid:
     """A flat disk mesh that cannot tilt or rotate, loaded by a constant vertical force.
 
-    ``fix mesh/surface/stress/servo`` cannot be combined with ``move/mesh``, so it cannot follow the shear
-    ring, and its proportional controller lags behind the dilation of the sheared sample. Instead the lid
-    mesh moves with ``move/mesh linear/variable``: along x at the shear velocity (with the ring) and along
-    z at the velocity of a proxy rigid body (two atoms without contacts, as LIGGGHTS' fix rigid needs at
-    least two, placed above the lid plane) of the lid's mass, integrated under the particles' vertical
-    force on the mesh minus F_N (its weight cancelled). The lid is thus an ideal force servo: a flat rigid
+    The lid mesh moves along x at the shear velocity (with the ring) and along z at the velocity of a proxy
+    rigid body (two point masses without contacts, placed above the lid plane) of the lid's mass, integrated
+    under the particles' vertical force on the mesh minus F_N (its weight cancelled); a proportional force
+    controller would lag behind the dilation of the sheared sample. The lid is thus an ideal force servo: a flat rigid
     lid free to move vertically only, with the same mass as the rigid lid of the same cell.
 
     Attributes

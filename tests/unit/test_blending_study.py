@@ -284,7 +284,7 @@ def test_particle_rtd_of_a_too_short_run_says_what_to_change(n_frames, which, nr
     timing = loop_timing(short, short_events, OUTLET)
     message = (
         rf"none of the 16 tracer passes \({which} RTD\) entering after Nr = 0.4 left the silo before the end "
-        rf"of the run \(Nr = {nr_run}\); run more recirculations \(blending.recirculations\)"
+        rf"of the run \(Nr = {nr_run}\); run more recirculations \(silo_recirculation.recirculations\)"
     )
     with pytest.raises(ValueError, match=message):
         particle_rtd(short_events, timing, TRACER_FRACTION, TRACER_START, RTD_BINS, WINDOW)
@@ -469,7 +469,7 @@ def test_main_run_eulerian_rtd_of_uniform_downflow_is_height_over_speed(tracks, 
 
 def test_main_run_eulerian_rtd_asks_for_more_time_when_no_tracer_leaves(tracks, result):
     # 0.5 t_res = 3.75 s is less than the shortest residence time, 7.125 s
-    with pytest.raises(ValueError, match=r"no virtual tracer reached the outlet; raise blending.eulerian.max_recirculations"):
+    with pytest.raises(ValueError, match=r"no virtual tracer reached the outlet; raise silo_recirculation.eulerian.max_recirculations"):
         main_run_eulerian_rtd(tracks, conveyor_velocity(TIMES.size), np.ones(N_CLUMPS), result, WIDTH, DEPTH, TOP,
                               INLET_WIDTH, bin_size=0.05, dt=DT, max_recirculations=0.5, bins=4)
 

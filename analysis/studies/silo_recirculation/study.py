@@ -209,8 +209,8 @@ def particle_rtd(events: RecirculationEvents, timing: LoopTiming, tracer_fractio
             raise ValueError(
                 f"none of the {passes.exit_time.size} tracer passes ({what} RTD) entering after Nr = {tracer_start:g} "
                 f"left the silo before the end of the run (Nr = {timing.recirculations:.2f}); run more "
-                "recirculations (blending.recirculations) or mark the tracer earlier "
-                "(blending.tracer.start_recirculations)"
+                "recirculations (silo_recirculation.recirculations) or mark the tracer earlier "
+                "(silo_recirculation.tracer.start_recirculations)"
             )
     silo = rtd_from_exit_times(tracer.exit_time, t_entry=tracer.entry_time, bins=bins, n_total=n_tracer)
     loop_E = _with_little_tail(loop, window, events.n_clumps / timing.throughput)
@@ -468,5 +468,5 @@ def main_run_eulerian_rtd(tracks: ClumpTracks, velocity, mass, result: BlendingR
     )
     residence = eulerian.residence_time
     if not np.any(np.isfinite(residence)):
-        raise ValueError("no virtual tracer reached the outlet; raise blending.eulerian.max_recirculations")
+        raise ValueError("no virtual tracer reached the outlet; raise silo_recirculation.eulerian.max_recirculations")
     return rtd_from_exit_times(residence, t_entry=0.0, bins=bins, n_total=residence.size)
