@@ -197,7 +197,7 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
 
     Parameters
     ----------
-    signals : engines.cases.jenike.ShearSignals or any object with ``time``, ``lid_force``, ``ring_force``,
+    signals : calibration.shear.ShearSignals or any object with ``time``, ``lid_force``, ``ring_force``,
         ``bottom_force``, ``normal_force``, ``weight_above``
         Force histories of the shear stage (s, N).
     friction : calibration.friction.BulkFriction

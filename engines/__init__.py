@@ -1,5 +1,5 @@
-"""Turning siloflow cases into engine input decks and running the engines.
-
-LIGGGHTS specifics live in :mod:`engines.liggghts.run` and ``templates/liggghts/``; the case descriptions
-(:mod:`engines.cases.silo_flat`) and the physics helpers (:mod:`engines.cases.physics`) are engine-neutral.
+"""The case model and the engine seam: engine-neutral cases (:mod:`engines.cases`), the engine interface and its
+registry (:mod:`engines.interface`), one package per engine (``engines/<name>/``, the only place that knows an
+engine's syntax, file names and formats), the results layout (:mod:`engines.layout`) and run planning
+(:mod:`engines.estimates`, :mod:`engines.planning`, :mod:`engines.runs`).
 """

@@ -9,7 +9,8 @@ import sys
 
 import pytest
 
-from engines.config import load_config_file, validate_config, REPO_ROOT
+from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.interface import engine_named
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
@@ -101,6 +102,12 @@ def run_snakemake(workdir, *arguments: str, targets=()) -> subprocess.CompletedP
         text=True,
         check=False,
     )
+
+
+def liggghts():
+    """The LIGGGHTS engine, through the registry (the integration tests run it only through the interface)."""
+    require_liggghts()
+    return engine_named("liggghts")
 
 
 def require_liggghts():

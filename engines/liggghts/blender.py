@@ -15,7 +15,8 @@ from engines.cases.blender import BlenderCase
 from engines.cases.blender_geometry import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
 from engines.liggghts.run import Resume, run_checked
-from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context
+from analysis.data.record import RunRecord
+from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_run_record
 from engines.liggghts.inputs import write_case_inputs
 from engines.templating import render_deck
 
@@ -81,20 +82,16 @@ def check_blender_run(case: BlenderCase, markers, dump_files, run_dir: Path) -> 
 
 def run_blender(
     case: BlenderCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
-) -> Path:
-    """Run a rendered blender deck, check it and write ``run.json``; returns its path."""
+) -> RunRecord:
+    """Run a rendered blender deck, check it and write ``run.json``; returns the record."""
     return run_checked(
         run_dir,
         lambda markers, dumps: check_blender_run(case, markers, dumps, Path(run_dir)),
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case.silo)},
-        {
-            "run_id": case.run_id,
-            "configuration": case.configuration,
-            "gravity_factor": case.gravity_factor,
-            "mode": case.mode,
-            "domain_z": [-case.silo.sink_depth, case.silo.domain_top],
-            "outlet_z": 0.0,
-        },
+        lambda checked: silo_run_record(
+            "blender", case.run_id, checked,
+            {"configuration": case.configuration, "gravity_factor": case.gravity_factor, "mode": case.mode},
+            [-case.silo.sink_depth, case.silo.domain_top]),
         Resume("liggghts/blender.lmp.j2", blender_deck_context(case), case.silo.discharge_steps),
     )

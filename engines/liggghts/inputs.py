@@ -9,6 +9,8 @@ from pathlib import Path
 
 from engines.cases.geometry import write_stl
 
+#: The engine's registry name (engine.kind), written into every run record.
+ENGINE_NAME = "liggghts"
 DECK_NAME = "in.liggghts"
 
 # LIGGGHTS only accepts 5e6 <= E <= 1e9 Pa (SI) unless told otherwise.

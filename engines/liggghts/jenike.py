@@ -1,5 +1,13 @@
 """LIGGGHTS: the Jenike direct shear deck, its inputs, running it and reading its force history.
 
+How the deck carries out the case's stages: levelling deletes clumps with ``delete_atoms region`` (LIGGGHTS
+removes the partner spheres of a deleted sphere's clump at the start of the next run, so a one-step run follows).
+The mould stays after levelling: removing it would mean re-creating the single mesh wall, which LIGGGHTS refuses
+while ``compute wall/gran/local`` (the wall-contact diagnostics, defined before the first run) exists. The servo
+lid is not LIGGGHTS' ``mesh/surface/stress/servo`` (it cannot be combined with ``move/mesh``, so it could not follow
+the shear ring, and its proportional controller lags behind the dilation of the sheared sample): the lid mesh
+moves with ``move/mesh linear/variable``, z with a proxy rigid body of two atoms (fix rigid needs two).
+
 Run directory layout (the engine runs inside the run directory; relative paths are what the deck sees)::
 
     <run>/deck/in.liggghts     the rendered deck
@@ -7,7 +15,8 @@ Run directory layout (the engine runs inside the run directory; relative paths a
     <run>/deck/case.json       derived case quantities
     <run>/dumps/               particle dumps during consolidation and shear (binary legacy VTK), and
                                contact dumps pair_contacts_<step>.txt, wall_contacts_<step>.txt (rigid lid)
-    <run>/forces.txt           force history during consolidation and shear (see read_force_history)
+    <run>/forces.txt           force history during consolidation and shear (see read_force_history;
+                               engines.liggghts.forces reads it as a WallForceHistory)
     <run>/log.liggghts         the engine log
     <run>/engine.out           the engine's screen output
     <run>/run.json             written last, only after every check passed
@@ -22,16 +31,19 @@ import numpy as np
 
 from engines.cases.geometry import write_stl
 from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
-from engines.liggghts.inputs import DECK_NAME, common_context, flat_matrix, write_text_atomic
+from analysis.data.record import RunRecord
+from engines.interface import EngineRunError
+from engines.layout import RUN_RECORD
+from engines.liggghts.contacts import parse_local_table
+from engines.liggghts.dumps import list_dumps
+from engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix, write_text_atomic
+from engines.liggghts.markers import parse_markers
 from engines.liggghts.run import (
     DUMP_PREFIX,
     RUN_OUTPUTS,
-    RUN_RECORD,
-    EngineRunError,
-    parse_markers,
+    output_bytes,
     run_engine,
     set_aside_previous_attempt,
-    output_bytes,
     write_run_record,
 )
 from engines.templating import render_deck
@@ -55,8 +67,12 @@ FORCE_COLUMNS = (
 )
 
 STAGES = ("filled", "levelled", "lid_placed", "consolidated", "sheared")
+#: Stage kinds of the markers that end the stages of the Jenike case (lid_placed starts the consolidation).
+JENIKE_STAGE_MARKERS = {"filled": "fill", "levelled": "settle", "consolidated": "consolidate", "sheared": "shear"}
 
 PAIR_CONTACT_PREFIX = "pair_contacts"
+#: The meshes of the cell's one mesh wall, by their index in the wall contact dumps.
+WALL_MESHES = ("base", "shear_ring", "mould", "lid")
 WALL_CONTACT_PREFIX = "wall_contacts"
 
 #: Columns of the contact dumps (``compute pair/gran/local`` and ``wall/gran/local`` with ``pos id
@@ -247,8 +263,6 @@ def read_contact_dump(path: str | Path) -> dict[str, np.ndarray]:
         Naming the file, if the header is incomplete, the entry count disagrees with the rows, or a row
         has the wrong number of columns.
     """
-    from engines.liggghts.contacts import parse_local_table
-
     path = Path(path)
     step, table = parse_local_table(
         path.read_text(encoding="utf-8", errors="replace"), len(CONTACT_COLUMNS), str(path)
@@ -318,8 +332,8 @@ def set_aside_previous_jenike_attempt(run_dir: str | Path) -> Path | None:
 
 def run_jenike(
     case: JenikeCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
-) -> Path:
-    """Run a rendered Jenike deck, check it and write ``run.json``; returns its path.
+) -> RunRecord:
+    """Run a rendered Jenike deck, check it and write ``run.json``; returns the record.
 
     Output of an earlier unfinished attempt (dumps, log, screen output, force history) is moved to
     ``failed_attempts/`` first.
@@ -331,7 +345,20 @@ def run_jenike(
     (run_dir / RUN_RECORD).unlink(missing_ok=True)
     set_aside_previous_jenike_attempt(run_dir)
     log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
-    record = check_jenike_run(case, parse_markers(log_text), run_dir)
-    record.update({"run_id": case.run_id, "mpi_ranks": mpi_ranks, "dump_prefix": DUMP_PREFIX,
-                   "output_bytes": output_bytes(run_dir)})
-    return write_run_record(run_dir, record)
+    checked = check_jenike_run(case, parse_markers(log_text), run_dir)
+    stages = checked["stages"]
+    record = RunRecord(
+        engine=ENGINE_NAME,
+        case="jenike",
+        run_id=case.run_id,
+        timestep_s=case.timestep,
+        n_clumps=checked["n_clumps"],
+        n_frames=len(list_dumps(run_dir / "dumps", DUMP_PREFIX)),
+        mpi_ranks=mpi_ranks,
+        stages={kind: stages[marker] for marker, kind in JENIKE_STAGE_MARKERS.items()},
+        output_bytes=output_bytes(run_dir),
+        labels={key: checked[key] for key in ("consolidation_start_s", "shear_start_s", "shear_end_s",
+                                              "n_clumps_created", "force_samples")},
+    )
+    write_run_record(run_dir, record)
+    return record

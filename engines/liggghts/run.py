@@ -87,7 +87,9 @@ def _mpi_environment() -> dict:
     return environment
 
 
-RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart")
+#: The force history of the walls the silo-type decks write (read by :mod:`engines.liggghts.forces`).
+WALL_FORCES_NAME = "wall_forces.txt"
+RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart", WALL_FORCES_NAME)
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:

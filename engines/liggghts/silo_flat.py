@@ -7,21 +7,23 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.data.record import RunRecord
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.silo_flat import SiloCase
 from engines.estimates import CostModel, silo_run_steps
-from engines.liggghts.inputs import common_context, write_case_inputs
+from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
+from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX, WALL_FORCES_NAME
 from engines.liggghts.run import (
     CONTACT_PREFIX,
     DUMP_PREFIX,
     RESTART_DIR,
     RESTART_PREFIX,
-    EngineRunError,
-    Marker,
     Resume,
     restart_every,
     run_checked,
 )
+from engines.interface import EngineRunError
+from engines.liggghts.markers import Marker
 from engines.templating import render_deck
 
 #: What the silo-type decks dump per sphere: what their analyses read (ids, clump ids, centres, velocities,
@@ -98,6 +100,9 @@ def silo_deck_context(case: SiloCase) -> dict:
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
             "thermo_every": dump_every,
+            # force and torque of every wall on the particles, one sample per dump interval (engines.liggghts.forces)
+            "wall_forces": {"every": dump_every, "timestep": case.timestep, "path": WALL_FORCES_NAME,
+                            "resume_prefix": RESUMED_WALL_FORCES_PREFIX},
         }
     )
     return context
@@ -177,15 +182,44 @@ def expected_simulated_time(silo: SiloCase) -> float:
     return silo_run_steps(silo, CostModel().settle_fraction) * silo.timestep
 
 
+#: Stage kinds of the markers a silo-type deck prints at the end of its stages.
+SILO_STAGE_MARKERS = {"filled": "fill", "settled": "settle", "opened": "open", "discharged": "discharge",
+                      "recirculated": "recirculate"}
+
+
+def silo_run_record(case_kind: str, run_id: str, checked: dict, labels: dict | None = None,
+                    domain_z: list | None = None) -> RunRecord:
+    """The run record of a checked silo-type run (``checked``: :func:`check_silo_run` plus the run's ``mpi_ranks``,
+    ``resumed_attempts`` and ``output_bytes``)."""
+    return RunRecord(
+        engine=ENGINE_NAME,
+        case=case_kind,
+        run_id=run_id,
+        timestep_s=checked["timestep_s"],
+        n_clumps=checked["n_clumps"],
+        n_frames=checked["n_dumps"],
+        mpi_ranks=checked["mpi_ranks"],
+        stages={kind: checked[marker] for marker, kind in SILO_STAGE_MARKERS.items() if marker in checked},
+        resumed_attempts=checked["resumed_attempts"],
+        output_bytes=checked["output_bytes"],
+        settle_checks=checked["settle_checks"],
+        open_step=checked["open_step"],
+        open_time_s=checked["open_time_s"],
+        domain_z=domain_z,
+        outlet_z=0.0,
+        labels=dict(labels or {}),
+    )
+
+
 def run_silo(
     case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
-) -> Path:
-    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns its path."""
+) -> RunRecord:
+    """Run a rendered flat-bottom silo deck, check it and write ``run.json``; returns the record."""
     return run_checked(
         run_dir,
         lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case)},
-        {"run_id": case.run_id},
+        lambda checked: silo_run_record("silo_flat", case.run_id, checked),
         Resume("liggghts/silo_flat.lmp.j2", silo_deck_context(case), case.discharge_steps),
     )

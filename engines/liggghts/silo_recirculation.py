@@ -14,7 +14,8 @@ from pathlib import Path
 from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.geometry import vertical_rectangle_x
 from engines.liggghts.run import Resume, run_checked
-from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_meshes
+from analysis.data.record import RunRecord
+from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_run_record, silo_meshes
 from engines.liggghts.inputs import write_case_inputs
 from engines.templating import render_deck
 
@@ -74,20 +75,17 @@ def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_di
 def run_recirculation(
     case: RecirculationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
     mpirun: str = "mpirun",
-) -> Path:
-    """Run a rendered recirculation deck, check it and write ``run.json``; returns its path."""
+) -> RunRecord:
+    """Run a rendered recirculation deck, check it and write ``run.json``; returns the record."""
     return run_checked(
         run_dir,
         lambda markers, dumps: check_recirculation_run(case, markers, dumps, Path(run_dir)),
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case.silo)},
-        {
-            "run_id": case.run_id,
-            "flow_pattern": case.pattern,
-            "role": case.role,
-            "estimated_residence_time_s": case.estimated_residence_time,
-            "domain_z": [-case.channel_length, case.silo.domain_top],
-            "outlet_z": 0.0,
-        },
+        lambda checked: silo_run_record(
+            "silo_recirculation", case.run_id, checked,
+            {"flow_pattern": case.pattern, "role": case.role,
+             "estimated_residence_time_s": case.estimated_residence_time},
+            [-case.channel_length, case.silo.domain_top]),
         Resume("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps),
     )

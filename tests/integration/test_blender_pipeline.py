@@ -16,20 +16,21 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.studies.silo_recirculation.blending import recirculation_events
-from analysis.studies.silo_recirculation.tracks_io import read_recirculation_tracks
+from analysis.data.record import read_run_record
+from analysis.studies.silo_recirculation.tracks import recirculation_events, recirculation_tracks
 from engines.cases.blender import blender_cases
 from engines.config import validate_config
-from tests.conftest import NO_BLENDING, TINY_BLENDER, TINY_SILO, require_liggghts, run_snakemake
+from engines.layout import case_root, run_dir
+from tests.conftest import NO_BLENDING, TINY_BLENDER, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
 CONFIG = {
     "blender": TINY_BLENDER,
-    "blending": NO_BLENDING,
+    "silo_recirculation": NO_BLENDING,
     # a taller, faster pour than the tiny silo's fills the thin hopper in fewer insertion events
-    "silo_flat": {"fill": {"zone_width_fraction": 0.6, "zone_height": 0.04, "insertion_velocity": 3.0},
-                  "settle": TINY_SILO["settle"]},
+    "defaults": {"fill": {"zone_width_fraction": 0.6, "zone_height": 0.04, "insertion_velocity": 3.0},
+                 "settle": TINY_SILO["settle"]},
 }
 
 
@@ -43,7 +44,7 @@ def blender_pipeline(tmp_path_factory):
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["blender_all"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     cases = blender_cases(validate_config(copy.deepcopy(CONFIG)))
-    runs = {case.gravity_factor: workdir / "results" / "blender" / run for run, case in cases.items()}
+    runs = {case.gravity_factor: workdir / run_dir("blender", run) for run, case in cases.items()}
     yield workdir, runs
 
 
@@ -55,11 +56,10 @@ def test_clumps_discharge_through_the_outlet_past_the_insert(blender_pipeline):
     _, runs = blender_pipeline
     run = runs[1.0]
     case = json.loads((run / "deck" / "case.json").read_text())
-    record = json.loads((run / "run.json").read_text())
-    tracks = read_recirculation_tracks(run / "dumps", record["dump_prefix"], record["timestep_s"], record["domain_z"],
-                                       cache_dir=run / "frames").tracks
+    record = read_run_record(run / "run.json")
+    tracks = recirculation_tracks(liggghts().read_frames(run, record), record.domain_z).tracks
     # continuous discharge: every clump in every dump, none lost at the periodic boundary
-    assert tracks.n_clumps == case["n_clumps"] == int(record["discharged"]["clumps"])
+    assert tracks.n_clumps == case["n_clumps"] == int(record.stage("discharge")["clumps"])
     assert tracks.present.all()
     events = recirculation_events(tracks, 0.0, *case["domain_z"])
     crossed = np.unique(events.exit_clump_index)
@@ -90,6 +90,6 @@ def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipelin
     print(f"mass flow rate g: {slow['mass_flow_rate_kg_s']:.5g} kg/s, 4 g: {fast['mass_flow_rate_kg_s']:.5g} kg/s, "
           f"ratio {ratio:.3f}")
     assert ratio == pytest.approx(2.0, abs=0.2)
-    with open(workdir / "results" / "blender" / "gravity" / "scaling.csv", newline="") as handle:
+    with open(workdir / case_root("blender") / "gravity" / "scaling.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) >= 2

@@ -16,19 +16,22 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.studies.silo_recirculation.blending import recirculation_events
+from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from engines.cases.silo_recirculation import recirculation_cases
+from analysis.data.record import read_run_record
 from engines.config import validate_config
+from engines.layout import case_root, run_dir
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
 CONFIG = {
-    "blending": TINY_BLENDING,
+    "silo_recirculation": TINY_BLENDING,
     "blender": NO_BLENDER,
     "engine": {"mpi_ranks": 2},
-    "silo_flat": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
+    # the recirculating silo inherits fill and settle from defaults
+    "defaults": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
 }
 
 
@@ -39,11 +42,11 @@ def blending_pipeline(tmp_path_factory):
     workdir = tmp_path_factory.mktemp("blending")
     config_path = workdir / "blending.yaml"
     config_path.write_text(yaml.safe_dump(CONFIG))
-    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["blending_all"])
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["silo_recirculation_all"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus CONFIG.
     cases = recirculation_cases(validate_config(copy.deepcopy(CONFIG)))
-    runs = {case.role: workdir / "results" / "blending" / run for run, case in cases.items()}
+    runs = {case.role: workdir / run_dir("silo_recirculation", run) for run, case in cases.items()}
     yield workdir, runs, cases
 
 
@@ -55,10 +58,10 @@ def test_clump_count_is_conserved_over_more_than_one_recirculation(blending_pipe
     _, runs, _ = blending_pipeline
     loaded, case = _tracks_and_case(runs["blending"])
     tracks = loaded.tracks
-    record = json.loads((runs["blending"] / "run.json").read_text())
-    assert record["mpi_ranks"] == 2
+    record = read_run_record(runs["blending"] / "run.json")
+    assert record.mpi_ranks == 2
     # Every clump is in every dump, with its id: none lost or duplicated at the periodic boundary.
-    assert tracks.n_clumps == case["n_clumps"] == int(record["recirculated"]["clumps"])
+    assert tracks.n_clumps == case["n_clumps"] == int(record.stage("recirculate")["clumps"])
     assert tracks.present.all()
     summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
     assert summary["recirculations"] >= 1.0
@@ -119,7 +122,7 @@ def test_make_run_outputs_exist_and_the_prediction_tracks_the_measurement(blendi
         p = layout["blue_fraction"]
         assert layout["vrr_by_recirculation"][0] > 1.0
         assert layout["prediction_rms_error"] < 0.7 * (p * (1.0 - p)) ** 0.5
-    rows = list(csv.DictReader((workdir / "results" / "blending" / "summary" / "blending.csv").open()))
+    rows = list(csv.DictReader((workdir / case_root("silo_recirculation") / "summary" / "blending.csv").open()))
     assert len(rows) == 5
 
 

@@ -27,7 +27,7 @@ TINY_CALIBRATION = {
     "calibration": {"targets_deg": {"internal": 24.0, "aluminium": 9.5}, "tolerance_deg": 1.0, "shape": "sphere2",
                     "rolling_friction": 0.0},
     "silo_flat": {**TINY_SILO, "parameters": "calibrated"},
-    "blending": NO_BLENDING,
+    "silo_recirculation": NO_BLENDING,
     "blender": NO_BLENDER,
 }
 

@@ -7,7 +7,6 @@ and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, 
 
 from __future__ import annotations
 
-import json
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,11 +15,15 @@ import numpy as np
 import pytest
 
 from engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
+from analysis.data.record import RunRecord
 from calibration.friction import BulkFriction, bulk_friction
+from calibration.shear import ShearSignals, shear_signals
 from engines.config import validate_config
-from engines.cases.jenike import LID_TYPE, JenikeCase, ShearSignals, build_jenike_case, shear_signals
+from engines.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from engines.liggghts.forces import read_jenike_forces
 from engines.liggghts.run import DUMP_PREFIX
 from engines.liggghts.jenike import (
+    FORCES_NAME,
     PAIR_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,
     read_contact_dump,
@@ -53,7 +56,7 @@ RUNS = {
 class Run:
     case: JenikeCase
     run_dir: Path
-    record: dict
+    record: RunRecord
     history: dict
     signals: ShearSignals
     friction: BulkFriction
@@ -61,9 +64,10 @@ class Run:
 
 def _run(case: JenikeCase, run_dir: Path) -> Run:
     write_jenike_inputs(case, run_dir / "deck")
-    record = json.loads(run_jenike(case, run_dir).read_text())
-    history = read_force_history(run_dir / record["forces"])
-    signals = shear_signals(history, record["shear_start_s"], record["shear_end_s"])
+    record = run_jenike(case, run_dir)
+    # the engine's own columns (with the step) for the contact dump check; the neutral history for the friction
+    history = read_force_history(run_dir / FORCES_NAME)
+    signals = shear_signals(read_jenike_forces(run_dir), record.labels["shear_start_s"], record.labels["shear_end_s"])
     # A 4 mm shear of a 40 mm cell is too short for a plateau: average over its second half.
     half = signals.time[0] + 0.5 * (signals.time[-1] - signals.time[0])
     friction = bulk_friction(
@@ -94,9 +98,9 @@ def runs(tmp_path_factory) -> dict[str, Run]:
 def test_runs_fill_level_and_keep_every_clump(runs):
     for name, run in runs.items():
         record = run.record
-        assert record["n_clumps_created"] == run.case.fill.n_clumps, name
-        assert 0 < record["n_clumps"] < record["n_clumps_created"], name
-        assert record["stages"]["sheared"]["clumps"] == record["n_clumps"], name
+        assert record.labels["n_clumps_created"] == run.case.fill.n_clumps, name
+        assert 0 < record.n_clumps < record.labels["n_clumps_created"], name
+        assert record.stage("shear")["clumps"] == record.n_clumps, name
         assert (run.run_dir / "run.json").exists() and list_dumps(run.run_dir / "dumps", DUMP_PREFIX), name
 
 
@@ -136,7 +140,7 @@ def test_bulk_wall_friction_does_not_exceed_the_particle_wall_friction(runs):
 def test_rigid_lid_moves_with_the_shear_ring(runs):
     run = runs["rigid_0.5"]
     dumps = list_dumps(run.run_dir / "dumps", DUMP_PREFIX)
-    shear_start = int(run.record["stages"]["consolidated"]["step"])
+    shear_start = int(run.record.stage("consolidate")["step"])
     x = []
     for path in (dumps[0], dumps[-1]):
         frame = parse_legacy_vtk_polydata(path.read_bytes(), str(path))

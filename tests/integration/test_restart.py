@@ -19,14 +19,16 @@ import time
 import pytest
 import yaml
 
+from analysis.data.record import read_run_record
 from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.layout import run_dir as layout_run_dir, run_path
 from engines.liggghts.run import restart_files
 from engines.cases.silo_flat import build_silo_case
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
-CONFIG = {"silo_flat": TINY_SILO, "blending": NO_BLENDING, "blender": NO_BLENDER}
+CONFIG = {"silo_flat": TINY_SILO, "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}
 
 
 def _snakemake_command(workdir, config_path, target):
@@ -40,7 +42,7 @@ def killed_and_uninterrupted(tmp_path_factory):
     raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
     raw["silo_flat"] = {**raw["silo_flat"], **TINY_SILO}
     run_id = build_silo_case(validate_config(raw)).run_id
-    target = f"results/silo_flat/{run_id}/metrics/flow.csv"
+    target = run_path("silo_flat", "metrics/flow.csv", run_id)
     dirs = {}
     for name in ("killed", "uninterrupted"):
         dirs[name] = tmp_path_factory.mktemp(name)
@@ -49,7 +51,7 @@ def killed_and_uninterrupted(tmp_path_factory):
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     killed = subprocess.Popen(_snakemake_command(dirs["killed"], dirs["killed"] / "tiny.yaml", target),
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-    run_dir = dirs["killed"] / "results" / "silo_flat" / run_id
+    run_dir = dirs["killed"] / layout_run_dir("silo_flat", run_id)
     deadline = time.monotonic() + 600
     while len(restart_files(run_dir)) < 2 and killed.poll() is None and time.monotonic() < deadline:
         time.sleep(0.5)
@@ -67,15 +69,15 @@ def killed_and_uninterrupted(tmp_path_factory):
     assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
     output, _ = uninterrupted.communicate(timeout=900)
     assert uninterrupted.returncode == 0, output[-3000:]
-    yield run_dir, dirs["uninterrupted"] / "results" / "silo_flat" / run_id
+    yield run_dir, dirs["uninterrupted"] / layout_run_dir("silo_flat", run_id)
 
 
 def test_the_killed_run_resumes_from_its_restart_file(killed_and_uninterrupted):
     run_dir, _ = killed_and_uninterrupted
     log = (run_dir / "logs" / "run.log").read_text()
     assert "resuming" in log and "from restart file restart/state_" in log
-    record = json.loads((run_dir / "run.json").read_text())
-    assert record["resumed_attempts"] == 1
+    record = read_run_record(run_dir / "run.json")
+    assert record.resumed_attempts == 1
     assert "SILOFLOW resumed" in (run_dir / "resume1.log.liggghts").read_text()
     # restart files only serve resumption; a finished run has none left
     assert not (run_dir / "restart").exists()
@@ -83,11 +85,11 @@ def test_the_killed_run_resumes_from_its_restart_file(killed_and_uninterrupted):
 
 def test_resumed_and_uninterrupted_runs_agree(killed_and_uninterrupted):
     resumed_dir, uninterrupted_dir = killed_and_uninterrupted
-    resumed = json.loads((resumed_dir / "run.json").read_text())
-    uninterrupted = json.loads((uninterrupted_dir / "run.json").read_text())
-    assert resumed["filled"]["clumps"] == uninterrupted["filled"]["clumps"] == resumed["n_clumps"]
-    assert resumed["n_dumps"] == uninterrupted["n_dumps"]
-    assert resumed["discharged"]["step"] == uninterrupted["discharged"]["step"]
+    resumed = read_run_record(resumed_dir / "run.json")
+    uninterrupted = read_run_record(uninterrupted_dir / "run.json")
+    assert resumed.stage("fill")["clumps"] == uninterrupted.stage("fill")["clumps"] == resumed.n_clumps
+    assert resumed.n_frames == uninterrupted.n_frames
+    assert resumed.stage("discharge")["step"] == uninterrupted.stage("discharge")["step"]
     (a,) = csv.DictReader((resumed_dir / "metrics" / "flow.csv").open())
     (b,) = csv.DictReader((uninterrupted_dir / "metrics" / "flow.csv").open())
     rate_a, rate_b = float(a["mass_flow_rate_kg_s"]), float(b["mass_flow_rate_kg_s"])
@@ -99,7 +101,7 @@ def test_resumed_and_uninterrupted_runs_agree(killed_and_uninterrupted):
     counted = rate_b * window / clump_mass
     noise = 3.0 * math.sqrt(2.0) * rate_b / math.sqrt(counted)
     print(f"flow rate resumed {rate_a:.5g} kg/s, uninterrupted {rate_b:.5g} kg/s, 3 sigma of counting noise "
-          f"{noise:.2g} kg/s ({counted:.0f} clumps in the window); clumps left {resumed['discharged']['clumps']:.0f} "
-          f"and {uninterrupted['discharged']['clumps']:.0f}")
+          f"{noise:.2g} kg/s ({counted:.0f} clumps in the window); clumps left {resumed.stage('discharge')['clumps']:.0f} "
+          f"and {uninterrupted.stage('discharge')['clumps']:.0f}")
     assert abs(rate_a - rate_b) <= noise
-    assert abs(resumed["discharged"]["clumps"] - uninterrupted["discharged"]["clumps"]) <= 0.05 * resumed["n_clumps"]
+    assert abs(resumed.stage("discharge")["clumps"] - uninterrupted.stage("discharge")["clumps"]) <= 0.05 * resumed.n_clumps

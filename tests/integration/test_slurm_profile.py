@@ -16,5 +16,5 @@ def test_slurm_profile_plans_the_thesis_config(tmp_path):
     output = result.stdout + result.stderr
     assert "This was a dry-run" in output
     # every engine stage of the study is planned as a job
-    for rule in ("jenike_run", "silo_run", "blending_run", "blender_run"):
+    for rule in ("jenike_run", "silo_run", "silo_recirculation_run", "blender_run"):
         assert rule in output

@@ -1,17 +1,49 @@
-"""Silo field analysis on synthetic input with exact answers."""
+"""Silo field analysis (fields, field_study, field_comparisons) on synthetic input with exact answers."""
 
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
+from scipy.optimize import OptimizeWarning
 
-from analysis.numerics.field_ops import depth_average
+from analysis.data.contacts import ContactFrame
 from analysis.data.frames import ClumpFrame
+from analysis.numerics.constants import GRAVITY
+from analysis.numerics.field_ops import depth_average
+from analysis.numerics.grid import Fields
 from analysis.numerics.janssen import janssen_vertical_stress
+from analysis.studies.silo_flat.field_comparisons import (
+    MEASURED_PLANES,
+    compare_with_measurements,
+    comparison_plane,
+    measured_comparison_rows,
+    parametric_profiles,
+    parametric_rows,
+)
+from analysis.studies.silo_flat.field_study import (
+    SURFACE_COLUMN_DIAMETERS,
+    SiloDimensions,
+    SiloFieldOptions,
+    analyse_silo_fields,
+    boundary_rows,
+    centreline_rows,
+    field_summary,
+    fill_surface_heights,
+    force_chain_cap,
+    instantaneous_profile_rows,
+    janssen_rows,
+    kinematic_rows,
+    profile_heights_inside,
+    profile_rows,
+    vtk_series,
+)
 from analysis.studies.silo_flat.fields import (
     FieldSettings,
+    JanssenComparison,
+    ProfileAnalysis,
     analyse_profiles,
     centreline_velocity,
     clump_fields,
@@ -19,6 +51,7 @@ from analysis.studies.silo_flat.fields import (
     profile_mass_flow_rate,
     silo_grid,
 )
+from analysis.studies.silo_flat.measured import MeasuredProfile
 
 
 def test_grid_tiles_the_silo_and_rounds_the_top_up_to_whole_cells():
@@ -82,3 +115,266 @@ def test_janssen_comparison_of_a_janssen_stress_field_is_exact():
     comparison = compare_janssen(stress, grid, surface, 667.0, 0.15, 0.04, 0.17, 0.2, 30.0, margin=0.01)
     np.testing.assert_allclose(comparison.simulated, comparison.janssen, rtol=1e-12)
     assert comparison.depth_below_surface.min() > 0.01 - 1e-12
+
+
+# --------------------------------------------------------------------------- the study of one run (field_study)
+
+
+def _clumps(position, velocity, mass, time=0.0, step=0):
+    position = np.asarray(position, dtype=float)
+    n = len(position)
+    return ClumpFrame(time=time, step=step, clump_id=np.arange(1, n + 1), position=position,
+                      velocity=np.broadcast_to(np.asarray(velocity, dtype=float), (n, 3)), mass=np.full(n, mass),
+                      n_spheres=np.full(n, 2))
+
+
+def test_fill_surface_is_the_highest_particle_top_per_column_of_four_diameters():
+    radius = 0.001
+    frame = _lattice_frame(0.06, 0.012, 0.06, 0.002, 1e-5, (0.0, 0.0, 0.0))
+    # A step in the fill: nothing above z = 0.04 on the left half.
+    keep = ~((frame.position[:, 0] < 0.0) & (frame.position[:, 2] > 0.04))
+    stepped = _clumps(frame.position[keep], (0.0, 0.0, 0.0), 1e-5)
+    surface = fill_surface_heights(stepped, radius, 0.06)
+    # int(0.06 / (4 * 0.002)) = 7 columns of 8.57 mm; columns 0-2 lie left of the axis, column 3 straddles it.
+    assert surface.shape == (7,)
+    np.testing.assert_allclose(surface, [0.04, 0.04, 0.04, 0.06, 0.06, 0.06, 0.06], rtol=1e-12)
+    assert SURFACE_COLUMN_DIAMETERS == 4
+
+
+def test_profile_heights_inside_the_fill_keep_their_order():
+    grid = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))  # nodes z = 3, 9, ..., 57 mm
+    requested = [0.002, 0.02, 0.05, 0.052, 0.04]
+    assert profile_heights_inside(requested, grid, 0.06, 0.006) == [0.02, 0.05, 0.04]  # up to 57 - 6 mm
+    assert profile_heights_inside(requested, grid, 0.03, 0.006) == [0.02]  # up to 30 - 6 mm
+    with pytest.raises(ValueError, match="profile_heights"):
+        profile_heights_inside(requested, grid, 0.005, 0.006)
+
+
+def test_force_chain_cap_is_fifty_particle_weights_at_the_simulated_gravity():
+    assert GRAVITY == 9.81  # the decks' g, not scipy's 9.80665
+    assert force_chain_cap(2e-5) == pytest.approx(50 * 2e-5 * 9.81, rel=1e-15)
+    assert force_chain_cap(2e-5, gravity=1.0) == pytest.approx(1e-3, rel=1e-15)
+
+
+def test_vtk_series_takes_every_nth_frame_named_by_step():
+    series = vtk_series((100, 200, 300, 400, 500), np.array([0.0, 0.1, 0.2, 0.3, 0.4]), 2)
+    assert series == [(0, 0.0, "fields_100.vti"), (2, 0.2, "fields_300.vti"), (4, 0.4, "fields_500.vti")]
+    assert [name for _, _, name in vtk_series((7,), [0.0], 5)] == ["fields_7.vti"]
+
+
+FIELD_SECTION = {
+    "spacing": [0.006, 0.004, 0.006], "kernel": "gaussian", "width_radii": 3.0, "cutoff": 3.0,
+    "profile_heights": [0.03, 0.04, 0.06], "fcb_fractions": [0.1], "subtract_wall_velocity": False,
+    "average_window": None, "vtk_every": 2,
+    "janssen": {"internal_friction_angle_deg": 30.0, "side_wall_friction_angle_deg": 0.0,
+                "front_wall_friction_angle_deg": 0.0},
+    "force_chain_slice": 0.004, "measured_profiles": None, "measured_plane": "front_wall",
+}
+CASE = {"width_m": 0.06, "depth_m": 0.012, "outlet_width_m": 0.02, "equivalent_diameter_m": 0.002,
+        "clump_mass_kg": 1e-5, "run_id": "lattice"}
+
+
+def test_settings_and_dimensions_from_the_config_section_and_the_case_summary():
+    options = SiloFieldOptions.from_config(FIELD_SECTION)
+    assert options.spacing == (0.006, 0.004, 0.006) and options.profile_heights == (0.03, 0.04, 0.06)
+    assert options.average_window is None and options.vtk_every == 2 and options.force_chain_slice == 0.004
+    assert options.internal_friction_angle_deg == 30.0 and options.side_wall_friction_angle_deg == 0.0
+    assert SiloFieldOptions.from_config({**FIELD_SECTION, "average_window": [0.2, 0.8]}).average_window == (0.2, 0.8)
+    settings = options.field_settings(0.001)
+    assert settings == FieldSettings((0.006, 0.004, 0.006), "gaussian", 0.003, 3.0)
+    silo = SiloDimensions.from_case_summary(CASE)
+    assert silo == SiloDimensions(width=0.06, depth=0.012, outlet_width=0.02, particle_radius=0.001, clump_mass=1e-5)
+
+
+SPEEDS = (0.1, 0.2, 0.4)  # downward speed of the whole lattice in each frame (m/s)
+STEADY_WINDOW = (0.005, 0.03)  # holds the second and third frame (s)
+BULK_DENSITY = 600.0
+SPACING = 0.002  # lattice spacing (m); one clump of 1e-5 kg per 8e-9 m3
+FORCES = (1e-3, 2e-3, 1.0)  # normal forces of the three vertical contacts (N)
+
+
+@pytest.fixture(scope="module")
+def lattice_study():
+    frames = []
+    for index, speed in enumerate(SPEEDS):
+        frame = _lattice_frame(0.06, 0.012, 0.06, SPACING, 1e-5, (0.0, 0.0, -speed))
+        frames.append(_clumps(frame.position, frame.velocity, 1e-5, time=1.0 + 0.01 * index, step=1000 + 10 * index))
+    # Two contacts in the mid-depth slice (|y - 6 mm| <= 2 mm) and one outside it, all vertical, 2 mm long, with
+    # the upper sphere pushing the lower one down.
+    lower = np.array([[0.0, 0.006, 0.03], [0.01, 0.007, 0.03], [-0.01, 0.001, 0.03]])
+    upper = lower + [0.0, 0.0, SPACING]
+    force = np.array([[0.0, 0.0, -f] for f in FORCES])
+    contacts = ContactFrame(step=1000, position_i=lower, position_j=upper, id_i=np.arange(3), id_j=np.arange(3, 6),
+                            force=force)
+    with warnings.catch_warnings():
+        # A flat profile gives the kinematic fit no curvature to fit (scipy warns; B is not asserted here).
+        warnings.simplefilter("ignore", OptimizeWarning)
+        study = analyse_silo_fields(frames, contacts, SiloDimensions.from_case_summary(CASE),
+                                    SiloFieldOptions.from_config(FIELD_SECTION), STEADY_WINDOW, BULK_DENSITY)
+    return frames, contacts, study
+
+
+def test_silo_field_study_of_a_uniformly_sinking_lattice(lattice_study):
+    frames, contacts, study = lattice_study
+    rho = 1e-5 / SPACING**3
+    np.testing.assert_allclose(study.surface, 0.06, rtol=1e-12)  # top lattice row 59 mm + radius 1 mm
+    assert study.top == pytest.approx(0.06, rel=1e-12)
+    assert study.grid.shape == (10, 3, 10) and study.settings.width == pytest.approx(0.003, rel=1e-15)
+    assert study.steps == (1000, 1010, 1020)
+    np.testing.assert_allclose(study.times, [0.0, 0.01, 0.02], rtol=0, atol=1e-12)
+    assert study.window == STEADY_WINDOW
+    assert study.heights == [0.03, 0.04]  # 60 mm lies above 57 - 6 mm
+    inside = rho * 0.06 * 0.012 * 0.06
+    assert study.averaged.total_mass == pytest.approx(inside, rel=1e-12)
+    # Averaged over the second and third frame: 0.3 m/s down everywhere in the fill.
+    mean_speed = 0.5 * (SPEEDS[1] + SPEEDS[2])
+    np.testing.assert_allclose(study.profiles.v_z, -mean_speed, rtol=1e-12)
+    np.testing.assert_allclose(study.front.v_z, -mean_speed, rtol=1e-12)
+    np.testing.assert_allclose(study.centreline, -np.array([SPEEDS, SPEEDS]).T, rtol=1e-12)
+    # At 30 mm, midway between two lattice planes, the kernel's ripple over the lattice cancels.
+    assert study.profile_rate == pytest.approx(rho * 0.06 * 0.012 * mean_speed, rel=1e-9)
+    # Trapezoid rule between the outermost nodes: W - dx of the width.
+    assert study.bulk_rate == pytest.approx(BULK_DENSITY * 0.012 * mean_speed * (0.06 - 0.006), rel=1e-12)
+
+
+def test_silo_field_study_contact_stress_janssen_and_force_chains(lattice_study):
+    frames, contacts, study = lattice_study
+    # Virial: the contact stress integrates to sum f l over the contacts (compression positive).
+    total = study.stress[..., 2, 2].sum() * study.grid.cell_volume
+    assert total == pytest.approx(SPACING * sum(FORCES), rel=1e-12)
+    janssen = study.janssen
+    assert janssen.surface_height == pytest.approx(0.06, rel=1e-12)
+    # Rows more than 3 widths (9 mm) from floor and surface: z = 15, 21, ..., 45 mm.
+    np.testing.assert_allclose(janssen.depth_below_surface, 0.06 - np.arange(0.015, 0.046, 0.006), rtol=1e-12)
+    # No wall friction: Janssen's stress is the hydrostatic rho_b g h.
+    np.testing.assert_allclose(janssen.janssen, BULK_DENSITY * GRAVITY * janssen.depth_below_surface, rtol=1e-12)
+    rows = (study.grid.z > 0.012) & (study.grid.z < 0.048)  # the rows z = 15 ... 45 mm
+    np.testing.assert_array_equal(janssen.simulated, study.stress[..., 2, 2].mean(axis=(0, 1))[rows])
+    cap = 50 * 1e-5 * GRAVITY
+    assert study.segments.cap == pytest.approx(cap, rel=1e-15)
+    np.testing.assert_allclose(study.segments.normal_force, [FORCES[0], FORCES[1]], rtol=1e-12)  # 1 N is outside
+    np.testing.assert_array_equal(study.segments.start, contacts.position_i[:2])
+    assert study.n_contacts == 3
+
+
+def test_silo_field_study_needs_a_frame():
+    with pytest.raises(ValueError, match="frames"):
+        analyse_silo_fields([], None, SiloDimensions.from_case_summary(CASE),
+                            SiloFieldOptions.from_config(FIELD_SECTION), STEADY_WINDOW, BULK_DENSITY)
+
+
+def _profile_analysis():
+    return ProfileAnalysis(
+        heights=np.array([0.02, 0.04]), x=np.array([-0.01, 0.0, 0.01]),
+        v_z=np.array([[-1.0, -2.0, -3.0], [-4.0, -5.0, -6.0]]), v_x=np.array([[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]),
+        fcb_fractions=(0.05, 0.1), fcb_left=np.array([[-0.01, -0.009], [-0.008, -0.007]]),
+        fcb_right=np.array([[0.01, 0.009], [0.008, 0.007]]), kinematic_B=np.array([0.002, np.nan]),
+        kinematic_u=np.array([[7.0, 8.0, 9.0], [10.0, 11.0, 12.0]]))
+
+
+def test_table_rows_lay_out_the_profiles_boundaries_and_kinematic_constant():
+    profiles = _profile_analysis()
+    front = ProfileAnalysis(**{**profiles.__dict__, "v_z": -profiles.v_z, "v_x": -profiles.v_x})
+    rows = profile_rows(profiles, front)
+    assert len(rows) == 6
+    assert rows[4] == {"z_m": 0.04, "x_m": 0.0, "v_z_m_s": -5.0, "v_x_m_s": 0.5, "u_kinematic_m_s": 11.0,
+                       "v_z_front_wall_m_s": 5.0, "v_x_front_wall_m_s": -0.5}
+    boundaries = boundary_rows(profiles)
+    assert [(r["z_m"], r["fraction"]) for r in boundaries] == [(0.02, 0.05), (0.02, 0.1), (0.04, 0.05), (0.04, 0.1)]
+    assert boundaries[2] == {"z_m": 0.04, "fraction": 0.05, "x_left_m": -0.008, "x_right_m": 0.008}
+    kinematic = kinematic_rows(profiles)
+    assert kinematic[0] == {"z_m": 0.02, "B_m": 0.002} and kinematic[1]["z_m"] == 0.04
+    assert math.isnan(kinematic[1]["B_m"])
+
+
+def test_table_rows_of_the_centreline_and_janssen():
+    centre = np.array([[-0.1, -0.2], [-0.3, -0.4], [-0.5, -0.6]])
+    rows = centreline_rows([0.0, 0.01, 0.02], [0.02, 0.045], centre)
+    assert rows[1] == {"time_s": 0.01, "v_z_at_20mm_m_s": -0.3, "v_z_at_45mm_m_s": -0.4}
+    assert len(rows) == 3
+    comparison = JanssenComparison(np.array([0.01, 0.02]), np.array([50.0, 90.0]), np.array([55.0, 100.0]), 0.06)
+    assert janssen_rows(comparison) == [
+        {"depth_below_surface_m": 0.01, "sigma_v_dem_Pa": 50.0, "sigma_v_janssen_Pa": 55.0},
+        {"depth_below_surface_m": 0.02, "sigma_v_dem_Pa": 90.0, "sigma_v_janssen_Pa": 100.0},
+    ]
+
+
+def test_instantaneous_rows_and_summary_of_the_lattice_study(lattice_study):
+    _, _, study = lattice_study
+    rows = instantaneous_profile_rows(study.times, study.depth_series, study.heights)
+    assert len(rows) == len(SPEEDS) * len(study.heights) * study.grid.shape[0]
+    for row in rows:
+        frame = int(round(row["time_s"] / 0.01))
+        assert row["v_z_m_s"] == pytest.approx(-SPEEDS[frame], rel=1e-12)
+        assert row["v_x_m_s"] == pytest.approx(0.0, abs=1e-12)
+    assert [r["x_m"] for r in rows[:10]] == list(study.grid.x)
+    summary = field_summary(study, outflow_rate=2.0)
+    assert summary["grid_shape"] == [10, 3, 10] and summary["kernel"] == "gaussian"
+    assert summary["kernel_width_m"] == study.settings.width and summary["average_window_s"] == list(STEADY_WINDOW)
+    assert summary["profile_heights_m"] == [0.03, 0.04] and summary["profile_flow_height_m"] == 0.03
+    assert summary["profile_over_outflow"] == study.profile_rate / 2.0
+    assert summary["outflow_mass_flow_rate_kg_s"] == 2.0
+    assert summary["profile_bulk_density_mass_flow_rate_kg_s"] == study.bulk_rate
+    assert list(summary["kinematic_B_m"]) == ["0.03", "0.04"]
+    assert summary["surface_height_m"] == study.top and summary["contacts"] == 3
+
+
+# --------------------------------------------------------------------------- comparisons (field_comparisons)
+
+
+def _linear_fields(grid, slope, offset):
+    """Fields of unit density whose v_z = offset + slope * x everywhere, v_x = 0."""
+    density = np.ones(grid.shape)
+    momentum = np.zeros(grid.shape + (3,))
+    momentum[..., 2] = offset + slope * grid.node_positions()[..., 0]
+    return Fields.from_moments(grid, density, momentum, np.zeros(grid.shape + (3, 3)))
+
+
+def test_comparison_plane_is_the_front_wall_layer_or_the_depth_average():
+    grid = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))
+    fields = _linear_fields(grid, -1.0, -0.1)
+    front = comparison_plane(fields, "front_wall")
+    assert front.grid.shape == (10, 1, 10) and front.grid.y[0] == pytest.approx(0.002, rel=1e-12)
+    averaged = comparison_plane(fields, "depth_average")
+    assert averaged.grid.shape == (10, 1, 10) and averaged.grid.y[0] == pytest.approx(0.006, rel=1e-12)
+    with pytest.raises(ValueError, match="plane"):
+        comparison_plane(fields, "back_wall")
+    assert MEASURED_PLANES == ("front_wall", "depth_average")
+
+
+def test_a_measurement_of_the_simulated_linear_profile_has_no_error():
+    grid = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))
+    plane = comparison_plane(_linear_fields(grid, -2.0, -0.1), "depth_average")
+    x = np.array([-0.02, 0.0, 0.015])
+    exact = MeasuredProfile(z=0.03, window="a", x=x, v_z=-0.1 - 2.0 * x, v_x=np.zeros(3), uncertainty=None)
+    shifted = MeasuredProfile(z=0.021, window="b", x=x, v_z=-0.1 - 2.0 * x + 0.01, v_x=np.zeros(3),
+                              uncertainty=np.full(3, 0.02))
+    comparisons = compare_with_measurements(plane, [exact, shifted])
+    np.testing.assert_allclose(comparisons[0].simulated_v_z, exact.v_z, rtol=1e-12)
+    assert comparisons[0].errors.rms_error == pytest.approx(0.0, abs=1e-15)
+    assert comparisons[1].errors.rms_error == pytest.approx(0.01, rel=1e-9)
+    rows = measured_comparison_rows(comparisons)
+    assert [r["z_m"] for r in rows] == [0.03, 0.021] and [r["window"] for r in rows] == ["a", "b"]
+    assert rows[1]["n_points"] == 3 and rows[1]["max_abs_error_m_s"] == pytest.approx(0.01, rel=1e-9)
+    assert rows[1]["fraction_within_uncertainty"] == 1.0
+
+
+def test_parametric_profiles_at_the_highest_height_every_run_covers():
+    tall = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))  # nodes up to 57 mm
+    short = silo_grid(0.06, 0.012, 0.048, (0.004, 0.004, 0.006))  # nodes up to 45 mm, 4 mm across
+    runs = [_linear_fields(tall, -1.0, -0.1), _linear_fields(short, -2.0, -0.2)]
+    profiles = parametric_profiles(runs, 0.05)
+    assert profiles.height == pytest.approx(0.039, rel=1e-12)  # the short run's second-highest row
+    assert parametric_profiles(runs, 0.02).height == 0.02
+    np.testing.assert_allclose(profiles.x, tall.x, rtol=1e-12)
+    np.testing.assert_allclose(profiles.v_z[1], -0.2 - 2.0 * tall.x, rtol=1e-12)  # interpolated onto the tall x
+    flows = [{"mass_flow_rate_kg_s": 0.1, "mass_flow_rate_stderr_kg_s": 0.001, "beverloo_ratio": 1.5,
+              "filling_bulk_density_kg_m3": 600.0}, {"mass_flow_rate_kg_s": 0.2, "mass_flow_rate_stderr_kg_s": 0.002,
+                                                     "beverloo_ratio": 1.4, "filling_bulk_density_kg_m3": 610.0}]
+    rows = parametric_rows("friction", ["mu=0", "mu=1"], ["r0", "r1"], flows, profiles)
+    assert rows[1] == {"study": "friction", "label": "mu=1", "run_id": "r1", "profile_height_m": profiles.height,
+                       "mass_flow_rate_kg_s": 0.2, "mass_flow_rate_stderr_kg_s": 0.002, "beverloo_ratio": 1.4,
+                       "filling_bulk_density_kg_m3": 610.0, "centreline_v_z_m_s": pytest.approx(-0.2, rel=1e-12)}
+    assert rows[0]["centreline_v_z_m_s"] == pytest.approx(-0.1, rel=1e-12)
+    with pytest.raises(ValueError, match="averaged"):
+        parametric_profiles([], 0.05)

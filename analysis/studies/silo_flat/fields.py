@@ -16,6 +16,7 @@ import numpy as np
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.field_ops import average_fields, depth_average
 from analysis.numerics.coarse_graining import coarse_grain
+from analysis.numerics.constants import GRAVITY
 from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity
@@ -209,17 +210,19 @@ def compare_janssen(
     front_wall_friction: float,
     internal_friction_angle_deg: float,
     margin: float = 0.0,
+    gravity: float = GRAVITY,
 ) -> JanssenComparison:
     """Cross-section mean vertical contact stress per grid row against Janssen's formula.
 
-    Rows within ``margin`` of the floor or of the surface are left out (boundary rows of the kernel).
+    Rows within ``margin`` (m) of the floor or of the surface are left out (boundary rows of the kernel);
+    ``gravity`` is g (m/s2) of the formula's unit weight rho_b g.
     """
     sigma_zz = stress[..., 2, 2]
     mean = sigma_zz.mean(axis=(0, 1))
     rows = (grid.z > margin) & (grid.z < surface_height - margin)
     h = surface_height - grid.z[rows]
     janssen = janssen_vertical_stress(
-        h, bulk_density, width, depth, side_wall_friction, front_wall_friction, internal_friction_angle_deg
+        h, bulk_density, width, depth, side_wall_friction, front_wall_friction, internal_friction_angle_deg, gravity
     )
     return JanssenComparison(h, mean[rows], np.asarray(janssen, dtype=float), float(surface_height))
 

@@ -1,0 +1,446 @@
+"""The continuum study of one flat-bottom silo run, from the frames after opening to the rows of its tables.
+
+:func:`analyse_silo_fields` takes the clump frames since the outlet opened, the contacts of the settled fill,
+the silo's dimensions (:class:`SiloDimensions`, from the case summary) and the ``silo_flat.fields`` settings
+(:class:`SiloFieldOptions`) and returns a :class:`SiloFieldStudy`: the coarse-grained fields and their time
+average, the velocity profiles, flow channel boundaries and kinematic constant, the centreline velocity, the
+profile flow rates, the Janssen comparison and the force-chain segments. The small functions after it lay the
+results out as table rows and the summary. Nothing here reads or writes files; the building blocks are in
+:mod:`analysis.studies.silo_flat.fields`. Coordinates as everywhere in siloflow: x across the width (0 on the
+axis), y front to back (0 at the front wall), z up (0 at the outlet).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.data.contacts import ContactFrame
+from analysis.data.frames import ClumpFrame
+from analysis.numerics.constants import GRAVITY
+from analysis.numerics.field_ops import depth_average, front_wall_slice
+from analysis.numerics.flow import column_surface_heights
+from analysis.numerics.force_chains import ForceChainSegments, force_chain_segments
+from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.profiles import profile_flow_rate, velocity_profile
+from analysis.studies.silo_flat.fields import (
+    FieldSettings,
+    JanssenComparison,
+    ProfileAnalysis,
+    analyse_profiles,
+    centreline_velocity,
+    clump_fields,
+    compare_janssen,
+    contact_stress_field,
+    profile_mass_flow_rate,
+    silo_grid,
+    time_average,
+)
+
+__all__ = [
+    "FORCE_CHAIN_CAP_WEIGHTS",
+    "SURFACE_COLUMN_DIAMETERS",
+    "SiloDimensions",
+    "SiloFieldOptions",
+    "SiloFieldStudy",
+    "analyse_silo_fields",
+    "fill_surface_heights",
+    "profile_heights_inside",
+    "force_chain_cap",
+    "vtk_series",
+    "profile_rows",
+    "boundary_rows",
+    "kinematic_rows",
+    "instantaneous_profile_rows",
+    "centreline_rows",
+    "janssen_rows",
+    "field_summary",
+]
+
+SURFACE_COLUMN_DIAMETERS = 4
+"""Width of the columns in which the fill surface is found, in particle diameters (-)."""
+
+FORCE_CHAIN_CAP_WEIGHTS = 50
+"""Force-chain colours are capped at this many particle weights (-), as in the study's pictures."""
+
+
+# --------------------------------------------------------------------------- inputs
+
+
+@dataclass(frozen=True)
+class SiloDimensions:
+    """The numbers of a silo case the field study uses.
+
+    Attributes
+    ----------
+    width, depth : float
+        Silo width W (x) and depth T (y) (m).
+    outlet_width : float
+        Slot outlet width (m).
+    particle_radius : float
+        Volume-equivalent particle radius (m).
+    clump_mass : float
+        Mass of one particle (clump) (kg).
+    """
+
+    width: float
+    depth: float
+    outlet_width: float
+    particle_radius: float
+    clump_mass: float
+
+    @classmethod
+    def from_case_summary(cls, case: Mapping) -> "SiloDimensions":
+        """From the case summary (``case.json``: ``width_m``, ``depth_m``, ``outlet_width_m``,
+        ``equivalent_diameter_m``, ``clump_mass_kg``)."""
+        return cls(
+            width=case["width_m"],
+            depth=case["depth_m"],
+            outlet_width=case["outlet_width_m"],
+            particle_radius=0.5 * case["equivalent_diameter_m"],
+            clump_mass=case["clump_mass_kg"],
+        )
+
+
+@dataclass(frozen=True)
+class SiloFieldOptions:
+    """The ``silo_flat.fields`` settings (see the configuration schema for each key's meaning).
+
+    Attributes
+    ----------
+    spacing : tuple of float
+        Requested grid spacing (dx, dy, dz) (m).
+    kernel : str
+        Coarse-graining kernel.
+    width_radii : float
+        Kernel width in particle radii (-).
+    cutoff : float
+        Kernel cut-off in kernel widths (-).
+    profile_heights : tuple of float
+        Heights of the velocity profiles (m); those outside the fill are skipped.
+    fcb_fractions : tuple of float
+        Fractions of the centreline velocity that define the flow channel boundary (-).
+    subtract_wall_velocity : bool
+        Subtract the near-wall velocity before locating the boundary.
+    average_window : tuple of float or None
+        Time window since opening of the time average (s); None: the steady flow window.
+    vtk_every : int
+        Every n-th frame is written as .vti (-).
+    internal_friction_angle_deg, side_wall_friction_angle_deg, front_wall_friction_angle_deg : float
+        Bulk friction angles of Janssen's formula (degrees).
+    force_chain_slice : float
+        Thickness of the mid-depth slice of the force-chain picture (m).
+    """
+
+    spacing: tuple[float, float, float]
+    kernel: str
+    width_radii: float
+    cutoff: float
+    profile_heights: tuple[float, ...]
+    fcb_fractions: tuple[float, ...]
+    subtract_wall_velocity: bool
+    average_window: tuple[float, float] | None
+    vtk_every: int
+    internal_friction_angle_deg: float
+    side_wall_friction_angle_deg: float
+    front_wall_friction_angle_deg: float
+    force_chain_slice: float
+
+    @classmethod
+    def from_config(cls, section: Mapping) -> "SiloFieldOptions":
+        """From the validated ``silo_flat.fields`` section (defaults filled in by the schema)."""
+        janssen = section["janssen"]
+        window = section["average_window"]
+        return cls(
+            spacing=tuple(section["spacing"]),
+            kernel=section["kernel"],
+            width_radii=section["width_radii"],
+            cutoff=section["cutoff"],
+            profile_heights=tuple(section["profile_heights"]),
+            fcb_fractions=tuple(section["fcb_fractions"]),
+            subtract_wall_velocity=section["subtract_wall_velocity"],
+            average_window=tuple(window) if window else None,
+            vtk_every=section["vtk_every"],
+            internal_friction_angle_deg=janssen["internal_friction_angle_deg"],
+            side_wall_friction_angle_deg=janssen["side_wall_friction_angle_deg"],
+            front_wall_friction_angle_deg=janssen["front_wall_friction_angle_deg"],
+            force_chain_slice=section["force_chain_slice"],
+        )
+
+    def field_settings(self, particle_radius: float) -> FieldSettings:
+        """How particles of radius ``particle_radius`` (m) become fields: the kernel width is
+        ``width_radii`` radii."""
+        return FieldSettings(self.spacing, self.kernel, self.width_radii * particle_radius, self.cutoff)
+
+
+# --------------------------------------------------------------------------- small steps
+
+
+def fill_surface_heights(settled: ClumpFrame, particle_radius: float, width: float) -> np.ndarray:
+    """Fill surface height (m) in columns of :data:`SURFACE_COLUMN_DIAMETERS` particle diameters across the width.
+
+    The highest particle top ``z + r`` per column (NaN for an empty column); at least one column.
+    """
+    n_columns = max(1, int(width / (SURFACE_COLUMN_DIAMETERS * 2 * particle_radius)))
+    return column_surface_heights(settled.position[:, 0], settled.position[:, 2], particle_radius, width, n_columns)
+
+
+def profile_heights_inside(requested: Sequence[float], grid: Grid, top: float, dz: float) -> list[float]:
+    """The requested profile heights (m) that lie inside the fill, away from its top row.
+
+    A height is kept when ``grid.z[0] <= z <= min(top, grid.z[-1]) - dz``, ``top`` the fill surface (m) and
+    ``dz`` the requested vertical spacing (m); the order is kept.
+
+    Raises
+    ------
+    ValueError
+        If no height is left.
+    """
+    heights = [z for z in requested if grid.z[0] <= z <= min(top, grid.z[-1]) - dz]
+    if not heights:
+        raise ValueError(f"no profile height lies inside the fill (surface at {top:.3f} m): lower fields.profile_heights")
+    return heights
+
+
+def force_chain_cap(clump_mass: float, gravity: float = GRAVITY) -> float:
+    """The cap of the force-chain colours: :data:`FORCE_CHAIN_CAP_WEIGHTS` particle weights m g (N)."""
+    return FORCE_CHAIN_CAP_WEIGHTS * (clump_mass * gravity)
+
+
+def vtk_series(steps: Sequence[int], times: Sequence[float], every: int) -> list[tuple[int, float, str]]:
+    """Which frames go into the ParaView time series: ``(frame index, time (s), file name)`` of every
+    ``every``-th frame from the first, named ``fields_<step>.vti``."""
+    return [(index, float(times[index]), f"fields_{steps[index]}.vti") for index in range(0, len(steps), every)]
+
+
+# --------------------------------------------------------------------------- the study
+
+
+@dataclass(frozen=True)
+class SiloFieldStudy:
+    """The continuum view of one silo run (see :func:`analyse_silo_fields`).
+
+    Attributes
+    ----------
+    settings : FieldSettings
+        How the particles became fields.
+    grid : Grid
+        Grid of the fields, tiling the silo up to the fill surface.
+    steps : tuple of int
+        Time steps of the frames (-).
+    times : numpy.ndarray
+        Time of each frame since the first frame after opening (s).
+    fields : list of Fields
+        Fields of each frame.
+    window : tuple of float
+        Time window of the average (s).
+    averaged : Fields
+        Time average over ``window``.
+    averaged_depth : Fields
+        Its depth average.
+    surface : numpy.ndarray
+        Fill surface height per column of the settled frame (m).
+    top : float
+        Highest surface point (m).
+    heights : list of float
+        Profile heights inside the fill (m).
+    profiles : ProfileAnalysis
+        Depth-averaged profiles, boundaries and kinematic constant.
+    front : ProfileAnalysis
+        The same at the front wall (what a camera sees).
+    depth_series : list of Fields
+        Depth average of each frame.
+    centreline : numpy.ndarray
+        (frames, heights) v_z on the axis (m/s).
+    profile_rate : float
+        Mass flow rate through the lowest profile height from the momentum density (kg/s).
+    bulk_rate : float
+        The same from ``rho_b T integral(v_z dx)`` at the filling bulk density (kg/s).
+    stress : numpy.ndarray
+        Contact stress of the settled fill on the grid (Pa, compression positive).
+    janssen : JanssenComparison
+        Mean vertical contact stress against Janssen's formula.
+    segments : ForceChainSegments
+        Force chains in the mid-depth slice.
+    n_contacts : int
+        Contacts of the settled fill (-).
+    """
+
+    settings: FieldSettings
+    grid: Grid
+    steps: tuple[int, ...]
+    times: np.ndarray
+    fields: list[Fields]
+    window: tuple[float, float]
+    averaged: Fields
+    averaged_depth: Fields
+    surface: np.ndarray
+    top: float
+    heights: list[float]
+    profiles: ProfileAnalysis
+    front: ProfileAnalysis
+    depth_series: list[Fields]
+    centreline: np.ndarray
+    profile_rate: float
+    bulk_rate: float
+    stress: np.ndarray
+    janssen: JanssenComparison
+    segments: ForceChainSegments
+    n_contacts: int
+
+
+def analyse_silo_fields(
+    frames: Sequence[ClumpFrame],
+    contacts: ContactFrame,
+    silo: SiloDimensions,
+    options: SiloFieldOptions,
+    steady_window: tuple[float, float],
+    bulk_density: float,
+) -> SiloFieldStudy:
+    """Coarse-grained fields, profiles, flow channel boundary, kinematic constant, Janssen and force chains.
+
+    Parameters
+    ----------
+    frames : sequence of ClumpFrame
+        The clumps of each frame from the opening of the outlet on; the first is the settled fill.
+    contacts : ContactFrame
+        Contacts of the settled fill.
+    silo : SiloDimensions
+        The silo's dimensions and particle.
+    options : SiloFieldOptions
+        The study's settings.
+    steady_window : tuple of float
+        Steady flow window since opening (s), the time average's window when ``options.average_window``
+        is None.
+    bulk_density : float
+        Filling bulk density (kg/m3), for the profile flow rate and Janssen's formula.
+
+    Returns
+    -------
+    SiloFieldStudy
+    """
+    frames = list(frames)
+    if not frames:
+        raise ValueError("frames must hold at least the settled frame at the opening")
+    settings = options.field_settings(silo.particle_radius)
+    surface = fill_surface_heights(frames[0], silo.particle_radius, silo.width)
+    top = float(np.nanmax(surface))
+    grid = silo_grid(silo.width, silo.depth, top, settings.spacing)
+    times = np.array([frame.time for frame in frames]) - frames[0].time
+    fields = [clump_fields(frame, grid, settings) for frame in frames]
+    window = tuple(options.average_window or steady_window)
+    averaged = time_average(fields, times, window)
+    averaged_depth = depth_average(averaged)
+
+    heights = profile_heights_inside(options.profile_heights, grid, top, settings.spacing[2])
+    profiles = analyse_profiles(averaged_depth, heights, options.fcb_fractions, options.subtract_wall_velocity,
+                                kernel_width=settings.width)
+    # What a camera behind the front wall sees, next to the depth average.
+    front = analyse_profiles(front_wall_slice(averaged), heights, options.fcb_fractions)
+    depth_series = [depth_average(f) for f in fields]
+    centre = centreline_velocity(depth_series, heights)
+
+    # Mass flow rate through the lowest profile height, from the averaged momentum density, and the same with
+    # the study's formula W = rho_b T integral(v_z dx) at the filling bulk density.
+    profile_rate = profile_mass_flow_rate(averaged_depth, heights[0], silo.depth)
+    bulk_rate = profile_flow_rate(profiles.x, profiles.v_z[0], bulk_density, silo.depth)
+
+    # Janssen: mean vertical contact stress of the settled fill against the formula, below the lowest point of
+    # the surface.
+    stress = contact_stress_field(contacts, grid, settings)
+    janssen = compare_janssen(
+        stress, grid, float(np.nanmin(surface)), bulk_density, silo.width, silo.depth,
+        math.tan(math.radians(options.side_wall_friction_angle_deg)),
+        math.tan(math.radians(options.front_wall_friction_angle_deg)),
+        options.internal_friction_angle_deg, margin=settings.cutoff * settings.width)
+    segments = force_chain_segments(contacts, 0.5 * silo.depth, options.force_chain_slice,
+                                    cap=force_chain_cap(silo.clump_mass))
+    return SiloFieldStudy(
+        settings=settings, grid=grid, steps=tuple(frame.step for frame in frames), times=times, fields=fields,
+        window=window, averaged=averaged, averaged_depth=averaged_depth, surface=surface, top=top, heights=heights,
+        profiles=profiles, front=front, depth_series=depth_series, centreline=centre, profile_rate=profile_rate,
+        bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments, n_contacts=len(contacts),
+    )
+
+
+# --------------------------------------------------------------------------- table rows
+
+
+def profile_rows(profiles: ProfileAnalysis, front: ProfileAnalysis) -> list[dict]:
+    """Rows of ``profiles.csv``: per height and node, v_z, v_x and the kinematic u (m/s), with the front-wall
+    v_z and v_x next to them."""
+    return [
+        {"z_m": z, "x_m": x, "v_z_m_s": vz, "v_x_m_s": vx, "u_kinematic_m_s": u,
+         "v_z_front_wall_m_s": fz, "v_x_front_wall_m_s": fx}
+        for i, z in enumerate(profiles.heights)
+        for x, vz, vx, u, fz, fx in zip(profiles.x, profiles.v_z[i], profiles.v_x[i], profiles.kinematic_u[i],
+                                        front.v_z[i], front.v_x[i])
+    ]
+
+
+def boundary_rows(profiles: ProfileAnalysis) -> list[dict]:
+    """Rows of ``flow_channel_boundary.csv``: per height and fraction, the left and right boundary (m)."""
+    return [
+        {"z_m": z, "fraction": f, "x_left_m": profiles.fcb_left[i, j], "x_right_m": profiles.fcb_right[i, j]}
+        for i, z in enumerate(profiles.heights) for j, f in enumerate(profiles.fcb_fractions)
+    ]
+
+
+def kinematic_rows(profiles: ProfileAnalysis) -> list[dict]:
+    """Rows of ``kinematic.csv``: the kinematic constant B (m) per height."""
+    return [{"z_m": z, "B_m": b} for z, b in zip(profiles.heights, profiles.kinematic_B)]
+
+
+def instantaneous_profile_rows(times: Sequence[float], depth_series: Sequence[Fields],
+                               heights: Sequence[float]) -> list[dict]:
+    """Rows of ``profiles_instantaneous.csv``: per frame, height and node, v_z and v_x (m/s) of the depth
+    average."""
+    rows = []
+    for t, frame_fields in zip(times, depth_series):
+        for z in heights:
+            profile = velocity_profile(frame_fields, z)
+            rows.extend(
+                {"time_s": t, "z_m": z, "x_m": x, "v_z_m_s": vz, "v_x_m_s": vx}
+                for x, vz, vx in zip(profile.x, profile.v_z, profile.v_x))
+    return rows
+
+
+def centreline_rows(times: Sequence[float], heights: Sequence[float], centreline: np.ndarray) -> list[dict]:
+    """Rows of ``centreline_velocity.csv``: per frame, v_z on the axis (m/s) in one column per height
+    (``v_z_at_<mm>mm_m_s``)."""
+    return [
+        {"time_s": t, **{f"v_z_at_{1e3 * z:g}mm_m_s": centreline[i, j] for j, z in enumerate(heights)}}
+        for i, t in enumerate(times)
+    ]
+
+
+def janssen_rows(comparison: JanssenComparison) -> list[dict]:
+    """Rows of ``janssen.csv``: per depth below the surface (m), the simulated and Janssen vertical stress (Pa)."""
+    return [
+        {"depth_below_surface_m": h, "sigma_v_dem_Pa": s, "sigma_v_janssen_Pa": j}
+        for h, s, j in zip(comparison.depth_below_surface, comparison.simulated, comparison.janssen)
+    ]
+
+
+def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
+    """The contents of ``fields.json``: grid, kernel, window, heights, the profile flow rates against the
+    measured outflow ``outflow_rate`` (kg/s), B per height, surface height and number of contacts."""
+    return {
+        "grid_shape": list(study.grid.shape),
+        "grid_spacing_m": list(study.grid.spacing),
+        "kernel": study.settings.kernel,
+        "kernel_width_m": study.settings.width,
+        "average_window_s": list(study.window),
+        "profile_heights_m": study.heights,
+        "profile_flow_height_m": study.heights[0],
+        "profile_mass_flow_rate_kg_s": study.profile_rate,
+        "outflow_mass_flow_rate_kg_s": outflow_rate,
+        "profile_over_outflow": study.profile_rate / outflow_rate,
+        "profile_bulk_density_mass_flow_rate_kg_s": study.bulk_rate,
+        "kinematic_B_m": {f"{z:g}": b for z, b in zip(study.profiles.heights, study.profiles.kinematic_B)},
+        "surface_height_m": study.top,
+        "contacts": study.n_contacts,
+    }
