@@ -20,7 +20,6 @@ from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals
 from engines.config import validate_config
 from engines.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
-from engines.liggghts.forces import read_jenike_forces
 from engines.liggghts.run import DUMP_PREFIX
 from engines.liggghts.jenike import (
     FORCES_NAME,
@@ -28,10 +27,9 @@ from engines.liggghts.jenike import (
     WALL_CONTACT_PREFIX,
     read_contact_dump,
     read_force_history,
-    run_jenike,
-    write_jenike_inputs,
 )
-from tests.conftest import require_liggghts
+from engines.interface import EngineOptions
+from tests.conftest import liggghts, require_liggghts
 
 pytestmark = pytest.mark.integration
 
@@ -63,11 +61,12 @@ class Run:
 
 
 def _run(case: JenikeCase, run_dir: Path) -> Run:
-    write_jenike_inputs(case, run_dir / "deck")
-    record = run_jenike(case, run_dir)
+    engine = liggghts()
+    engine.write_inputs(case, run_dir)
+    record = engine.run(case, run_dir, EngineOptions())
     # the engine's own columns (with the step) for the contact dump check; the neutral history for the friction
     history = read_force_history(run_dir / FORCES_NAME)
-    signals = shear_signals(read_jenike_forces(run_dir), record.labels["shear_start_s"], record.labels["shear_end_s"])
+    signals = shear_signals(engine.wall_forces(run_dir, record), record.labels["shear_start_s"], record.labels["shear_end_s"])
     # A 4 mm shear of a 40 mm cell is too short for a plateau: average over its second half.
     half = signals.time[0] + 0.5 * (signals.time[-1] - signals.time[0])
     friction = bulk_friction(

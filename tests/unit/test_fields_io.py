@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -10,6 +13,7 @@ from analysis.numerics.coarse_graining import coarse_grain
 from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.field_ops import depth_average
 from analysis.io.fields import (
+    fields_image,
     load_fields_npz,
     read_fields_vti,
     save_fields_npz,
@@ -128,3 +132,40 @@ def test_load_fields_npz_rejects_other_files(tmp_path):
     np.savez(tmp_path / "other.npz", density=np.zeros(3))
     with pytest.raises(ValueError, match="path"):
         load_fields_npz(tmp_path / "other.npz")
+
+
+def test_vti_names_its_active_arrays_and_rejects_names_vtk_would_not_escape(tmp_path):
+    fields = make_fields()
+    image = pyvista.read(write_fields_vti(tmp_path / "fields.vti", GRID, fields))
+    assert image.point_data.active_scalars_name == "density"
+    assert image.point_data.active_vectors_name == "velocity"
+    assert image.point_data.VTKObject.GetTensors().GetName() == "kinetic_stress"
+    assert "TimeValue" not in image.field_data  # only written when a time is given
+    np.testing.assert_array_equal(image.field_data["grid_spacing"], GRID.spacing)
+    for name in ("a<b", "a&b", "", " padded"):
+        with pytest.raises(ValueError, match="extra_arrays"):
+            write_fields_vti(tmp_path / "bad.vti", GRID, fields, extra_arrays={name: fields.density})
+    assert not (tmp_path / "bad.vti").exists()
+
+
+def test_fields_image_is_what_the_vti_holds(tmp_path):
+    fields = make_fields()
+    image = fields_image(GRID, fields, time=1.5, cell_data=True)
+    assert isinstance(image, pyvista.ImageData)
+    assert tuple(image.dimensions) == tuple(n + 1 for n in GRID.shape)
+    np.testing.assert_allclose(image.origin, GRID.origin, rtol=0, atol=0)
+    written = pyvista.read(write_fields_vti(tmp_path / "cells.vti", GRID, fields, time=1.5, cell_data=True))
+    for name in image.cell_data.keys():
+        np.testing.assert_array_equal(written.cell_data[name], image.cell_data[name], err_msg=name)
+    assert written.field_data["TimeValue"][0] == 1.5
+
+
+def test_pvd_escapes_file_names_and_keeps_the_order(tmp_path):
+    write_fields_vti(tmp_path / "a&b.vti", GRID, make_fields(), time=0.2)
+    write_fields_vti(tmp_path / "c.vti", GRID, make_fields(1), time=0.1)
+    pvd = write_pvd(tmp_path / "series.pvd", [(0.2, "a&b.vti"), (0.1, "c.vti")])
+    assert "a&amp;b.vti" in pvd.read_text()
+    written = [(float(d.get("timestep")), d.get("file")) for d in ElementTree.parse(pvd).iter("DataSet")]
+    assert written == [(0.2, "a&b.vti"), (0.1, "c.vti")]  # in the order given
+    reader = pyvista.get_reader(str(pvd))  # ParaView and pyvista order the series by time
+    assert [(d.time, Path(d.path).name) for d in reader.datasets] == [(0.1, "c.vti"), (0.2, "a&b.vti")]

@@ -1,6 +1,6 @@
 """Unit tests for analysis.studies.silo_recirculation.study (the composed blending analysis) on exact cases.
 
-Most tests use the "conveyor" of ``test_blending.py`` (helpers copied here): 100 clumps evenly spaced
+Most tests use the "conveyor" of ``test_silo_recirculation_blending.py`` (helpers copied here): 100 clumps evenly spaced
 along z, all moving down at 0.1 m/s through a domain periodic in z, so every crossing, re-entry, pass,
 window concentration and residence time is known in closed form. Here the clumps are also spread over
 four columns in x (``x = -0.075, -0.025, 0.025, 0.075`` m by ``index mod 4``), so that every Eulerian bin
