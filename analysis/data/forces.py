@@ -16,17 +16,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from analysis.data.arrays import frozen_array
+
 __all__ = ["WallForceHistory"]
-
-
-def _array(value, name: str, shape_tail: tuple[int, ...], n: int | None) -> np.ndarray:
-    array = np.array(value, dtype=float)  # a copy the history owns
-    expected_ndim = 1 + len(shape_tail)
-    if array.ndim != expected_ndim or array.shape[1:] != shape_tail or (n is not None and array.shape[0] != n):
-        expected = ("n" if n is None else str(n),) + tuple(str(s) for s in shape_tail)
-        raise ValueError(f"{name} must have shape ({', '.join(expected)}), got {array.shape}")
-    array.setflags(write=False)
-    return array
 
 
 def _first_bad(mask: np.ndarray) -> int:
@@ -73,7 +65,7 @@ class WallForceHistory:
     signals: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        time = _array(self.time, "time", (), None)
+        time = frozen_array(self.time, float, (), "time", None)
         n = time.shape[0]
         if n == 0:
             raise ValueError("a wall force history needs at least one sample; time is empty")
@@ -94,7 +86,7 @@ class WallForceHistory:
         for name, value in dict(self.signals).items():
             if not isinstance(name, str) or not name:
                 raise ValueError(f"signal names must be non-empty strings, got {name!r}")
-            array = _array(value, f"signal {name!r}", (), n)
+            array = frozen_array(value, float, (), f"signal {name!r}", n)
             if not np.all(np.isfinite(array)):
                 bad = _first_bad(~np.isfinite(array))
                 raise ValueError(f"signal {name!r} holds a non-finite value at sample {bad}")
@@ -115,7 +107,7 @@ class WallForceHistory:
                              f"walls are {list(walls)}")
         checked = {}
         for name in walls:
-            array = _array(values[name], f"{what} of wall {name!r}", (3,), n)
+            array = frozen_array(values[name], float, (3,), f"{what} of wall {name!r}", n)
             bad = np.isinf(array) if allow_nan else ~np.isfinite(array)
             if bad.any():
                 kind = "an infinite" if allow_nan else "a non-finite"

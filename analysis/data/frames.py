@@ -13,21 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.data.arrays import frozen_array
+
 __all__ = ["ParticleFrame", "ClumpFrame", "clumps_from_frame"]
 
 #: Per-sphere vectors a frame may carry or leave out (dumps of the silo-type decks omit them).
 OPTIONAL_VECTORS = ("angular_velocity", "force")
 
-
-
-def _frozen_array(value, dtype, shape_tail: tuple[int, ...], name: str, n: int | None) -> np.ndarray:
-    array = np.array(value, dtype=dtype)  # a copy the frame owns
-    expected_ndim = 1 + len(shape_tail)
-    if array.ndim != expected_ndim or array.shape[1:] != shape_tail or (n is not None and array.shape[0] != n):
-        expected = ("n" if n is None else str(n),) + tuple(str(s) for s in shape_tail)
-        raise ValueError(f"{name} must have shape ({', '.join(expected)}), got {array.shape}")
-    array.setflags(write=False)
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,21 +70,21 @@ class ParticleFrame:
     force: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        ids = _frozen_array(self.id, np.int64, (), "id", None)
+        ids = frozen_array(self.id, np.int64, (), "id", None)
         n = ids.shape[0]
         set_field = object.__setattr__
         set_field(self, "time", float(self.time))
         set_field(self, "step", int(self.step))
         set_field(self, "id", ids)
-        set_field(self, "type", _frozen_array(self.type, np.int32, (), "type", n))
-        set_field(self, "clump_id", _frozen_array(self.clump_id, np.int64, (), "clump_id", n))
+        set_field(self, "type", frozen_array(self.type, np.int32, (), "type", n))
+        set_field(self, "clump_id", frozen_array(self.clump_id, np.int64, (), "clump_id", n))
         for name in ("position", "velocity"):
-            set_field(self, name, _frozen_array(getattr(self, name), np.float64, (3,), name, n))
+            set_field(self, name, frozen_array(getattr(self, name), np.float64, (3,), name, n))
         for name in ("radius", "mass"):
-            set_field(self, name, _frozen_array(getattr(self, name), np.float64, (), name, n))
+            set_field(self, name, frozen_array(getattr(self, name), np.float64, (), name, n))
         for name in OPTIONAL_VECTORS:
             if getattr(self, name) is not None:
-                set_field(self, name, _frozen_array(getattr(self, name), np.float64, (3,), name, n))
+                set_field(self, name, frozen_array(getattr(self, name), np.float64, (3,), name, n))
         # engines write spheres in ascending id order: checking that first spares the sort (a third of a read)
         sorted_ids = ids if np.all(ids[1:] > ids[:-1]) else np.sort(ids)
         if np.any(sorted_ids[1:] == sorted_ids[:-1]):
@@ -134,16 +126,16 @@ class ClumpFrame:
     n_spheres: np.ndarray
 
     def __post_init__(self) -> None:
-        ids = _frozen_array(self.clump_id, np.int64, (), "clump_id", None)
+        ids = frozen_array(self.clump_id, np.int64, (), "clump_id", None)
         m = ids.shape[0]
         set_field = object.__setattr__
         set_field(self, "time", float(self.time))
         set_field(self, "step", int(self.step))
         set_field(self, "clump_id", ids)
-        set_field(self, "position", _frozen_array(self.position, np.float64, (3,), "position", m))
-        set_field(self, "velocity", _frozen_array(self.velocity, np.float64, (3,), "velocity", m))
-        set_field(self, "mass", _frozen_array(self.mass, np.float64, (), "mass", m))
-        set_field(self, "n_spheres", _frozen_array(self.n_spheres, np.int64, (), "n_spheres", m))
+        set_field(self, "position", frozen_array(self.position, np.float64, (3,), "position", m))
+        set_field(self, "velocity", frozen_array(self.velocity, np.float64, (3,), "velocity", m))
+        set_field(self, "mass", frozen_array(self.mass, np.float64, (), "mass", m))
+        set_field(self, "n_spheres", frozen_array(self.n_spheres, np.int64, (), "n_spheres", m))
 
     def __len__(self) -> int:
         return int(self.clump_id.shape[0])

@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 import json
 import math
-import os
 import re
 from pathlib import Path
 
@@ -16,6 +15,7 @@ from engines.cases.blender import blender_case_for_run, blender_cases, build_ble
 from engines.cases.blender_geometry import blender_geometry, is_watertight
 from engines.config import ConfigError, load_config, validate_config
 from engines.liggghts.blender import blender_mesh_set, render_blender_deck, write_blender_inputs
+from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 
@@ -33,10 +33,7 @@ def changed(config, edit):
 
 def test_blender_deck_matches_golden_file(golden_config):
     rendered = render_blender_deck(build_blender_case(golden_config, "straight"))
-    golden = GOLDEN / "blender.lmp"
-    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
-        golden.write_text(rendered)
-    assert rendered == golden.read_text()
+    assert_matches_golden(rendered, "blender.lmp")
 
 
 def test_continuous_deck_is_periodic_and_loses_no_clump_batch_deck_drains(golden_config):

@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-import os
 import re
 from pathlib import Path
 
@@ -47,6 +46,7 @@ from engines.liggghts.jenike import (
 )
 from engines.cases.physics import rayleigh_time
 from engines.templating import UnsafeDeckValue, render_deck
+from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 
@@ -381,10 +381,7 @@ def test_servo_lid_proxy_has_the_rigid_lid_mass():
 
 def test_jenike_deck_matches_golden_file():
     rendered = render_jenike_deck(_case())
-    golden = GOLDEN / "jenike_internal_rigid.lmp"
-    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
-        golden.write_text(rendered)
-    assert rendered == golden.read_text()
+    assert_matches_golden(rendered, "jenike_internal_rigid.lmp")
 
 
 def test_every_contact_uses_hertz_with_cdt_rolling_friction():

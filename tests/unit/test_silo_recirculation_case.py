@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import os
 import re
 from pathlib import Path
 
@@ -19,6 +18,7 @@ from engines.cases.silo_recirculation import (
 )
 from engines.config import ConfigError, load_config, validate_config
 from engines.liggghts.silo_recirculation import recirculation_meshes, render_recirculation_deck, write_recirculation_inputs
+from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 
@@ -30,10 +30,7 @@ def golden_config():
 
 def test_recirculation_deck_matches_golden_file(golden_config):
     rendered = render_recirculation_deck(build_recirculation_case(golden_config, "internal_flow"))
-    golden = GOLDEN / "silo_recirculation.lmp"
-    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
-        golden.write_text(rendered)
-    assert rendered == golden.read_text()
+    assert_matches_golden(rendered, "silo_recirculation.lmp")
 
 
 def test_deck_is_periodic_in_z_with_feeder_and_no_lost_clumps(golden_config):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import os
 import re
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from engines.templating import (
     deck_path,
     render_deck,
 )
+from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 
@@ -32,10 +32,7 @@ def _golden_case():
 
 def test_silo_deck_matches_golden_file():
     rendered = render_silo_deck(_golden_case())
-    golden = GOLDEN / "silo_flat.lmp"
-    if os.environ.get("SILOFLOW_UPDATE_GOLDEN"):
-        golden.write_text(rendered)
-    assert rendered == golden.read_text()
+    assert_matches_golden(rendered, "silo_flat.lmp")
 
 
 def test_every_contact_uses_hertz_with_cdt_rolling_friction():
