@@ -9,9 +9,8 @@ lines of its own logs). MPI ranks divide that by ``ranks * efficiency^log2(ranks
 Every estimate is a worst case: the settling stage counts all its checks, the sphere count is the largest the
 run holds, and a dumped stage counts the largest number of dump frames its length allows.
 
-Disk space: binary legacy VTK particle dumps (``bytes_per_sphere_per_dump`` plus a header per file), the
-parsed-frame cache of the analyses under ``frames/`` (``cache_factor`` times the particle dumps) and
-text contact dumps (``contact_bytes_per_sphere_per_dump``).
+Disk space: binary legacy VTK particle dumps (``bytes_per_sphere_per_dump`` plus a header per file) and text
+contact dumps (``contact_bytes_per_sphere_per_dump``); the analyses keep no cache of parsed frames.
 """
 
 from __future__ import annotations
@@ -49,8 +48,6 @@ class CostModel:
         Size of one sphere in one binary VTK particle dump with the 16 fields siloflow dumps (bytes).
     dump_header_bytes : float
         Fixed size per dump file: VTK header plus the small bounding-box file LIGGGHTS writes with it (bytes).
-    cache_factor : float
-        Size of the parsed-frame cache under ``frames/`` relative to the particle dumps (-).
     parallel_efficiency : float
         Efficiency per doubling of the MPI ranks, in (0, 1] (-):
         wall = serial / (ranks * efficiency^log2(ranks)).
@@ -65,7 +62,6 @@ class CostModel:
     seconds_per_sphere_step: float = 5.0e-7
     bytes_per_sphere_per_dump: float = 128.0
     dump_header_bytes: float = 1024.0
-    cache_factor: float = 1.0
     parallel_efficiency: float = 0.8
     contact_bytes_per_sphere_per_dump: float = 200.0
     settle_fraction: float = 0.25
@@ -73,7 +69,7 @@ class CostModel:
     def __post_init__(self) -> None:
         if not _finite(self.seconds_per_sphere_step) or self.seconds_per_sphere_step <= 0:
             raise ValueError(f"seconds_per_sphere_step must be > 0 s, got {self.seconds_per_sphere_step!r}")
-        for name in ("bytes_per_sphere_per_dump", "dump_header_bytes", "cache_factor",
+        for name in ("bytes_per_sphere_per_dump", "dump_header_bytes",
                      "contact_bytes_per_sphere_per_dump"):
             value = getattr(self, name)
             if not _finite(value) or value < 0:
@@ -156,7 +152,7 @@ class RunEstimate:
     dump_frames : int
         Particle dump files at most.
     dump_bytes : int
-        Disk space of particle dumps, contact dumps and the parsed-frame cache (bytes).
+        Disk space of particle dumps and contact dumps (bytes).
     mpi_ranks : int
         MPI ranks the estimate assumes.
     """
@@ -192,13 +188,12 @@ def estimate_run(
     *,
     extra_spheres: int = 0,
     contact_frames: int = 0,
-    frame_cache: bool = True,
 ) -> RunEstimate:
     """The estimate every case kind shares.
 
     spheres N = clumps * spheres_per_clump + extra_spheres;
     wall time = N * steps * seconds_per_sphere_step / (ranks * efficiency^log2(ranks));
-    disk = frames (header + N bytes_per_sphere_per_dump) (1 + cache_factor if frame_cache)
+    disk = frames (header + N bytes_per_sphere_per_dump)
     + contact_frames (header + N contact_bytes_per_sphere_per_dump).
 
     Parameters
@@ -225,8 +220,6 @@ def estimate_run(
         Atoms that belong to no clump (a lid of glued spheres, a servo proxy) (>= 0).
     contact_frames : int
         Text contact dump files (>= 0).
-    frame_cache : bool
-        Whether the analyses of this kind cache parsed frames under ``frames/``.
 
     Returns
     -------
@@ -245,7 +238,6 @@ def estimate_run(
     spheres = clumps * spheres_per_clump + extra_spheres
     serial = spheres * steps * model.seconds_per_sphere_step
     particle_dumps = dump_frames * (model.dump_header_bytes + spheres * model.bytes_per_sphere_per_dump)
-    cache = model.cache_factor * particle_dumps if frame_cache else 0.0
     contacts = contact_frames * (model.dump_header_bytes + spheres * model.contact_bytes_per_sphere_per_dump)
     return RunEstimate(
         run_id=run_id,
@@ -256,7 +248,7 @@ def estimate_run(
         simulated_time_s=steps * timestep,
         wall_time_s=wall_time(serial, mpi_ranks, model),
         dump_frames=dump_frames,
-        dump_bytes=math.ceil(particle_dumps + cache + contacts),
+        dump_bytes=math.ceil(particle_dumps + contacts),
         mpi_ranks=mpi_ranks,
     )
 
@@ -287,7 +279,6 @@ def _estimate_silo_deck(
         mpi_ranks=mpi_ranks,
         model=model,
         contact_frames=SILO_CONTACT_SNAPSHOTS,
-        frame_cache=True,
     )
 
 
@@ -355,7 +346,6 @@ def estimate_jenike_case(case: JenikeCase, mpi_ranks: int = 1, model: CostModel 
         model=model,
         extra_spheres=jenike_lid_atoms(case),
         contact_frames=frames,
-        frame_cache=False,
     )
 
 
@@ -367,7 +357,7 @@ class InsufficientDiskSpace(RuntimeError):
 
 
 def check_disk_space(required_bytes: float, free_bytes: float, where: str, what: str) -> float:
-    """Refuse runs whose dumps and caches would not fit on the disk.
+    """Refuse runs whose dumps would not fit on the disk.
 
     Parameters
     ----------
@@ -395,7 +385,7 @@ def check_disk_space(required_bytes: float, free_bytes: float, where: str, what:
             raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     if required_bytes > free_bytes:
         raise InsufficientDiskSpace(
-            f"the runs {what} need about {format_bytes(required_bytes)} for dumps and caches but only "
+            f"the runs {what} need about {format_bytes(required_bytes)} for dumps but only "
             f"{format_bytes(free_bytes)} are free on {where}; free space, move results/ to a larger disk, "
             "or raise dump intervals"
         )
@@ -450,7 +440,7 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
     """Rows of the table ``make estimate`` prints: one per run, then a totals row.
 
     Columns (:data:`ESTIMATE_COLUMNS`): run, kind, mpi_ranks, clumps, spheres, steps, simulated_s (s),
-    wall_time (formatted), dump_frames, disk (formatted dumps and caches). The totals row sums wall time
+    wall_time (formatted), dump_frames, disk (formatted dumps). The totals row sums wall time
     (the runs one after another), dump frames and disk; its other cells are empty.
     """
     estimates = list(estimates)
@@ -481,7 +471,7 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
 
 
 def total_dump_bytes(estimates: Iterable[RunEstimate]) -> int:
-    """Disk space of all the runs' dumps and caches (bytes), for :func:`check_disk_space`."""
+    """Disk space of all the runs' dumps (bytes), for :func:`check_disk_space`."""
     return sum(estimate.dump_bytes for estimate in estimates)
 
 

@@ -79,7 +79,7 @@ def preflight(config: dict, estimate: RunEstimate, run_dir: str | Path) -> str:
     check_run_disk_space(config, estimate, run_dir)
     return (f"estimate for {estimate.run_id}: {estimate.clumps} clumps, {estimate.steps} steps "
             f"({estimate.simulated_time_s:.3g} s simulated), about {format_duration(estimate.wall_time_s)} on "
-            f"{estimate.mpi_ranks} rank(s) and {format_bytes(estimate.dump_bytes)} of dumps and caches")
+            f"{estimate.mpi_ranks} rank(s) and {format_bytes(estimate.dump_bytes)} of dumps")
 
 
 def estimate_table(estimates: list[RunEstimate]) -> str:

@@ -73,13 +73,12 @@ def test_cost_model_defaults_are_the_measured_values():
     assert model.seconds_per_sphere_step == 5.0e-7
     assert model.bytes_per_sphere_per_dump == 128
     assert model.dump_header_bytes == 1024
-    assert model.cache_factor == 1.0
     assert model.parallel_efficiency == 0.8
 
 
 @pytest.mark.parametrize(
     "field, value",
-    [("seconds_per_sphere_step", 0.0), ("bytes_per_sphere_per_dump", -1.0), ("cache_factor", float("nan")),
+    [("seconds_per_sphere_step", 0.0), ("bytes_per_sphere_per_dump", -1.0), ("contact_bytes_per_sphere_per_dump", float("nan")),
      ("parallel_efficiency", 0.0), ("parallel_efficiency", 1.5), ("dump_header_bytes", float("inf"))],
 )
 def test_cost_model_refuses_impossible_values_and_names_them(field, value):
@@ -149,15 +148,15 @@ def test_estimate_run_exact_numbers():
     assert estimate.simulated_time_s == pytest.approx(0.1, rel=1e-12)
     # 2000 spheres x 10,000 steps x 0.5 microseconds
     assert estimate.wall_time_s == pytest.approx(10.0, rel=1e-12)
-    # 11 dumps of 1024 + 2000 x 128 bytes, and a cache as large
-    assert estimate.dump_bytes == 2 * 11 * (1024 + 2000 * 128) == 5_654_528
+    # 11 dumps of 1024 + 2000 x 128 bytes (no frame cache: it did not pay, make bench)
+    assert estimate.dump_bytes == 11 * (1024 + 2000 * 128) == 2_827_264
     assert (estimate.run_id, estimate.kind, estimate.clumps, estimate.steps, estimate.dump_frames,
             estimate.mpi_ranks) == ("r", "silo_flat", 1000, 10_000, 11, 1)
 
 
-def test_estimate_run_with_ranks_lid_spheres_contacts_and_no_cache():
+def test_estimate_run_with_ranks_lid_spheres_and_contacts():
     estimate = estimate_run("r", "jenike", clumps=100, spheres_per_clump=3, steps=1000, timestep=2.0e-6,
-                            dump_frames=5, mpi_ranks=2, extra_spheres=20, contact_frames=4, frame_cache=False)
+                            dump_frames=5, mpi_ranks=2, extra_spheres=20, contact_frames=4)
     assert estimate.spheres == 320
     assert estimate.wall_time_s == pytest.approx(320 * 1000 * 5.0e-7 / 1.6, rel=1e-12)
     assert estimate.dump_bytes == 5 * (1024 + 320 * 128) + 4 * (1024 + 320 * 200)
@@ -199,8 +198,8 @@ def test_hand_made_silo_case_exact_numbers():
     assert estimate.dump_frames == 1 + math.ceil(2000 / 300) == 8
     assert estimate.simulated_time_s == pytest.approx(0.032, rel=1e-12)
     assert estimate.wall_time_s == pytest.approx(200 * 3200 * 5.0e-7, rel=1e-12)
-    # 8 dumps and their cache, plus the one contact snapshot of the settled fill
-    assert estimate.dump_bytes == 2 * 8 * (1024 + 200 * 128) + (1024 + 200 * 200) == 467_008
+    # 8 dumps, plus the one contact snapshot of the settled fill
+    assert estimate.dump_bytes == 8 * (1024 + 200 * 128) + (1024 + 200 * 200) == 254_016
     assert (estimate.run_id, estimate.kind) == ("silo-test", "silo_flat")
 
 
@@ -215,7 +214,7 @@ def test_silo_case_from_config_counts_the_settle_stage_at_its_longest(config):
     assert estimate.wall_time_s == pytest.approx(estimate.spheres * expected_steps * 5.0e-7 / 1.6, rel=1e-12)
     assert estimate.dump_frames == 1 + math.ceil(case.discharge_steps / case.dump_every)
     frames_bytes = estimate.dump_frames * (1024 + estimate.spheres * 128)
-    assert estimate.dump_bytes == 2 * frames_bytes + 1024 + estimate.spheres * 200
+    assert estimate.dump_bytes == frames_bytes + 1024 + estimate.spheres * 200
     assert estimate.run_id == case.run_id and estimate.mpi_ranks == 2
 
 
@@ -230,7 +229,7 @@ def test_changing_a_silo_case_changes_its_estimate_exactly(config):
     assert estimate.dump_frames == 10
     assert estimate.simulated_time_s == pytest.approx(16300 * 2.0e-5, rel=1e-12)
     spheres = 500 * case.particle.n_spheres
-    assert estimate.dump_bytes == 2 * 10 * (1024 + spheres * 128) + 1024 + spheres * 200
+    assert estimate.dump_bytes == 10 * (1024 + spheres * 128) + 1024 + spheres * 200
 
 
 def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
@@ -277,7 +276,7 @@ def test_hand_made_jenike_case_exact_numbers():
     assert estimate.clumps == 453 and estimate.spheres == 906 + 280
     # as the recorded run: 14 particle dumps over consolidation and shear
     assert estimate.dump_frames == 14
-    # particle dumps and contact dumps, no frame cache
+    # particle dumps and contact dumps
     assert estimate.dump_bytes == 14 * (1024 + 1186 * 128) + 14 * (1024 + 1186 * 200)
     assert estimate.simulated_time_s == pytest.approx(0.40299, rel=1e-12)
     assert estimate.kind == "jenike"
@@ -307,7 +306,7 @@ def test_disk_check_refuses_when_the_estimate_exceeds_the_free_space():
     with pytest.raises(InsufficientDiskSpace) as caught:
         check_disk_space(12.3e9, 4.5e9, "/data", "of the blender study")
     assert str(caught.value) == (
-        "the runs of the blender study need about 12.3 GB for dumps and caches but only 4.5 GB are free on "
+        "the runs of the blender study need about 12.3 GB for dumps but only 4.5 GB are free on "
         "/data; free space, move results/ to a larger disk, or raise dump intervals"
     )
     assert isinstance(caught.value, RuntimeError)
@@ -316,9 +315,9 @@ def test_disk_check_refuses_when_the_estimate_exceeds_the_free_space():
 def test_disk_check_of_estimated_runs_names_both_sizes():
     estimates = [estimate_silo_case(_silo_like(), model=WORST_CASE), estimate_silo_case(_silo_like(run_id="silo-2"), model=WORST_CASE)]
     required = total_dump_bytes(estimates)
-    assert required == 2 * 467_008
-    with pytest.raises(InsufficientDiskSpace, match=r"need about 934 kB .* only 900 kB are free on results/"):
-        check_disk_space(required, 900_000, "results/", "of silo_flat")
+    assert required == 2 * 254_016
+    with pytest.raises(InsufficientDiskSpace, match=r"need about 508 kB .* only 500 kB are free on results/"):
+        check_disk_space(required, 500_000, "results/", "of silo_flat")
 
 
 def test_disk_check_returns_the_margin():
@@ -370,7 +369,7 @@ def test_estimate_rows_have_stable_columns_and_a_totals_row():
     assert [list(row) for row in rows] == [list(ESTIMATE_COLUMNS)] * 3
     assert rows[1] == {"run": "b", "kind": "blender", "mpi_ranks": 2, "clumps": 10, "spheres": 20, "steps": 100,
                        "simulated_s": 0.5, "wall_time": "1 h", "dump_frames": 7, "disk": "2 GB"}
-    assert rows[0]["disk"] == "467 kB" and rows[0]["wall_time"] == "0.32 s"
+    assert rows[0]["disk"] == "254 kB" and rows[0]["wall_time"] == "0.32 s"
     assert rows[2] == {"run": "total (2 runs)", "kind": "", "mpi_ranks": "", "clumps": "", "spheres": "",
                        "steps": "", "simulated_s": "", "wall_time": "1 h", "dump_frames": 15, "disk": "2 GB"}
 
