@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.data.constants import GRAVITY
 from analysis.data.forces import WallForceHistory
 
 __all__ = ["ShearSignals", "shear_signals"]
@@ -50,7 +51,7 @@ class ShearSignals:
 
 
 def shear_signals(history: WallForceHistory, shear_start: float, shear_end: float | None = None,
-                  gravity: float = 9.81) -> ShearSignals:
+                  gravity: float = GRAVITY) -> ShearSignals:
     """Cut the shear stage out of a Jenike wall force history and sign its forces for the bulk friction.
 
     Parameters

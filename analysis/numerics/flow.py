@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import linregress
 
+from analysis.data.constants import GRAVITY
 from analysis.checks import finite_array, non_negative_number, per_particle_values, positive_number
 
 __all__ = [
@@ -110,7 +111,7 @@ def beverloo_mass_flow_rate(
     particle_diameter: float,
     discharge_coefficient: float = 0.58,
     shape_coefficient: float = 1.5,
-    gravity: float = 9.81,
+    gravity: float = GRAVITY,
 ) -> float:
     """Beverloo mass flow rate through a slot outlet.
 
@@ -131,7 +132,7 @@ def beverloo_mass_flow_rate(
     shape_coefficient : float, optional
         Empty-annulus coefficient k [-] (default 1.5).
     gravity : float, optional
-        Gravitational acceleration g [m/s2] (default 9.81).
+        Gravitational acceleration g [m/s2] (default :data:`analysis.data.constants.GRAVITY`).
 
     Returns
     -------

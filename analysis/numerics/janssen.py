@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from analysis.data.constants import GRAVITY
 from analysis.checks import non_negative_number, positive_number
 
 __all__ = ["janssen_coefficient", "janssen_characteristic_depth", "janssen_vertical_stress"]
@@ -52,7 +53,7 @@ def janssen_vertical_stress(
     wall_friction_side: float,
     wall_friction_front: float,
     internal_friction_angle_deg: float,
-    gravity: float = 9.81,
+    gravity: float = GRAVITY,
 ):
     """Mean vertical stress in a rectangular silo by Janssen's method.
 
@@ -82,7 +83,7 @@ def janssen_vertical_stress(
     internal_friction_angle_deg : float
         Bulk internal friction angle phi [deg].
     gravity : float, optional
-        g [m/s2] (default 9.81).
+        g [m/s2] (default :data:`analysis.data.constants.GRAVITY`).
 
     Returns
     -------

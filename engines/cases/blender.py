@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
 from engines.cases.particles import particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
-from engines.cases.common import GRAVITY, engine_kind, material_table, plan_fill, run_id
+from analysis.data.constants import GRAVITY
+from engines.cases.common import engine_kind, material_table, plan_fill, run_id
 from engines.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"

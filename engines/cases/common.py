@@ -11,11 +11,10 @@ import json
 import math
 from dataclasses import dataclass
 
+from analysis.data.constants import GRAVITY
 from engines.cases.particles import ParticleTemplate
 from engines.cases.physics import steps_for
 
-#: Standard gravity (m/s^2).
-GRAVITY = 9.81
 
 
 @dataclass(frozen=True)

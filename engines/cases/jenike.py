@@ -51,6 +51,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from analysis.data.constants import GRAVITY
 from engines.cases.geometry import TriangleMesh, horizontal_rectangle
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
@@ -59,7 +60,6 @@ from engines.cases.jenike_sweep import sweep_points
 from engines.cases.stages import Stage
 
 CASE_NAME = "jenike"
-GRAVITY = 9.81
 
 #: Engine atom types by role. The plate type exists only in wall tests; the rings share one material.
 PARTICLE_TYPE, RING_TYPE, LID_TYPE, PLATE_TYPE = 1, 2, 3, 4

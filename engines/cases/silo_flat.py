@@ -15,7 +15,8 @@ import copy
 import math
 from dataclasses import asdict, dataclass, field
 
-from engines.cases.common import GRAVITY, FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id
+from analysis.data.constants import GRAVITY
+from engines.cases.common import FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
 from engines.cases.stages import Stage

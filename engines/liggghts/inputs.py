@@ -7,6 +7,7 @@ import json
 import os
 from pathlib import Path
 
+from analysis.data.constants import GRAVITY
 from engines.cases.geometry import write_stl
 
 #: The engine's registry name (engine.kind), written into every run record.
@@ -41,7 +42,7 @@ def common_context(case) -> dict:
             "hard_particles": max(moduli) > HARD_LIMIT,
         },
         "timestep": case.timestep,
-        "gravity": 9.81,
+        "gravity": GRAVITY,
         "neighbor_skin": 0.4 * particle.smallest_radius,
         "particle": {
             "name": particle.name,

@@ -12,7 +12,8 @@ from engines.cases.geometry import horizontal_rectangle
 from engines.cases.silo_flat import SiloCase
 from engines.estimates import CostModel, silo_run_steps
 from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
-from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX, WALL_FORCES_NAME
+from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
+from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.run import (
     CONTACT_PREFIX,
     DUMP_PREFIX,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from analysis.data.frames import clumps_from_frame
-from engines.cases.common import GRAVITY
+from analysis.data.constants import GRAVITY
 from engines.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for

@@ -11,7 +11,7 @@ from scipy.optimize import OptimizeWarning
 
 from analysis.data.contacts import ContactFrame
 from analysis.data.frames import ClumpFrame
-from analysis.numerics.constants import GRAVITY
+from analysis.data.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average
 from analysis.numerics.grid import Fields
 from analysis.numerics.janssen import janssen_vertical_stress

@@ -15,12 +15,12 @@ from engines.cases.silo_flat import build_silo_case
 from engines.liggghts.forces import (
     JENIKE_WALLS,
     RESUMED_WALL_FORCES_PREFIX,
-    WALL_FORCES_NAME,
     read_jenike_forces,
     read_silo_wall_forces,
     read_wall_force_file,
     read_wall_forces,
 )
+from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.jenike import FORCE_COLUMNS, FORCES_NAME
 from engines.liggghts.run import RESUME_STEM, Resume
 from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context

@@ -108,7 +108,8 @@ def parametric_rows(study: str, labels: Sequence[str], runs: Sequence[str], flow
     centreline v_z (m/s) at the profile height."""
     return [
         {"study": study, "label": label, "run_id": run, "profile_height_m": profiles.height,
-         "mass_flow_rate_kg_s": flow["mass_flow_rate_kg_s"], "mass_flow_rate_stderr_kg_s": flow["mass_flow_rate_stderr_kg_s"],
+         "mass_flow_rate_kg_s": flow["mass_flow_rate_kg_s"],
+         "mass_flow_rate_stderr_kg_s": flow["mass_flow_rate_stderr_kg_s"],
          "beverloo_ratio": flow["beverloo_ratio"], "filling_bulk_density_kg_m3": flow["filling_bulk_density_kg_m3"],
          "centreline_v_z_m_s": float(np.interp(0.0, profiles.x, profile))}
         for label, run, flow, profile in zip(labels, runs, flows, profiles.v_z)

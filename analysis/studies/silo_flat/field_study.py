@@ -20,7 +20,7 @@ import numpy as np
 
 from analysis.data.contacts import ContactFrame
 from analysis.data.frames import ClumpFrame
-from analysis.numerics.constants import GRAVITY
+from analysis.data.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.flow import column_surface_heights
 from analysis.numerics.force_chains import ForceChainSegments, force_chain_segments
@@ -201,7 +201,8 @@ def profile_heights_inside(requested: Sequence[float], grid: Grid, top: float, d
     """
     heights = [z for z in requested if grid.z[0] <= z <= min(top, grid.z[-1]) - dz]
     if not heights:
-        raise ValueError(f"no profile height lies inside the fill (surface at {top:.3f} m): lower fields.profile_heights")
+        raise ValueError(
+            f"no profile height lies inside the fill (surface at {top:.3f} m): lower fields.profile_heights")
     return heights
 
 

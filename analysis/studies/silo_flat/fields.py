@@ -16,7 +16,7 @@ import numpy as np
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.field_ops import average_fields, depth_average
 from analysis.numerics.coarse_graining import coarse_grain
-from analysis.numerics.constants import GRAVITY
+from analysis.data.constants import GRAVITY
 from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity

@@ -11,6 +11,7 @@ from typing import Sequence
 
 import numpy as np
 
+from analysis.data.constants import GRAVITY
 from analysis.numerics.flow import (
     BulkDensity,
     DischargeHistory,
@@ -86,7 +87,7 @@ def silo_flow_metrics(
     steady_window: tuple[float, float] = (0.2, 0.8),
     discharge_coefficient: float = 0.58,
     shape_coefficient: float = 1.5,
-    gravity: float = 9.81,
+    gravity: float = GRAVITY,
 ) -> SiloFlowMetrics:
     """Filling bulk density, discharge history, steady flow rate and Beverloo's prediction.
 
