@@ -31,7 +31,7 @@ engine, serial and ``mpirun -np 2`` alike; binary arrays are raw big-endian, eac
     radius 1 <n> double
     [omega 3 <n> double]
 
-A dump with no spheres (step 0, with no sphere in the domain (before the first insertion, or a silo that has emptied)) is the header and ``POINTS 0 float``
+A dump with no spheres (before the first insertion, or of a silo that has emptied) is the header and ``POINTS 0 float``
 followed by one empty line. A ``<prefix>_boundingBox_<step>.vtk`` file (a RECTILINEAR_GRID) is
 written beside each dump and is not a particle dump.
 
