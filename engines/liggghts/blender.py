@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from engines.cases.blender import BlenderCase
-from engines.cases.blender_geometry import blender_meshes
+from engines.cases.blender_meshes import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
