@@ -14,13 +14,13 @@ from analysis.studies.blender.plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from analysis.studies.blender.study import (
-    BlenderSettings,
-    analyse_blender,
-    key_heights,
-    rtd_summary,
-    study_metrics,
-    study_summary,
+from analysis.studies.blender.study import BlenderSettings, analyse_blender, key_heights, study_metrics
+from analysis.studies.blender.tables import (
+    blender_summary,
+    profile_rows,
+    residence_rows,
+    rtd_rows,
+    vrr_period_rows,
 )
 from analysis.io.tables import write_flow_table, write_json
 from engines.cases import case_for_run
@@ -39,39 +39,13 @@ with logged_to(snakemake.log[0]) as log:
                             window_times, heights, geometry.annulus_bounds, geometry.wall_x, settings)
     name = f"{case['configuration']} ({case['gravity_factor']:g} g)"
     metrics = study_metrics(case["configuration"], study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions)
-    rtd = study.rtd.rtd
-    summary = {
-        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
-        "geometry": case["geometry"], "mode": case["mode"], "n_clumps": case["n_clumps"],
-        "steady_window_s": case["steady_window"], "mass_flow_rate_standard_error_kg_s":
-            flow["mass_flow_rate_standard_error_kg_s"],
-        **study_summary(study, metrics),
-        "rtd_curve": rtd_summary(rtd),
-        "flow_history": {"time_since_open_s": flow["time_since_open_s"], "discharged_mass_kg": flow["discharged_mass_kg"],
-                         "mean_v_z_m_s": flow["mean_v_z_m_s"]},
-    }
-    write_json(snakemake.output.summary, summary)
+    write_json(snakemake.output.summary, blender_summary(case, flow, study, metrics))
+    write_flow_table(snakemake.output.profiles, profile_rows(study.profiles))
+    write_flow_table(snakemake.output.residence, residence_rows(study.pathlines))
+    write_flow_table(snakemake.output.rtd, rtd_rows(study.rtd.rtd))
+    write_flow_table(snakemake.output.vrr, vrr_period_rows(study.continuous))
 
-    profiles = study.profiles
-    write_flow_table(snakemake.output.profiles, [
-        {"window_time_s": float(t), "height_m": float(h), "x_m": float(x), "v_z_m_s": float(v), "normalised": float(n)}
-        for w, t in enumerate(profiles.window_time) for k, h in enumerate(profiles.heights)
-        for x, v, n in zip(profiles.x, profiles.v_z[w, k], profiles.normalised[w, k])
-    ])
-    write_flow_table(snakemake.output.residence, [
-        {"release_x_m": float(x), "residence_time_s": float(t)}
-        for x, t in zip(study.pathlines.release_x, study.pathlines.residence_time)
-    ])
-    write_flow_table(snakemake.output.rtd, [
-        {"time_s": float(t), "E_per_s": float(e), "theta": float(th), "E_theta": float(et)}
-        for t, e, th, et in zip(rtd.time, rtd.E, rtd.theta, rtd.E_theta)
-    ])
-    write_flow_table(snakemake.output.vrr, [
-        {"period_over_tm": float(p), "vrr": float(v), "cov_out": float(c)}
-        for p, v, c in zip(study.continuous.period_over_tm, study.continuous.vrr, study.continuous.cov_out)
-    ])
-
-    plot_profiles_over_time(profiles, snakemake.output.profiles_plot, f"Normalised v_z profiles: {name}")
+    plot_profiles_over_time(study.profiles, snakemake.output.profiles_plot, f"Normalised v_z profiles: {name}")
     inlet = study.inlet if study.inlet is not None else study.outlet
     plot_passage_distributions(inlet, study.outlet, snakemake.output.distribution_plot,
                                f"Velocity across the insert inlet and outlet: {name}")

@@ -6,21 +6,18 @@ from pathlib import Path
 from analysis.studies.blender.comparison import best_blender, comparison_table
 from analysis.studies.blender.plots import plot_configuration_comparison, plot_rtd_theta
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
-from analysis.io.tables import markdown_table, write_flow_table, write_text
+from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs
+from analysis.io.tables import write_flow_table, write_text
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     summaries = [json.loads(Path(path).read_text()) for path in snakemake.input.summaries]
-    lowest = min(summary["gravity_factor"] for summary in summaries)
-    chosen = [summary for summary in summaries if summary["gravity_factor"] == lowest]
+    lowest, chosen = lowest_gravity_runs(summaries)
     metrics = [metrics_from_summary(summary) for summary in chosen]
     rows = comparison_table(metrics)
     best = best_blender(metrics)
     write_flow_table(snakemake.output.table, rows)
-    tolerance = snakemake.params.tolerance
-    write_text(snakemake.output.markdown, f"# Insert configurations at {lowest:g} g\n\n{markdown_table(rows)}\n"
-               f"Best blender: **{best}** (fewest recirculations to homogenise within +-{tolerance:.0%}, ties broken "
-               "by the highest VRR at the shortest period).\n")
+    write_text(snakemake.output.markdown, comparison_markdown(lowest, rows, best, snakemake.params.tolerance))
     plot_configuration_comparison(rows, [c for c in rows[0] if c != "configuration"], snakemake.output.plot,
                                   f"Insert configurations at {lowest:g} g (best: {best})", best=best)
     plot_rtd_theta({s["configuration"]: rtd_from_summary(s["rtd_curve"]) for s in chosen}, snakemake.output.rtd_plot,

@@ -5,7 +5,6 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
@@ -19,7 +18,16 @@ from analysis.studies.silo_recirculation.rtd_plots import (
     plot_vrr_versus_period,
 )
 from analysis.studies.silo_recirculation.study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
-from analysis.numerics.rtd import johanson_rtd
+from analysis.studies.silo_recirculation.tables import (
+    blending_summary,
+    clumps_per_window,
+    concentration_rows,
+    johanson_curve,
+    model_rows,
+    rtd_rows,
+    vrr_period_rows,
+    vrr_rows,
+)
 from analysis.io.tables import write_flow_table, write_json
 from engines.logs import logged_to
 
@@ -50,62 +58,13 @@ with logged_to(snakemake.log[0]) as log:
     title = f"{case['flow_pattern']} ({case['run_id']})"
 
     # --- tables
-    concentration_rows, vrr_rows, model_rows = [], [], []
-    for layout in result.layouts:
-        c = layout.concentration
-        for i in range(c.centres.size):
-            concentration_rows.append({
-                "layout": layout.layout.name, "time_s": c.centres[i], "recirculations": layout.recirculation_number[i],
-                "crossings": int(c.n_total[i]), "concentration": c.concentration[i],
-                "first_exit_concentration": layout.first_pass.concentration[i], "predicted": layout.predicted[i],
-                "predicted_johanson": layout.predicted_johanson[i],
-            })
-        for row, predicted in zip(layout.vrr.rows(), layout.vrr_predicted.vrr):
-            vrr_rows.append({"layout": layout.layout.name, **row, "vrr_predicted": predicted})
-        for nr, value in zip(layout.model_time_nr, layout.model_concentration):
-            model_rows.append({"layout": layout.layout.name, "recirculations": nr, "concentration": value})
-    write_flow_table(out.concentration, concentration_rows)
-    write_flow_table(out.vrr, vrr_rows)
-    write_flow_table(out.model, model_rows)
-    johanson = johanson_rtd(silo_rtd.time, silo_rtd.t_mean, result.rtd.johanson_V1, result.rtd.johanson_P)
-    rtd_rows = [
-        {"method": method, "time_s": t, "E_per_s": e, "t_mean_s": tm}
-        for method, rtd_time, values, tm in (
-            ("particle_ids", silo_rtd.time, silo_rtd.E, silo_rtd.t_mean),
-            ("eulerian", eulerian_rtd.time, eulerian_rtd.E, eulerian_rtd.t_mean),
-            ("johanson", silo_rtd.time, johanson, silo_rtd.t_mean),
-        )
-        for t, e in zip(rtd_time, values)
-    ]
-    write_flow_table(out.rtd, rtd_rows)
-    write_flow_table(out.vrr_period, result.vrr_sine.rows() + result.vrr_square.rows())
-    particles_per_window = timing.throughput * result.window
-    summary = {
-        "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
-        "residence_time_s": timing.residence_time, "estimated_residence_time_s": case["estimated_residence_time_s"],
-        "holdup_clumps": timing.holdup, "throughput_clumps_per_s": timing.throughput,
-        "recirculations": timing.recirculations, "window_s": result.window,
-        "clumps_per_window": particles_per_window,
-        "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window),
-        "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
-                             "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
-                             "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited},
-        "rtd_eulerian": {"t_mean_s": eulerian_rtd.t_mean, "variance_s2": eulerian_rtd.variance,
-                         "t_s": eulerian_rtd.t_first, "t_d": eulerian_rtd.t_last,
-                         "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian["bin_size"]},
-        "johanson": {"V1": result.rtd.johanson_V1, "P": result.rtd.johanson_P},
-        "layouts": {
-            layout.layout.name: {
-                "blue_fraction": layout.layout.blue_fraction, "sublayers": layout.layout.sublayers,
-                "vrr_by_recirculation": layout.vrr.vrr, "vrr_predicted": layout.vrr_predicted.vrr,
-                "prediction_rms_error": layout.prediction_rms_error(),
-                "homogenised_after_recirculations": layout.homogenised_after,
-                "model_homogenised_after_recirculations": layout.model_homogenised_after,
-            }
-            for layout in result.layouts
-        },
-    }
-    write_json(out.summary, summary)
+    write_flow_table(out.concentration, concentration_rows(result))
+    write_flow_table(out.vrr, vrr_rows(result))
+    write_flow_table(out.model, model_rows(result))
+    johanson = johanson_curve(result)
+    write_flow_table(out.rtd, rtd_rows(result, eulerian_rtd, johanson))
+    write_flow_table(out.vrr_period, vrr_period_rows(result))
+    write_json(out.summary, blending_summary(case, result, eulerian_rtd, eulerian["bin_size"]))
 
     # --- plots
     plot_outlet_concentration(
@@ -115,7 +74,7 @@ with logged_to(snakemake.log[0]) as log:
     )
     plot_vrr_versus_recirculations(
         [(l.layout.name, l.vrr.recirculation_number, l.vrr.vrr) for l in result.layouts],
-        out.vrr_plot, f"VRR per recirculation, {title}", noise_limit=particles_per_window,
+        out.vrr_plot, f"VRR per recirculation, {title}", noise_limit=clumps_per_window(result),
     )
     plot_rtd_comparison(
         [("particle ids", silo_rtd.time, silo_rtd.E, silo_rtd.t_mean),

@@ -6,7 +6,8 @@ from pathlib import Path
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from analysis.studies.silo_recirculation.plots import plot_paths_comparison
 from analysis.studies.silo_recirculation.rtd_plots import plot_residence_time_comparison
-from analysis.studies.silo_recirculation.study import residence_summary, verify_eulerian_rtd
+from analysis.studies.silo_recirculation.study import verify_eulerian_rtd
+from analysis.studies.silo_recirculation.tables import verification_rows, verification_summary
 from analysis.io.tables import write_flow_table, write_json
 from engines.logs import logged_to
 
@@ -24,13 +25,8 @@ with logged_to(snakemake.log[0]) as log:
         settings["eulerian"]["integration_step"], settings["eulerian"]["max_recirculations"],
         verification["paths_shown"], settings["tracer"]["volume_fraction"],
     )
-    rows = [{"method": "particles", "bin_size_m": "", "residence_time_s": t} for t in result.particle_residence]
-    for bin_size, times in result.eulerian_residence.items():
-        rows += [{"method": "eulerian", "bin_size_m": bin_size, "residence_time_s": t} for t in times]
-    write_flow_table(out.table, rows)
-    summary = {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
-               "particles": residence_summary(result.particle_residence),
-               "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}
+    write_flow_table(out.table, verification_rows(result))
+    summary = verification_summary(case, result)
     write_json(out.summary, summary)
     samples = [("particle tracks", result.particle_residence)] + [
         (f"Eulerian, {1000 * b:g} mm bins", t) for b, t in result.eulerian_residence.items()]

@@ -1,0 +1,244 @@
+"""Table rows and JSON summaries of the blender study: one run, the configuration comparison, gravity scaling.
+
+Pure functions from the results of :mod:`analysis.studies.blender.study` (and the run summaries it writes, as read
+back from JSON) to plain rows (one dict per row, for :func:`analysis.io.tables.write_flow_table`), summary dicts
+(for :func:`analysis.io.tables.write_json`) and the comparison's Markdown page; no file I/O. The column names and
+their order are the file formats the comparison, report and thesis read, so they change only together with their
+readers. SI units: times in s, E in 1/s, lengths in m, velocities in m/s, mass flow rates in kg/s.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from analysis.io.tables import markdown_table
+from analysis.numerics.rtd import RTD
+from analysis.studies.blender.comparison import BlenderMetrics
+from analysis.studies.blender.gravity import gravity_scaling
+from analysis.studies.blender.modes import ContinuousMode
+from analysis.studies.blender.profiles import ProfilesOverTime
+from analysis.studies.blender.study import BlenderStudy, rtd_summary, study_summary
+from analysis.studies.blender.tracers import TracerPathlines
+
+__all__ = [
+    "blender_summary",
+    "profile_rows",
+    "residence_rows",
+    "rtd_rows",
+    "vrr_period_rows",
+    "lowest_gravity_runs",
+    "comparison_markdown",
+    "GRAVITY_QUANTITIES",
+    "gravity_rows",
+]
+
+#: Steady quantities of a run summary's ``metrics`` tested for ``sqrt(g)`` scaling, in table order.
+GRAVITY_QUANTITIES = ("mass_flow_rate_kg_s", "exterior_v_z_m_s", "interior_v_z_m_s")
+
+
+def _number(value) -> float:
+    # write_json keeps NaN as null (e.g. a passage without bins); read back, it is NaN again.
+    return math.nan if value is None else float(value)
+
+
+def blender_summary(case: Mapping, flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics) -> dict:
+    """The summary of one blender run (``blender.json``).
+
+    Parameters
+    ----------
+    case : mapping
+        The run's case record: ``run_id``, ``configuration``, ``gravity_factor`` [-], ``geometry`` (the insert
+        summary [m]), ``mode``, ``n_clumps`` [-] and ``steady_window`` ([start, end] [s]).
+    flow : mapping
+        The run's flow record: ``mass_flow_rate_standard_error_kg_s`` [kg/s] and the history
+        ``time_since_open_s`` [s], ``discharged_mass_kg`` [kg], ``mean_v_z_m_s`` [m/s].
+    study : BlenderStudy
+        The study of the run (:func:`analysis.studies.blender.study.analyse_blender`).
+    metrics : BlenderMetrics
+        Its figures of merit (:func:`analysis.studies.blender.study.study_metrics`).
+
+    Returns
+    -------
+    dict
+        The case keys, ``mass_flow_rate_standard_error_kg_s``, the keys of
+        :func:`~analysis.studies.blender.study.study_summary`, ``rtd_curve`` (the RTD as
+        :func:`~analysis.studies.blender.study.rtd_summary`, which
+        :func:`~analysis.studies.blender.study.rtd_from_summary` reads back) and ``flow_history``.
+    """
+    return {
+        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
+        "geometry": case["geometry"], "mode": case["mode"], "n_clumps": case["n_clumps"],
+        "steady_window_s": case["steady_window"], "mass_flow_rate_standard_error_kg_s":
+            flow["mass_flow_rate_standard_error_kg_s"],
+        **study_summary(study, metrics),
+        "rtd_curve": rtd_summary(study.rtd.rtd),
+        "flow_history": {"time_since_open_s": flow["time_since_open_s"],
+                         "discharged_mass_kg": flow["discharged_mass_kg"], "mean_v_z_m_s": flow["mean_v_z_m_s"]},
+    }
+
+
+def profile_rows(profiles: ProfilesOverTime) -> list[dict]:
+    """The vertical velocity profiles at the key heights over time, one row per bin (``profiles.csv``).
+
+    Parameters
+    ----------
+    profiles : ProfilesOverTime
+        Profiles per window and height (:func:`analysis.studies.blender.profiles.profiles_over_time`).
+
+    Returns
+    -------
+    list of dict
+        Rows ``window_time_s`` [s], ``height_m`` [m], ``x_m`` (bin centre [m]), ``v_z_m_s`` [m/s] and
+        ``normalised`` (``v_z`` over the cross-section mean [-]), window-major, then height, then x.
+    """
+    return [
+        {"window_time_s": float(t), "height_m": float(h), "x_m": float(x), "v_z_m_s": float(v), "normalised": float(n)}
+        for w, t in enumerate(profiles.window_time) for k, h in enumerate(profiles.heights)
+        for x, v, n in zip(profiles.x, profiles.v_z[w, k], profiles.normalised[w, k])
+    ]
+
+
+def residence_rows(pathlines: TracerPathlines) -> list[dict]:
+    """Residence time of the pathlines released across the width (``residence_across_width.csv``).
+
+    Parameters
+    ----------
+    pathlines : TracerPathlines
+        Virtual tracers released at one height (:func:`analysis.studies.blender.tracers.tracer_pathlines`).
+
+    Returns
+    -------
+    list of dict
+        Rows ``release_x_m`` [m] and ``residence_time_s`` [s] (NaN: not out within the time followed).
+    """
+    return [
+        {"release_x_m": float(x), "residence_time_s": float(t)}
+        for x, t in zip(pathlines.release_x, pathlines.residence_time)
+    ]
+
+
+def rtd_rows(rtd: RTD) -> list[dict]:
+    """An RTD in dimensional and dimensionless form, one row per bin (``rtd.csv``).
+
+    Parameters
+    ----------
+    rtd : analysis.numerics.rtd.RTD
+        The RTD of the run (``study.rtd.rtd``).
+
+    Returns
+    -------
+    list of dict
+        Rows ``time_s`` (bin centre [s]), ``E_per_s`` [1/s], ``theta`` (``t / t_m`` [-]) and ``E_theta``
+        (``t_m E`` [-]).
+    """
+    return [
+        {"time_s": float(t), "E_per_s": float(e), "theta": float(th), "E_theta": float(et)}
+        for t, e, th, et in zip(rtd.time, rtd.E, rtd.theta, rtd.E_theta)
+    ]
+
+
+def vrr_period_rows(continuous: ContinuousMode) -> list[dict]:
+    """VRR and outlet CoV of sine inputs against their period (``vrr_period.csv``).
+
+    Parameters
+    ----------
+    continuous : ContinuousMode
+        The continuous mode of the run (:func:`analysis.studies.blender.modes.continuous_mode`).
+
+    Returns
+    -------
+    list of dict
+        Rows ``period_over_tm`` [-], ``vrr`` [-] and ``cov_out`` [-].
+    """
+    return [
+        {"period_over_tm": float(p), "vrr": float(v), "cov_out": float(c)}
+        for p, v, c in zip(continuous.period_over_tm, continuous.vrr, continuous.cov_out)
+    ]
+
+
+def lowest_gravity_runs(summaries: Sequence[Mapping]) -> tuple[float, list[Mapping]]:
+    """The runs at the lowest gravity factor, the ones the configuration comparison compares.
+
+    Parameters
+    ----------
+    summaries : sequence of mapping
+        Run summaries (:func:`blender_summary`, as read from JSON), each with its ``gravity_factor`` [-].
+
+    Returns
+    -------
+    tuple of (float, list of mapping)
+        The lowest gravity factor [-] and the summaries run at it, in the given order.
+    """
+    lowest = min(summary["gravity_factor"] for summary in summaries)
+    return lowest, [summary for summary in summaries if summary["gravity_factor"] == lowest]
+
+
+def comparison_markdown(gravity_factor: float, rows: Sequence[Mapping], best: str, tolerance: float) -> str:
+    """The configuration comparison as a Markdown page (``configurations.md``).
+
+    Parameters
+    ----------
+    gravity_factor : float
+        Gravity factor the configurations were compared at [-].
+    rows : sequence of mapping
+        The comparison table (:func:`analysis.studies.blender.comparison.comparison_table`).
+    best : str
+        The best configuration (:func:`analysis.studies.blender.comparison.best_blender`).
+    tolerance : float
+        Homogenisation band the ranking used, relative to the mean [-].
+
+    Returns
+    -------
+    str
+        A heading, the table and a sentence naming the best blender and the ranking rule.
+    """
+    return (f"# Insert configurations at {gravity_factor:g} g\n\n{markdown_table(list(rows))}\n"
+            f"Best blender: **{best}** (fewest recirculations to homogenise within +-{tolerance:.0%}, ties broken "
+            "by the highest VRR at the shortest period).\n")
+
+
+def gravity_rows(summaries: Sequence[Mapping], tolerance: float = 0.1) -> tuple[list[dict], list[tuple], list[tuple]]:
+    """Gravity scaling of every configuration run at 1 g and at least one other factor (``scaling.csv``).
+
+    For each configuration (in sorted order), its runs sorted by gravity factor give the quantities of
+    :data:`GRAVITY_QUANTITIES` per factor; those finite at every factor (JSON's null, a NaN written out, counts
+    as not finite) go to :func:`analysis.studies.blender.gravity.gravity_scaling`.
+
+    Parameters
+    ----------
+    summaries : sequence of mapping
+        Run summaries (:func:`blender_summary`, as read from JSON): ``configuration``, ``gravity_factor`` [-],
+        ``metrics`` and ``flow_history``.
+    tolerance : float, optional
+        Relative tolerance of the scaling test [-]; default 0.1.
+
+    Returns
+    -------
+    rows : list of dict
+        ``configuration``, then the columns of :attr:`analysis.studies.blender.gravity.GravityScaling.rows`
+        (``quantity``, ``gravity_factor`` [-], ``value``, ``ratio_to_1g`` [-], ``expected_ratio`` [-],
+        ``relative_deviation`` [-], ``scales``); empty when no configuration can be scaled.
+    curves : list of tuple
+        ``(configuration, gravity_factor [-], time_since_open_s [s], mean_v_z_m_s [m/s])`` of each scaled run,
+        for :func:`analysis.studies.blender.plots.plot_gravity_scaling`.
+    skipped : list of tuple
+        ``(configuration, gravity_factors)`` of the configurations left out: without a 1 g run or another
+        factor.
+    """
+    rows, curves, skipped = [], [], []
+    for configuration in sorted({s["configuration"] for s in summaries}):
+        runs = sorted((s for s in summaries if s["configuration"] == configuration), key=lambda s: s["gravity_factor"])
+        factors = [s["gravity_factor"] for s in runs]
+        if 1.0 not in factors or len(factors) < 2:
+            skipped.append((configuration, factors))
+            continue
+        quantities = {key: [_number(s["metrics"][key]) for s in runs] for key in GRAVITY_QUANTITIES}
+        quantities = {k: v for k, v in quantities.items() if np.all(np.isfinite(v))}
+        scaling = gravity_scaling(factors, quantities, tolerance=tolerance)
+        rows += [{"configuration": configuration, **row} for row in scaling.rows]
+        curves += [(configuration, s["gravity_factor"], s["flow_history"]["time_since_open_s"],
+                    s["flow_history"]["mean_v_z_m_s"]) for s in runs]
+    return rows, curves, skipped

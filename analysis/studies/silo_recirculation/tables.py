@@ -1,0 +1,288 @@
+"""Table rows and JSON summaries of the blending study of one recirculation run, and of its Eulerian verification.
+
+Pure functions from the results of :mod:`analysis.studies.silo_recirculation.study` to plain rows (one dict per
+row, for :func:`analysis.io.tables.write_flow_table`) and summary dicts (for :func:`analysis.io.tables.write_json`);
+no file I/O. The column names and their order are the file formats the summary, report and thesis read, so they
+change only together with their readers. SI units: times in s, E in 1/s, lengths in m; concentrations and VRRs
+are dimensionless.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from analysis.numerics.rtd import RTD, johanson_rtd
+from analysis.studies.silo_recirculation.study import BlendingResult, VerificationResult, residence_summary
+from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
+
+__all__ = [
+    "concentration_rows",
+    "vrr_rows",
+    "model_rows",
+    "johanson_curve",
+    "rtd_rows",
+    "vrr_period_rows",
+    "clumps_per_window",
+    "blending_summary",
+    "verification_rows",
+    "verification_summary",
+]
+
+
+def concentration_rows(result: BlendingResult) -> list[dict]:
+    """Outlet concentration per window of every batch layout, measured and predicted (``concentration.csv``).
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run (:func:`analysis.studies.silo_recirculation.study.analyse_blending`).
+
+    Returns
+    -------
+    list of dict
+        One row per layout and window, in layout order then time order, with the columns ``layout``,
+        ``time_s`` (window centre [s]), ``recirculations`` (its Nr [-]), ``crossings`` (outlet crossings in
+        the window [-]), ``concentration`` (measured blue fraction [-], NaN without crossings),
+        ``first_exit_concentration`` (first exits of the initial fill [-]), ``predicted`` (renewal prediction
+        with the measured loop RTD [-]) and ``predicted_johanson`` (with Johanson's RTD [-]).
+    """
+    rows = []
+    for layout in result.layouts:
+        c = layout.concentration
+        for i in range(c.centres.size):
+            rows.append({
+                "layout": layout.layout.name, "time_s": c.centres[i], "recirculations": layout.recirculation_number[i],
+                "crossings": int(c.n_total[i]), "concentration": c.concentration[i],
+                "first_exit_concentration": layout.first_pass.concentration[i], "predicted": layout.predicted[i],
+                "predicted_johanson": layout.predicted_johanson[i],
+            })
+    return rows
+
+
+def vrr_rows(result: BlendingResult) -> list[dict]:
+    """VRR per recirculation of every batch layout, measured and predicted (``vrr.csv``).
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run.
+
+    Returns
+    -------
+    list of dict
+        One row per layout and recirculation: ``layout``, then the columns of
+        :meth:`analysis.studies.silo_recirculation.vrr.RecirculationVRR.rows` (``recirculation_number`` [-],
+        ``vrr`` [-], ``sigma_out`` [-], ``n_windows`` [-], ``sigma_in`` [-], ``blue_fraction`` [-]) of the
+        measured VRR, then ``vrr_predicted`` (the VRR of the renewal prediction [-]).
+    """
+    return [
+        {"layout": layout.layout.name, **row, "vrr_predicted": predicted}
+        for layout in result.layouts
+        for row, predicted in zip(layout.vrr.rows(), layout.vrr_predicted.vrr)
+    ]
+
+
+def model_rows(result: BlendingResult) -> list[dict]:
+    """The discontinuous LTI model of every batch layout: the batch recirculated through the silo RTD
+    (``recirculation_model.csv``).
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run.
+
+    Returns
+    -------
+    list of dict
+        One row per layout and model sample: ``layout``, ``recirculations`` (Nr [-]) and ``concentration``
+        (modelled outlet blue fraction [-]).
+    """
+    return [
+        {"layout": layout.layout.name, "recirculations": nr, "concentration": value}
+        for layout in result.layouts
+        for nr, value in zip(layout.model_time_nr, layout.model_concentration)
+    ]
+
+
+def johanson_curve(result: BlendingResult) -> np.ndarray:
+    """Johanson's triangular RTD fitted to the particle RTD, on the particle RTD's bin centres [1/s].
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run; its ``rtd.silo`` gives the time axis and ``t_m``, its ``rtd.johanson_V1`` and
+        ``rtd.johanson_P`` the shape (:func:`analysis.numerics.rtd.johanson_rtd`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_bins,)
+        ``E(t)`` [1/s] at ``result.rtd.silo.time``.
+    """
+    silo = result.rtd.silo
+    return johanson_rtd(silo.time, silo.t_mean, result.rtd.johanson_V1, result.rtd.johanson_P)
+
+
+def rtd_rows(result: BlendingResult, eulerian_rtd: RTD, johanson) -> list[dict]:
+    """The three RTDs of the run in one long table (``rtd.csv``): particle ids, Eulerian, Johanson.
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run (its particle RTD, ``result.rtd.silo``).
+    eulerian_rtd : analysis.numerics.rtd.RTD
+        The Eulerian RTD of the run (:func:`analysis.studies.silo_recirculation.study.main_run_eulerian_rtd`).
+    johanson : array_like, shape (n_bins,)
+        Johanson's RTD on the particle RTD's bin centres [1/s] (:func:`johanson_curve`).
+
+    Returns
+    -------
+    list of dict
+        Rows ``method`` (``"particle_ids"``, ``"eulerian"``, ``"johanson"``, in that order), ``time_s`` (bin
+        centre [s]), ``E_per_s`` [1/s] and ``t_mean_s`` (the curve's mean residence time [s]; Johanson's is the
+        particle RTD's).
+    """
+    silo = result.rtd.silo
+    return [
+        {"method": method, "time_s": t, "E_per_s": e, "t_mean_s": tm}
+        for method, rtd_time, values, tm in (
+            ("particle_ids", silo.time, silo.E, silo.t_mean),
+            ("eulerian", eulerian_rtd.time, eulerian_rtd.E, eulerian_rtd.t_mean),
+            ("johanson", silo.time, johanson, silo.t_mean),
+        )
+        for t, e in zip(rtd_time, values)
+    ]
+
+
+def vrr_period_rows(result: BlendingResult) -> list[dict]:
+    """VRR of the continuous mode against the input period, sine rows then square rows (``vrr_period.csv``).
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run (its ``vrr_sine`` and ``vrr_square`` tables).
+
+    Returns
+    -------
+    list of dict
+        The rows of :meth:`analysis.numerics.lti.VRRTable.rows`: ``period_over_tm`` [-], ``period_s`` [s],
+        ``vrr`` [-], ``t_mean_s`` [s], ``waveform``.
+    """
+    return result.vrr_sine.rows() + result.vrr_square.rows()
+
+
+def clumps_per_window(result: BlendingResult) -> float:
+    """Mean outlet crossings per concentration window, throughput x window [-].
+
+    The ``n`` of :func:`analysis.studies.silo_recirculation.vrr.sampling_noise_vrr_limit`: the largest VRR that
+    windows of that many crossings can measure.
+
+    Parameters
+    ----------
+    result : BlendingResult
+        The study of the run (``timing.throughput`` [1/s], ``window`` [s]).
+
+    Returns
+    -------
+    float
+        Clumps per window [-].
+    """
+    return result.timing.throughput * result.window
+
+
+def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float) -> dict:
+    """The summary of one recirculation run (``blending.json``).
+
+    Parameters
+    ----------
+    case : mapping
+        The run's case record: ``run_id``, ``flow_pattern`` and ``estimated_residence_time_s`` [s].
+    result : BlendingResult
+        The study of the run.
+    eulerian_rtd : analysis.numerics.rtd.RTD
+        Its Eulerian RTD.
+    eulerian_bin_size : float
+        Bin edge of the Eulerian RTD's velocity field [m].
+
+    Returns
+    -------
+    dict
+        ``run_id``, ``flow_pattern``, the timing (``residence_time_s`` [s], ``estimated_residence_time_s`` [s],
+        ``holdup_clumps`` [-], ``throughput_clumps_per_s`` [1/s], ``recirculations`` [-], ``window_s`` [s],
+        ``clumps_per_window`` [-], ``vrr_sampling_limit`` [-]), the RTDs (``rtd_particle_ids``,
+        ``rtd_eulerian``: moments [s, s^2], first and last residence times [s], fraction exited [-]), Johanson's
+        ``V1`` and ``P`` [-], and per layout its VRRs, prediction error and homogenisation Nr [-].
+    """
+    timing = result.timing
+    silo_rtd = result.rtd.silo
+    particles_per_window = clumps_per_window(result)
+    return {
+        "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
+        "residence_time_s": timing.residence_time, "estimated_residence_time_s": case["estimated_residence_time_s"],
+        "holdup_clumps": timing.holdup, "throughput_clumps_per_s": timing.throughput,
+        "recirculations": timing.recirculations, "window_s": result.window,
+        "clumps_per_window": particles_per_window,
+        "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window),
+        "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
+                             "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
+                             "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited},
+        "rtd_eulerian": {"t_mean_s": eulerian_rtd.t_mean, "variance_s2": eulerian_rtd.variance,
+                         "t_s": eulerian_rtd.t_first, "t_d": eulerian_rtd.t_last,
+                         "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian_bin_size},
+        "johanson": {"V1": result.rtd.johanson_V1, "P": result.rtd.johanson_P},
+        "layouts": {
+            layout.layout.name: {
+                "blue_fraction": layout.layout.blue_fraction, "sublayers": layout.layout.sublayers,
+                "vrr_by_recirculation": layout.vrr.vrr, "vrr_predicted": layout.vrr_predicted.vrr,
+                "prediction_rms_error": layout.prediction_rms_error(),
+                "homogenised_after_recirculations": layout.homogenised_after,
+                "model_homogenised_after_recirculations": layout.model_homogenised_after,
+            }
+            for layout in result.layouts
+        },
+    }
+
+
+def verification_rows(result: VerificationResult) -> list[dict]:
+    """Residence times of the real tracer passes and of the virtual tracers of each bin size
+    (``residence_times.csv``).
+
+    Parameters
+    ----------
+    result : VerificationResult
+        Particle tracks against Eulerian pathlines
+        (:func:`analysis.studies.silo_recirculation.study.verify_eulerian_rtd`).
+
+    Returns
+    -------
+    list of dict
+        Rows ``method`` (``"particles"`` first, then ``"eulerian"`` per bin size in the result's order),
+        ``bin_size_m`` (bin edge [m]; empty for the particles) and ``residence_time_s`` [s] (NaN: not out).
+    """
+    rows = [{"method": "particles", "bin_size_m": "", "residence_time_s": t} for t in result.particle_residence]
+    for bin_size, times in result.eulerian_residence.items():
+        rows += [{"method": "eulerian", "bin_size_m": bin_size, "residence_time_s": t} for t in times]
+    return rows
+
+
+def verification_summary(case: Mapping, result: VerificationResult) -> dict:
+    """The summary of the Eulerian RTD verification (``verification.json``).
+
+    Parameters
+    ----------
+    case : mapping
+        The run's case record (its ``run_id``).
+    result : VerificationResult
+        Particle tracks against Eulerian pathlines.
+
+    Returns
+    -------
+    dict
+        ``run_id``, ``residence_time_s`` (holdup over throughput [s]), ``particles`` (the
+        :func:`~analysis.studies.silo_recirculation.study.residence_summary` of the real tracer [s]) and
+        ``eulerian`` (bin size as ``"<mm> mm"`` -> the same summary of its virtual tracers [s]).
+    """
+    return {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
+            "particles": residence_summary(result.particle_residence),
+            "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}

@@ -1,0 +1,239 @@
+"""Unit tests for analysis.studies.silo_recirculation.tables: the rows and summaries of a hand-built result.
+
+The result is built by hand from its dataclasses, with numbers chosen so every row follows in closed form:
+``t_open = 0``, ``t_res = 2 s``, windows of 1 s (centres 0.5, 1.5, 2.5 s, so Nr = 0.25, 0.75, 1.25), 4, 4 and
+0 crossings (the last window empty, NaN). Only the parts the tables read are filled; the events, tracer passes
+and kernels the tables never touch are None.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from analysis.io.tables import write_flow_table, write_json
+from analysis.numerics.lti import VRRTable
+from analysis.numerics.rtd import RTD
+from analysis.studies.silo_recirculation.concentration import OutletConcentration
+from analysis.studies.silo_recirculation.study import (
+    BlendingResult,
+    Layout,
+    LayoutResult,
+    LoopTiming,
+    ParticleRTD,
+    VerificationResult,
+)
+from analysis.studies.silo_recirculation.tables import (
+    blending_summary,
+    clumps_per_window,
+    concentration_rows,
+    johanson_curve,
+    model_rows,
+    rtd_rows,
+    verification_rows,
+    verification_summary,
+    vrr_period_rows,
+    vrr_rows,
+)
+from analysis.studies.silo_recirculation.vrr import RecirculationVRR
+
+NAN = math.nan
+EDGES = np.array([0.0, 1.0, 2.0, 3.0])
+CENTRES = np.array([0.5, 1.5, 2.5])
+TIMING = LoopTiming(t_open=0.0, t_end=3.0, residence_time=2.0, holdup=20.0, throughput=10.0, recirculations=1.5)
+# Particle RTD of 4 tracers, 3 out at 1.25, 2.0 and 2.75 s: bins [1, 2) and [2, 3] hold 1 and 2 of 4.
+SILO_RTD = RTD(time=np.array([1.5, 2.5]), edges=np.array([1.0, 2.0, 3.0]), E=np.array([0.25, 0.5]), t_mean=2.0,
+               variance=0.375, t_first=1.25, t_last=2.75, n_exited=3, n_total=4)
+# Eulerian RTD of 4 virtual tracers out at 0.5, 1.5, 2.5 and 3.5 s.
+EULERIAN_RTD = RTD(time=np.array([1.0, 3.0]), edges=np.array([0.0, 2.0, 4.0]), E=np.array([0.25, 0.25]), t_mean=2.0,
+                   variance=1.25, t_first=0.5, t_last=3.5, n_exited=4, n_total=4)
+
+
+def outlet(n_blue, n_total=(4, 4, 0)) -> OutletConcentration:
+    n_total, n_blue = np.array(n_total), np.array(n_blue)
+    concentration = np.array([b / n if n else NAN for b, n in zip(n_blue, n_total)])
+    return OutletConcentration(edges=EDGES, centres=CENTRES, n_total=n_total, n_blue=n_blue,
+                               concentration=concentration, window=1.0)
+
+
+def vrr(values, sigma_out, n_windows, blue_fraction) -> RecirculationVRR:
+    return RecirculationVRR(recirculation_number=np.array([0.5, 1.5]), vrr=np.array(values),
+                            sigma_out=np.array(sigma_out), n_windows=np.array(n_windows),
+                            sigma_in=math.sqrt(blue_fraction * (1 - blue_fraction)), blue_fraction=blue_fraction)
+
+
+# Layout 1: measured 0.25, 0.75 in recirculation 1 (variance 1/16, VRR 0.25 / (1/16) = 4); predicted 0.5, 0.75
+# (variance 1/64, VRR 16); one window in recirculation 2, so NaN there.
+HALF = LayoutResult(
+    layout=Layout("bottom half", 0.5), colours=None, concentration=outlet([1, 3, 0]), first_pass=outlet([1, 2, 0]),
+    predicted=np.array([0.5, 0.75, 0.5]), predicted_johanson=np.array([0.375, 0.625, 0.5]),
+    vrr=vrr([4.0, NAN], [0.25, NAN], [2, 0], 0.5), vrr_predicted=vrr([16.0, NAN], [0.125, NAN], [2, 1], 0.5),
+    homogenised_after=NAN, model_time_nr=np.array([0.0, 0.5, 1.0]), model_concentration=np.array([1.0, 0.0, 0.5]),
+    model_homogenised_after=1.0, recirculation_number=np.array([0.25, 0.75, 1.25]),
+)
+# Layout 2: measured 0, 0.5 (VRR 0.1875 / 0.0625 = 3); the prediction is constant (VRR inf).
+TOP = LayoutResult(
+    layout=Layout("top 25 %", 0.25, sublayers=2, blue_at="top"), colours=None, concentration=outlet([0, 2, 0]),
+    first_pass=outlet([0, 1, 0]), predicted=np.array([0.25, 0.25, 0.25]),
+    predicted_johanson=np.array([0.0, 0.5, 0.25]), vrr=vrr([3.0, NAN], [0.25, NAN], [2, 0], 0.25),
+    vrr_predicted=vrr([math.inf, NAN], [0.0, NAN], [2, 1], 0.25), homogenised_after=2.0,
+    model_time_nr=np.array([0.0, 0.5]), model_concentration=np.array([0.0, 1.0]), model_homogenised_after=NAN,
+    recirculation_number=np.array([0.25, 0.75, 1.25]),
+)
+PARTICLE_RTD = ParticleRTD(tracer=None, silo=SILO_RTD, loop=None, loop_E_on_windows=None, start_time=0.8, n_tracer=4,
+                           johanson_V1=0.5, johanson_P=0.75, steady=None, silo_E_on_windows=None,
+                           johanson_loop_E_on_windows=None)
+RESULT = BlendingResult(
+    timing=TIMING, events=None, window=1.0, rtd=PARTICLE_RTD, layouts=[HALF, TOP],
+    vrr_sine=VRRTable(period_over_tm=np.array([0.5, 1.0]), period=np.array([1.0, 2.0]), vrr=np.array([10.0, 2.0]),
+                      t_mean=2.0, waveform="sine", n_periods=4),
+    vrr_square=VRRTable(period_over_tm=np.array([0.5]), period=np.array([1.0]), vrr=np.array([8.0]), t_mean=2.0,
+                        waveform="square", n_periods=4),
+)
+CASE = {"run_id": "recirculation_ab12", "flow_pattern": "mass flow", "estimated_residence_time_s": 2.5,
+        "width_m": 0.2}
+
+
+def assert_rows(rows, columns, expected):
+    """Same columns in the same order in every row, and the same values (NaN equal to NaN)."""
+    assert [list(row) for row in rows] == [columns] * len(expected)
+    np.testing.assert_equal(rows, expected)
+
+
+def test_concentration_rows_list_every_window_of_every_layout_in_order():
+    columns = ["layout", "time_s", "recirculations", "crossings", "concentration", "first_exit_concentration",
+               "predicted", "predicted_johanson"]
+    assert_rows(concentration_rows(RESULT), columns, [dict(zip(columns, row)) for row in [
+        ["bottom half", 0.5, 0.25, 4, 0.25, 0.25, 0.5, 0.375],
+        ["bottom half", 1.5, 0.75, 4, 0.75, 0.5, 0.75, 0.625],
+        ["bottom half", 2.5, 1.25, 0, NAN, NAN, 0.5, 0.5],
+        ["top 25 %", 0.5, 0.25, 4, 0.0, 0.0, 0.25, 0.0],
+        ["top 25 %", 1.5, 0.75, 4, 0.5, 0.25, 0.25, 0.5],
+        ["top 25 %", 2.5, 1.25, 0, NAN, NAN, 0.25, 0.25],
+    ]])
+    assert all(type(row["crossings"]) is int for row in concentration_rows(RESULT))
+
+
+def test_vrr_rows_put_the_layout_first_and_the_predicted_vrr_last():
+    columns = ["layout", "recirculation_number", "vrr", "sigma_out", "n_windows", "sigma_in", "blue_fraction",
+               "vrr_predicted"]
+    sigma_top = math.sqrt(0.1875)
+    assert_rows(vrr_rows(RESULT), columns, [dict(zip(columns, row)) for row in [
+        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0],
+        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN],
+        ["top 25 %", 0.5, 3.0, 0.25, 2, sigma_top, 0.25, math.inf],
+        ["top 25 %", 1.5, NAN, NAN, 0, sigma_top, 0.25, NAN],
+    ]])
+
+
+def test_model_rows_follow_each_layouts_own_model_axis():
+    columns = ["layout", "recirculations", "concentration"]
+    assert_rows(model_rows(RESULT), columns, [dict(zip(columns, row)) for row in [
+        ["bottom half", 0.0, 1.0], ["bottom half", 0.5, 0.0], ["bottom half", 1.0, 0.5],
+        ["top 25 %", 0.0, 0.0], ["top 25 %", 0.5, 1.0],
+    ]])
+
+
+def test_johanson_curve_is_the_triangle_on_the_particle_rtd_bins():
+    # tau = 2 s, V1 = 0.5, P = 0.75: the triangle ends at theta = 3 - 0.5 - 0.75 = 1.75, base 1.25. At t = 1.5 and
+    # 2.5 s (theta 0.75 and 1.25, both on the falling side) E(theta) = 2 (1.75 - theta) / (1.25 * 1) = 1.6 and 0.8,
+    # so E(t) = E(theta) / tau = 0.8 and 0.4 1/s.
+    np.testing.assert_allclose(johanson_curve(RESULT), [0.8, 0.4], rtol=1e-15, atol=0)
+
+
+def test_rtd_rows_stack_particle_ids_eulerian_and_johanson():
+    columns = ["method", "time_s", "E_per_s", "t_mean_s"]
+    assert_rows(rtd_rows(RESULT, EULERIAN_RTD, np.array([0.8, 0.4])), columns, [dict(zip(columns, row)) for row in [
+        ["particle_ids", 1.5, 0.25, 2.0], ["particle_ids", 2.5, 0.5, 2.0],
+        ["eulerian", 1.0, 0.25, 2.0], ["eulerian", 3.0, 0.25, 2.0],
+        ["johanson", 1.5, 0.8, 2.0], ["johanson", 2.5, 0.4, 2.0],
+    ]])
+
+
+def test_vrr_period_rows_are_the_sine_rows_then_the_square_rows():
+    columns = ["period_over_tm", "period_s", "vrr", "t_mean_s", "waveform"]
+    assert_rows(vrr_period_rows(RESULT), columns, [dict(zip(columns, row)) for row in [
+        [0.5, 1.0, 10.0, 2.0, "sine"], [1.0, 2.0, 2.0, 2.0, "sine"], [0.5, 1.0, 8.0, 2.0, "square"],
+    ]])
+
+
+def test_clumps_per_window_is_throughput_times_window():
+    assert clumps_per_window(RESULT) == 10.0  # 10 clumps/s x 1 s
+
+
+def test_blending_summary_holds_timing_rtds_and_every_layout():
+    summary = blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)
+    half, top = summary.pop("layouts").values()
+    np.testing.assert_equal(summary, {
+        "run_id": "recirculation_ab12", "flow_pattern": "mass flow", "residence_time_s": 2.0,
+        "estimated_residence_time_s": 2.5, "holdup_clumps": 20.0, "throughput_clumps_per_s": 10.0,
+        "recirculations": 1.5, "window_s": 1.0, "clumps_per_window": 10.0, "vrr_sampling_limit": 10.0,
+        "rtd_particle_ids": {"t_mean_s": 2.0, "variance_s2": 0.375, "t_s": 1.25, "t_d": 2.75,
+                             "t_s_over_t_d": 1.25 / 2.75, "n_tracer": 4, "fraction_exited": 0.75},
+        "rtd_eulerian": {"t_mean_s": 2.0, "variance_s2": 1.25, "t_s": 0.5, "t_d": 3.5, "fraction_exited": 1.0,
+                         "bin_size_m": 0.005},
+        "johanson": {"V1": 0.5, "P": 0.75},
+    })
+    assert list(blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)["layouts"]) == ["bottom half", "top 25 %"]
+    # RMS of (0.5 - 0.25, 0.75 - 0.75) over the two windows with data: sqrt(0.0625 / 2)
+    np.testing.assert_equal(half, {
+        "blue_fraction": 0.5, "sublayers": 1, "vrr_by_recirculation": [4.0, NAN], "vrr_predicted": [16.0, NAN],
+        "prediction_rms_error": math.sqrt(0.03125), "homogenised_after_recirculations": NAN,
+        "model_homogenised_after_recirculations": 1.0,
+    })
+    # RMS of (0.25 - 0, 0.25 - 0.5): sqrt(0.0625)
+    np.testing.assert_equal(top, {
+        "blue_fraction": 0.25, "sublayers": 2, "vrr_by_recirculation": [3.0, NAN], "vrr_predicted": [math.inf, NAN],
+        "prediction_rms_error": 0.25, "homogenised_after_recirculations": 2.0,
+        "model_homogenised_after_recirculations": NAN,
+    })
+
+
+def test_blending_summary_and_tables_write_as_json_and_csv(tmp_path):
+    loaded = json.loads(write_json(tmp_path / "blending.json",
+                                   blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)).read_text())
+    # arrays become lists, NaN and inf become null
+    assert loaded["layouts"]["bottom half"]["vrr_by_recirculation"] == [4.0, None]
+    assert loaded["layouts"]["top 25 %"]["vrr_predicted"] == [None, None]
+    assert loaded["layouts"]["top 25 %"]["model_homogenised_after_recirculations"] is None
+    text = write_flow_table(tmp_path / "concentration.csv", concentration_rows(RESULT)).read_text()
+    assert text.splitlines()[:2] == [
+        "layout,time_s,recirculations,crossings,concentration,first_exit_concentration,predicted,predicted_johanson",
+        "bottom half,0.5,0.25,4,0.25,0.25,0.5,0.375",
+    ]
+    assert text.splitlines()[3] == "bottom half,2.5,1.25,0,,,0.5,0.5"
+
+
+VERIFICATION = VerificationResult(
+    particle_residence=np.array([1.0, 3.0, NAN]),
+    eulerian_residence={0.005: np.array([2.0, 4.0]), 0.01: np.array([NAN])},
+    particle_paths=[], pathlines={}, timing=TIMING,
+)
+
+
+def test_verification_rows_list_the_particles_then_each_bin_size():
+    columns = ["method", "bin_size_m", "residence_time_s"]
+    assert_rows(verification_rows(VERIFICATION), columns, [dict(zip(columns, row)) for row in [
+        ["particles", "", 1.0], ["particles", "", 3.0], ["particles", "", NAN],
+        ["eulerian", 0.005, 2.0], ["eulerian", 0.005, 4.0], ["eulerian", 0.01, NAN],
+    ]])
+
+
+def test_verification_summary_names_bin_sizes_in_millimetres():
+    summary = verification_summary(CASE, VERIFICATION)
+    assert summary == {
+        "run_id": "recirculation_ab12", "residence_time_s": 2.0,
+        "particles": {"n": 3, "n_exited": 2, "mean_s": 2.0, "std_s": 1.0},
+        "eulerian": {"5 mm": {"n": 2, "n_exited": 2, "mean_s": 3.0, "std_s": 1.0},
+                     "10 mm": {"n": 1, "n_exited": 0, "mean_s": None, "std_s": None}},
+    }
+    assert list(summary["eulerian"]) == ["5 mm", "10 mm"]
+
+
+@pytest.mark.parametrize("function", [concentration_rows, vrr_rows, model_rows])
+def test_a_result_without_layouts_gives_no_rows(function):
+    empty = BlendingResult(timing=TIMING, events=None, window=1.0, rtd=PARTICLE_RTD)
+    assert function(empty) == []
