@@ -216,3 +216,16 @@ def write_discharge_history_csv(path: str | os.PathLike, history) -> Path:
     lines = ["time_s,discharged_mass_kg"]
     lines += [f"{t!r},{m!r}" for t, m in zip(time.tolist(), mass.tolist())]
     return _write_text_atomic(path, "\n".join(lines) + "\n")
+
+
+def _cell_value(text: str):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return text if text != "" else None
+
+
+def read_table(path: str | os.PathLike) -> list[dict]:
+    """Rows of a CSV table written by :func:`write_flow_table`: numbers as float, empty cells as None, text as is."""
+    with open(path, newline="", encoding="utf-8") as handle:
+        return [{key: _cell_value(value) for key, value in row.items()} for row in csv.DictReader(handle)]

@@ -9,7 +9,7 @@ import html
 import math
 from collections.abc import Mapping, Sequence
 
-__all__ = ["summary_html", "format_cell", "calibration_rows"]
+__all__ = ["summary_html", "format_cell", "calibration_rows", "silo_flow_rows", "recirculation_rows", "summary_sections"]
 
 
 def format_cell(value) -> str:
@@ -69,3 +69,48 @@ def calibration_rows(parameters: Mapping) -> list[dict]:
     for wall in parameters.get("not_tested") or []:
         rows.append({"contact": f"particle-{wall}", "sliding_friction": None, "note": "not tested; config value kept"})
     return rows
+
+
+#: The columns of a silo run's flow summary (metrics/flow.json) on the summary page.
+SILO_FLOW_COLUMNS = ("run_id", "n_clumps", "filling_bulk_density_kg_m3", "mass_flow_rate_kg_s",
+                     "beverloo_mass_flow_rate_kg_s", "beverloo_ratio")
+#: The columns of the recirculating-silo summary table on the summary page.
+RECIRCULATION_COLUMNS = ("flow_pattern", "layout", "residence_time_s", "t_s_over_t_d", "vrr_nr1", "vrr_nr2", "vrr_nr3",
+                         "vrr_nr4", "prediction_rms_error")
+
+
+def silo_flow_rows(flows: Sequence[Mapping]) -> list[dict]:
+    """One row per flat-bottom silo run: its flow summary's :data:`SILO_FLOW_COLUMNS`."""
+    return [{key: flow[key] for key in SILO_FLOW_COLUMNS} for flow in flows]
+
+
+def recirculation_rows(rows: Sequence[Mapping]) -> list[dict]:
+    """The recirculating-silo summary rows cut to :data:`RECIRCULATION_COLUMNS` (missing ones as None)."""
+    return [{key: row.get(key) for key in RECIRCULATION_COLUMNS} for row in rows]
+
+
+def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
+                     recirculation: Sequence[Mapping], blender: Sequence[Mapping]) -> list[tuple[str, str, list]]:
+    """The sections of the summary page (:func:`summary_html`) from the results of every stage.
+
+    Parameters
+    ----------
+    parameters : mapping
+        The calibration's chosen parameters (``results/calibration/parameters.yaml`` as read).
+    flows : sequence of mapping
+        The flow summary of each flat-bottom silo run (``metrics/flow.json``).
+    measured, recirculation, blender : sequence of mapping
+        Rows of the measured-profile comparisons, of the recirculating-silo summary and of the blender comparison.
+    """
+    return [
+        ("Calibration", f"Contact parameters chosen from the Jenike shear sweep (particle model {parameters.get('shape')}, "
+                        f"rolling friction {parameters.get('rolling_friction')}), with the band that reproduces the "
+                        f"target angles {parameters.get('targets_deg')} deg within {parameters.get('tolerance_deg')} deg.",
+         calibration_rows(parameters)),
+        ("Silo validation", "Steady discharge rate of each flat-bottom silo run against Beverloo's prediction.",
+         silo_flow_rows(flows)),
+        ("Silo against measurements", "Velocity profile errors against the measured profiles.", list(measured)),
+        ("Blending", "Mean residence time, RTD spread and VRR after each recirculation per flow pattern and batch "
+                     "layout, and the RMS error of the LTI prediction.", recirculation_rows(recirculation)),
+        ("Blender", "Insert configurations compared (see the blender comparison table).", list(blender)),
+    ]

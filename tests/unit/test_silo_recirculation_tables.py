@@ -33,6 +33,7 @@ from analysis.studies.silo_recirculation.tables import (
     johanson_curve,
     model_rows,
     rtd_rows,
+    summary_rows,
     verification_rows,
     verification_summary,
     vrr_period_rows,
@@ -237,3 +238,16 @@ def test_verification_summary_names_bin_sizes_in_millimetres():
 def test_a_result_without_layouts_gives_no_rows(function):
     empty = BlendingResult(timing=TIMING, events=None, window=1.0, rtd=PARTICLE_RTD)
     assert function(empty) == []
+
+
+def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
+    summary = {"flow_pattern": "semi", "run_id": "r1", "residence_time_s": 2.0,
+               "rtd_particle_ids": {"t_s_over_t_d": 0.25, "t_mean_s": 1.5}, "rtd_eulerian": {"t_mean_s": 1.6},
+               "layouts": {"blue13": {"vrr_by_recirculation": [2.0, None], "prediction_rms_error": 0.1,
+                                      "homogenised_after_recirculations": 3, "model_homogenised_after_recirculations": 4}}}
+    rows, curves = summary_rows([summary])
+    assert len(rows) == 1 and rows[0]["vrr_nr1"] == 2.0 and math.isnan(rows[0]["vrr_nr2"])
+    assert list(rows[0]) == ["flow_pattern", "layout", "run_id", "residence_time_s", "t_s_over_t_d", "rtd_mean_ids_s",
+                             "rtd_mean_eulerian_s", "vrr_nr1", "vrr_nr2", "prediction_rms_error",
+                             "homogenised_after_recirculations", "model_homogenised_after_recirculations"]
+    assert curves[0][0] == "semi blue13" and curves[0][1] == [0.5, 1.5]

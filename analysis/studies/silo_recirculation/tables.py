@@ -9,7 +9,7 @@ are dimensionless.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -286,3 +286,37 @@ def verification_summary(case: Mapping, result: VerificationResult) -> dict:
     return {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
             "particles": residence_summary(result.particle_residence),
             "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}
+
+
+def summary_rows(summaries: Sequence[Mapping]) -> tuple[list[dict], list[tuple]]:
+    """The rows of the summary table of every flow pattern and batch layout, and their VRR curves.
+
+    Parameters
+    ----------
+    summaries : sequence of mapping
+        The ``metrics/blending.json`` of each recirculation run, as read (:func:`blending_summary`).
+
+    Returns
+    -------
+    rows : list of dict
+        One row per run and layout: residence time (s), t_s/t_d, RTD means (s), ``vrr_nr<k>`` per recirculation
+        (NaN where the JSON has null), the LTI prediction's RMS error and the recirculations to homogenise.
+    curves : list of tuple
+        ``(label, recirculation at mid-window, VRR)`` per row, for the VRR plot.
+    """
+    rows, curves = [], []
+    for summary in summaries:
+        for name, layout in summary["layouts"].items():
+            vrr = [v if v is not None else float("nan") for v in layout["vrr_by_recirculation"]]
+            curves.append((f"{summary['flow_pattern']} {name}", [k + 0.5 for k in range(len(vrr))], vrr))
+            rows.append({
+                "flow_pattern": summary["flow_pattern"], "layout": name, "run_id": summary["run_id"],
+                "residence_time_s": summary["residence_time_s"], "t_s_over_t_d": summary["rtd_particle_ids"]["t_s_over_t_d"],
+                "rtd_mean_ids_s": summary["rtd_particle_ids"]["t_mean_s"],
+                "rtd_mean_eulerian_s": summary["rtd_eulerian"]["t_mean_s"],
+                **{f"vrr_nr{k + 1}": v for k, v in enumerate(vrr)},
+                "prediction_rms_error": layout["prediction_rms_error"],
+                "homogenised_after_recirculations": layout["homogenised_after_recirculations"],
+                "model_homogenised_after_recirculations": layout["model_homogenised_after_recirculations"],
+            })
+    return rows, curves
