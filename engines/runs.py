@@ -12,9 +12,9 @@ from pathlib import Path
 
 from analysis.data.record import RunRecord
 from engines.cases import case_for_run
+from engines.cases.common import engine_kind
 from engines.estimates import estimate_case
 from engines.interface import EngineOptions, engine_for
-from engines.cases.common import engine_kind
 from engines.planning import cost_model, preflight
 
 __all__ = ["render_run", "run_case"]
