@@ -7,7 +7,7 @@ rule blender_deck:
         case=deck_rule_output("blender"),
     params:
         case="blender",
-        defining=lambda wildcards: cases_of(config, "blender")[wildcards.run].defining_parameters,
+        defining=lambda wildcards: cases("blender")[wildcards.run].defining_parameters,
     log:
         run_path("blender", "logs/deck.log"),
     script:

@@ -2,7 +2,7 @@
 
 from calibration.sweep import diagnostic_points
 
-JENIKE_CASES = cases_of(config, "jenike")
+JENIKE_CASES = cases("jenike")
 CALIBRATION = f"{RESULTS}/calibration"
 
 

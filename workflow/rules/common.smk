@@ -24,20 +24,31 @@ except ConfigError as error:
 
 
 def check_cases(configuration):
-    """Build every case and let its engine accept it: geometry, sizing and engine limits fail here, first."""
+    """Build every case and let its engine accept it: geometry, sizing and engine limits fail here, first.
+    Returns ``{case kind: {run id: case}}``, so that the rules need not build the cases again."""
+    built = {}
     for kind in CASE_BUILDERS:
         try:
-            cases = cases_of(configuration, kind)
+            built[kind] = cases_of(configuration, kind)
             engine = engine_for(configuration, kind)
-            for case in cases.values():
+            for case in built[kind].values():
                 engine.check_case(case)
         except CaseNotSupported as error:
             raise WorkflowError(f"The {kind} runs cannot run on their engine: {error}") from None
         except (ValueError, KeyError) as error:
             raise WorkflowError(f"Invalid {kind} configuration: {error}") from None
+    return built
 
 
-check_cases(config)
+#: Every case the validated configuration defines (the flat-bottom silo's as configured, before calibration).
+CASES = check_cases(config)
+
+
+def cases(kind):
+    """The runs of case ``kind``: the flat-bottom silo's with calibrated parameters applied when asked for."""
+    if kind == "silo_flat" and uses_calibrated_parameters():
+        return cases_of(silo_config(), kind)
+    return CASES[kind]
 
 
 def check_disk_for_pending_runs():
@@ -71,7 +82,7 @@ def silo_config():
 
 def run_ids(kind):
     """Run ids of case ``kind`` (the flat-bottom silo's with calibrated parameters applied when asked for)."""
-    return list(cases_of(silo_config() if kind == "silo_flat" else config, kind))
+    return list(cases(kind))
 
 
 def silo_dir(run_id):
@@ -111,7 +122,7 @@ def parametric_targets(wildcards=None):
 
 def recirculation_runs(role="blending"):
     """Run ids of the recirculating-silo runs with the given role (the blending study or the thin verification silo)."""
-    return [run for run, case in cases_of(config, RECIRCULATION).items() if case.role == role]
+    return [run for run, case in cases(RECIRCULATION).items() if case.role == role]
 
 
 def recirculation_targets(wildcards=None):

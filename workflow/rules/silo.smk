@@ -11,7 +11,7 @@ rule silo_deck:
         case=deck_rule_output("silo_flat"),
     params:
         case="silo_flat",
-        defining=lambda wildcards: cases_of(silo_config(), "silo_flat")[wildcards.run].defining_parameters,
+        defining=lambda wildcards: cases("silo_flat")[wildcards.run].defining_parameters,
     log:
         run_path("silo_flat", "logs/deck.log"),
     script:

@@ -7,7 +7,7 @@ rule silo_recirculation_deck:
         case=deck_rule_output(RECIRCULATION),
     params:
         case=RECIRCULATION,
-        defining=lambda wildcards: cases_of(config, RECIRCULATION)[wildcards.run].defining_parameters,
+        defining=lambda wildcards: cases(RECIRCULATION)[wildcards.run].defining_parameters,
     log:
         run_path(RECIRCULATION, "logs/deck.log"),
     script:
