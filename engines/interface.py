@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
+from engines.cases import CASE_BUILDERS
 from engines.cases.common import engine_kind
 
 if TYPE_CHECKING:  # the neutral types appear in signatures only
@@ -45,9 +46,6 @@ __all__ = [
 
 #: Engines siloflow can drive, by registry name (the package ``engines.<name>`` implements each).
 ENGINE_KINDS = ("liggghts",)
-
-#: Config sections of the cases, each of which may name its own engine (``<section>.engine``).
-CASE_SECTIONS = ("jenike", "silo_flat", "silo_recirculation", "blender")
 
 
 class EngineError(RuntimeError):
@@ -170,6 +168,6 @@ def engine_named(name: str) -> Engine:
 
 def engine_for(config: Mapping, section: str) -> Engine:
     """The engine that runs the cases of config section ``section``."""
-    if section not in CASE_SECTIONS:
-        raise KeyError(f"unknown case section {section!r}; the cases are {', '.join(CASE_SECTIONS)}")
+    if section not in CASE_BUILDERS:
+        raise KeyError(f"unknown case section {section!r}; the cases are {', '.join(CASE_BUILDERS)}")
     return engine_named(engine_kind(config, section))

@@ -475,8 +475,9 @@ def dump_step(path: str | os.PathLike) -> int:
     return int(digits)
 
 
-def list_dumps(dump_dir: str | os.PathLike, prefix: str) -> list[Path]:
-    """Dump files ``<prefix>_<digits>.vtk`` in a folder, sorted by step.
+def list_dumps(dump_dir: str | os.PathLike, prefix: str, suffix: str = ".vtk") -> list[Path]:
+    """Dump files ``<prefix>_<digits><suffix>`` in a folder, sorted by step (particle dumps ``.vtk``, contact
+    dumps ``.txt``).
 
     Files such as ``<prefix>_boundingBox_<step>.vtk`` are ignored.
 
@@ -486,13 +487,15 @@ def list_dumps(dump_dir: str | os.PathLike, prefix: str) -> list[Path]:
         Folder holding the dumps.
     prefix : str
         File name prefix (``silo`` for ``silo_*.vtk``).
+    suffix : str
+        File name ending, with its dot.
 
     Returns
     -------
     list of pathlib.Path
         Ascending by step number (numerically: 2000 before 10000).
     """
-    pattern = re.compile(re.escape(prefix) + r"_([0-9]+)\.vtk")
+    pattern = re.compile(re.escape(prefix) + r"_([0-9]+)" + re.escape(suffix))
     matches = [
         (int(match.group(1)), entry)
         for entry in Path(dump_dir).iterdir()

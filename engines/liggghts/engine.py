@@ -26,7 +26,7 @@ from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
-from engines.liggghts.dumps import read_frames
+from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
 from engines.liggghts.jenike import (
@@ -147,20 +147,10 @@ class LiggghtsEngine(Engine):
         if record.case != "jenike":
             if kind == "wall":
                 raise ValueError(f"{record.case} runs save no particle-wall contacts")
-            return [read_contacts(path) for path in _numbered(dumps, CONTACT_PREFIX)]
+            return [read_contacts(path) for path in list_dumps(dumps, CONTACT_PREFIX, ".txt")]
         if kind == "pair":
-            return [_pair_frame(read_contact_dump(path)) for path in _numbered(dumps, PAIR_CONTACT_PREFIX)]
-        return [_wall_frame(read_contact_dump(path)) for path in _numbered(dumps, WALL_CONTACT_PREFIX)]
-
-
-def _numbered(folder: Path, prefix: str) -> list[Path]:
-    """The contact dumps ``<prefix>_<step>.txt`` of a folder, by step."""
-    found = []
-    for path in folder.glob(f"{prefix}_*.txt"):
-        step = path.stem[len(prefix) + 1:]
-        if step.isdigit():
-            found.append((int(step), path))
-    return [path for _, path in sorted(found)]
+            return [_pair_frame(read_contact_dump(path)) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
+        return [_wall_frame(read_contact_dump(path)) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
 
 
 def _columns(table: dict, *names: str) -> np.ndarray:

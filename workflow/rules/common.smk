@@ -85,10 +85,6 @@ def run_ids(kind):
     return list(cases(kind))
 
 
-def silo_dir(run_id):
-    return run_dir("silo_flat", run_id)
-
-
 def silo_flat_targets(wildcards=None):
     return [
         run_path("silo_flat", name, run)

@@ -111,8 +111,8 @@ def _study_runs(wildcards):
 
 rule silo_parametric:
     input:
-        flows=lambda wildcards: [f"{silo_dir(run)}/metrics/flow.json" for _, run in _study_runs(wildcards)],
-        fields=lambda wildcards: [f"{silo_dir(run)}/fields/averaged.npz" for _, run in _study_runs(wildcards)],
+        flows=lambda wildcards: [run_path("silo_flat", "metrics/flow.json", run) for _, run in _study_runs(wildcards)],
+        fields=lambda wildcards: [run_path("silo_flat", "fields/averaged.npz", run) for _, run in _study_runs(wildcards)],
     output:
         table=f"{case_root('silo_flat')}/parametric/{{study}}.csv",
         plot=report(f"{case_root('silo_flat')}/parametric/{{study}}.png", caption="../report/silo_parametric.rst", category="2 Silo validation", subcategory="Parametric studies", labels={"figure": "{study}"}),
