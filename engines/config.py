@@ -212,7 +212,6 @@ def _check_finite(node: Any, path: tuple) -> None:
 
 def _check_references(config: dict) -> None:
     materials = config["materials"]
-    models = config["particle_models"]
 
     def require(name: str, defined: Mapping, key: str, kind: str) -> None:
         if name not in defined:

@@ -11,10 +11,8 @@ import json
 import math
 from dataclasses import dataclass
 
-from analysis.data.constants import GRAVITY
 from engines.cases.particles import ParticleTemplate
 from engines.cases.physics import steps_for
-
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,6 @@ Run directory layout (relative paths are what the deck sees, the engine runs ins
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 import re
@@ -23,8 +22,6 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
 
 from analysis.data.record import RunRecord
 from engines.estimates import format_bytes
