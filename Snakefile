@@ -17,6 +17,7 @@ include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
 include: "workflow/rules/silo_recirculation.smk"
 include: "workflow/rules/blender.smk"
+include: "workflow/rules/fill_balance.smk"
 include: "workflow/rules/report.smk"
 
 

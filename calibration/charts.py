@@ -2,20 +2,22 @@
 
 Every writer draws a figure and saves it atomically (via
 :func:`analysis.io.plots.save_png`): a reader never sees a half-written PNG
-and a failed write leaves no temporary file behind.
+and a failed write leaves no temporary file behind. It returns that figure,
+already closed (let go by pyplot, so a caller that ignores it leaks nothing):
+its artists still hold the plotted data, which is what the tests check.
 """
 
 from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")  # headless: runs on clusters and in CI
 
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 import numpy as np  # noqa: E402
 
 from analysis.io.plots import save_png  # noqa: E402
@@ -47,7 +49,7 @@ def plot_calibration_chart(
     title: str,
     target_angle_deg: float | None = None,
     tolerance_deg: float | None = None,
-) -> Path:
+) -> Figure:
     """Plot a calibration chart: bulk friction against particle sliding friction.
 
     One line with markers per curve (normally one per rolling friction, legend
@@ -74,8 +76,8 @@ def plot_calibration_chart(
 
     Returns
     -------
-    pathlib.Path
-        The written path.
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
     """
     curves = list(curves)
     if not curves:
@@ -137,12 +139,13 @@ def plot_calibration_chart(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="best", fontsize="small")
         figure.tight_layout()
-        return save_png(figure, path)
+        save_png(figure, path)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str) -> Path:
+def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str) -> Figure:
     """Plot an angular histogram as a polar bar chart (a rose diagram).
 
     Parameters
@@ -160,8 +163,8 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
 
     Returns
     -------
-    pathlib.Path
-        The written path.
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
     """
     edges = np.asarray(edges_rad, dtype=float)
     counts = np.asarray(counts, dtype=float)
@@ -187,12 +190,13 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
         )
         axes.set_title(title)
         figure.tight_layout()
-        return save_png(figure, path)
+        save_png(figure, path)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -> Path:
+def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -> Figure:
     """Shear force histories of one shear test with the averaging window and the bulk friction.
 
     Parameters
@@ -225,12 +229,13 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
                   transform=axes.transAxes, va="top", fontsize=9)
         axes.legend(loc="lower right", fontsize=8)
         axes.grid(alpha=0.3)
-        return save_png(figure, path)
+        save_png(figure, path)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -> Path:
+def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -> Figure:
     """Bulk friction against particle friction with the rigid and the servo lid (rows of
     :func:`calibration.sweep.lid_comparison`)."""
     figure, axes = plt.subplots(figsize=(6.4, 4.4))
@@ -249,6 +254,7 @@ def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return save_png(figure, path)
+        save_png(figure, path)
     finally:
         plt.close(figure)
+    return figure

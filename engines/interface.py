@@ -30,6 +30,7 @@ if TYPE_CHECKING:  # the neutral types appear in signatures only
     from analysis.data.forces import WallForceHistory
     from analysis.data.frames import ParticleFrame
     from analysis.data.record import RunRecord
+    from analysis.data.settled import SettledFill
 
 __all__ = [
     "ENGINE_KINDS",
@@ -136,6 +137,17 @@ class Engine(ABC):
     @abstractmethod
     def contacts(self, run_dir: str | Path, record: RunRecord, kind: str = "pair") -> list[ContactFrame]:
         """Contact forces at the saved instants, oldest first: ``pair`` (particle-particle) or ``wall``."""
+
+    @abstractmethod
+    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
+        """The fill at rest after its settle stage: spheres with the walls' force on each, the pair contacts of the
+        same step, and each wall's force (for the force balance of :mod:`analysis.numerics.force_balance`).
+
+        Raises
+        ------
+        CaseNotSupported
+            When the engine saves no settled fill for this case.
+        """
 
 
 _REGISTERED: dict[str, type[Engine]] = {}

@@ -14,6 +14,12 @@ from engines.interface import engine_named
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
+# The tiny fills of the tests that check other stages pour fast (a gentle pour would take several times longer):
+# no limit on the stream's momentum flux, and a force balance that only refuses a fill far from rest. The fill's
+# physics (gentle pour, force balance) is checked by tests/integration/test_fill_balance_liggghts.py.
+FAST_POUR = {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocity": 2.0, "momentum_flux_ratio": 100.0,
+             "balance_tolerance": {"support": 0.2, "plane": 1.0}}
+
 # A silo small enough for a real LIGGGHTS run in well under a minute (~1,400 two-sphere clumps), with an
 # outlet of about 7 clump diameters so that it flows without arching.
 TINY_SILO = {
@@ -21,7 +27,7 @@ TINY_SILO = {
     "depth": 0.012,
     "fill_height": 0.04,
     "outlet_width": 0.024,
-    "fill": {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocity": 2.0},
+    "fill": FAST_POUR,
     "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
     "discharge_time": 0.6,
     # the fill is only 40 mm high: profiles low enough to stay inside it during the steady discharge

@@ -1,58 +1,465 @@
-"""The summary page of the report: the figures of merit of every stage as HTML tables.
+"""The summary page of the report: the figures of merit of every stage as HTML tables for people.
 
 Pure: the caller reads the stage results and passes plain rows; :func:`summary_html` returns the page.
+
+Conventions of the page
+-----------------------
+- Every column key has a header in words with its unit: :data:`COLUMNS`, or for the keys numbered by
+  recirculation or sine period :data:`COLUMN_FAMILIES`. A row with any other key is refused when the page is
+  built (the error names the key), so no raw key reaches the page.
+- A row may carry ``"<key>_error"`` (the standard error of ``"<key>"``, same unit) beside ``"<key>"``: the two
+  print as one cell "value ± error" (:func:`format_value_with_error`). A figure of merit (kind
+  :data:`ESTIMATE`) without its error prints as "value ±?" (:data:`NO_UNCERTAINTY`), so a missing uncertainty
+  is visible rather than silently absent.
+- Mappings and lists never reach a cell as a Python repr: the row builders below turn them into text, and any
+  other non-scalar cell value is refused.
+- Flags print as "yes" / "no".
+- A table with more columns than rows is transposed (one row per quantity, one column per item), and every
+  table sits in a horizontally scrolling box, so the page fits 1000 px.
 """
 
 from __future__ import annotations
 
 import html
 import math
-from collections.abc import Mapping, Sequence
+import numbers
+import re
+from collections.abc import Callable, Mapping, Sequence
+from decimal import ROUND_HALF_UP, Decimal
+from typing import NamedTuple
 
-__all__ = ["summary_html", "format_cell", "calibration_rows", "silo_flow_rows", "recirculation_rows", "summary_sections"]
+import numpy as np
+
+__all__ = [
+    "COLUMNS",
+    "COLUMN_FAMILIES",
+    "NO_UNCERTAINTY",
+    "Column",
+    "Section",
+    "column_for",
+    "column_header",
+    "format_number",
+    "format_value_with_error",
+    "format_cell",
+    "summary_html",
+    "calibration_rows",
+    "silo_flow_rows",
+    "measured_rows",
+    "recirculation_rows",
+    "blender_rows",
+    "summary_sections",
+]
+
+#: Column kinds: free text, a whole count, a number shown as it is, a figure of merit that should carry its
+#: standard error, a yes/no flag.
+TEXT, COUNT, NUMBER, ESTIMATE, FLAG = "text", "count", "number", "estimate", "flag"
+#: What a figure of merit without an uncertainty shows after its value.
+NO_UNCERTAINTY = "±?"
+#: Suffix of the key that carries the standard error of a column.
+ERROR_SUFFIX = "_error"
+#: Significant digits of a number printed without an uncertainty.
+SIGNIFICANT_DIGITS = 4
+#: Decimal exponents outside [-3, 5] print as mantissa × 10^n (a column of zeros or digits is unreadable).
+_PLAIN_EXPONENTS = range(-3, 6)
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 
-def format_cell(value) -> str:
-    """A table cell: numbers with 4 significant digits, NaN and None as "n/a", text escaped."""
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+class Column(NamedTuple):
+    """How a column prints: its header in words, its unit ("" when dimensionless or text) and its kind."""
+
+    header: str
+    unit: str = ""
+    kind: str = NUMBER
+
+
+#: The header and unit of every column key the summary page shows.
+COLUMNS: dict[str, Column] = {
+    # calibration
+    "contact": Column("Contact", kind=TEXT),
+    "sliding_friction": Column("Sliding friction coefficient"),
+    "lower": Column("Band, lower end"),
+    "upper": Column("Band, upper end"),
+    "band_clipped": Column("Band clipped at the swept range", kind=FLAG),
+    "note": Column("Note", kind=TEXT),
+    # flat-bottom silo
+    "run_id": Column("Run", kind=TEXT),
+    "n_clumps": Column("Particles", kind=COUNT),
+    "filling_bulk_density_kg_m3": Column("Filling bulk density", "kg/m³", ESTIMATE),
+    "mass_flow_rate_kg_s": Column("Flow rate", "kg/s", ESTIMATE),
+    "beverloo_mass_flow_rate_kg_s": Column("Beverloo flow rate", "kg/s"),
+    "beverloo_ratio": Column("Flow rate / Beverloo", kind=ESTIMATE),
+    # silo against measured profiles
+    "z_m": Column("Height above the outlet", "m"),
+    "window": Column("Averaging window", kind=TEXT),
+    "n_points": Column("Points compared", kind=COUNT),
+    "mean_error_percent": Column("Mean error", "%"),
+    "rms_error_m_s": Column("RMS error", "m/s"),
+    "max_abs_error_m_s": Column("Largest error", "m/s"),
+    "fraction_within_uncertainty": Column("Fraction within the measurement uncertainty"),
+    # recirculating silo
+    "flow_pattern": Column("Flow pattern", kind=TEXT),
+    "layout": Column("Batch layout", kind=TEXT),
+    "residence_time_s": Column("Residence time", "s", ESTIMATE),
+    "t_s_over_t_d": Column("First appearance / discharge time t_s/t_d", kind=ESTIMATE),
+    "prediction_rms_error": Column("LTI prediction RMS error (blue fraction)"),
+    "vrr_ceiling": Column("VRR counting-noise ceiling"),
+    # blender
+    "configuration": Column("Configuration", kind=TEXT),
+    "exterior_v_z_m_s": Column("Mean vertical velocity, exterior annulus", "m/s", ESTIMATE),
+    "interior_v_z_m_s": Column("Mean vertical velocity, interior annulus", "m/s", ESTIMATE),
+    "tube_v_z_m_s": Column("Mean vertical velocity, tube", "m/s", ESTIMATE),
+    "rtd_mean_s": Column("Mean residence time t_m", "s", ESTIMATE),
+    "rtd_spread": Column("RTD spread σ/t_m", kind=ESTIMATE),
+    "ts_over_td": Column("First appearance / discharge time t_s/t_d", kind=ESTIMATE),
+    "recirculations_to_homogenise": Column("Recirculations to homogenise"),
+}
+
+#: The blender comparison's VRR columns, one per sine period (a fraction of the mean residence time).
+_PERIOD_VRR = re.compile(r"vrr_at_(\d+(?:\.\d+)?)_tm")
+
+#: Families of numbered keys: (pattern, header from the match, unit, kind).
+COLUMN_FAMILIES: tuple[tuple[re.Pattern, Callable[[re.Match], str], str, str], ...] = (
+    (re.compile(r"vrr_nr(\d+)"), lambda match: f"VRR after recirculation {int(match[1])}", "", ESTIMATE),
+    (re.compile(r"vrr_at_ceiling_nr(\d+)"),
+     lambda match: f"VRR after recirculation {int(match[1])} at the counting-noise ceiling", "", FLAG),
+    (_PERIOD_VRR, lambda match: f"VRR, sine period {match[1]} t_m", "", ESTIMATE),
+)
+
+
+def column_for(key: str) -> Column:
+    """The :class:`Column` of a row key.
+
+    Raises
+    ------
+    ValueError
+        If the key has no header (it names the key): add it to :data:`COLUMNS`.
+    """
+    if key in COLUMNS:
+        return COLUMNS[key]
+    for pattern, header, unit, kind in COLUMN_FAMILIES:
+        match = pattern.fullmatch(str(key))
+        if match:
+            return Column(header(match), unit, kind)
+    raise ValueError(f"the summary page has no header for the column {key!r}: "
+                     "add it to analysis.report.summary.COLUMNS")
+
+
+def column_header(key: str) -> str:
+    """The header text of a row key: its words, then its unit in parentheses if it has one."""
+    column = column_for(key)
+    return f"{column.header} ({column.unit})" if column.unit else column.header
+
+
+# --------------------------------------------------------------------------- numbers
+
+
+def _missing(value) -> bool:
+    return value is None or (isinstance(value, numbers.Real) and not math.isfinite(float(value)))
+
+
+def _decimal(value: float) -> Decimal:
+    # Through repr: the digits a person sees, so 2.675 rounds up as written, not as its binary neighbour.
+    return Decimal(repr(float(value)))
+
+
+def _rounded(value: Decimal, decimals: int) -> Decimal:
+    result = value.quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_UP)
+    return result if result != 0 else abs(result)  # no "-0.00"
+
+
+def _plain(value: Decimal) -> str:
+    return format(value, "f")
+
+
+def _times_ten_to(exponent: int) -> str:
+    return f"× 10{str(exponent).translate(_SUPERSCRIPT)}"
+
+
+def format_number(value) -> str:
+    """A number with :data:`SIGNIFICANT_DIGITS` significant digits (whole digits are never cut).
+
+    Magnitudes below 10⁻³ or from 10⁶ print as ``1.235 × 10⁻⁷``; NaN, infinities and None as "n/a".
+
+    Examples
+    --------
+    >>> format_number(0.123456), format_number(535.9231), format_number(123456.7), format_number(1.2345e-7)
+    ('0.1235', '535.9', '123457', '1.235 × 10⁻⁷')
+    """
+    if _missing(value):
         return "n/a"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    return html.escape(str(value))
+    number = _decimal(value)
+    if number == 0:
+        return "0"
+    exponent = number.adjusted()
+    if exponent not in _PLAIN_EXPONENTS:
+        return f"{format_number(float(number.scaleb(-exponent)))} {_times_ten_to(exponent)}"
+    rounded = _rounded(number, max(0, SIGNIFICANT_DIGITS - 1 - exponent))
+    if rounded.adjusted() > exponent:  # 9.9996 rounds to 10.000: one digit too many
+        rounded = _rounded(number, max(0, SIGNIFICANT_DIGITS - 2 - exponent))
+    return _plain(rounded)
+
+
+def _with_error(value: Decimal, error: Decimal) -> str:
+    """``value ± error``, both finite, error > 0, in plain decimal notation."""
+    exponent = error.adjusted()
+    decimals = 1 - exponent
+    rounded_error = _rounded(error, decimals)
+    if rounded_error.adjusted() > exponent:  # 0.0999 rounds to 0.100: keep 2 significant digits, 0.10
+        decimals -= 1
+        rounded_error = _rounded(error, decimals)
+    return f"{_plain(_rounded(value, decimals))} ± {_plain(rounded_error)}"
+
+
+def format_value_with_error(value, error) -> str:
+    """A value with its standard error: the error to 2 significant digits, the value to the same decimal place.
+
+    Parameters
+    ----------
+    value : float or None
+        The value (any unit); None or non-finite prints "n/a".
+    error : float or None
+        Its standard error (same unit, >= 0). None, NaN or infinite (not estimated) prints the value alone
+        (:func:`format_number`) followed by :data:`NO_UNCERTAINTY`; 0 prints "value ± 0".
+
+    Returns
+    -------
+    str
+        E.g. ``"0.1168 ± 0.0021"``; magnitudes below 10⁻³ or from 10⁶ as ``"(1.230 ± 0.045) × 10⁻⁷"``.
+
+    Raises
+    ------
+    ValueError
+        If the error is negative.
+
+    Examples
+    --------
+    >>> format_value_with_error(0.116844, 0.002134), format_value_with_error(535.92, 12.4)
+    ('0.1168 ± 0.0021', '536 ± 12')
+    """
+    if _missing(value):
+        return "n/a"
+    if error is not None and float(error) < 0.0:
+        raise ValueError(f"a standard error must be >= 0, got {error!r}")
+    if _missing(error):
+        return f"{format_number(value)} {NO_UNCERTAINTY}"
+    if float(error) == 0.0:
+        return f"{format_number(value)} ± 0"
+    number, uncertainty = _decimal(value), _decimal(error)
+    exponent = max(number.adjusted() if number != 0 else uncertainty.adjusted(), uncertainty.adjusted())
+    if exponent not in _PLAIN_EXPONENTS:
+        scaled = _with_error(number.scaleb(-exponent), uncertainty.scaleb(-exponent))
+        return f"({scaled}) {_times_ten_to(exponent)}"
+    return _with_error(number, uncertainty)
+
+
+def _is_scalar(value) -> bool:
+    return value is None or isinstance(value, (str, bool, np.bool_, numbers.Real))
+
+
+def _flag(value) -> str:
+    if _missing(value):
+        return "n/a"
+    # A flag read back from a CSV table is the text "True"/"False" (or 1.0/0.0).
+    text = str(value).strip().lower()
+    if text in ("true", "yes", "1", "1.0"):
+        return "yes"
+    if text in ("false", "no", "0", "0.0"):
+        return "no"
+    raise ValueError(f"{value!r} is not a flag (yes/no)")
+
+
+def format_cell(value, kind: str = NUMBER, error=None, has_error: bool = False) -> str:
+    """A table cell as escaped HTML text.
+
+    Parameters
+    ----------
+    value : str, bool, number or None
+        The cell value. NaN and None print "n/a", booleans "yes"/"no", numbers by :func:`format_number`.
+    kind : str
+        The column kind (:data:`TEXT`, :data:`COUNT`, :data:`NUMBER`, :data:`ESTIMATE`, :data:`FLAG`).
+    error : float or None
+        The value's standard error (same unit).
+    has_error : bool
+        Whether the column carries errors (then a number prints with :func:`format_value_with_error`, as it
+        does for the kind :data:`ESTIMATE`).
+
+    Raises
+    ------
+    TypeError
+        If the value is not a scalar (a mapping or a list must be formatted as text by its row builder).
+    """
+    if not _is_scalar(value):
+        raise TypeError(f"a {type(value).__name__} is not a table cell value: format it as text first, got "
+                        f"{value!r:.80}")
+    if kind == FLAG or isinstance(value, (bool, np.bool_)):
+        return _flag(value)
+    if isinstance(value, str):
+        return html.escape(value)
+    if _missing(value):
+        return "n/a"
+    if kind == TEXT:
+        return html.escape(f"{value:g}")
+    if kind == ESTIMATE or has_error or error is not None:
+        return html.escape(format_value_with_error(value, error))
+    if isinstance(value, numbers.Integral) or (kind == COUNT and float(value).is_integer()):
+        return str(int(value))
+    return html.escape(format_number(value))
+
+
+# --------------------------------------------------------------------------- tables
+
+
+def _error_key(key: str) -> str:
+    return f"{key}{ERROR_SUFFIX}"
+
+
+def _shown_columns(rows: Sequence[Mapping]) -> tuple[list[str], set[str]]:
+    """(the keys shown as columns in order of first appearance, the keys whose errors the rows carry)."""
+    keys: list[str] = []
+    for row in rows:
+        keys += [key for key in row if key not in keys]
+    present = set(keys)
+    errors = {key for key in keys if _error_key(key) in present}
+    shown = [key for key in keys
+             if not (isinstance(key, str) and key.endswith(ERROR_SUFFIX) and key[: -len(ERROR_SUFFIX)] in present)]
+    for key in shown:
+        column_for(key)  # refuse a key without a header before anything is drawn
+    return shown, errors
+
+
+def _cell_text(row: Mapping, key: str, errors: set[str]) -> str:
+    try:
+        return format_cell(row.get(key), column_for(key).kind, row.get(_error_key(key)), key in errors)
+    except (TypeError, ValueError) as error:
+        raise type(error)(f"column {key!r}: {error}") from None
+
+
+def _cell(row: Mapping, key: str, errors: set[str]) -> str:
+    align = ' class="text"' if column_for(key).kind == TEXT else ""
+    return f"<td{align}>{_cell_text(row, key, errors)}</td>"
+
+
+def _label_columns(columns: Sequence[str]) -> list[str]:
+    """The columns that name a row: the leading text columns (e.g. flow pattern and layout), at least one."""
+    labels = []
+    for key in columns[:-1]:
+        if column_for(key).kind != TEXT:
+            break
+        labels.append(key)
+    return labels or list(columns[:1])
 
 
 def _table(rows: Sequence[Mapping]) -> str:
-    columns: list[str] = []
-    for row in rows:
-        columns += [key for key in row if key not in columns]
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in columns)
-    body = "".join(
-        "<tr>" + "".join(f"<td>{format_cell(row.get(c))}</td>" for c in columns) + "</tr>" for row in rows
-    )
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    """One table; transposed (one row per quantity, one column per row, headed by the row's leading text
+    columns) when it has more columns than rows, so that a wide table grows down the page instead."""
+    columns, errors = _shown_columns(rows)
+    headers = {key: html.escape(column_header(key)) for key in columns}
+    if len(columns) > len(rows):
+        labels = _label_columns(columns)
+        quantities = columns[len(labels):]
+        head = f'<th scope="col">{", ".join(headers[key] for key in labels)}</th>' + "".join(
+            f'<th scope="col">{", ".join(_cell_text(row, key, errors) for key in labels)}</th>' for row in rows)
+        body = "".join(
+            f'<tr><th scope="row">{headers[key]}</th>' + "".join(_cell(row, key, errors) for row in rows) + "</tr>"
+            for key in quantities)
+        layout = ' class="transposed"'
+    else:
+        head = "".join(f'<th scope="col">{headers[key]}</th>' for key in columns)
+        body = "".join("<tr>" + "".join(_cell(row, key, errors) for key in columns) + "</tr>" for row in rows)
+        layout = ""
+    return (f'<div class="table-box"><table{layout}><thead><tr>{head}</tr></thead><tbody>{body}</tbody>'
+            "</table></div>")
 
 
-def summary_html(title: str, sections: Sequence[tuple[str, str, Sequence[Mapping]]]) -> str:
-    """A self-contained HTML page: a heading, then per section its title, a sentence and a table of rows.
+# --------------------------------------------------------------------------- page
+
+
+class Section(NamedTuple):
+    """One section of the summary page: a title, a sentence saying what the table shows, its rows and a
+    legend (a short paragraph under the table; "" for none)."""
+
+    title: str
+    explanation: str
+    rows: Sequence[Mapping]
+    legend: str = ""
+
+
+#: Fits the page in 1000 px: a bounded body, tables that scroll sideways inside it rather than overflow.
+STYLE = ("body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;box-sizing:border-box}"
+         ".table-box{max-width:100%;overflow-x:auto;margin-bottom:0.5em}"
+         "table{border-collapse:collapse}"
+         "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right;vertical-align:top}"
+         "td{white-space:nowrap}th{background:#eee}"
+         "th[scope=row],td.text{text-align:left}td.text{white-space:normal}"
+         "p.legend{font-size:90%;color:#444;margin-top:0.3em}")
+
+#: The page's key to its figures, shown under the title.
+PAGE_LEGEND = (f"Figures are given as value ± standard error, the error to 2 significant digits and the value to "
+               f"the same decimal place; \"{NO_UNCERTAINTY}\" marks a figure whose uncertainty is not estimated yet; "
+               "n/a: not available.")
+
+
+def summary_html(title: str, sections: Sequence[Section | tuple]) -> str:
+    """A self-contained HTML page: a heading and the key to the figures, then per section its title, a sentence,
+    a table of rows and an optional legend.
 
     Parameters
     ----------
     title : str
         Page title.
-    sections : sequence of (str, str, sequence of mapping)
-        ``(section title, explanation, rows)``; the columns are the rows' keys in order of first appearance. A
-        section without rows says so instead of a table.
+    sections : sequence of Section or of (str, str, sequence of mapping[, str])
+        ``(section title, explanation, rows[, legend])``; the columns are the rows' keys in order of first
+        appearance, each ``"<key>_error"`` merged into the cell of ``"<key>"``. A section without rows says so
+        instead of a table.
+
+    Raises
+    ------
+    ValueError
+        If a row has a key without a header in :data:`COLUMNS` (the message names it).
+    TypeError
+        If a cell value is not a scalar (a mapping or a list).
     """
-    parts = [f"<h1>{html.escape(title)}</h1>"]
-    for heading, explanation, rows in sections:
-        parts.append(f"<h2>{html.escape(heading)}</h2><p>{html.escape(explanation)}</p>")
-        parts.append(_table(rows) if rows else "<p><em>Not run in this configuration.</em></p>")
-    style = ("body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin-bottom:1.5em}"
-             "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}")
-    return (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>"
-            f"<style>{style}</style></head><body>{''.join(parts)}</body></html>\n")
+    parts = [f"<h1>{html.escape(title)}</h1><p class=\"legend\">{html.escape(PAGE_LEGEND)}</p>"]
+    for section in sections:
+        section = Section(*section)
+        parts.append(f"<h2>{html.escape(section.title)}</h2><p>{html.escape(section.explanation)}</p>")
+        parts.append(_table(section.rows) if section.rows else "<p><em>Not run in this configuration.</em></p>")
+        if section.legend and section.rows:
+            parts.append(f"<p class=\"legend\">{html.escape(section.legend)}</p>")
+    return (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\">"
+            f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{html.escape(title)}"
+            f"</title><style>{STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+
+
+# --------------------------------------------------------------------------- rows of each stage
+
+
+def _with_errors(row: Mapping, keys: Sequence[str], aliases: Mapping[str, str] | None = None) -> dict:
+    """The given keys of a row (missing ones as None), each with ``"<key>_error"`` when the row has it (or,
+    failing that, the older error key ``aliases[key]``)."""
+    picked = {}
+    for key in keys:
+        picked[key] = row.get(key)
+        for source in (_error_key(key), (aliases or {}).get(key)):
+            if source is not None and source in row:
+                picked[_error_key(key)] = row[source]
+                break
+    return picked
+
+
+def _config_number(value) -> str:
+    # Settings read from the configuration print as they were written (0.1, not 0.1000).
+    return "n/a" if _missing(value) else f"{float(value):g}"
+
+
+def _degrees(value) -> str:
+    angle = float(value)
+    return f"{angle:.1f}°" if round(angle, 1) == angle else f"{angle:g}°"
+
+
+def _targets_text(targets: Mapping) -> str:
+    """``{"internal": 30.0, "aluminium": 9.5}`` as "internal 30.0°, aluminium 9.5°"."""
+    return ", ".join(f"{name} {_degrees(angle)}" for name, angle in targets.items())
 
 
 def calibration_rows(parameters: Mapping) -> list[dict]:
@@ -71,26 +478,95 @@ def calibration_rows(parameters: Mapping) -> list[dict]:
     return rows
 
 
+def calibration_explanation(parameters: Mapping) -> str:
+    """The sentence over the calibration table: particle model, rolling friction, targets and tolerance."""
+    model = [f"particle model {parameters['shape']}"] if parameters.get("shape") else []
+    if parameters.get("rolling_friction") is not None:
+        model.append(f"rolling friction {_config_number(parameters['rolling_friction'])}")
+    text = "Contact parameters chosen from the Jenike shear sweep" + (f" ({', '.join(model)})" if model else "")
+    targets = parameters.get("targets_deg") or {}
+    if targets:
+        text += f", with the band that reproduces the target bulk friction angles ({_targets_text(targets)})"
+        if parameters.get("tolerance_deg") is not None:
+            text += f" within ±{_degrees(parameters['tolerance_deg'])}"
+    return text + "."
+
+
 #: The columns of a silo run's flow summary (metrics/flow.json) on the summary page.
 SILO_FLOW_COLUMNS = ("run_id", "n_clumps", "filling_bulk_density_kg_m3", "mass_flow_rate_kg_s",
                      "beverloo_mass_flow_rate_kg_s", "beverloo_ratio")
+#: Error keys flow.json writes under another name than "<key>_error".
+SILO_FLOW_ERROR_ALIASES = {"mass_flow_rate_kg_s": "mass_flow_rate_stderr_kg_s"}
+#: The columns of the measured-profile comparison (metrics/measured_comparison.csv) on the summary page.
+MEASURED_COLUMNS = ("z_m", "window", "n_points", "mean_error_percent", "rms_error_m_s", "max_abs_error_m_s",
+                    "fraction_within_uncertainty")
 #: The columns of the recirculating-silo summary table on the summary page.
 RECIRCULATION_COLUMNS = ("flow_pattern", "layout", "residence_time_s", "t_s_over_t_d", "vrr_nr1", "vrr_nr2", "vrr_nr3",
                          "vrr_nr4", "prediction_rms_error")
+#: The counting-noise ceiling of the VRR and the flags of the VRRs at it, shown when the summary table has them.
+RECIRCULATION_CEILING_COLUMNS = ("vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3",
+                                 "vrr_at_ceiling_nr4")
+#: The fixed columns of the blender comparison (comparison/configurations.csv) on the summary page; its
+#: ``vrr_at_<f>_tm`` columns follow, as many as the configuration asks for.
+BLENDER_COLUMNS = ("configuration", "mass_flow_rate_kg_s", "exterior_v_z_m_s", "interior_v_z_m_s", "tube_v_z_m_s",
+                   "rtd_mean_s", "rtd_spread", "ts_over_td", "recirculations_to_homogenise")
 
 
 def silo_flow_rows(flows: Sequence[Mapping]) -> list[dict]:
-    """One row per flat-bottom silo run: its flow summary's :data:`SILO_FLOW_COLUMNS`."""
-    return [{key: flow[key] for key in SILO_FLOW_COLUMNS} for flow in flows]
+    """One row per flat-bottom silo run: its flow summary's :data:`SILO_FLOW_COLUMNS` with their errors.
+
+    The flow rate's standard error is ``mass_flow_rate_kg_s_error`` or, as flow.json writes it today,
+    ``mass_flow_rate_stderr_kg_s``. Without an own error, the Beverloo ratio's is the flow rate's divided by the
+    Beverloo prediction (the prediction counted exact).
+    """
+    rows = []
+    for flow in flows:
+        row = _with_errors(flow, SILO_FLOW_COLUMNS, SILO_FLOW_ERROR_ALIASES)
+        rate_error, prediction = row.get("mass_flow_rate_kg_s_error"), row.get("beverloo_mass_flow_rate_kg_s")
+        if "beverloo_ratio_error" not in row and not _missing(rate_error) and not _missing(prediction) and prediction:
+            row["beverloo_ratio_error"] = float(rate_error) / abs(float(prediction))
+        rows.append(row)
+    return rows
+
+
+def measured_rows(rows: Sequence[Mapping]) -> list[dict]:
+    """The measured-profile comparison rows cut to :data:`MEASURED_COLUMNS` (with their errors, if any)."""
+    return [_with_errors(row, MEASURED_COLUMNS) for row in rows]
 
 
 def recirculation_rows(rows: Sequence[Mapping]) -> list[dict]:
-    """The recirculating-silo summary rows cut to :data:`RECIRCULATION_COLUMNS` (missing ones as None)."""
-    return [{key: row.get(key) for key in RECIRCULATION_COLUMNS} for row in rows]
+    """The recirculating-silo summary rows cut to :data:`RECIRCULATION_COLUMNS` (missing ones as None), then
+    those of :data:`RECIRCULATION_CEILING_COLUMNS` the row has, with their errors when the table has them."""
+    return [_with_errors(row, RECIRCULATION_COLUMNS + tuple(key for key in RECIRCULATION_CEILING_COLUMNS if key in row))
+            for row in rows]
+
+
+def blender_rows(rows: Sequence[Mapping]) -> list[dict]:
+    """The blender comparison rows: :data:`BLENDER_COLUMNS`, then every ``vrr_at_<f>_tm`` column of the row, with
+    their errors when the table has them; other columns are left out."""
+    return [_with_errors(row, BLENDER_COLUMNS + tuple(key for key in row if _PERIOD_VRR.fullmatch(str(key))))
+            for row in rows]
+
+
+CALIBRATION_LEGEND = ("Band: the sliding friction range whose bulk friction angle lies within the target "
+                      "± tolerance, the calibration's uncertainty. Band clipped: the band reaches the end of the "
+                      "swept friction range, so that end is only a bound.")
+SILO_LEGEND = ("Flow rate: slope of the discharged mass over the steady window. Beverloo flow rate: the "
+               "correlation's prediction at the filling bulk density; the ratio's uncertainty is the flow "
+               "rate's alone.")
+MEASURED_LEGEND = "Errors of the simulated vertical velocity against each measured profile."
+BLENDING_LEGEND = ("Residence time: hold-up over throughput. t_s/t_d: first appearance of the tracer over the "
+                   "time to discharge all of it. VRR after recirculation n: variance reduction ratio "
+                   "σ_in²/σ_out² of the outlet blue fraction during pass n. At the counting-noise ceiling: the VRR "
+                   "is close to the largest one the windows' particle counts can measure, so it is only a lower "
+                   "bound.")
+BLENDER_LEGEND = ("Mean vertical velocity: the mean v_z of each passage (negative: downwards). VRR, sine period "
+                  "f t_m: variance reduction ratio of a sine input whose period is f times the mean residence time. "
+                  "n/a under recirculations to homogenise: not homogenised within the simulated passes.")
 
 
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
-                     recirculation: Sequence[Mapping], blender: Sequence[Mapping]) -> list[tuple[str, str, list]]:
+                     recirculation: Sequence[Mapping], blender: Sequence[Mapping]) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -103,14 +579,15 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         Rows of the measured-profile comparisons, of the recirculating-silo summary and of the blender comparison.
     """
     return [
-        ("Calibration", f"Contact parameters chosen from the Jenike shear sweep (particle model {parameters.get('shape')}, "
-                        f"rolling friction {parameters.get('rolling_friction')}), with the band that reproduces the "
-                        f"target angles {parameters.get('targets_deg')} deg within {parameters.get('tolerance_deg')} deg.",
-         calibration_rows(parameters)),
-        ("Silo validation", "Steady discharge rate of each flat-bottom silo run against Beverloo's prediction.",
-         silo_flow_rows(flows)),
-        ("Silo against measurements", "Velocity profile errors against the measured profiles.", list(measured)),
-        ("Blending", "Mean residence time, RTD spread and VRR after each recirculation per flow pattern and batch "
-                     "layout, and the RMS error of the LTI prediction.", recirculation_rows(recirculation)),
-        ("Blender", "Insert configurations compared (see the blender comparison table).", list(blender)),
+        Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
+                CALIBRATION_LEGEND),
+        Section("Silo validation", "Steady discharge rate of each flat-bottom silo run against Beverloo's prediction.",
+                silo_flow_rows(flows), SILO_LEGEND),
+        Section("Silo against measurements", "Velocity profile errors against the measured profiles.",
+                measured_rows(measured), MEASURED_LEGEND),
+        Section("Blending", "Residence time, RTD shape (t_s/t_d) and VRR after each recirculation per flow pattern "
+                            "and batch layout, and the RMS error of the LTI prediction.",
+                recirculation_rows(recirculation), BLENDING_LEGEND),
+        Section("Blender", "Insert configurations compared (see the blender comparison table).",
+                blender_rows(blender), BLENDER_LEGEND),
     ]

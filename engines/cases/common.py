@@ -97,6 +97,11 @@ class FillPlan:
         Insertion rate (clumps/s).
     fill_steps : int
         Steps of the filling stage (all insertions plus the last batch's fall to the heap).
+    impact_velocity : float
+        Speed of the stream where it lands on the finished fill: the insertion velocity plus the free fall from the
+        zone's floor to fill_height (m/s).
+    momentum_flux_ratio : float
+        The stream's momentum flux there (mass rate times impact velocity) over the fill's weight (-).
     """
 
     n_clumps: int
@@ -106,6 +111,8 @@ class FillPlan:
     clumps_per_insertion: int
     particle_rate: float
     fill_steps: int
+    impact_velocity: float = float("nan")
+    momentum_flux_ratio: float = float("nan")
 
 
 def run_id(prefix: str, parameters: dict) -> str:
@@ -133,6 +140,12 @@ def plan_fill(
     the highest heap the pile can form, H + (W/2) tan(heap angle), plus two clump diameters. Each insertion
     event fills the zone to the given solid fraction; the next one comes when the batch has moved one zone
     height down, so batches never overlap.
+
+    The pour is gentle: the stream's momentum flux where it lands on the finished fill (mass rate times impact
+    velocity, the insertion velocity plus the free fall from the zone's floor to fill_height) stays below
+    ``momentum_flux_ratio`` times the fill's weight; the planner puts fewer clumps into each insertion event until
+    it does. A stream whose momentum flux is comparable to the weight compacts the bed, which springs back when the
+    pour stops and is then held down by its walls (the settled fill's force balance shows it).
     """
     if n_clumps is None:
         n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
@@ -151,6 +164,10 @@ def plan_fill(
     clumps_per_insertion = max(1, int(fill_config["volume_fraction"] * zone_volume / particle.volume))
     velocity = fill_config["insertion_velocity"]
     insert_every = steps_for(fill_config["zone_height"] / velocity, timestep)
+    impact_velocity = math.sqrt(velocity**2 + 2.0 * gravity * (z_min - fill_height))
+    weight = n_clumps * particle.mass * gravity
+    gentle_rate = fill_config["momentum_flux_ratio"] * weight / (impact_velocity * particle.mass)  # clumps/s
+    clumps_per_insertion = max(1, min(clumps_per_insertion, int(gentle_rate * insert_every * timestep)))
     particle_rate = clumps_per_insertion / (insert_every * timestep)
     insertions = math.ceil(n_clumps / clumps_per_insertion)
     # Worst-case fall of the last batch from the top of the zone to the floor.
@@ -165,6 +182,8 @@ def plan_fill(
         clumps_per_insertion=clumps_per_insertion,
         particle_rate=particle_rate,
         fill_steps=fill_steps,
+        impact_velocity=impact_velocity,
+        momentum_flux_ratio=particle_rate * particle.mass * impact_velocity / weight,
     )
 
 

@@ -72,6 +72,11 @@ class SiloCase:
         )
 
     @property
+    def gravity(self) -> float:
+        """Magnitude of gravity (m/s^2)."""
+        return GRAVITY
+
+    @property
     def spheres_per_clump(self) -> int:
         return self.particle.n_spheres
 

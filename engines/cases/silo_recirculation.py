@@ -72,6 +72,16 @@ class RecirculationCase:
     defining_parameters: dict = field(repr=False)
 
     @property
+    def fill_height(self) -> float:
+        """Fill height of the silo (m)."""
+        return self.silo.fill_height
+
+    @property
+    def gravity(self) -> float:
+        """Magnitude of gravity (m/s^2)."""
+        return self.silo.gravity
+
+    @property
     def run_id(self) -> str:
         """Directory name: role, flow pattern and a hash of every defining parameter."""
         prefix = self.pattern if self.role == "blending" else f"thin-{self.pattern}"

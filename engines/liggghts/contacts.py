@@ -30,8 +30,11 @@ class ContactDumpError(ValueError):
     """A local dump is truncated or malformed; the message names the file."""
 
 
-def parse_local_table(text: str, n_columns: int, source: str = "<text>") -> tuple[int, np.ndarray]:
-    """The time step and the (n, n_columns) value table of one ``dump local`` snapshot.
+def parse_local_table(
+    text: str, n_columns: int, source: str = "<text>", count_item: str = "NUMBER OF ENTRIES", table_item: str = "ENTRIES"
+) -> tuple[int, np.ndarray]:
+    """The time step and the (n, n_columns) value table of one ``dump local`` snapshot (or, with ``count_item``
+    "NUMBER OF ATOMS" and ``table_item`` "ATOMS", of one text ``dump custom`` snapshot).
 
     Raises
     ------
@@ -49,10 +52,10 @@ def parse_local_table(text: str, n_columns: int, source: str = "<text>") -> tupl
 
     try:
         step = int(lines[item("TIMESTEP") + 1])
-        count = int(lines[item("NUMBER OF ENTRIES") + 1])
+        count = int(lines[item(count_item) + 1])
     except (IndexError, ValueError):
         raise ContactDumpError(f"{source}: malformed TIMESTEP or NUMBER OF ENTRIES") from None
-    rows = [line.split() for line in lines[item("ENTRIES") + 1 :] if line.strip()]
+    rows = [line.split() for line in lines[item(table_item) + 1 :] if line.strip()]
     if len(rows) != count:
         raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")
     if any(len(row) != n_columns for row in rows):

@@ -18,13 +18,14 @@ from analysis.data.contacts import ContactFrame, WallContactFrame
 from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.record import RunRecord
+from analysis.data.settled import SettledFill
 from engines.cases.blender import BlenderCase
 from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import SiloCase
 from engines.cases.silo_recirculation import RecirculationCase
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
-from engines.liggghts.blender import run_blender, write_blender_inputs
+from engines.liggghts.blender import GATE, run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
 from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
@@ -38,13 +39,18 @@ from engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
-from engines.liggghts.silo_flat import run_silo, write_silo_inputs
+from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
+from engines.liggghts.settled import read_settled_fill
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 
 __all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]
 
 #: LIGGGHTS 3.8 refuses a coefficient of restitution at or below this value (it requires 0.05 < e <= 1).
 MIN_RESTITUTION = 0.05
+
+#: Per case that saves a settled fill, the walls (meshes) that make its floor: the plates and the gate of the silos,
+#: the blender's gate (its hopper and inserts are walls).
+FLOOR_WALLS = {"silo_flat": FLOOR_MESHES, "silo_recirculation": FLOOR_MESHES, "blender": (GATE,)}
 
 #: The stage sequences the decks implement, per case kind.
 _STAGES = {
@@ -151,6 +157,12 @@ class LiggghtsEngine(Engine):
         if kind == "pair":
             return [_pair_frame(read_contact_dump(path)) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
         return [_wall_frame(read_contact_dump(path)) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
+
+    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
+        if record.case not in FLOOR_WALLS:
+            raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
+        return read_settled_fill(Path(run_dir) / "dumps", record.timestep_s, read_wall_forces(run_dir),
+                                 FLOOR_WALLS[record.case])
 
 
 def _columns(table: dict, *names: str) -> np.ndarray:

@@ -38,6 +38,8 @@ LOG_NAME = "log.liggghts"
 SCREEN_NAME = "engine.out"
 DUMP_PREFIX = "particles"
 CONTACT_PREFIX = "contacts"
+#: The settled fill's spheres with their wall forces (``dump custom``), one file ``settled_fill_<step>.txt``.
+SETTLED_FILL_PREFIX = "settled_fill"
 
 
 

@@ -11,12 +11,14 @@ from analysis.data.record import RunRecord
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.silo_flat import SiloCase
 from engines.estimates import CostModel, silo_run_steps
+from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
 from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
 from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.run import (
     CONTACT_PREFIX,
     DUMP_PREFIX,
+    SETTLED_FILL_PREFIX,
     RESTART_DIR,
     RESTART_PREFIX,
     Resume,
@@ -31,6 +33,10 @@ from engines.templating import render_deck
 #: radii, masses), in binary. Forces and angular velocities are left out (a third of the volume); contact forces
 #: come from the separate contact dump.
 SILO_DUMP_FIELDS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass")
+
+#: The meshes of the silo's floor: the plates left and right of the outlet and its gate.
+FLOOR_MESHES = ("floor_left", "floor_right", "outlet_gate")
+
 
 def silo_meshes(case: SiloCase) -> dict:
     """Floor plates left and right of the outlet and the gate that closes it (z = 0, normals up)."""
@@ -97,7 +103,12 @@ def silo_deck_context(case: SiloCase) -> dict:
             },
             "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
                      "fields": list(SILO_DUMP_FIELDS)},
-            "contact_dump": f"dumps/{CONTACT_PREFIX}_*.txt",
+            "settled_fill": {
+                "path": f"dumps/{SETTLED_FILL_PREFIX}_*.txt",
+                "contacts_path": f"dumps/{CONTACT_PREFIX}_*.txt",
+                "contact_compute": "pair_contacts",
+                "contact_columns": N_CONTACT_COLUMNS,
+            },
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
             "thermo_every": dump_every,

@@ -21,7 +21,7 @@ from analysis.studies.silo_recirculation.tracks import recirculation_events, rec
 from engines.cases.blender import blender_cases
 from engines.config import validate_config
 from engines.layout import case_root, run_dir
-from tests.conftest import NO_BLENDING, TINY_BLENDER, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import FAST_POUR, NO_BLENDING, TINY_BLENDER, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -29,7 +29,7 @@ CONFIG = {
     "blender": TINY_BLENDER,
     "silo_recirculation": NO_BLENDING,
     # a taller, faster pour than the tiny silo's fills the thin hopper in fewer insertion events
-    "defaults": {"fill": {"zone_width_fraction": 0.6, "zone_height": 0.04, "insertion_velocity": 3.0},
+    "defaults": {"fill": {**FAST_POUR, "zone_height": 0.04, "insertion_velocity": 3.0},
                  "settle": TINY_SILO["settle"]},
 }
 

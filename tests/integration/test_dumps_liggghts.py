@@ -39,7 +39,7 @@ from engines.liggghts.dumps import (
     read_frame,
 )
 from engines.liggghts.run import DUMP_PREFIX
-from tests.conftest import DEFAULT_CONFIG, liggghts
+from tests.conftest import DEFAULT_CONFIG, FAST_POUR, liggghts
 from tests.dump_fixtures import write_liggghts_dump
 
 pytestmark = pytest.mark.integration
@@ -50,7 +50,7 @@ DRAINING_SILO = {
     "depth": 0.012,
     "fill_height": 0.015,
     "outlet_width": 0.029,
-    "fill": {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocity": 2.0},
+    "fill": FAST_POUR,
     "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
     "discharge_time": 0.2,  # the last clump leaves after about 0.13 s
     "dump_interval": 0.02,

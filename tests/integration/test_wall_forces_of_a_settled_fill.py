@@ -16,7 +16,7 @@ from analysis.data.constants import GRAVITY
 from engines.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import DEFAULT_CONFIG, require_liggghts
+from tests.conftest import DEFAULT_CONFIG, FAST_POUR, require_liggghts
 
 pytestmark = pytest.mark.integration
 
@@ -26,7 +26,7 @@ TINY_FILL = {
     "fill_height": 0.025,
     "outlet_width": 0.012,
     "front_back_walls": True,
-    "fill": {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocity": 2.0},
+    "fill": FAST_POUR,
     "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
     "discharge_time": 0.02,
 }

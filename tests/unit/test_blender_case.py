@@ -49,7 +49,7 @@ def test_continuous_deck_is_periodic_and_loses_no_clump_batch_deck_drains(golden
     assert ("meshes hopper_left hopper_right insert_left insert_right tube_left tube_right outlet_gate"
             in continuous)
     opened = continuous[continuous.index("# --- open the outlet"):]
-    assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right\n" in opened
+    assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right store_force yes\n" in opened
     # every wall writes its force and torque on the particles: the front and back planes, then each mesh
     forces = next(line for line in continuous.splitlines() if line.startswith("fix wall_forces all ave/time"))
     assert re.findall(r" v_(\w+)_fx", forces) == ["wall_front", "wall_back", "hopper_left", "hopper_right", "insert_left",

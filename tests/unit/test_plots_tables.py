@@ -1,4 +1,5 @@
-"""Unit tests for the discharge plot (analysis.studies.silo_flat.plots) and analysis.io.tables (files under tmp_path only)."""
+"""Unit tests for the discharge plot (analysis.studies.silo_flat.plots: the PNG and the plotted data) and
+analysis.io.tables (files under tmp_path only)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import csv
 import json
 import math
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
@@ -30,15 +32,36 @@ def _only_file(folder, name):
 
 
 @pytest.mark.parametrize("beverloo_rate", [2.7, None])
-def test_plot_discharge_writes_valid_png(tmp_path, beverloo_rate):
+def test_plot_discharge_draws_the_history_the_fit_and_the_beverloo_slope(tmp_path, beverloo_rate):
     history, fit = _history()
     target = tmp_path / "plots" / "discharge.png"
-    returned = plot_discharge(history, fit, beverloo_rate, target, "flat-bottom silo")
-    assert returned == target
-    data = target.read_bytes()
-    assert len(data) > 0
-    assert data.startswith(PNG_SIGNATURE)
+    figure = plot_discharge(history, fit, beverloo_rate, target, "flat-bottom silo")
+    assert target.read_bytes().startswith(PNG_SIGNATURE)
     _only_file(target.parent, "discharge.png")
+    assert not plt.fignum_exists(figure.number), "the writer closes its figure"
+    (axes,) = figure.axes
+    assert (axes.get_title(), axes.get_xlabel(), axes.get_ylabel()) == (
+        "flat-bottom silo", "time since opening [s]", "discharged mass [kg]")
+    lines = {line.get_label(): line for line in axes.get_lines()}
+    # The dots are the synthetic history: nothing until 0.1 s, then 2.5 kg/s for 0.7 s.
+    time = np.linspace(0.0, 1.0, 101)
+    np.testing.assert_allclose(lines["DEM discharged mass"].get_xydata(),
+                               np.column_stack([time, 2.5 * np.clip(time - 0.1, 0.0, 0.7)]), rtol=0, atol=1e-12)
+    assert fit.mass_flow_rate == pytest.approx(2.5, rel=1e-12)
+    fit_line = lines[f"fit: {fit.mass_flow_rate:.4g} ± {fit.standard_error:.2g} kg/s"]
+    window = [fit.t_start, fit.t_end]
+    np.testing.assert_allclose(fit_line.get_xydata(), np.column_stack([window, 2.5 * (np.array(window) - 0.1)]),
+                               rtol=1e-12)
+    (span,) = [patch for patch in axes.patches if patch.get_label() == "steady window"]
+    assert (span.get_x(), span.get_x() + span.get_width()) == pytest.approx(window, rel=1e-15)
+    if beverloo_rate is None:
+        assert len(lines) == 2
+    else:
+        beverloo = lines["Beverloo: 2.7 kg/s"]
+        middle = 0.5 * (fit.t_start + fit.t_end)
+        np.testing.assert_allclose(beverloo.get_xydata(), np.column_stack(
+            [window, 2.5 * (middle - 0.1) + 2.7 * (np.array(window) - middle)]), rtol=1e-12)
+    plt.close(figure)
 
 
 def test_write_flow_table_round_trip(tmp_path):

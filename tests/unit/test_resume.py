@@ -53,7 +53,7 @@ def test_blender_resume_deck_has_the_open_walls():
     case = build_blender_case(load_config(GOLDEN / "blender_config.yaml"), "straight")
     deck = _resume_deck("liggghts/blender.lmp.j2", blender_deck_context(case), case.silo.discharge_steps)
     _check_common(deck)
-    assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right\n" in deck
+    assert "meshes hopper_left hopper_right insert_left insert_right tube_left tube_right store_force yes\n" in deck
 
 
 def test_restart_files_are_ordered_by_step_and_empty_ones_ignored(tmp_path):

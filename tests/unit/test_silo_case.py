@@ -54,6 +54,30 @@ def test_insertion_events_do_not_overlap(tiny_config):
     assert case.fill.fill_steps * case.timestep * case.fill.particle_rate >= case.fill.n_clumps
 
 
+def test_the_pour_is_gentle_its_momentum_flux_on_the_finished_fill_stays_below_the_set_share_of_the_weight(tiny_config):
+    tiny_config["silo_flat"]["fill"]["momentum_flux_ratio"] = 0.05
+    case = build_silo_case(tiny_config)
+    fill, particle, g = case.fill, case.particle, 9.81
+    # free fall from the zone's floor to the fill height, starting at the insertion velocity
+    impact = math.sqrt(fill.insertion_velocity**2 + 2 * g * (fill.zone[4] - case.fill_height))
+    assert fill.impact_velocity == pytest.approx(impact, rel=1e-12)
+    flux_ratio = fill.particle_rate * particle.mass * impact / (fill.n_clumps * particle.mass * g)
+    assert fill.momentum_flux_ratio == pytest.approx(flux_ratio, rel=1e-12)
+    assert flux_ratio <= 0.05
+    # one clump more per insertion event would exceed it: the planner keeps the largest gentle batch
+    faster = (fill.clumps_per_insertion + 1) / (fill.insert_every * case.timestep)
+    assert faster * particle.mass * impact / (fill.n_clumps * particle.mass * g) > 0.05
+
+
+def test_a_loose_flux_limit_leaves_the_batches_the_zone_holds(tiny_config):
+    tiny_config["silo_flat"]["fill"]["momentum_flux_ratio"] = 100.0
+    loose = build_silo_case(tiny_config).fill
+    tiny_config["silo_flat"]["fill"]["momentum_flux_ratio"] = 0.01
+    gentle = build_silo_case(tiny_config).fill
+    assert gentle.clumps_per_insertion < loose.clumps_per_insertion
+    assert gentle.insert_every == loose.insert_every and gentle.fill_steps > loose.fill_steps
+
+
 def test_material_types_put_the_particle_first():
     config = validate_config({})
     table = material_table(config, "hdpe", ["aluminium", "aluminium", "perspex"])

@@ -90,7 +90,7 @@ def silo_flat_targets(wildcards=None):
         run_path("silo_flat", name, run)
         for run in run_ids("silo_flat")
         for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
-                     "plots/profiles.png", *measured_comparison_names())
+                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names())
     ]
 
 
@@ -126,7 +126,7 @@ def recirculation_targets(wildcards=None):
     targets = [
         run_path(RECIRCULATION, name, run)
         for run in runs
-        for name in ("metrics/blending.json", "plots/concentration.png", "plots/vrr.png", "plots/rtd.png",
+        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png", "plots/rtd.png",
                      "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png", "plots/snapshots")
     ]
     if runs:
@@ -136,6 +136,7 @@ def recirculation_targets(wildcards=None):
         for run in recirculation_runs("verification")
         for name in ("verification.json", "paths.png", "residence_times.png")
     ]
+    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in recirculation_runs("verification")]
     return targets
 
 
@@ -149,7 +150,7 @@ def blender_targets(wildcards=None):
     targets = [
         run_path("blender", name, run)
         for run in runs
-        for name in ("metrics/blender.json", "plots/profiles.png", "plots/insert_velocities.png",
+        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png", "plots/insert_velocities.png",
                      "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png", "plots/discontinuous.png",
                      "plots/vrr_period.png")
     ]

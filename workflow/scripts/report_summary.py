@@ -19,4 +19,4 @@ with logged_to(snakemake.log[0]) as log:
         [row for path in inputs.blender for row in read_table(path)],
     )
     write_text(snakemake.output.page, summary_html("siloflow: figures of merit", sections))
-    log.info("summary page: %s rows", ", ".join(f"{len(rows)} {title.lower()}" for title, _, rows in sections))
+    log.info("summary page: %s rows", ", ".join(f"{len(section.rows)} {section.title.lower()}" for section in sections))

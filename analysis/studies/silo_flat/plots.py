@@ -1,12 +1,12 @@
 """Plots of the flat-bottom silo flow in the study's style: discharge, velocity profiles and fields, stresses.
 
 Each writer takes arrays or dataclasses and a path, draws one figure and saves it atomically as a 150 dpi
-PNG (:func:`analysis.io.plots.save_png`)."""
+PNG (:func:`analysis.io.plots.save_png`). It returns that figure, already closed (let go by pyplot, so a
+caller that ignores it leaks nothing): its artists still hold the plotted data, which is what the tests check."""
 
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import matplotlib
 
@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 from analysis.io.plots import save_png, silo_outline  # noqa: E402
 from analysis.numerics.flow import DischargeHistory, FlowRateFit  # noqa: E402
@@ -26,7 +27,7 @@ def plot_discharge(
     beverloo_rate: float | None,
     path: str | os.PathLike,
     title: str,
-) -> Path:
+) -> Figure:
     """Plot discharged mass against time with the fitted and Beverloo flow rates.
 
     Draws the discharged mass, the least-squares line over the steady window
@@ -48,8 +49,8 @@ def plot_discharge(
 
     Returns
     -------
-    pathlib.Path
-        The written path.
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
     """
     time = np.asarray(history.time, dtype=float)
     mass = np.asarray(history.discharged_mass, dtype=float)
@@ -86,13 +87,14 @@ def plot_discharge(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="upper left", fontsize="small")
         figure.tight_layout()
-        return save_png(figure, path)
+        save_png(figure, path)
     finally:
         plt.close(figure)
+    return figure
 
 
 def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
-                            fcb_fraction_index: int = -1) -> Path:
+                            fcb_fraction_index: int = -1) -> Figure:
     """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary in red.
 
     Each profile is drawn at its height z as z + s v_z(x), with the scale s chosen so that the fastest
@@ -120,12 +122,13 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.legend(loc="upper center", fontsize=8)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, title: str) -> Path:
+def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, title: str) -> Figure:
     """Contours of the depth-averaged vertical velocity v_z(x, z) (m/s); ``v_z`` has shape (nx, nz)."""
     figure, axes = plt.subplots(figsize=(5.0, 6.0))
     try:
@@ -138,12 +141,13 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_kinematic_constant(heights, B, path, title: str) -> Path:
+def plot_kinematic_constant(heights, B, path, title: str) -> Figure:
     """Kinematic constant B (mm) against height above the outlet (mm)."""
     figure, axes = plt.subplots(figsize=(5.0, 4.0))
     try:
@@ -152,12 +156,13 @@ def plot_kinematic_constant(heights, B, path, title: str) -> Path:
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.grid(alpha=0.3)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_janssen(comparison, path, title: str) -> Path:
+def plot_janssen(comparison, path, title: str) -> Figure:
     """Mean vertical stress against depth below the surface: DEM contacts and Janssen's formula."""
     figure, axes = plt.subplots(figsize=(5.0, 4.0))
     try:
@@ -169,12 +174,13 @@ def plot_janssen(comparison, path, title: str) -> Path:
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Path:
+def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Figure:
     """Centreline vertical velocity against time since opening, one line per height."""
     figure, axes = plt.subplots(figsize=(6.0, 4.0))
     try:
@@ -185,12 +191,13 @@ def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Pa
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_force_chains(segments, width: float, outlet_width: float, top: float, path, title: str) -> Path:
+def plot_force_chains(segments, width: float, outlet_width: float, top: float, path, title: str) -> Figure:
     """Branch vectors of contacts in a slice, coloured by normal force (capped)."""
     figure, axes = plt.subplots(figsize=(5.0, 6.0))
     try:
@@ -206,12 +213,13 @@ def plot_force_chains(segments, width: float, outlet_width: float, top: float, p
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_measured_comparison(comparisons, path, title: str) -> Path:
+def plot_measured_comparison(comparisons, path, title: str) -> Figure:
     """Simulated against measured v_z(x), one panel row per measured profile, with the error metrics."""
     rows = max(1, len(comparisons))
     figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.6 * rows), squeeze=False)
@@ -232,12 +240,13 @@ def plot_measured_comparison(comparisons, path, title: str) -> Path:
         axes_list[-1, 0].set_xlabel("x [mm]")
         axes_list[0, 0].legend(fontsize=8)
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, title: str) -> Path:
+def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, title: str) -> Figure:
     """v_z profiles at one height (left) and the steady mass flow rate (right) for each run of a study."""
     figure, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.0), gridspec_kw={"width_ratios": [3, 2]})
     try:
@@ -253,12 +262,13 @@ def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, 
         right.set_ylabel("steady mass flow rate [kg/s]")
         right.grid(alpha=0.3, axis="y")
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure
 
 
-def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Path:
+def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Figure:
     """Horizontal velocity from the DEM (v_x) against the kinematic model's u = -B dv_z/dx at each height."""
     rows = len(profiles.heights)
     figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.2 * rows), squeeze=False, sharex=True)
@@ -272,6 +282,7 @@ def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Path:
         axes_list[0, 0].legend(fontsize=8)
         axes_list[-1, 0].set_xlabel("x [mm]")
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        save_png(figure, path, tight=True)
     finally:
         plt.close(figure)
+    return figure

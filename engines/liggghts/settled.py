@@ -1,0 +1,109 @@
+"""The settled fill's snapshot written by the silo-type decks (``settled_fill_snapshot`` in
+``templates/liggghts/macros.j2``), read into a neutral :class:`SettledFill`.
+
+The deck writes, at one ``run 0`` after the settle stage, a text ``dump custom`` of the spheres
+(``dumps/settled_fill_<step>.txt``: ``id type id_multisphere x y z vx vy vz radius mass`` and the summed force of
+every wall fix on the sphere, ``v_settled_wall_fx/fy/fz``, from their ``store_force``), and the pair contacts
+(``dumps/contacts_<step>.txt``, read by :mod:`engines.liggghts.contacts`). Values are written with 12 significant
+digits. The per-wall split comes from the wall force history (:mod:`engines.liggghts.forces`), at its last sample
+up to the snapshot.
+
+Why not a library reader: the text dump is the header of a ``dump local`` plus a table; the contact reader's
+strict parser (which names the file and the fault of a truncated dump) reads both.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from analysis.data.forces import WallForceHistory
+from analysis.data.frames import ParticleFrame
+from analysis.data.settled import SettledFill
+from engines.liggghts.contacts import ContactDumpError, parse_local_table, read_contacts
+from engines.liggghts.dumps import list_dumps
+from engines.liggghts.run import CONTACT_PREFIX, SETTLED_FILL_PREFIX
+
+__all__ = ["SETTLED_COLUMNS", "read_settled_spheres", "read_settled_fill"]
+
+#: The columns of the settled fill's sphere dump, in the deck's order.
+SETTLED_COLUMNS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass",
+                   "v_settled_wall_fx", "v_settled_wall_fy", "v_settled_wall_fz")
+
+
+def read_settled_spheres(path: str | Path, timestep: float) -> tuple[ParticleFrame, np.ndarray]:
+    """The spheres of a settled fill dump and the walls' force on each.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``settled_fill_<step>.txt`` dump.
+    timestep : float
+        The run's time step [s] (the frame's time is step times it).
+
+    Returns
+    -------
+    (ParticleFrame, numpy.ndarray of shape (n, 3))
+        The spheres, and the force of all walls on each [N].
+
+    Raises
+    ------
+    ContactDumpError
+        Naming the file, when it is truncated, malformed, or its columns are not :data:`SETTLED_COLUMNS`.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="utf-8", errors="replace")
+    header = next((line.split()[2:] for line in text.splitlines() if line.startswith("ITEM: ATOMS")), None)
+    if header is None or tuple(header) != SETTLED_COLUMNS:
+        raise ContactDumpError(f"{path}: columns {header} are not the settled fill's {list(SETTLED_COLUMNS)}")
+    step, table = parse_local_table(text, len(SETTLED_COLUMNS), str(path), "NUMBER OF ATOMS", "ATOMS")
+    column = {name: table[:, index] for index, name in enumerate(SETTLED_COLUMNS)}
+    ids = column["id"].astype(np.int64)
+    body = column["id_multisphere"].astype(np.int64)
+    frame = ParticleFrame(
+        time=step * timestep,
+        step=step,
+        id=ids,
+        type=column["type"].astype(np.int32),
+        # a free sphere gets the negative of its own id, as in the particle dumps
+        clump_id=np.where(body > 0, body, -ids),
+        position=table[:, 3:6],
+        velocity=table[:, 6:9],
+        angular_velocity=None,
+        radius=column["radius"],
+        mass=column["mass"],
+    )
+    return frame, table[:, 11:14].copy()
+
+
+def read_settled_fill(
+    dumps_dir: str | Path, timestep: float, history: WallForceHistory | None, floor_walls: tuple[str, ...]
+) -> SettledFill:
+    """The settled fill of a run: its sphere dump, the contacts of the same step and, from ``history`` (None: no
+    per-wall split), each wall's force at its last sample up to the snapshot.
+
+    Raises
+    ------
+    FileNotFoundError
+        When the run wrote no settled fill dump, or no contact dump at its step.
+    ContactDumpError
+        When a dump is damaged (see :func:`read_settled_spheres`).
+    """
+    dumps_dir = Path(dumps_dir)
+    paths = list_dumps(dumps_dir, SETTLED_FILL_PREFIX, ".txt")
+    if not paths:
+        raise FileNotFoundError(f"{dumps_dir}: no {SETTLED_FILL_PREFIX}_<step>.txt (a deck from before the force "
+                                "balance? render the run again)")
+    frame, wall_force = read_settled_spheres(paths[-1], timestep)
+    contacts_path = dumps_dir / f"{CONTACT_PREFIX}_{frame.step}.txt"
+    if not contacts_path.exists():
+        raise FileNotFoundError(f"{contacts_path}: the contacts of the settled fill (step {frame.step}) are missing")
+    wall_forces = {}
+    if history is not None:
+        before = np.flatnonzero(history.time <= frame.time * (1.0 + 1e-12))
+        if before.size:
+            sample = int(before[-1])
+            wall_forces = {name: history.force[name][sample] for name in history.walls}
+    return SettledFill(frame=frame, wall_force=wall_force, contacts=read_contacts(contacts_path),
+                       wall_forces=wall_forces, floor_walls=floor_walls if wall_forces else ())

@@ -1,0 +1,192 @@
+"""Unit tests for the flat-bottom silo plots (analysis.studies.silo_flat.plots): each writes its PNG and the figure
+it returns shows the synthetic input, scaled to the axes' units (files under tmp_path only).
+
+The discharge plot is tested in test_plots_tables.py.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from analysis.numerics.force_chains import ForceChainSegments
+from analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis
+from analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
+from analysis.studies.silo_flat.plots import (
+    plot_centreline_velocity,
+    plot_force_chains,
+    plot_janssen,
+    plot_kinematic_constant,
+    plot_kinematic_horizontal_velocity,
+    plot_measured_comparison,
+    plot_parametric_study,
+    plot_profiles_over_silo,
+    plot_velocity_contour,
+)
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+X = np.array([-0.02, -0.01, 0.0, 0.01, 0.02])
+HEIGHTS = np.array([0.01, 0.03])
+
+
+@pytest.fixture
+def written(tmp_path):
+    """Check that a writer left exactly its PNG and closed its figure; close it for good."""
+    figures = []
+
+    def check(figure, path):
+        assert path.read_bytes().startswith(PNG_SIGNATURE)
+        assert sorted(p.name for p in path.parent.iterdir()) == [path.name], "temporary files left behind"
+        assert not plt.fignum_exists(figure.number), "the writer closes its figure"
+        figures.append(figure)
+        return figure
+
+    yield check
+    for figure in figures:
+        plt.close(figure)
+
+
+def _profiles():
+    v_z = np.array([[-0.02, -0.06, -0.1, -0.06, -0.02], [-0.01, -0.03, -0.05, -0.03, -0.01]])
+    return ProfileAnalysis(
+        heights=HEIGHTS, x=X, v_z=v_z, v_x=np.array([[0.01, 0.02, 0.0, -0.02, -0.01], [0.0, 0.01, 0.0, -0.01, 0.0]]),
+        fcb_fractions=(0.05, 0.1), fcb_left=np.array([[-0.02, -0.015], [-0.018, -0.012]]),
+        fcb_right=np.array([[0.02, 0.015], [0.018, 0.012]]), kinematic_B=np.array([0.002, 0.003]),
+        kinematic_u=np.array([[0.012, 0.018, 0.0, -0.018, -0.012], [0.003, 0.009, 0.0, -0.009, -0.003]]))
+
+
+def _outline(width_mm, outlet_mm, top_mm):
+    half, slot = width_mm / 2, outlet_mm / 2
+    return [[[-half, top_mm], [-half, 0.0], [-slot, 0.0]], [[half, top_mm], [half, 0.0], [slot, 0.0]]]
+
+
+def test_plot_profiles_over_silo_draws_each_profile_at_its_height_with_the_boundary(tmp_path, written):
+    path = tmp_path / "profiles.png"
+    figure = written(plot_profiles_over_silo(_profiles(), 0.05, 0.01, 0.04, path, "profiles"), path)
+    (axes,) = figure.axes
+    assert (axes.get_title(), axes.get_xlabel(), axes.get_ylabel()) == ("profiles", "x [mm]", "z [mm]")
+    lines = axes.get_lines()
+    np.testing.assert_allclose([line.get_xydata() for line in lines[:2]], _outline(50.0, 10.0, 40.0))
+    scale = 0.8 * 0.02 / 0.1  # 80 % of the height spacing for the fastest profile
+    for i, z in enumerate(HEIGHTS):
+        guide, profile, boundary = lines[2 + 3 * i: 5 + 3 * i]
+        np.testing.assert_allclose(guide.get_ydata(), [1e3 * z] * 2)
+        np.testing.assert_allclose(profile.get_xydata(),
+                                   np.column_stack([1e3 * X, 1e3 * (z + scale * _profiles().v_z[i])]), rtol=1e-14)
+        left, right = _profiles().fcb_left[i, -1], _profiles().fcb_right[i, -1]
+        np.testing.assert_allclose(boundary.get_xydata(), [[1e3 * left, 1e3 * z], [1e3 * right, 1e3 * z]])
+    assert [line.get_label() for line in lines[-2:]] == ["FCB at 10 % of centreline v_z",
+                                                         f"v_z (1 mm = {1e-3 / scale:.3g} m/s)"]
+
+
+def test_plot_velocity_contour_fills_from_the_slowest_velocity_to_zero(tmp_path, written):
+    z = np.array([0.0, 0.02, 0.04])
+    v_z = np.array([[-0.01, -0.005, 0.0], [-0.2, -0.1, -0.05], [-0.01, -0.005, 0.0]])  # (nx, nz)
+    path = tmp_path / "contour.png"
+    figure = written(plot_velocity_contour(X[1:4], z, v_z, 0.05, 0.01, path, "v_z"), path)
+    axes, colorbar = figure.axes
+    filled = axes.collections[0]
+    np.testing.assert_allclose(filled.levels, np.linspace(-0.2, 0.0, 21))
+    np.testing.assert_allclose(axes.dataLim.get_points(), [[-25.0, 0.0], [25.0, 40.0]])  # the outline spans all
+    assert colorbar.get_ylabel() == "v_z [m/s]"
+    np.testing.assert_allclose([line.get_xydata() for line in axes.get_lines()], _outline(50.0, 10.0, 40.0))
+
+
+def test_plot_kinematic_constant_draws_b_against_height_in_mm(tmp_path, written):
+    path = tmp_path / "B.png"
+    figure = written(plot_kinematic_constant(HEIGHTS, [0.002, 0.0031], path, "B"), path)
+    (axes,) = figure.axes
+    (line,) = axes.get_lines()
+    np.testing.assert_allclose(line.get_xydata(), [[2.0, 10.0], [3.1, 30.0]])
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("B [mm]", "z [mm]")
+
+
+def test_plot_janssen_draws_both_stresses_against_depth(tmp_path, written):
+    comparison = JanssenComparison(depth_below_surface=np.array([0.005, 0.015]), simulated=np.array([40.0, 95.0]),
+                                   janssen=np.array([38.0, 100.0]), surface_height=0.05)
+    path = tmp_path / "janssen.png"
+    figure = written(plot_janssen(comparison, path, "stress"), path)
+    (axes,) = figure.axes
+    lines = {line.get_label(): line.get_xydata() for line in axes.get_lines()}
+    np.testing.assert_allclose(lines["DEM (contact stress)"], [[40.0, 5.0], [95.0, 15.0]])
+    np.testing.assert_allclose(lines["Janssen"], [[38.0, 5.0], [100.0, 15.0]])
+    assert axes.yaxis_inverted()  # depth grows downwards
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("vertical stress [Pa]", "depth below surface [mm]")
+
+
+def test_plot_centreline_velocity_draws_one_history_per_height(tmp_path, written):
+    times = np.array([0.0, 0.1, 0.2])
+    velocities = np.array([[0.0, 0.0], [-0.1, -0.05], [-0.12, -0.06]])
+    path = tmp_path / "centreline.png"
+    figure = written(plot_centreline_velocity(times, HEIGHTS, velocities, path, "axis"), path)
+    (axes,) = figure.axes
+    lines = {line.get_label(): line.get_xydata() for line in axes.get_lines()}
+    assert list(lines) == ["z = 10 mm", "z = 30 mm"]
+    np.testing.assert_array_equal(lines["z = 10 mm"], np.column_stack([times, velocities[:, 0]]))
+    np.testing.assert_array_equal(lines["z = 30 mm"], np.column_stack([times, velocities[:, 1]]))
+
+
+def test_plot_force_chains_draws_each_branch_in_the_x_z_plane_coloured_by_force(tmp_path, written):
+    segments = ForceChainSegments(start=np.array([[0.0, 0.001, 0.01], [0.01, -0.001, 0.02]]),
+                                  end=np.array([[0.002, 0.001, 0.012], [0.012, 0.0, 0.021]]),
+                                  normal_force=np.array([0.5, 3.0]), cap=2.0)
+    path = tmp_path / "chains.png"
+    figure = written(plot_force_chains(segments, 0.05, 0.01, 0.04, path, "chains"), path)
+    axes, colorbar = figure.axes
+    (chains,) = axes.collections
+    np.testing.assert_allclose(chains.get_segments(), [[[0.0, 10.0], [2.0, 12.0]], [[10.0, 20.0], [12.0, 21.0]]])
+    np.testing.assert_array_equal(chains.get_array(), [0.5, 3.0])
+    assert chains.get_clim() == (0.0, 2.0)
+    assert colorbar.get_ylabel() == "normal force [N] (capped at 2 N)"
+
+
+def test_plot_measured_comparison_draws_measured_points_and_the_interpolated_dem_profile(tmp_path, written):
+    x = np.array([-0.01, 0.0, 0.01])
+    with_error = MeasuredProfile(z=0.02, window="0-1 s", x=x, v_z=np.array([-0.05, -0.1, -0.05]), v_x=np.zeros(3),
+                                 uncertainty=np.array([0.01, 0.02, 0.01]))
+    without = MeasuredProfile(z=0.04, window="1-2 s", x=x, v_z=np.array([-0.02, -0.04, -0.02]), v_x=np.zeros(3),
+                              uncertainty=None)
+    simulated = np.array([-0.04, -0.06, -0.1, -0.06, -0.04])
+    comparisons = [compare_with_measurement(X, simulated, with_error), compare_with_measurement(X, simulated, without)]
+    path = tmp_path / "measured.png"
+    figure = written(plot_measured_comparison(comparisons, path, "DEM vs PIV"), path)
+    top, bottom = figure.axes
+    (bars,) = top.containers
+    np.testing.assert_allclose(bars.lines[0].get_xydata(), [[-10.0, -0.05], [0.0, -0.1], [10.0, -0.05]])
+    np.testing.assert_allclose([segment[:, 1] for segment in bars.lines[2][0].get_segments()],
+                               [[-0.06, -0.04], [-0.12, -0.08], [-0.06, -0.04]])
+    for axes, comparison in ((top, comparisons[0]), (bottom, comparisons[1])):
+        lines = {line.get_label(): line.get_xydata() for line in axes.get_lines()}
+        np.testing.assert_allclose(lines["DEM"], [[-10.0, -0.06], [0.0, -0.1], [10.0, -0.06]])
+        errors = comparison.errors
+        assert axes.get_title().endswith(f"mean error {errors.mean_error_percent:.1f} %, RMS {errors.rms_error:.3g} m/s")
+    np.testing.assert_allclose({line.get_label(): line for line in bottom.get_lines()}["measured"].get_xydata(),
+                               [[-10.0, -0.02], [0.0, -0.04], [10.0, -0.02]])
+    assert top.get_title().startswith("z = 20 mm, 0-1 s:") and bottom.get_xlabel() == "x [mm]"
+
+
+def test_plot_parametric_study_draws_the_profiles_and_a_bar_per_run(tmp_path, written):
+    profiles = [np.array([-0.02, -0.06, -0.1, -0.06, -0.02]), np.array([-0.01, -0.05, -0.12, -0.05, -0.01])]
+    path = tmp_path / "study.png"
+    figure = written(plot_parametric_study(X, profiles, ["base", "rough"], [0.12, 0.1], 0.03, path, "friction"), path)
+    left, right = figure.axes
+    lines = {line.get_label(): line.get_xydata() for line in left.get_lines()}
+    np.testing.assert_allclose(lines["base"], np.column_stack([1e3 * X, profiles[0]]))
+    np.testing.assert_allclose(lines["rough"], np.column_stack([1e3 * X, profiles[1]]))
+    assert left.get_ylabel() == "v_z at z = 30 mm [m/s]"
+    assert [bar.get_height() for bar in right.patches] == [0.12, 0.1]
+    assert [label.get_text() for label in right.get_xticklabels()] == ["base", "rough"]
+
+
+def test_plot_kinematic_horizontal_velocity_draws_dem_and_model_per_height(tmp_path, written):
+    profiles = _profiles()
+    path = tmp_path / "u.png"
+    figure = written(plot_kinematic_horizontal_velocity(profiles, path, "u"), path)
+    assert len(figure.axes) == 2
+    for i, axes in enumerate(figure.axes):
+        dem, model = axes.get_lines()
+        np.testing.assert_allclose(dem.get_xydata(), np.column_stack([1e3 * X, profiles.v_x[i]]))
+        np.testing.assert_allclose(model.get_xydata(), np.column_stack([1e3 * X, profiles.kinematic_u[i]]))
+        assert axes.get_ylabel() == f"z = {1e3 * HEIGHTS[i]:g} mm\n[m/s]"
+    assert [line.get_label() for line in figure.axes[0].get_lines()] == ["DEM v_x", "kinematic u = -B dv_z/dx"]

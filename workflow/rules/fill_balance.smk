@@ -1,0 +1,36 @@
+# The settled fill's force balance of every silo-type run (flat-bottom silo, recirculating silo, blender): the load the
+# floor and each wall carry and the load across horizontal planes, against the weight. A fill that is not at rest,
+# or whose walls hold it down, stops the pipeline here with a message that says so.
+
+FILL_BALANCE_CASES = ("silo_flat", RECIRCULATION, "blender")
+
+
+def fill_balance_params(kind):
+    """The balance's parameters of one run of ``kind``: its fill height, gravity, the plane fractions and the tolerances."""
+    def params(wildcards):
+        fill = config[kind]["fill"]
+        case = cases(kind)[wildcards.run]
+        return {"fill_height": case.fill_height, "gravity": case.gravity, "planes": fill["balance_planes"],
+                "tolerance": fill["balance_tolerance"]}
+    return params
+
+
+def fill_balance_targets(kind, runs):
+    return [run_path(kind, "metrics/fill_balance.json", run) for run in runs]
+
+
+for _kind in FILL_BALANCE_CASES:
+
+    rule:
+        name:
+            f"{_kind}_fill_balance"
+        input:
+            record=run_rule_output(_kind),
+        output:
+            balance=run_path(_kind, "metrics/fill_balance.json"),
+        params:
+            balance=fill_balance_params(_kind),
+        log:
+            run_path(_kind, "logs/fill_balance.log"),
+        script:
+            "../scripts/fill_balance.py"
