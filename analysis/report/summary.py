@@ -47,6 +47,7 @@ __all__ = [
     "measured_rows",
     "recirculation_rows",
     "blender_rows",
+    "fill_balance_rows",
     "summary_sections",
 ]
 
@@ -112,6 +113,13 @@ COLUMNS: dict[str, Column] = {
     "rtd_spread": Column("RTD spread σ/t_m", kind=ESTIMATE),
     "ts_over_td": Column("First appearance / discharge time t_s/t_d", kind=ESTIMATE),
     "recirculations_to_homogenise": Column("Recirculations to homogenise"),
+    # the settled fill's force balance (metrics/fill_balance.json)
+    "case": Column("Case", kind=TEXT),
+    "support_ratio": Column("Walls + floor / weight"),
+    "floor_ratio": Column("Floor / weight"),
+    "walls_ratio": Column("Walls / weight"),
+    "silo_like": Column("Walls carry part of the weight (silo-like)", kind=FLAG),
+    "balance_passed": Column("Force balance passed", kind=FLAG),
 }
 
 #: The blender comparison's VRR columns, one per sine period (a fraction of the mean residence time).
@@ -123,6 +131,8 @@ COLUMN_FAMILIES: tuple[tuple[re.Pattern, Callable[[re.Match], str], str, str], .
     (re.compile(r"vrr_at_ceiling_nr(\d+)"),
      lambda match: f"VRR after recirculation {int(match[1])} at the counting-noise ceiling", "", FLAG),
     (_PERIOD_VRR, lambda match: f"VRR, sine period {match[1]} t_m", "", ESTIMATE),
+    (re.compile(r"contacts_at_(\d+)_mm"), lambda match: f"Contacts / weight above, plane at {int(match[1])} mm", "",
+     NUMBER),
 )
 
 
@@ -548,6 +558,20 @@ def blender_rows(rows: Sequence[Mapping]) -> list[dict]:
             for row in rows]
 
 
+def fill_balance_rows(balances: Sequence[Mapping]) -> list[dict]:
+    """One row per settled fill (``metrics/fill_balance.json`` as read): the shares of the weight that the walls and
+    floor carry, and the contacts' share of the weight above each plane."""
+    rows = []
+    for balance in balances:
+        row = {"case": balance["case"], "run_id": balance["run_id"], "n_clumps": balance["clumps"]}
+        row.update({key: balance[key] for key in ("support_ratio", "floor_ratio", "walls_ratio", "silo_like")})
+        for plane in balance["planes"]:
+            row[f"contacts_at_{round(plane['height_m'] * 1e3)}_mm"] = plane["contact_ratio"]
+        row["balance_passed"] = not balance["problems"]
+        rows.append(row)
+    return rows
+
+
 CALIBRATION_LEGEND = ("Band: the sliding friction range whose bulk friction angle lies within the target "
                       "± tolerance, the calibration's uncertainty. Band clipped: the band reaches the end of the "
                       "swept friction range, so that end is only a bound.")
@@ -560,13 +584,19 @@ BLENDING_LEGEND = ("Residence time: hold-up over throughput. t_s/t_d: first appe
                    "σ_in²/σ_out² of the outlet blue fraction during pass n. At the counting-noise ceiling: the VRR "
                    "is close to the largest one the windows' particle counts can measure, so it is only a lower "
                    "bound.")
+FILL_LEGEND = ("Forces on the settled fill before its outlet opens, as shares of its weight. Walls + floor: 1 at "
+               "rest. Walls: positive when they carry part of the weight by friction, as in a silo (Janssen); "
+               "negative when they hold the fill down, a stress state a violent pour locks in. Contacts / weight "
+               "above: the load the contacts carry across a horizontal plane over the weight of the clumps above "
+               "it; at most 1 in a silo.")
 BLENDER_LEGEND = ("Mean vertical velocity: the mean v_z of each passage (negative: downwards). VRR, sine period "
                   "f t_m: variance reduction ratio of a sine input whose period is f times the mean residence time. "
                   "n/a under recirculations to homogenise: not homogenised within the simulated passes.")
 
 
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
-                     recirculation: Sequence[Mapping], blender: Sequence[Mapping]) -> list[Section]:
+                     recirculation: Sequence[Mapping], blender: Sequence[Mapping],
+                     balances: Sequence[Mapping] = ()) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -577,6 +607,8 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         The flow summary of each flat-bottom silo run (``metrics/flow.json``).
     measured, recirculation, blender : sequence of mapping
         Rows of the measured-profile comparisons, of the recirculating-silo summary and of the blender comparison.
+    balances : sequence of mapping
+        The force balance of each settled fill (``metrics/fill_balance.json``).
     """
     return [
         Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
@@ -590,4 +622,6 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
                 recirculation_rows(recirculation), BLENDING_LEGEND),
         Section("Blender", "Insert configurations compared (see the blender comparison table).",
                 blender_rows(blender), BLENDER_LEGEND),
+        Section("Settled fills", "How each settled fill carries its weight before the outlet opens.",
+                fill_balance_rows(balances), FILL_LEGEND),
     ]

@@ -487,6 +487,21 @@ def test_sampling_noise_vrr_limit_is_the_particles_per_window():
         sampling_noise_vrr_limit(0.0, 10)
 
 
+def test_recirculation_vrr_ceiling_is_the_clumps_per_window_and_flags_from_half_of_it():
+    result = RecirculationVRR(recirculation_number=np.array([0.5, 1.5, 2.5, 3.5]),
+                              vrr=np.array([20.0, 19.99, np.nan, np.inf]), sigma_out=np.full(4, np.nan),
+                              n_windows=np.array([5, 5, 1, 5]), sigma_in=math.sqrt(0.21), blue_fraction=0.3)
+    assert result.ceiling(40) == 40.0  # p (1 - p) / (p (1 - p) / 40)
+    flags = result.at_ceiling(40)
+    assert flags.dtype == bool
+    np.testing.assert_array_equal(flags, [True, False, False, True])  # 20 = 40 / 2; NaN never, inf always
+    np.testing.assert_array_equal(result.at_ceiling(40, factor=4.0), [True, True, False, True])
+    with pytest.raises(ValueError, match="clumps_per_window must be a finite number > 0"):
+        result.ceiling(0.0)
+    with pytest.raises(ValueError, match="factor must be a finite number >= 1"):
+        result.at_ceiling(40, factor=0.5)
+
+
 # --------------------------------------------------------------------------- tracer
 
 

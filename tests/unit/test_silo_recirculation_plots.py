@@ -1,10 +1,18 @@
-"""Unit tests for analysis.studies.silo_recirculation.plots and .rtd_plots (files under tmp_path only)."""
+"""Unit tests for analysis.studies.silo_recirculation.plots and .rtd_plots: PNGs are written (under tmp_path only)
+and the plotted data are the input, as each writer's docstring promises."""
 
 from __future__ import annotations
 
+import matplotlib.patches
 import numpy as np
 import pytest
+from matplotlib.collections import PathCollection
+from matplotlib.colors import to_hex
+from matplotlib.path import Path as MplPath
 
+import analysis.studies.silo_recirculation.plots as plots
+import analysis.studies.silo_recirculation.rtd_plots as rtd_plots
+from analysis.io.plots import save_png
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
     plot_outlet_concentration,
@@ -29,6 +37,46 @@ def _assert_png(target, returned):
     assert data.startswith(PNG_SIGNATURE)
     assert 5_000 < len(data) < 5_000_000
     assert sorted(p.name for p in target.parent.iterdir()) == [target.name], "temporary files left behind"
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures the writers save, kept (after they are written) so that their plotted data can be checked."""
+    saved = []
+
+    def keep(figure, path, tight=False):
+        saved.append(figure)
+        return save_png(figure, path, tight=tight)
+
+    monkeypatch.setattr(plots, "save_png", keep)
+    monkeypatch.setattr(rtd_plots, "save_png", keep)
+    return saved
+
+
+def _only_axes(figures):
+    (figure,) = figures
+    (axes,) = figure.axes
+    return axes
+
+
+def _line(axes, label):
+    (line,) = [line for line in axes.get_lines() if line.get_label() == label]
+    return line
+
+
+def _lines_with_gid(axes, gid):
+    return [line for line in axes.get_lines() if line.get_gid() == gid]
+
+
+def _pieces(line) -> int:
+    """Separate pieces matplotlib draws for a line: NaN samples split it (one MOVETO per piece)."""
+    return sum(code == MplPath.MOVETO for _, code in line.get_path().cleaned(remove_nans=True).iter_segments())
+
+
+def _horizontal_lines(axes) -> list[float]:
+    """The y of every horizontal reference line (axhline), in drawing order."""
+    return [line.get_ydata()[0] for line in axes.get_lines()
+            if line.get_transform() != axes.transData and list(line.get_xdata()) == [0, 1]]
 
 
 def _concentration_curves():
@@ -61,17 +109,33 @@ def _paths():
 
 
 @pytest.mark.parametrize("tolerance", [0.10, 0.05])
-def test_plot_outlet_concentration_writes_png(tmp_path, tolerance):
+def test_plot_outlet_concentration_draws_each_curve_and_the_band(tmp_path, figures, tolerance):
     target = tmp_path / "plots" / "outlet.png"
-    _assert_png(target, plot_outlet_concentration(_concentration_curves(), 0.5, target, "outlet", tolerance=tolerance))
+    _assert_png(target, plot_outlet_concentration(_concentration_curves(), 0.4, target, "outlet", tolerance=tolerance))
+    axes = _only_axes(figures)
+    for label, nr, c in _concentration_curves():
+        line = _line(axes, label)
+        np.testing.assert_array_equal(line.get_xdata(), nr)
+        np.testing.assert_array_equal(line.get_ydata(), c)
+        assert _pieces(line) == 1
+    assert _horizontal_lines(axes) == [0.4]  # the blue fraction
+    (band,) = [patch for patch in axes.patches if isinstance(patch, matplotlib.patches.Rectangle)]
+    np.testing.assert_allclose([band.get_y(), band.get_y() + band.get_height()],
+                               [0.4 * (1 - tolerance), 0.4 * (1 + tolerance)], rtol=1e-12)
+    assert axes.get_title() == "outlet"
 
 
-def test_plot_outlet_concentration_nan_is_a_gap(tmp_path):
+def test_plot_outlet_concentration_nan_is_a_gap(tmp_path, figures):
     label, nr, c = _concentration_curves()[0]
     c = c.copy()
     c[10:15] = np.nan
     target = tmp_path / "outlet.png"
     _assert_png(target, plot_outlet_concentration([(label, nr, c)], 0.5, target, "gaps"))
+    line = _line(_only_axes(figures), label)
+    # every sample is handed to matplotlib, NaN included (not dropped, not bridged), so the line breaks in two
+    np.testing.assert_array_equal(line.get_xdata(), nr)
+    np.testing.assert_array_equal(line.get_ydata(), c)
+    assert _pieces(line) == 2
 
 
 def test_plot_outlet_concentration_rejects_bad_input(tmp_path):
@@ -90,20 +154,71 @@ def test_plot_outlet_concentration_rejects_bad_input(tmp_path):
 # ---------------------------------------------------------------------------------------- VRR vs recirculations
 
 
+def _at_ceiling(axes) -> list[tuple[list, list]]:
+    """(x, y) of the open markers of VRRs at the counting-noise ceiling, one entry per curve that has some."""
+    return [(list(line.get_xdata()), list(line.get_ydata())) for line in _lines_with_gid(axes, "at_ceiling")]
+
+
 @pytest.mark.parametrize("noise_limit", [None, 250.0])
-def test_plot_vrr_versus_recirculations_writes_png(tmp_path, noise_limit):
+def test_plot_vrr_versus_recirculations_draws_the_ceiling_and_marks_vrrs_near_it(tmp_path, figures, noise_limit):
     nr = np.arange(1.0, 6.0)
     curves = [("DEM", nr, 3.0 ** nr), ("model", nr, 2.0 ** nr)]
     target = tmp_path / "vrr.png"
     _assert_png(target, plot_vrr_versus_recirculations(curves, target, "VRR", noise_limit=noise_limit))
+    axes = _only_axes(figures)
+    assert axes.get_yscale() == "log"
+    for label, x, y in curves:
+        np.testing.assert_array_equal(_line(axes, label).get_xdata(), x)
+        np.testing.assert_array_equal(_line(axes, label).get_ydata(), y)
+    if noise_limit is None:
+        assert _horizontal_lines(axes) == [1.0]
+        assert _at_ceiling(axes) == []
+    else:
+        assert _horizontal_lines(axes) == [1.0, 250.0]
+        assert [line.get_ydata()[0] for line in _lines_with_gid(axes, "ceiling")] == [250.0]
+        # 3^5 = 243 >= 250 / 2 is marked; 3^4 = 81 and every 2^k are not
+        assert _at_ceiling(axes) == [([5.0], [243.0])]
+        assert "within x2 of the ceiling: lower bound" in [text.get_text() for text in axes.get_legend().get_texts()]
 
 
-def test_plot_vrr_versus_recirculations_skips_non_finite(tmp_path):
+def test_plot_vrr_versus_recirculations_skips_non_finite(tmp_path, figures):
     nr = np.arange(1.0, 6.0)
     curves = [("mixed", nr, np.array([2.0, np.nan, 8.0, np.inf, -1.0])),
               ("all bad", nr, np.full(5, np.nan))]
     target = tmp_path / "vrr.png"
     _assert_png(target, plot_vrr_versus_recirculations(curves, target, "non-finite", noise_limit=10.0))
+    axes = _only_axes(figures)
+    mixed = _line(axes, "mixed")
+    np.testing.assert_array_equal(mixed.get_xdata(), [1.0, 3.0])  # NaN, inf and -1 are not on the line
+    np.testing.assert_array_equal(mixed.get_ydata(), [2.0, 8.0])
+    empty = _line(axes, "all bad (no finite VRR)")
+    assert np.size(empty.get_xdata()) == 0 and np.size(empty.get_ydata()) == 0
+    (infinite,) = _lines_with_gid(axes, "infinite")  # inf: a triangle at the top of the axes, at Nr = 4
+    np.testing.assert_array_equal(infinite.get_xdata(), [4.0])
+    np.testing.assert_array_equal(infinite.get_ydata(), [0.97])
+    assert infinite.get_color() == mixed.get_color()
+    assert _at_ceiling(axes) == [([3.0], [8.0])]  # 8 >= 10 / 2; 2 is not
+
+
+def test_plot_vrr_versus_recirculations_uses_each_curves_own_ceiling(tmp_path, figures):
+    nr = np.array([1.0, 2.0])
+    curves = [("run a", nr, [10.0, 30.0], 40.0), ("run b", nr, [10.0, 30.0], 100.0), ("run c", nr, [10.0, 30.0]),
+              ("run d", nr, [10.0, 30.0], None)]
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_versus_recirculations(curves, target, "ceilings"))
+    axes = _only_axes(figures)
+    assert [line.get_ydata()[0] for line in _lines_with_gid(axes, "ceiling")] == [40.0, 100.0]
+    assert _at_ceiling(axes) == [([2.0], [30.0])]  # run a only: 30 >= 40 / 2 but < 100 / 2; c and d have none
+    (marker,) = _lines_with_gid(axes, "at_ceiling")
+    assert marker.get_markerfacecolor() == "white" and marker.get_markeredgecolor() == _line(axes, "run a").get_color()
+    # the markers take no colour from the cycle: the curves keep the default colours in order
+    assert [to_hex(_line(axes, f"run {name}").get_color()) for name in "abcd"] == [
+        "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728"]
+    figures.clear()
+    _assert_png(target, plot_vrr_versus_recirculations(curves, target, "ceilings", noise_limit=60.0, factor=4.0))
+    # factor 4: 30 >= 100 / 4 and 60 / 4 too; 10 >= 40 / 4 as well
+    assert _at_ceiling(_only_axes(figures)) == [([1.0, 2.0], [10.0, 30.0]), ([2.0], [30.0]), ([2.0], [30.0]),
+                                                ([2.0], [30.0])]
 
 
 def test_plot_vrr_versus_recirculations_rejects_bad_input(tmp_path):
@@ -114,24 +229,54 @@ def test_plot_vrr_versus_recirculations_rejects_bad_input(tmp_path):
         plot_vrr_versus_recirculations([("a", [1.0, np.nan, 3.0], nr)], tmp_path / "a.png", "t")
     with pytest.raises(ValueError, match="noise_limit"):
         plot_vrr_versus_recirculations([("a", nr, nr)], tmp_path / "a.png", "t", noise_limit=0.0)
-    with pytest.raises(ValueError, match=r"curves\[0\]"):
+    with pytest.raises(ValueError, match=r"curves\[0\] must be a tuple of 3 items"):
         plot_vrr_versus_recirculations([("a", nr)], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] must be a tuple of 3 items"):
+        plot_vrr_versus_recirculations([("a", nr, nr, 5.0, 1)], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match=r"curves\[1\] ceiling must be a finite number > 0"):
+        plot_vrr_versus_recirculations([("a", nr, nr), ("b", nr, nr, 0.0)], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match="factor must be a finite number >= 1"):
+        plot_vrr_versus_recirculations([("a", nr, nr)], tmp_path / "a.png", "t", factor=0.5)
+    assert not (tmp_path / "a.png").exists()
 
 
 # ---------------------------------------------------------------------------------------- snapshots
 
 
+def _panels(figures):
+    (figure,) = figures
+    return [axes for axes in figure.axes if axes.get_visible()]
+
+
+def _scatter_points(axes) -> list[np.ndarray]:
+    """Offsets of the scatters of a panel, in drawing order (white batch, then blue)."""
+    return [np.asarray(c.get_offsets()) for c in axes.collections if isinstance(c, PathCollection)]
+
+
 @pytest.mark.parametrize("count", [1, 3, 6])
-def test_plot_coloured_snapshots_writes_png(tmp_path, count):
+def test_plot_coloured_snapshots_one_panel_per_snapshot_coloured_by_batch(tmp_path, figures, count):
     snapshots = [_snapshot(0.5 * k, seed=k) for k in range(count)]
     target = tmp_path / "snapshots.png"
     _assert_png(target, plot_coloured_snapshots(snapshots, WIDTH, OUTLET, TOP, CHANNEL, target, "blend"))
+    panels = _panels(figures)
+    assert len(panels) == count
+    columns = min(count, 4)  # rows of up to four panels, the spare ones hidden
+    assert len(figures[0].axes) == columns * -(-count // columns)
+    for axes, (nr, x, z, blue) in zip(panels, snapshots):
+        assert axes.get_title() == f"Nr = {nr:g}"
+        white, coloured = _scatter_points(axes)
+        np.testing.assert_array_equal(white, np.column_stack([1e3 * x[~blue], 1e3 * z[~blue]]))  # drawn in mm
+        np.testing.assert_array_equal(coloured, np.column_stack([1e3 * x[blue], 1e3 * z[blue]]))
+        assert axes.get_xlim() == pytest.approx((-0.55e3 * WIDTH, 0.55e3 * WIDTH))
 
 
-def test_plot_coloured_snapshots_empty_snapshot_allowed(tmp_path):
+def test_plot_coloured_snapshots_empty_snapshot_allowed(tmp_path, figures):
     target = tmp_path / "snapshots.png"
     empty = (0.0, np.empty(0), np.empty(0), np.empty(0, dtype=bool))
     _assert_png(target, plot_coloured_snapshots([empty, _snapshot(1.0)], WIDTH, OUTLET, TOP, CHANNEL, target, "t"))
+    first, second = _panels(figures)
+    assert [points.size for points in _scatter_points(first)] == [0, 0]
+    assert sum(len(points) for points in _scatter_points(second)) == 300
 
 
 def test_plot_coloured_snapshots_rejects_bad_input(tmp_path):
@@ -152,9 +297,17 @@ def test_plot_coloured_snapshots_rejects_bad_input(tmp_path):
 
 
 @pytest.mark.parametrize("dimensionless", [True, False])
-def test_plot_rtd_comparison_writes_png(tmp_path, dimensionless):
+def test_plot_rtd_comparison_draws_steps_of_each_rtd(tmp_path, figures, dimensionless):
     target = tmp_path / "rtd.png"
     _assert_png(target, plot_rtd_comparison(_rtd_curves(), target, "RTD", dimensionless=dimensionless))
+    axes = _only_axes(figures)
+    for label, t, e, t_mean in _rtd_curves():
+        line = _line(axes, f"{label} (t_m = {t_mean:.3g} s)")
+        assert line.get_drawstyle() == "steps-mid"
+        # E(theta) = t_m E(t) against theta = t / t_m, or E(t) against t
+        np.testing.assert_array_equal(line.get_xdata(), t / t_mean if dimensionless else t)
+        np.testing.assert_array_equal(line.get_ydata(), t_mean * e if dimensionless else e)
+    assert axes.get_xlim()[0] == 0.0 and axes.get_ylim()[0] == 0.0
 
 
 def test_plot_rtd_comparison_rejects_bad_input(tmp_path):
@@ -170,7 +323,7 @@ def test_plot_rtd_comparison_rejects_bad_input(tmp_path):
 # ---------------------------------------------------------------------------------------- LTI comparison
 
 
-def test_plot_lti_comparison_writes_png(tmp_path):
+def test_plot_lti_comparison_draws_every_series_in_its_style(tmp_path, figures):
     time = np.linspace(0.0, 20.0, 201)
     series = [
         ("square input", (np.sin(time) > 0).astype(float), "input"),
@@ -181,6 +334,16 @@ def test_plot_lti_comparison_writes_png(tmp_path):
     ]
     target = tmp_path / "lti.png"
     _assert_png(target, plot_lti_comparison(time, series, target, "LTI", blue_fraction=0.5, x_label="Nr [-]"))
+    axes = _only_axes(figures)
+    expected_styles = {"input": "-", "direct": "-", "predicted": "--", "first pass": ":", "whatever": "-"}
+    for label, concentration, style in series:
+        line = _line(axes, f"{label} ({style})")
+        np.testing.assert_array_equal(line.get_xdata(), time)
+        np.testing.assert_array_equal(line.get_ydata(), concentration)
+        assert line.get_linestyle() == expected_styles[style]
+    assert _line(axes, "square input (input)").get_color() == "0.5"
+    assert _horizontal_lines(axes) == [0.5]
+    assert axes.get_xlabel() == "Nr [-]"
 
 
 def test_plot_lti_comparison_rejects_bad_input(tmp_path):
@@ -198,11 +361,18 @@ def test_plot_lti_comparison_rejects_bad_input(tmp_path):
 # ---------------------------------------------------------------------------------------- VRR vs period
 
 
-def test_plot_vrr_versus_period_writes_png(tmp_path):
+def test_plot_vrr_versus_period_draws_the_finite_points_log_log(tmp_path, figures):
     fraction = np.logspace(-1, 1, 9)
     curves = [("DEM", 1.0 + (2 * np.pi / fraction) ** 2), ("mixer", np.r_[np.nan, 1.0 + (2 * np.pi / fraction[1:]) ** 2])]
     target = tmp_path / "vrr_period.png"
     _assert_png(target, plot_vrr_versus_period(fraction, curves, target, "VRR(T)"))
+    axes = _only_axes(figures)
+    assert (axes.get_xscale(), axes.get_yscale()) == ("log", "log")
+    np.testing.assert_array_equal(_line(axes, "DEM").get_xdata(), fraction)
+    np.testing.assert_array_equal(_line(axes, "DEM").get_ydata(), curves[0][1])
+    np.testing.assert_array_equal(_line(axes, "mixer").get_xdata(), fraction[1:])  # the NaN point is skipped
+    np.testing.assert_array_equal(_line(axes, "mixer").get_ydata(), curves[1][1][1:])
+    assert _horizontal_lines(axes) == [1.0]
 
 
 def test_plot_vrr_versus_period_rejects_bad_input(tmp_path):
@@ -219,12 +389,26 @@ def test_plot_vrr_versus_period_rejects_bad_input(tmp_path):
 
 
 @pytest.mark.parametrize("homogenised_after", [2.3, float("nan")])
-def test_plot_recirculation_model_writes_png(tmp_path, homogenised_after):
+def test_plot_recirculation_model_draws_the_model_and_when_it_is_homogenised(tmp_path, figures, homogenised_after):
     passes = np.linspace(0.0, 5.0, 251)
     concentration = 0.5 + 0.5 * np.exp(-passes) * np.cos(2 * np.pi * passes)
     target = tmp_path / "recirculation.png"
     returned = plot_recirculation_model(passes, concentration, 0.5, homogenised_after, target, "recirculation")
     _assert_png(target, returned)
+    axes = _only_axes(figures)
+    model = _line(axes, "LTI model, recirculated")
+    np.testing.assert_array_equal(model.get_xdata(), passes)
+    np.testing.assert_array_equal(model.get_ydata(), concentration)
+    (band,) = [patch for patch in axes.patches if isinstance(patch, matplotlib.patches.Rectangle)]
+    np.testing.assert_allclose([band.get_y(), band.get_y() + band.get_height()], [0.45, 0.55], rtol=1e-12)
+    marks = [line for line in axes.get_lines() if line.get_label().startswith("within band after")]
+    texts = [text.get_text() for text in axes.texts]
+    if np.isnan(homogenised_after):
+        assert marks == [] and texts == ["not within band"]
+    else:
+        (mark,) = marks
+        assert list(mark.get_xdata()) == [2.3, 2.3] and mark.get_label() == "within band after Nr = 2.3"
+        assert texts == []
 
 
 def test_plot_recirculation_model_rejects_bad_input(tmp_path):
@@ -242,16 +426,35 @@ def test_plot_recirculation_model_rejects_bad_input(tmp_path):
 # ---------------------------------------------------------------------------------------- paths
 
 
-def test_plot_paths_comparison_writes_png(tmp_path):
+def _path_lines(axes, linestyle):
+    """The drawn tracks (solid) or pathlines (dashed): lines of that style with data, not the legend proxies."""
+    return [line for line in axes.get_lines()
+            if line.get_linestyle() == linestyle and np.size(line.get_xdata()) and line.get_label().startswith("_")
+            and line.get_color() != "black"]
+
+
+def test_plot_paths_comparison_draws_tracks_solid_and_pathlines_dashed_in_mm(tmp_path, figures):
     tracks, lines = _paths()
     target = tmp_path / "paths.png"
     _assert_png(target, plot_paths_comparison(tracks, lines, WIDTH, OUTLET, TOP, target, "paths"))
+    axes = _only_axes(figures)
+    drawn_tracks, drawn_lines = _path_lines(axes, "-"), _path_lines(axes, "--")
+    assert len(drawn_tracks) == 2 and len(drawn_lines) == 1
+    for line, expected in zip(drawn_tracks + drawn_lines, tracks + lines):
+        np.testing.assert_array_equal(line.get_xdata(), 1e3 * expected[:, 0])
+        np.testing.assert_array_equal(line.get_ydata(), 1e3 * expected[:, 1])
+    assert [_pieces(line) for line in drawn_tracks] == [1, 2]  # the NaN row breaks the second track
+    legend = [text.get_text() for text in axes.get_legend().get_texts()]
+    assert legend == ["DEM particle tracks (2)", "pathlines (1)"]
 
 
-def test_plot_paths_comparison_one_list_may_be_empty(tmp_path):
+def test_plot_paths_comparison_one_list_may_be_empty(tmp_path, figures):
     tracks, _ = _paths()
     target = tmp_path / "paths.png"
     _assert_png(target, plot_paths_comparison(tracks, [], WIDTH, OUTLET, TOP, target, "tracks only"))
+    axes = _only_axes(figures)
+    assert len(_path_lines(axes, "-")) == 2 and _path_lines(axes, "--") == []
+    assert [text.get_text() for text in axes.get_legend().get_texts()] == ["DEM particle tracks (2)", "pathlines (0)"]
 
 
 def test_plot_paths_comparison_rejects_bad_input(tmp_path):
@@ -267,13 +470,25 @@ def test_plot_paths_comparison_rejects_bad_input(tmp_path):
 # ---------------------------------------------------------------------------------------- residence times
 
 
-def test_plot_residence_time_comparison_writes_png(tmp_path):
+def test_plot_residence_time_comparison_draws_histograms_and_cumulative_fractions(tmp_path, figures):
     rng = np.random.default_rng(1)
     dem = rng.exponential(2.0, 400)
     dem[:7] = np.nan
     samples = [("DEM", dem), ("pathlines", 1.0 + rng.gamma(4.0, 0.5, 300)), ("single", np.array([3.0]))]
     target = tmp_path / "residence.png"
     _assert_png(target, plot_residence_time_comparison(samples, target, "residence times"))
+    (figure,) = figures
+    left, right = figure.axes
+    labels = ["DEM (n = 393, 7 NaN ignored)", "pathlines (n = 300)", "single (n = 1)"]
+    assert [text.get_text() for text in left.get_legend().get_texts()] == labels
+    for label, (_, times) in zip(labels, samples):
+        finite = np.sort(times[np.isfinite(times)])
+        cumulative = _line(right, label)  # F(t): steps from 0 up to 1 at the sorted finite times
+        assert cumulative.get_drawstyle() == "steps-post"
+        np.testing.assert_array_equal(cumulative.get_xdata(), np.r_[finite[0], finite])
+        np.testing.assert_array_equal(cumulative.get_ydata(), np.r_[0.0, np.arange(1, finite.size + 1) / finite.size])
+    histograms = [patch for patch in left.patches if patch.get_label() in labels]
+    assert [patch.get_label() for patch in histograms] == labels  # one step histogram per sample
 
 
 def test_plot_residence_time_comparison_rejects_bad_input(tmp_path):

@@ -8,6 +8,7 @@ and kernels the tables never touch are None.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -118,16 +119,56 @@ def test_concentration_rows_list_every_window_of_every_layout_in_order():
     assert all(type(row["crossings"]) is int for row in concentration_rows(RESULT))
 
 
-def test_vrr_rows_put_the_layout_first_and_the_predicted_vrr_last():
-    columns = ["layout", "recirculation_number", "vrr", "sigma_out", "n_windows", "sigma_in", "blue_fraction",
-               "vrr_predicted"]
-    sigma_top = math.sqrt(0.1875)
-    assert_rows(vrr_rows(RESULT), columns, [dict(zip(columns, row)) for row in [
-        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0],
-        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN],
-        ["top 25 %", 0.5, 3.0, 0.25, 2, sigma_top, 0.25, math.inf],
-        ["top 25 %", 1.5, NAN, NAN, 0, sigma_top, 0.25, NAN],
+VRR_COLUMNS = ["layout", "recirculation_number", "vrr", "sigma_out", "n_windows", "sigma_in", "blue_fraction",
+               "vrr_predicted", "vrr_ceiling", "vrr_at_ceiling", "vrr_kind", "vrr_predicted_over_measured"]
+SIGMA_TOP = math.sqrt(0.1875)
+
+
+def with_throughput(throughput: float, result: BlendingResult = RESULT) -> BlendingResult:
+    """The hand-built result with another throughput: clumps per window (and the VRR ceiling) = throughput x 1 s."""
+    return dataclasses.replace(result, timing=dataclasses.replace(TIMING, throughput=throughput))
+
+
+def test_vrr_rows_put_the_layout_first_then_the_prediction_then_the_ceiling():
+    # 10 clumps per window: ceiling 10, flagged from 5 on; VRRs 4 and 3 are values, compared with the prediction
+    assert_rows(vrr_rows(RESULT), VRR_COLUMNS, [dict(zip(VRR_COLUMNS, row)) for row in [
+        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 10.0, False, "value", 4.0],
+        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 10.0, False, "none", NAN],
+        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 10.0, False, "value", math.inf],
+        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 10.0, False, "none", NAN],
     ]])
+    assert all(type(row["vrr_at_ceiling"]) is bool for row in vrr_rows(RESULT))
+
+
+def test_vrr_rows_mark_a_vrr_at_half_the_ceiling_as_a_lower_bound_not_compared():
+    # 8 clumps per window: ceiling 8, flagged from 8 / 2 = 4 on, so VRR 4 (bottom half) is at the boundary and
+    # flagged; VRR 3 (top 25 %) is not. The lower bound gets no prediction ratio.
+    assert_rows(vrr_rows(with_throughput(8.0)), VRR_COLUMNS, [dict(zip(VRR_COLUMNS, row)) for row in [
+        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 8.0, True, "lower bound", NAN],
+        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 8.0, False, "none", NAN],
+        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 8.0, False, "value", math.inf],
+        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 8.0, False, "none", NAN],
+    ]])
+
+
+@pytest.mark.parametrize("throughput, factor, expected", [
+    (8.0001, 2.0, [False, False]),  # 4 < 8.0001 / 2
+    (6.0, 2.0, [True, True]),  # 4 and 3 >= 3
+    (10.0, 2.5, [True, False]),  # 4 >= 10 / 2.5 > 3
+    (10.0, 1.0, [False, False]),  # at the ceiling itself only
+])
+def test_vrr_rows_flag_from_ceiling_over_factor(throughput, factor, expected):
+    rows = vrr_rows(with_throughput(throughput), factor=factor)
+    assert [row["vrr_at_ceiling"] for row in rows[::2]] == expected
+    assert [row["vrr_kind"] for row in rows[::2]] == ["lower bound" if flag else "value" for flag in expected]
+
+
+def test_an_infinite_measured_vrr_is_a_lower_bound():
+    # no variance left in 2 windows of 10 clumps: possible only through the sampling, so it is at the ceiling
+    infinite = dataclasses.replace(HALF, vrr=vrr([math.inf, NAN], [0.0, NAN], [2, 0], 0.5))
+    (row, _) = vrr_rows(dataclasses.replace(RESULT, layouts=[infinite]))
+    assert (row["vrr"], row["vrr_at_ceiling"], row["vrr_kind"]) == (math.inf, True, "lower bound")
+    assert math.isnan(row["vrr_predicted_over_measured"])
 
 
 def test_model_rows_follow_each_layouts_own_model_axis():
@@ -172,6 +213,7 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         "run_id": "recirculation_ab12", "flow_pattern": "mass flow", "residence_time_s": 2.0,
         "estimated_residence_time_s": 2.5, "holdup_clumps": 20.0, "throughput_clumps_per_s": 10.0,
         "recirculations": 1.5, "window_s": 1.0, "clumps_per_window": 10.0, "vrr_sampling_limit": 10.0,
+        "vrr_ceiling_factor": 2.0,
         "rtd_particle_ids": {"t_mean_s": 2.0, "variance_s2": 0.375, "t_s": 1.25, "t_d": 2.75,
                              "t_s_over_t_d": 1.25 / 2.75, "n_tracer": 4, "fraction_exited": 0.75},
         "rtd_eulerian": {"t_mean_s": 2.0, "variance_s2": 1.25, "t_s": 0.5, "t_d": 3.5, "fraction_exited": 1.0,
@@ -182,15 +224,24 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
     # RMS of (0.5 - 0.25, 0.75 - 0.75) over the two windows with data: sqrt(0.0625 / 2)
     np.testing.assert_equal(half, {
         "blue_fraction": 0.5, "sublayers": 1, "vrr_by_recirculation": [4.0, NAN], "vrr_predicted": [16.0, NAN],
-        "prediction_rms_error": math.sqrt(0.03125), "homogenised_after_recirculations": NAN,
-        "model_homogenised_after_recirculations": 1.0,
+        "vrr_at_ceiling": [False, False], "prediction_rms_error": math.sqrt(0.03125),
+        "homogenised_after_recirculations": NAN, "model_homogenised_after_recirculations": 1.0,
     })
     # RMS of (0.25 - 0, 0.25 - 0.5): sqrt(0.0625)
     np.testing.assert_equal(top, {
         "blue_fraction": 0.25, "sublayers": 2, "vrr_by_recirculation": [3.0, NAN], "vrr_predicted": [math.inf, NAN],
-        "prediction_rms_error": 0.25, "homogenised_after_recirculations": 2.0,
+        "vrr_at_ceiling": [False, False], "prediction_rms_error": 0.25, "homogenised_after_recirculations": 2.0,
         "model_homogenised_after_recirculations": NAN,
     })
+
+
+def test_blending_summary_flags_vrrs_at_the_ceiling_with_its_factor():
+    summary = blending_summary(CASE, with_throughput(8.0), EULERIAN_RTD, 0.005)
+    assert (summary["vrr_sampling_limit"], summary["vrr_ceiling_factor"]) == (8.0, 2.0)
+    assert [layout["vrr_at_ceiling"] for layout in summary["layouts"].values()] == [[True, False], [False, False]]
+    summary = blending_summary(CASE, with_throughput(8.0), EULERIAN_RTD, 0.005, factor=8.0 / 3.0)
+    assert summary["vrr_ceiling_factor"] == 8.0 / 3.0
+    assert [layout["vrr_at_ceiling"] for layout in summary["layouts"].values()] == [[True, False], [True, False]]
 
 
 def test_blending_summary_and_tables_write_as_json_and_csv(tmp_path):
@@ -200,6 +251,14 @@ def test_blending_summary_and_tables_write_as_json_and_csv(tmp_path):
     assert loaded["layouts"]["bottom half"]["vrr_by_recirculation"] == [4.0, None]
     assert loaded["layouts"]["top 25 %"]["vrr_predicted"] == [None, None]
     assert loaded["layouts"]["top 25 %"]["model_homogenised_after_recirculations"] is None
+    assert loaded["layouts"]["bottom half"]["vrr_at_ceiling"] == [False, False]
+    text = write_flow_table(tmp_path / "vrr.csv", vrr_rows(with_throughput(8.0))).read_text()
+    assert text.splitlines()[:3] == [
+        "layout,recirculation_number,vrr,sigma_out,n_windows,sigma_in,blue_fraction,vrr_predicted,vrr_ceiling,"
+        "vrr_at_ceiling,vrr_kind,vrr_predicted_over_measured",
+        "bottom half,0.5,4.0,0.25,2,0.5,0.5,16.0,8.0,True,lower bound,",
+        "bottom half,1.5,,,0,0.5,0.5,,8.0,False,none,",
+    ]
     text = write_flow_table(tmp_path / "concentration.csv", concentration_rows(RESULT)).read_text()
     assert text.splitlines()[:2] == [
         "layout,time_s,recirculations,crossings,concentration,first_exit_concentration,predicted,predicted_johanson",
@@ -240,14 +299,42 @@ def test_a_result_without_layouts_gives_no_rows(function):
     assert function(empty) == []
 
 
+SUMMARY = {"flow_pattern": "semi", "run_id": "r1", "residence_time_s": 2.0, "vrr_sampling_limit": 4.0,
+           "rtd_particle_ids": {"t_s_over_t_d": 0.25, "t_mean_s": 1.5}, "rtd_eulerian": {"t_mean_s": 1.6},
+           "layouts": {"blue13": {"vrr_by_recirculation": [2.0, None, 1.9], "prediction_rms_error": 0.1,
+                                  "homogenised_after_recirculations": 3, "model_homogenised_after_recirculations": 4}}}
+
+
 def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
-    summary = {"flow_pattern": "semi", "run_id": "r1", "residence_time_s": 2.0,
-               "rtd_particle_ids": {"t_s_over_t_d": 0.25, "t_mean_s": 1.5}, "rtd_eulerian": {"t_mean_s": 1.6},
-               "layouts": {"blue13": {"vrr_by_recirculation": [2.0, None], "prediction_rms_error": 0.1,
-                                      "homogenised_after_recirculations": 3, "model_homogenised_after_recirculations": 4}}}
-    rows, curves = summary_rows([summary])
-    assert len(rows) == 1 and rows[0]["vrr_nr1"] == 2.0 and math.isnan(rows[0]["vrr_nr2"])
+    rows, curves = summary_rows([SUMMARY])
+    assert len(rows) == 1
     assert list(rows[0]) == ["flow_pattern", "layout", "run_id", "residence_time_s", "t_s_over_t_d", "rtd_mean_ids_s",
-                             "rtd_mean_eulerian_s", "vrr_nr1", "vrr_nr2", "prediction_rms_error",
-                             "homogenised_after_recirculations", "model_homogenised_after_recirculations"]
-    assert curves[0][0] == "semi blue13" and curves[0][1] == [0.5, 1.5]
+                             "rtd_mean_eulerian_s", "vrr_nr1", "vrr_nr2", "vrr_nr3", "prediction_rms_error",
+                             "homogenised_after_recirculations", "model_homogenised_after_recirculations",
+                             "vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3"]
+    np.testing.assert_equal(rows[0], {
+        "flow_pattern": "semi", "layout": "blue13", "run_id": "r1", "residence_time_s": 2.0, "t_s_over_t_d": 0.25,
+        "rtd_mean_ids_s": 1.5, "rtd_mean_eulerian_s": 1.6, "vrr_nr1": 2.0, "vrr_nr2": NAN, "vrr_nr3": 1.9,
+        "prediction_rms_error": 0.1, "homogenised_after_recirculations": 3, "model_homogenised_after_recirculations": 4,
+        # ceiling 4: VRR 2 = 4 / 2 is flagged, 1.9 and the missing VRR are not
+        "vrr_ceiling": 4.0, "vrr_at_ceiling_nr1": True, "vrr_at_ceiling_nr2": False, "vrr_at_ceiling_nr3": False,
+    })
+    ((label, nr, values, ceiling),) = curves
+    assert (label, nr, ceiling) == ("semi blue13", [0.5, 1.5, 2.5], 4.0)
+    np.testing.assert_equal(values, [2.0, NAN, 1.9])
+
+
+def test_summary_rows_take_the_flags_the_summary_holds_and_the_factor_otherwise():
+    # an infinite VRR is written as null; the flag written with it still says it is at the ceiling
+    layout = {**SUMMARY["layouts"]["blue13"], "vrr_at_ceiling": [False, True, False]}
+    stored = {**SUMMARY, "layouts": {"blue13": layout}}
+    rows, _ = summary_rows([stored])
+    assert [rows[0][f"vrr_at_ceiling_nr{k}"] for k in (1, 2, 3)] == [False, True, False]
+    rows, _ = summary_rows([SUMMARY], factor=2.5)  # flagged from 4 / 2.5 = 1.6 on
+    assert [rows[0][f"vrr_at_ceiling_nr{k}"] for k in (1, 2, 3)] == [True, False, True]
+
+
+def test_summary_rows_without_a_ceiling_flag_nothing():
+    rows, curves = summary_rows([{key: value for key, value in SUMMARY.items() if key != "vrr_sampling_limit"}])
+    assert math.isnan(rows[0]["vrr_ceiling"]) and curves[0][3] is None
+    assert [rows[0][f"vrr_at_ceiling_nr{k}"] for k in (1, 2, 3)] == [False, False, False]

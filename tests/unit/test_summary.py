@@ -17,6 +17,7 @@ from analysis.report.summary import (
     blender_rows,
     calibration_rows,
     column_header,
+    fill_balance_rows,
     format_cell,
     format_number,
     format_value_with_error,
@@ -261,7 +262,7 @@ def test_summary_sections_take_the_columns_each_stage_shows():
                                   "vrr_nr1_error": 0.1, "extra": 1}],
                                 [{"configuration": "straight", "vrr_at_0.5_tm": 3.0, "extra": 1}])
     assert [section.title for section in sections] == ["Calibration", "Silo validation", "Silo against measurements",
-                                                       "Blending", "Blender"]
+                                                       "Blending", "Blender", "Settled fills"]
     assert sections[0].rows == [{"contact": "particle-particle", "sliding_friction": 0.3}]
     assert sections[1].rows == [{key: flow[key] for key in SILO_FLOW_COLUMNS}]
     assert sections[2].rows == []
@@ -298,3 +299,16 @@ def test_blending_rows_show_the_ceiling_flags_read_back_from_the_csv_and_are_hea
 def test_tables_read_back_numbers_text_and_empty_cells(tmp_path):
     path = write_flow_table(tmp_path / "t.csv", [{"a": 1.5, "b": "x", "c": None}])
     assert read_table(path) == [{"a": 1.5, "b": "x", "c": None}]
+
+
+def test_fill_balance_rows_give_the_shares_of_the_weight_and_the_planes_in_mm():
+    balance = {"case": "silo_flat", "run_id": "sphere2-abc", "clumps": 6539, "support_ratio": 0.998,
+               "floor_ratio": 0.63, "walls_ratio": 0.368, "silo_like": True,
+               "planes": [{"height_m": 0.01, "contact_ratio": 0.65}, {"height_m": 0.06, "contact_ratio": 0.92}],
+               "problems": []}
+    (row,) = fill_balance_rows([balance])
+    assert row == {"case": "silo_flat", "run_id": "sphere2-abc", "n_clumps": 6539, "support_ratio": 0.998,
+                   "floor_ratio": 0.63, "walls_ratio": 0.368, "silo_like": True, "contacts_at_10_mm": 0.65,
+                   "contacts_at_60_mm": 0.92, "balance_passed": True}
+    page = summary_html("t", [Section("Settled fills", "x", [row])])
+    assert "Contacts / weight above, plane at 60 mm" in page and "Walls / weight" in page

@@ -37,6 +37,7 @@ from analysis.io.plots import (  # noqa: E402
     silo_outline,
     tuple_entry,
 )
+from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_near_ceiling  # noqa: E402
 from analysis.studies.silo_recirculation.rtd_plots import BLUE, tolerance_band  # noqa: E402
 
 __all__ = [
@@ -115,25 +116,49 @@ def plot_outlet_concentration(curves, blue_fraction: float, path: str | os.PathL
         plt.close(figure)
 
 
-def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str,
-                                   noise_limit: float | None = None) -> Path:
-    """Variance reduction ratio against the number of recirculations (log y axis).
+def _vrr_curves(curves, noise_limit: float | None) -> list[tuple[str, np.ndarray, np.ndarray, float | None]]:
+    """Checked (label, Nr, VRR, ceiling) curves; a curve without its own ceiling takes ``noise_limit``."""
+    checked = []
+    for i, item in enumerate(non_empty_list("curves", curves)):
+        entry = tuple(item) if isinstance(item, (tuple, list)) else ()
+        if len(entry) not in (3, 4):
+            raise ValueError(f"curves[{i}] must be a tuple of 3 items (label, Nr, VRR) or 4 (with the ceiling)")
+        label, x, y = entry[:3]
+        ceiling = entry[3] if len(entry) == 4 else None
+        x = finite_abscissa(f"curves[{i}] x", x)
+        y = matching_ordinate(f"curves[{i}] y", y, x.size, f"curves[{i}] x")
+        ceiling = noise_limit if ceiling is None else positive_number(f"curves[{i}] ceiling", ceiling)
+        checked.append((str(label), x, y, ceiling))
+    return checked
+
+
+def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, noise_limit: float | None = None,
+                                   factor: float = CEILING_FACTOR) -> Path:
+    """Variance reduction ratio against the number of recirculations (log y axis), with the counting-noise
+    ceiling.
 
     Points whose VRR is NaN, zero or negative are skipped; a VRR of +inf (no variance left at the
-    outlet) is marked by an upward triangle at the top of the axes.
+    outlet) is marked by an upward triangle at the top of the axes. Each ceiling is drawn as a dashed
+    horizontal line; finite VRRs within ``factor`` of their curve's ceiling
+    (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`) get an open marker: they are lower bounds,
+    set by the sampling noise, not measurements.
 
     Parameters
     ----------
-    curves : list of (str, array_like, array_like)
-        ``(label, Nr, VRR)``: number of recirculations [-] (finite) and the variance reduction ratio
-        sigma_in^2 / sigma_out^2 [-] (same length).
+    curves : list of tuple
+        ``(label, Nr, VRR)`` or ``(label, Nr, VRR, ceiling)``: number of recirculations [-] (finite), the
+        variance reduction ratio sigma_in^2 / sigma_out^2 [-] (same length), and the counting-noise ceiling
+        of that curve's VRR [-] (> 0; None or absent: ``noise_limit``).
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
     title : str
         Figure title.
     noise_limit : float or None, optional
-        VRR of a perfectly mixed sample of the same size (sampling-noise limit) [-] (> 0), drawn as a
-        dashed line; None to omit.
+        Counting-noise ceiling (VRR of a perfectly mixed outflow sampled in windows of the same size,
+        :func:`analysis.numerics.uncertainty.vrr_ceiling`) of the curves without their own [-] (> 0);
+        None: those curves have none.
+    factor : float, optional
+        VRRs at or above ``ceiling / factor`` are drawn open, >= 1 [-].
 
     Returns
     -------
@@ -143,26 +168,41 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str,
     Raises
     ------
     ValueError
-        Naming the argument: empty ``curves``, mismatched lengths, non-positive ``noise_limit``.
+        Naming the argument: empty ``curves``, a curve not of 3 or 4 items, mismatched lengths,
+        non-positive ``noise_limit`` or ceiling, ``factor < 1``.
     """
-    checked = _xy_curves("curves", curves)
     if noise_limit is not None:
         noise_limit = positive_number("noise_limit", noise_limit)
+    factor = float(factor)
+    if not (math.isfinite(factor) and factor >= 1.0):
+        raise ValueError(f"factor must be a finite number >= 1, got {factor!r}")
+    checked = _vrr_curves(curves, noise_limit)
+    # One line per distinct ceiling: the layouts of one run share theirs.
+    ceilings = sorted({ceiling for *_, ceiling in checked if ceiling is not None})
+    flags = [np.zeros(0, dtype=bool) if ceiling is None else
+             np.asarray(vrr_near_ceiling(positive_finite_points(x, y)[1], ceiling, factor), dtype=bool)
+             for _, x, y, ceiling in checked]
     figure, axes = plt.subplots(figsize=(6.4, 4.2))
     try:
         axes.set_yscale("log")
         axes.axhline(1.0, color="black", linewidth=0.9, label="VRR = 1 (no blending)")
-        if noise_limit is not None:
-            axes.axhline(noise_limit, color="tab:red", linestyle="--", linewidth=1.0,
-                         label=f"sampling-noise limit {noise_limit:.3g}")
-        for label, recirculations, vrr in checked:
+        for ceiling in ceilings:
+            axes.axhline(ceiling, color="tab:red", linestyle="--", linewidth=1.0, gid="ceiling",
+                         label=f"counting-noise ceiling {ceiling:.3g}")
+        for (label, recirculations, vrr, _), at_ceiling in zip(checked, flags):
             x, y = positive_finite_points(recirculations, vrr)
             (line,) = axes.plot(x, y, "o-", markersize=4, linewidth=1.2,
                                 label=label if x.size else f"{label} (no finite VRR)")
+            if at_ceiling.any():
+                axes.plot(x[at_ceiling], y[at_ceiling], "o", color=line.get_color(), markersize=7,
+                          markerfacecolor="white", markeredgewidth=1.3, gid="at_ceiling", label="_nolegend_")
             infinite = recirculations[np.isposinf(vrr)]
             if infinite.size:
                 axes.plot(infinite, np.full(infinite.size, 0.97), "^", color=line.get_color(), markersize=6,
-                          transform=axes.get_xaxis_transform(), clip_on=False)
+                          transform=axes.get_xaxis_transform(), clip_on=False, gid="infinite")
+        if any(at_ceiling.any() for at_ceiling in flags):
+            axes.plot([], [], "o", color="0.3", markersize=7, markerfacecolor="white",
+                      label=f"within x{factor:g} of the ceiling: lower bound")
         axes.set_xlabel("number of recirculations Nr = t / t_res [-]")
         axes.set_ylabel("variance reduction ratio VRR [-]")
         axes.set_title(title)

@@ -3,17 +3,24 @@
 Pure functions from the results of :mod:`analysis.studies.silo_recirculation.study` to plain rows (one dict per
 row, for :func:`analysis.io.tables.write_flow_table`) and summary dicts (for :func:`analysis.io.tables.write_json`);
 no file I/O. The column names and their order are the file formats the summary, report and thesis read, so they
-change only together with their readers. SI units: times in s, E in 1/s, lengths in m; concentrations and VRRs
-are dimensionless.
+change only together with their readers (new columns are appended, never renamed). SI units: times in s, E in
+1/s, lengths in m; concentrations and VRRs are dimensionless.
+
+Every measured VRR comes with its counting-noise ceiling (:func:`analysis.numerics.uncertainty.vrr_ceiling`,
+``clumps_per_window`` for a 0/1 batch) and a flag where it lies within a factor 2 of it
+(:func:`analysis.numerics.uncertainty.vrr_near_ceiling`): such a VRR is a lower bound, so it is not compared with
+the LTI prediction as if it were a measurement.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from analysis.numerics.rtd import RTD, johanson_rtd
+from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_near_ceiling
 from analysis.studies.silo_recirculation.study import BlendingResult, VerificationResult, residence_summary
 from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 
@@ -28,6 +35,7 @@ __all__ = [
     "blending_summary",
     "verification_rows",
     "verification_summary",
+    "summary_rows",
 ]
 
 
@@ -61,13 +69,16 @@ def concentration_rows(result: BlendingResult) -> list[dict]:
     return rows
 
 
-def vrr_rows(result: BlendingResult) -> list[dict]:
-    """VRR per recirculation of every batch layout, measured and predicted (``vrr.csv``).
+def vrr_rows(result: BlendingResult, factor: float = CEILING_FACTOR) -> list[dict]:
+    """VRR per recirculation of every batch layout, measured and predicted, with the counting-noise ceiling
+    (``vrr.csv``).
 
     Parameters
     ----------
     result : BlendingResult
         The study of the run.
+    factor : float, optional
+        A measured VRR at or above ``ceiling / factor`` is flagged as at the ceiling, >= 1 [-].
 
     Returns
     -------
@@ -75,13 +86,26 @@ def vrr_rows(result: BlendingResult) -> list[dict]:
         One row per layout and recirculation: ``layout``, then the columns of
         :meth:`analysis.studies.silo_recirculation.vrr.RecirculationVRR.rows` (``recirculation_number`` [-],
         ``vrr`` [-], ``sigma_out`` [-], ``n_windows`` [-], ``sigma_in`` [-], ``blue_fraction`` [-]) of the
-        measured VRR, then ``vrr_predicted`` (the VRR of the renewal prediction [-]).
+        measured VRR, ``vrr_predicted`` (the VRR of the renewal prediction [-]), then ``vrr_ceiling`` (the
+        counting-noise ceiling for :func:`clumps_per_window` clumps per window [-]), ``vrr_at_ceiling`` (bool:
+        the measured VRR is within ``factor`` of it), ``vrr_kind`` (``"value"``; ``"lower bound"`` when at the
+        ceiling; ``"none"`` without a VRR) and ``vrr_predicted_over_measured`` (the prediction over a measured
+        value [-]; NaN where the measurement is only a lower bound or missing).
     """
-    return [
-        {"layout": layout.layout.name, **row, "vrr_predicted": predicted}
-        for layout in result.layouts
-        for row, predicted in zip(layout.vrr.rows(), layout.vrr_predicted.vrr)
-    ]
+    particles_per_window = clumps_per_window(result)
+    rows = []
+    for layout in result.layouts:
+        ceiling = layout.vrr.ceiling(particles_per_window)
+        flags = layout.vrr.at_ceiling(particles_per_window, factor)
+        for row, predicted, at_ceiling in zip(layout.vrr.rows(), layout.vrr_predicted.vrr, flags):
+            measured = row["vrr"]
+            kind = "none" if math.isnan(measured) else "lower bound" if at_ceiling else "value"
+            rows.append({
+                "layout": layout.layout.name, **row, "vrr_predicted": float(predicted), "vrr_ceiling": ceiling,
+                "vrr_at_ceiling": bool(at_ceiling), "vrr_kind": kind,
+                "vrr_predicted_over_measured": float(predicted) / measured if kind == "value" else math.nan,
+            })
+    return rows
 
 
 def model_rows(result: BlendingResult) -> list[dict]:
@@ -175,8 +199,9 @@ def vrr_period_rows(result: BlendingResult) -> list[dict]:
 def clumps_per_window(result: BlendingResult) -> float:
     """Mean outlet crossings per concentration window, throughput x window [-].
 
-    The ``n`` of :func:`analysis.studies.silo_recirculation.vrr.sampling_noise_vrr_limit`: the largest VRR that
-    windows of that many crossings can measure.
+    The ``n`` of :func:`analysis.numerics.uncertainty.vrr_ceiling`: the largest VRR that windows of that many
+    crossings can measure (the exact ceiling of windows of unequal size is the harmonic mean of their crossings,
+    at most a few per cent lower in a steady flow).
 
     Parameters
     ----------
@@ -191,7 +216,8 @@ def clumps_per_window(result: BlendingResult) -> float:
     return result.timing.throughput * result.window
 
 
-def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float) -> dict:
+def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float,
+                     factor: float = CEILING_FACTOR) -> dict:
     """The summary of one recirculation run (``blending.json``).
 
     Parameters
@@ -204,15 +230,19 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         Its Eulerian RTD.
     eulerian_bin_size : float
         Bin edge of the Eulerian RTD's velocity field [m].
+    factor : float, optional
+        A measured VRR at or above ``vrr_sampling_limit / factor`` is flagged as at the ceiling, >= 1 [-].
 
     Returns
     -------
     dict
         ``run_id``, ``flow_pattern``, the timing (``residence_time_s`` [s], ``estimated_residence_time_s`` [s],
         ``holdup_clumps`` [-], ``throughput_clumps_per_s`` [1/s], ``recirculations`` [-], ``window_s`` [s],
-        ``clumps_per_window`` [-], ``vrr_sampling_limit`` [-]), the RTDs (``rtd_particle_ids``,
-        ``rtd_eulerian``: moments [s, s^2], first and last residence times [s], fraction exited [-]), Johanson's
-        ``V1`` and ``P`` [-], and per layout its VRRs, prediction error and homogenisation Nr [-].
+        ``clumps_per_window`` [-], ``vrr_sampling_limit`` (the counting-noise ceiling of the VRR [-]),
+        ``vrr_ceiling_factor`` (``factor`` [-])), the RTDs (``rtd_particle_ids``, ``rtd_eulerian``: moments [s,
+        s^2], first and last residence times [s], fraction exited [-]), Johanson's ``V1`` and ``P`` [-], and per
+        layout its VRRs with ``vrr_at_ceiling`` (bool per recirculation: a lower bound, within ``factor`` of the
+        ceiling), prediction error and homogenisation Nr [-].
     """
     timing = result.timing
     silo_rtd = result.rtd.silo
@@ -223,7 +253,7 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         "holdup_clumps": timing.holdup, "throughput_clumps_per_s": timing.throughput,
         "recirculations": timing.recirculations, "window_s": result.window,
         "clumps_per_window": particles_per_window,
-        "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window),
+        "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window), "vrr_ceiling_factor": factor,
         "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
                              "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
                              "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited},
@@ -235,6 +265,7 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
             layout.layout.name: {
                 "blue_fraction": layout.layout.blue_fraction, "sublayers": layout.layout.sublayers,
                 "vrr_by_recirculation": layout.vrr.vrr, "vrr_predicted": layout.vrr_predicted.vrr,
+                "vrr_at_ceiling": [bool(flag) for flag in layout.vrr.at_ceiling(particles_per_window, factor)],
                 "prediction_rms_error": layout.prediction_rms_error(),
                 "homogenised_after_recirculations": layout.homogenised_after,
                 "model_homogenised_after_recirculations": layout.model_homogenised_after,
@@ -288,27 +319,39 @@ def verification_summary(case: Mapping, result: VerificationResult) -> dict:
             "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}
 
 
-def summary_rows(summaries: Sequence[Mapping]) -> tuple[list[dict], list[tuple]]:
+def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -> tuple[list[dict], list[tuple]]:
     """The rows of the summary table of every flow pattern and batch layout, and their VRR curves.
 
     Parameters
     ----------
     summaries : sequence of mapping
         The ``metrics/blending.json`` of each recirculation run, as read (:func:`blending_summary`).
+    factor : float, optional
+        Flag factor for summaries written without ``vrr_at_ceiling`` (a VRR at or above ``ceiling / factor``),
+        >= 1 [-]; the flags a summary holds are taken as they are.
 
     Returns
     -------
     rows : list of dict
         One row per run and layout: residence time (s), t_s/t_d, RTD means (s), ``vrr_nr<k>`` per recirculation
-        (NaN where the JSON has null), the LTI prediction's RMS error and the recirculations to homogenise.
+        (NaN where the JSON has null), the LTI prediction's RMS error and the recirculations to homogenise, then
+        ``vrr_ceiling`` (the run's counting-noise ceiling, ``vrr_sampling_limit`` [-]; NaN if the summary has
+        none) and ``vrr_at_ceiling_nr<k>`` (bool: that VRR is only a lower bound).
     curves : list of tuple
-        ``(label, recirculation at mid-window, VRR)`` per row, for the VRR plot.
+        ``(label, recirculation at mid-window, VRR, ceiling)`` per row, for
+        :func:`analysis.studies.silo_recirculation.plots.plot_vrr_versus_recirculations` (``ceiling`` None if the
+        summary has none).
     """
     rows, curves = [], []
     for summary in summaries:
+        ceiling = summary.get("vrr_sampling_limit")
         for name, layout in summary["layouts"].items():
             vrr = [v if v is not None else float("nan") for v in layout["vrr_by_recirculation"]]
-            curves.append((f"{summary['flow_pattern']} {name}", [k + 0.5 for k in range(len(vrr))], vrr))
+            flags = layout.get("vrr_at_ceiling")
+            if flags is None:
+                flags = ([False] * len(vrr) if ceiling is None else
+                         [bool(flag) for flag in vrr_near_ceiling(vrr, ceiling, factor)])
+            curves.append((f"{summary['flow_pattern']} {name}", [k + 0.5 for k in range(len(vrr))], vrr, ceiling))
             rows.append({
                 "flow_pattern": summary["flow_pattern"], "layout": name, "run_id": summary["run_id"],
                 "residence_time_s": summary["residence_time_s"], "t_s_over_t_d": summary["rtd_particle_ids"]["t_s_over_t_d"],
@@ -318,5 +361,7 @@ def summary_rows(summaries: Sequence[Mapping]) -> tuple[list[dict], list[tuple]]
                 "prediction_rms_error": layout["prediction_rms_error"],
                 "homogenised_after_recirculations": layout["homogenised_after_recirculations"],
                 "model_homogenised_after_recirculations": layout["model_homogenised_after_recirculations"],
+                "vrr_ceiling": float("nan") if ceiling is None else ceiling,
+                **{f"vrr_at_ceiling_nr{k + 1}": bool(flag) for k, flag in enumerate(flags)},
             })
     return rows, curves

@@ -8,6 +8,12 @@ Recirculation number and VRR
 (Little's law, :func:`holdup_residence_time`). The windows of recirculation k are those with
 ``k - 1 <= Nr < k``; ``VRR_k = p (1 - p) / var(c)`` over them (:func:`vrr_by_recirculation`), the
 input variance being that of the 0/1 batch with blue fraction ``p``.
+
+Counting-noise ceiling
+----------------------
+Windows of ``n`` clumps cannot show a VRR above about ``n`` (:func:`analysis.numerics.uncertainty.vrr_ceiling`):
+the binomial noise of the blue count is left even in a perfectly mixed outflow. A VRR within a factor 2 of the
+ceiling (:meth:`RecirculationVRR.at_ceiling`) is a lower bound of the true VRR, not a measurement of it.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.checks import finite_array, finite_number, positive_number
+from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_ceiling, vrr_near_ceiling
 from analysis.studies.silo_recirculation.validation import event_times, integer_at_least, open_fraction
 
 __all__ = [
@@ -71,6 +78,39 @@ class RecirculationVRR:
             }
             for nr, v, s, n in zip(self.recirculation_number, self.vrr, self.sigma_out, self.n_windows)
         ]
+
+    def ceiling(self, clumps_per_window: float) -> float:
+        """Counting-noise ceiling of these VRRs for windows of ``clumps_per_window`` clumps [-].
+
+        :func:`analysis.numerics.uncertainty.vrr_ceiling` with the input variance of the 0/1 batch,
+        ``p (1 - p)``: the ceiling is ``clumps_per_window`` itself.
+
+        Parameters
+        ----------
+        clumps_per_window : float
+            Outlet crossings per window ``n``, > 0 [-]
+            (:func:`analysis.studies.silo_recirculation.tables.clumps_per_window`).
+        """
+        p = self.blue_fraction
+        return vrr_ceiling(clumps_per_window, p * (1.0 - p), p)
+
+    def at_ceiling(self, clumps_per_window: float, factor: float = CEILING_FACTOR) -> np.ndarray:
+        """Which VRRs are within ``factor`` of the counting-noise ceiling (lower bounds, not measurements).
+
+        Parameters
+        ----------
+        clumps_per_window : float
+            Outlet crossings per window ``n``, > 0 [-].
+        factor : float, optional
+            ``VRR >= ceiling / factor`` is flagged, >= 1 [-]
+            (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`).
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (K,)
+            False where the VRR is NaN, True where it is inf.
+        """
+        return np.asarray(vrr_near_ceiling(self.vrr, self.ceiling(clumps_per_window), factor), dtype=bool)
 
 
 def recirculation_number(t, t_open: float, residence_time: float):
@@ -159,8 +199,8 @@ def vrr_by_recirculation(
 
     Sampling noise: a window of ``n`` crossings from a perfectly mixed outflow has a binomial blue
     count, so its concentration still varies with variance ``p (1 - p) / n``; the measurable VRR is
-    capped at about ``n`` (:func:`sampling_noise_vrr_limit`). Windows of unequal ``n`` are weighted
-    equally.
+    capped at about ``n`` (:meth:`RecirculationVRR.ceiling`, :meth:`RecirculationVRR.at_ceiling`). Windows of
+    unequal ``n`` are weighted equally.
 
     Parameters
     ----------
@@ -217,7 +257,8 @@ def sampling_noise_vrr_limit(blue_fraction: float, particles_per_window: float) 
 
     A perfectly mixed outflow still gives window concentrations with the binomial variance
     ``p (1 - p) / n``, so ``sigma_in^2`` over it, i.e. ``n``, is the VRR of perfect mixing as measured
-    (a reference line for plots of :func:`vrr_by_recirculation`).
+    (a reference line for plots of :func:`vrr_by_recirculation`). The counting-noise ceiling of
+    :func:`analysis.numerics.uncertainty.vrr_ceiling` for a 0/1 batch input, kept under this name for its callers.
 
     Parameters
     ----------
@@ -232,5 +273,6 @@ def sampling_noise_vrr_limit(blue_fraction: float, particles_per_window: float) 
     float
         The VRR limit [-].
     """
-    open_fraction("blue_fraction", blue_fraction)  # checked for the caller; p (1 - p) cancels
-    return positive_number("particles_per_window", particles_per_window)
+    p = open_fraction("blue_fraction", blue_fraction)
+    n = positive_number("particles_per_window", particles_per_window)  # checked here to name the caller's argument
+    return vrr_ceiling(n, p * (1.0 - p), p)
