@@ -18,7 +18,7 @@ DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 # no limit on the stream's momentum flux, and a force balance that only refuses a fill far from rest. The fill's
 # physics (gentle pour, force balance) is checked by tests/integration/test_fill_balance_liggghts.py.
 FAST_POUR = {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocity": 2.0, "momentum_flux_ratio": 100.0,
-             "balance_tolerance": {"support": 0.2, "plane": 1.0}}
+             "balance_tolerance": {"support": 0.5, "plane": 1.0}}
 
 # A silo small enough for a real LIGGGHTS run in well under a minute (~1,400 two-sphere clumps), with an
 # outlet of about 7 clump diameters so that it flows without arching.
