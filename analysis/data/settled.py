@@ -52,7 +52,7 @@ class SettledFill:
         wall_force = frozen_array(self.wall_force, float, (3,), "wall_force", len(self.frame.id))
         if not np.all(np.isfinite(wall_force)):
             raise ValueError("wall_force holds a non-finite value")
-        wall_forces = {str(name): frozen_array(np.reshape(value, (1, 3)), float, (3,), f"force of wall {name!r}", 1)[0]
+        wall_forces = {str(name): frozen_array([value], float, (3,), f"force of wall {name!r}", 1)[0]
                        for name, value in dict(self.wall_forces).items()}
         floor_walls = tuple(self.floor_walls)
         unknown = [name for name in floor_walls if wall_forces and name not in wall_forces]

@@ -167,6 +167,19 @@ def _method(method: str) -> str:
 # --------------------------------------------------------------------------- convolution
 
 
+def _series_on_axis(time, name: str, values, from_zero: bool = False) -> tuple[np.ndarray, float, np.ndarray]:
+    """(time axis, its uniform step, ``values`` checked to be finite and sampled on it); with ``from_zero`` the
+    axis must start at 0 (time[k] = k dt). Errors name the argument."""
+    t = finite_array("time", time, ndim=1)
+    dt = uniform_step("time", t)
+    if from_zero and abs(t[0]) > 1.0e-9 * dt:
+        raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
+    series = finite_array(name, values, ndim=1)
+    if series.shape != t.shape:
+        raise ValueError(f"{name} must have the shape of time {t.shape}, got {series.shape}")
+    return t, dt, series
+
+
 def convolve_with_rtd(time, c_in, E, c_before: float = 0.0, method: str = "auto") -> np.ndarray:
     """Outlet signal of the LTI model: ``c_out(t) = integral c_in(t - tau) E(tau) dtau`` on a uniform grid.
 
@@ -197,11 +210,7 @@ def convolve_with_rtd(time, c_in, E, c_before: float = 0.0, method: str = "auto"
     numpy.ndarray, shape (n,)
         Output concentration at ``time``.
     """
-    t = finite_array("time", time, ndim=1)
-    dt = uniform_step("time", t)
-    c = finite_array("c_in", c_in, ndim=1)
-    if c.shape != t.shape:
-        raise ValueError(f"c_in must have the shape of time {t.shape}, got {c.shape}")
+    t, dt, c = _series_on_axis(time, "c_in", c_in)
     e = finite_array("E", E, ndim=1)
     if e.size == 0:
         raise ValueError("E must have at least 1 sample")
@@ -402,13 +411,7 @@ def vrr_versus_period(
     -------
     VRRTable
     """
-    t = finite_array("time", time, ndim=1)
-    dt = uniform_step("time", t)
-    if abs(t[0]) > 1.0e-9 * dt:
-        raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
-    e = finite_array("E", E, ndim=1)
-    if e.shape != t.shape:
-        raise ValueError(f"E must have the shape of time {t.shape}, got {e.shape}")
+    t, dt, e = _series_on_axis(time, "E", E, from_zero=True)
     fractions = finite_array("periods_over_tm", periods_over_tm, ndim=None).ravel()
     if fractions.size == 0 or np.any(fractions <= 0.0):
         raise ValueError("periods_over_tm must be a non-empty array of numbers > 0")
@@ -485,11 +488,7 @@ def recirculate(c_first_input, E, time, passes: int, normalise: bool = True, met
     -------
     Recirculation
     """
-    t = finite_array("time", time, ndim=1)
-    dt = uniform_step("time", t)
-    c = finite_array("c_first_input", c_first_input, ndim=1)
-    if c.shape != t.shape:
-        raise ValueError(f"c_first_input must have the shape of time {t.shape}, got {c.shape}")
+    t, dt, c = _series_on_axis(time, "c_first_input", c_first_input)
     e = finite_array("E", E, ndim=1)
     if e.size == 0:
         raise ValueError("E must have at least 1 sample")
@@ -593,13 +592,7 @@ def carson_royal_recycle(first_pass_E, time, passes: int) -> np.ndarray:
         the passes wanted (``sum(E_n) dt`` falls below ``sum(E1) dt`` when it is not).
         ``rows.sum(axis=0)`` is the outlet concentration of the recycle loop after a unit pulse.
     """
-    t = finite_array("time", time, ndim=1)
-    dt = uniform_step("time", t)
-    if abs(t[0]) > 1.0e-9 * dt:
-        raise ValueError(f"time must start at 0 (time[k] = k dt), got time[0] = {t[0]!r}")
-    e1 = finite_array("first_pass_E", first_pass_E, ndim=1)
-    if e1.shape != t.shape:
-        raise ValueError(f"first_pass_E must have the shape of time {t.shape}, got {e1.shape}")
+    t, _, e1 = _series_on_axis(time, "first_pass_E", first_pass_E, from_zero=True)
     passes = _count("passes", passes)
     rows = np.empty((passes, t.size))
     rows[0] = e1

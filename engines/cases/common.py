@@ -111,8 +111,8 @@ class FillPlan:
     clumps_per_insertion: int
     particle_rate: float
     fill_steps: int
-    impact_velocity: float = float("nan")
-    momentum_flux_ratio: float = float("nan")
+    impact_velocity: float
+    momentum_flux_ratio: float
 
 
 def run_id(prefix: str, parameters: dict) -> str:

@@ -54,7 +54,7 @@ def parse_local_table(
         step = int(lines[item("TIMESTEP") + 1])
         count = int(lines[item(count_item) + 1])
     except (IndexError, ValueError):
-        raise ContactDumpError(f"{source}: malformed TIMESTEP or NUMBER OF ENTRIES") from None
+        raise ContactDumpError(f"{source}: malformed TIMESTEP or {count_item}") from None
     rows = [line.split() for line in lines[item(table_item) + 1 :] if line.strip()]
     if len(rows) != count:
         raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")

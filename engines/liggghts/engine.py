@@ -39,8 +39,8 @@ from engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
-from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
 from engines.liggghts.settled import read_settled_fill
+from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 
 __all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]

@@ -22,7 +22,7 @@ from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.settled import SettledFill
 from engines.liggghts.contacts import ContactDumpError, parse_local_table, read_contacts
-from engines.liggghts.dumps import list_dumps
+from engines.liggghts.dumps import frame_from_arrays, list_dumps
 from engines.liggghts.run import CONTACT_PREFIX, SETTLED_FILL_PREFIX
 
 __all__ = ["SETTLED_COLUMNS", "read_settled_spheres", "read_settled_fill"]
@@ -59,21 +59,10 @@ def read_settled_spheres(path: str | Path, timestep: float) -> tuple[ParticleFra
         raise ContactDumpError(f"{path}: columns {header} are not the settled fill's {list(SETTLED_COLUMNS)}")
     step, table = parse_local_table(text, len(SETTLED_COLUMNS), str(path), "NUMBER OF ATOMS", "ATOMS")
     column = {name: table[:, index] for index, name in enumerate(SETTLED_COLUMNS)}
-    ids = column["id"].astype(np.int64)
-    body = column["id_multisphere"].astype(np.int64)
-    frame = ParticleFrame(
-        time=step * timestep,
-        step=step,
-        id=ids,
-        type=column["type"].astype(np.int32),
-        # a free sphere gets the negative of its own id, as in the particle dumps
-        clump_id=np.where(body > 0, body, -ids),
-        position=table[:, 3:6],
-        velocity=table[:, 6:9],
-        angular_velocity=None,
-        radius=column["radius"],
-        mass=column["mass"],
-    )
+    # the arrays of a particle dump, so that the one reader rule (free spheres, clump ids) applies
+    arrays = {"points": table[:, 3:6], "v": table[:, 6:9], "radius": column["radius"], "mass": column["mass"],
+              **{name: column[name].astype(np.int64) for name in ("id", "type", "id_multisphere")}}
+    frame = frame_from_arrays(arrays, step, step * timestep, source=str(path))
     return frame, table[:, 11:14].copy()
 
 

@@ -126,8 +126,9 @@ def recirculation_targets(wildcards=None):
     targets = [
         run_path(RECIRCULATION, name, run)
         for run in runs
-        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png", "plots/rtd.png",
-                     "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png", "plots/snapshots")
+        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png",
+                     "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
+                     "plots/snapshots")
     ]
     if runs:
         targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
@@ -150,9 +151,9 @@ def blender_targets(wildcards=None):
     targets = [
         run_path("blender", name, run)
         for run in runs
-        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png", "plots/insert_velocities.png",
-                     "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png", "plots/discontinuous.png",
-                     "plots/vrr_period.png")
+        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png",
+                     "plots/insert_velocities.png", "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png",
+                     "plots/discontinuous.png", "plots/vrr_period.png")
     ]
     if runs:
         targets += [f"{case_root('blender')}/comparison/{name}"

@@ -15,10 +15,6 @@ def fill_balance_params(kind):
     return params
 
 
-def fill_balance_targets(kind, runs):
-    return [run_path(kind, "metrics/fill_balance.json", run) for run in runs]
-
-
 for _kind in FILL_BALANCE_CASES:
 
     rule:

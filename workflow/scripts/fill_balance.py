@@ -18,11 +18,13 @@ with logged_to(snakemake.log[0]) as log:
     balance = settled_fill_balance(settled, heights, balance_params["gravity"])
     tolerances = BalanceTolerances(**balance_params["tolerance"])
     problems = balance_problems(balance, tolerances)
+    log.info("balance of %s: %s", record.run_id, balance.as_dict())
     write_json(snakemake.output.balance, {**balance.as_dict(), "run_id": record.run_id, "case": record.case,
                                           "tolerance": balance_params["tolerance"], "problems": problems})
     log.info("%s: walls + floor carry %.4f of the weight (floor %.3f, walls %+.3f); contacts / weight above %s",
              record.run_id, balance.support_ratio, balance.floor_ratio, balance.walls_ratio,
              ", ".join(f"{plane.contact_ratio:.3f} at {plane.height * 1e3:.0f} mm" for plane in balance.planes))
     if problems:
+        # Snakemake deletes a failed job's outputs: the figures stay in this log and in the message
         raise RuntimeError(f"the settled fill of {record.case} run {record.run_id} fails its force balance "
-                           f"(written to {snakemake.output.balance}):\n- " + "\n- ".join(problems))
+                           f"(figures in {snakemake.log[0]}):\n- " + "\n- ".join(problems))
