@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.checks import finite_array
+from analysis.numerics.uncertainty import batch_means
 
 __all__ = [
     "SteadyWindow",
@@ -37,6 +38,7 @@ __all__ = [
     "friction_angle",
     "friction_coefficient",
     "bulk_friction_of_shear",
+    "bulk_friction_summary",
 ]
 
 
@@ -104,6 +106,12 @@ class BulkFriction:
     relative_difference: float
     shear_force: float
     normal_load: float
+
+    @property
+    def angle_standard_error_deg(self) -> float:
+        """Standard error of ``angle_deg`` [deg], to first order ``degrees(se / (1 + mu^2))`` since
+        ``d atan(mu) / d mu = 1 / (1 + mu^2)``."""
+        return math.degrees(self.standard_error / (1.0 + self.coefficient**2))
 
 
 # --------------------------------------------------------------------------- validation
@@ -326,9 +334,7 @@ def mean_and_standard_error(values, n_batches: int = 10) -> tuple[float, float]:
     mean = float(np.mean(values))
     if n < 2 * n_batches:
         return mean, float(np.std(values, ddof=1)) / math.sqrt(n)
-    batch = n // n_batches
-    batch_means = values[n - n_batches * batch :].reshape(n_batches, batch).mean(axis=1)
-    return mean, float(np.std(batch_means, ddof=1)) / math.sqrt(n_batches)
+    return mean, batch_means(values, n_batches).std_error
 
 
 # --------------------------------------------------------------------------- bulk friction
@@ -529,3 +535,42 @@ def bulk_friction_of_shear(signals) -> tuple[BulkFriction, str]:
     time = np.asarray(signals.time, dtype=float)
     half = time[0] + 0.5 * (time[-1] - time[0])
     return bulk_friction(*arguments, window=(half, time[-1])), "second half"
+
+
+def bulk_friction_summary(friction: BulkFriction, window_method: str) -> dict:
+    """The bulk friction figures of one shear test as a flat record (``metrics/bulk_friction.json``).
+
+    Each ``<key>_error`` is the standard error of ``<key>`` in its unit: the batch-means error of the ratio
+    over the steady shear-stress/normal-stress window (:func:`bulk_friction`), and for the angle its first-order
+    propagation (:attr:`BulkFriction.angle_standard_error_deg`). ``bulk_friction_stderr`` is the same error under
+    its old name, kept for the readers of that key.
+
+    Parameters
+    ----------
+    friction : BulkFriction
+        The bulk friction of the test.
+    window_method : str
+        How the window was chosen (``"steady"`` or ``"second half"``, :func:`bulk_friction_of_shear`).
+
+    Returns
+    -------
+    dict
+        ``bulk_friction`` [-], ``bulk_friction_error`` [-], ``bulk_friction_stderr`` [-],
+        ``bulk_friction_angle_deg`` [deg], ``bulk_friction_angle_deg_error`` [deg], ``bottom_bulk_friction`` [-],
+        ``bottom_bulk_friction_error`` [-], ``ring_sides_relative_difference`` [-], ``window_start_s``,
+        ``window_end_s`` [s], ``window_samples`` [-] and ``window_method``.
+    """
+    return {
+        "bulk_friction": friction.coefficient,
+        "bulk_friction_error": friction.standard_error,
+        "bulk_friction_stderr": friction.standard_error,
+        "bulk_friction_angle_deg": friction.angle_deg,
+        "bulk_friction_angle_deg_error": friction.angle_standard_error_deg,
+        "bottom_bulk_friction": friction.bottom_coefficient,
+        "bottom_bulk_friction_error": friction.bottom_standard_error,
+        "ring_sides_relative_difference": friction.relative_difference,
+        "window_start_s": friction.window.t_start,
+        "window_end_s": friction.window.t_end,
+        "window_samples": friction.window.i_end - friction.window.i_start,
+        "window_method": window_method,
+    }

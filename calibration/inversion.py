@@ -13,6 +13,17 @@ inverse problem reads a chart backwards: the particle friction whose bulk fricti
 angle equals a measured one (30 deg internal, 9.5 deg aluminium, 11 deg perspex),
 with the band of particle friction that the measurement uncertainty (+-1 deg)
 allows.
+
+Error of the calibrated friction. Besides that band, the inverted particle friction carries the simulations'
+own noise: each chart point's bulk friction has a standard error (batch means of its steady shear window,
+:mod:`calibration.friction`). Propagated to first order through the piecewise linear inversion, the points
+``i``, ``i + 1`` of the segment that holds the target (at fraction ``t`` of its angle span) give
+
+    ``se(p) = sqrt(((1 - t) se_i)^2 + (t se_{i+1})^2) / s``,
+
+``se_i`` the points' angle errors [deg] and ``s = (theta_{i+1} - theta_i) / (p_{i+1} - p_i)`` the local slope of
+the chart [deg per unit particle friction]: a shift of the chart by ``d theta`` moves the inverted friction by
+``d theta / s``. The points are independent runs, so their errors add in quadrature.
 """
 
 from __future__ import annotations
@@ -22,10 +33,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.numerics.uncertainty import combine_independent
+
 __all__ = [
     "CalibrationCurve",
     "Inversion",
     "UnreachableTarget",
+    "inversion_error",
     "invert_curve",
     "invert_calibration",
     "curves_from_table",
@@ -133,6 +147,14 @@ class CalibrationCurve:
         """Bulk friction angles ``degrees(atan(bulk_friction))`` [deg]."""
         return np.degrees(np.arctan(self.bulk_friction))
 
+    @property
+    def bulk_angle_standard_error_deg(self) -> np.ndarray | None:
+        """Standard errors of :attr:`bulk_angle_deg` [deg], ``degrees(se / (1 + mu^2))`` to first order; None
+        without ``bulk_standard_error``, NaN where it is NaN."""
+        if self.bulk_standard_error is None:
+            return None
+        return np.degrees(self.bulk_standard_error / (1.0 + self.bulk_friction**2))
+
 
 @dataclass(frozen=True)
 class Inversion:
@@ -161,6 +183,9 @@ class Inversion:
     plateau_particle_friction : float or None
         Particle friction above which bulk friction stops growing (the end of
         the monotone part used), or None if the whole curve increases.
+    standard_error : float
+        Standard error of ``particle_friction`` from the chart points' bulk
+        friction errors (module docstring) [-]; NaN when those are unknown.
     """
 
     particle_friction: float
@@ -175,6 +200,7 @@ class Inversion:
     wall_material: str | None
     band_clipped: bool
     plateau_particle_friction: float | None
+    standard_error: float
 
 
 # --------------------------------------------------------------------------- inversion
@@ -188,6 +214,43 @@ def _monotone_part(curve: CalibrationCurve) -> tuple[np.ndarray, np.ndarray, flo
         return angles, curve.particle_friction, None
     last = int(not_growing[0])
     return angles[: last + 1], curve.particle_friction[: last + 1], float(curve.particle_friction[last])
+
+
+def inversion_error(angles, particle, angle_errors, target_angle_deg: float) -> float:
+    """Standard error of the particle friction read off a piecewise linear chart at a target angle [-].
+
+    First-order propagation of independent errors of the chart's angles through the local slope (module
+    docstring): with the target in the segment ``[theta_i, theta_{i+1}]`` at ``t = (target - theta_i) /
+    (theta_{i+1} - theta_i)`` (the segment to the right of a chart point, the last one at the last point),
+    ``sqrt(((1 - t) se_i)^2 + (t se_{i+1})^2) / s`` with ``s`` the segment's slope d theta / d p.
+
+    Parameters
+    ----------
+    angles : array_like, shape (n,)
+        Chart angles, strictly increasing [deg].
+    particle : array_like, shape (n,)
+        Particle friction at those angles, strictly increasing [-].
+    angle_errors : array_like, shape (n,), or None
+        Standard errors of ``angles`` [deg], NaN where unknown; None: all unknown.
+    target_angle_deg : float
+        Target angle inside ``[angles[0], angles[-1]]`` [deg].
+
+    Returns
+    -------
+    float
+        The error [-]; NaN when an error with a non-zero weight is unknown or the chart has one point.
+    """
+    angles = np.asarray(angles, dtype=float)
+    particle = np.asarray(particle, dtype=float)
+    if angle_errors is None or angles.size < 2:
+        return math.nan
+    errors = np.asarray(angle_errors, dtype=float)
+    i = int(np.clip(np.searchsorted(angles, target_angle_deg, side="right") - 1, 0, angles.size - 2))
+    t = (target_angle_deg - angles[i]) / (angles[i + 1] - angles[i])
+    slope = (angles[i + 1] - angles[i]) / (particle[i + 1] - particle[i])
+    # a point with weight 0 does not enter, even when its error is unknown
+    terms = [weight * errors[k] for weight, k in ((1.0 - t, i), (t, i + 1)) if weight != 0.0]
+    return combine_independent(terms) / slope
 
 
 def _describe(curve: CalibrationCurve) -> str:
@@ -210,6 +273,9 @@ def invert_curve(curve: CalibrationCurve, target_angle_deg: float, tolerance_deg
     *first* maximum is used: the points up to the first one that is not
     followed by a larger angle. Targets above that maximum are reported as
     unreachable, naming the particle friction where growth stops.
+
+    Error. ``standard_error`` propagates the chart points' bulk friction errors
+    through the local slope of the chart (:func:`inversion_error`).
 
     Band. ``lower`` and ``upper`` are the particle friction at
     ``target - tolerance`` and ``target + tolerance``. If the target itself is
@@ -250,6 +316,9 @@ def invert_curve(curve: CalibrationCurve, target_angle_deg: float, tolerance_deg
         raise ValueError(f"tolerance_deg must be >= 0, got {tolerance!r}")
 
     angles, particle, plateau = _monotone_part(curve)
+    angle_errors = curve.bulk_angle_standard_error_deg
+    if angle_errors is not None:
+        angle_errors = angle_errors[: angles.size]
     low, high = float(angles[0]), float(angles[-1])
     if not low <= target <= high:
         reason = (
@@ -278,6 +347,7 @@ def invert_curve(curve: CalibrationCurve, target_angle_deg: float, tolerance_deg
         wall_material=curve.wall_material,
         band_clipped=bool(band_clipped),
         plateau_particle_friction=plateau,
+        standard_error=float(inversion_error(angles, particle, angle_errors, target)),
     )
 
 
@@ -353,12 +423,15 @@ def invert_calibration(
         Plain Python values, ready for YAML::
 
             {"shape": "sphere2", "rolling_friction": 0.1, "tolerance_deg": 1.0,
-             "particle_particle": {"sliding_friction": x, "lower": .., "upper": .., "band_clipped": False},
+             "particle_particle": {"sliding_friction": x, "sliding_friction_error": se, "lower": ..,
+                                   "upper": .., "band_clipped": False},
              "particle_wall": {"aluminium": {...}, "perspex": {...}},
              "targets_deg": {"internal": 30.0, "aluminium": 9.5, "perspex": 11.0}}
 
         ``particle_particle`` is present only with an ``"internal"`` target;
         ``particle_wall`` holds one entry per wall material (possibly none).
+        ``sliding_friction_error`` is :attr:`Inversion.standard_error` [-], None
+        (YAML null) when the chart has no bulk friction errors.
 
     Raises
     ------
@@ -401,6 +474,8 @@ def invert_calibration(
             continue
         entry = {
             "sliding_friction": inversion.particle_friction,
+            # YAML null, not .nan, for an unknown error: plain data that round-trips
+            "sliding_friction_error": None if math.isnan(inversion.standard_error) else inversion.standard_error,
             "lower": inversion.lower,
             "upper": inversion.upper,
             "band_clipped": inversion.band_clipped,
@@ -431,9 +506,11 @@ def curves_from_table(rows: list[dict]) -> list[CalibrationCurve]:
     Each row is one simulated shear test with the keys ``shape``, ``test``
     ("internal" or "wall"), ``wall_material`` (empty, None or NaN for internal
     friction), ``rolling_friction``, ``particle_friction``, ``bulk_friction``
-    and, optionally, ``bulk_friction_stderr``. Values may be strings (as
+    and, optionally, ``bulk_friction_error`` (or ``bulk_friction_stderr``). Values may be strings (as
     read from CSV). Rows are grouped by (shape, test, wall material, rolling
-    friction); each curve is sorted by particle friction.
+    friction); each curve is sorted by particle friction. The bulk friction's
+    standard error is read from ``bulk_friction_error``, or, when a row lacks
+    that key, from ``bulk_friction_stderr``.
 
     Parameters
     ----------
@@ -464,7 +541,8 @@ def curves_from_table(rows: list[dict]) -> list[CalibrationCurve]:
             rolling = _finite_number("rolling_friction", row["rolling_friction"])
             particle = _finite_number("particle_friction", row["particle_friction"])
             bulk = _finite_number("bulk_friction", row["bulk_friction"])
-            error = _optional_number(row.get("bulk_friction_stderr"))
+            # the error under its current name, else under the name tables written before it had
+            error = _optional_number(row.get("bulk_friction_error", row.get("bulk_friction_stderr")))
         except KeyError as missing:
             raise ValueError(f"rows[{index}] lacks the key {missing.args[0]!r}") from None
         except ValueError as problem:

@@ -25,16 +25,17 @@ from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, IN
 from engines.cases.particles import particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
 from analysis.data.constants import GRAVITY
-from engines.cases.common import engine_kind, material_table, plan_fill, run_id
+from engines.cases.common import engine_kind, material_table, plan_fill, run_id, without_fill_checks
 from engines.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"
 MODES = ("continuous", "batch")
 
-#: Keys of ``blender`` that only steer the analysis; they do not define (or rerun) a simulation.
+#: Keys of ``blender`` that only steer the analysis or say how many runs to make; they do not define (or rerun) a
+#: simulation (a replicate is defined by its seed).
 ANALYSIS_ONLY_KEYS = (
     "enabled", "configurations", "gravity_factors", "bin_size", "profile_heights_above", "pathlines", "rtd",
-    "discontinuous", "continuous",
+    "discontinuous", "continuous", "replicates",
 )
 
 
@@ -262,8 +263,8 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         ),
         "engine": engine_kind(config, CASE_NAME),
         # the inserts enter through "insert"; the steady and profile windows only steer the analysis
-        "blender": {k: copy.deepcopy(v) for k, v in blender.items()
-                    if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine")},
+        "blender": without_fill_checks({k: copy.deepcopy(v) for k, v in blender.items()
+                                        if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine")}),
         "discharge": {"mode": discharge["mode"], "time": discharge["time"]},
     }
     silo = SiloCase(

@@ -115,6 +115,19 @@ class FillPlan:
     momentum_flux_ratio: float
 
 
+#: Keys of a ``fill`` section that only steer the check of the settled fill: they do not define (or rerun) a run.
+FILL_CHECK_KEYS = ("balance_planes", "balance_tolerance")
+
+
+def without_fill_checks(section: dict) -> dict:
+    """A copy of a case section (or of its ``fill``) without the :data:`FILL_CHECK_KEYS` of its fill, for the
+    parameters that define a run (a new tolerance must not rerun a simulation)."""
+    fill = section.get("fill")
+    if isinstance(fill, dict):
+        return {**section, "fill": {key: value for key, value in fill.items() if key not in FILL_CHECK_KEYS}}
+    return dict(section)
+
+
 def run_id(prefix: str, parameters: dict) -> str:
     """Stable run directory name: ``<prefix>-<first 10 hex digits of sha256 of canonical JSON>``."""
     canonical = json.dumps(parameters, sort_keys=True, separators=(",", ":"))

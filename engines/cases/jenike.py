@@ -36,7 +36,7 @@ from engines.cases.jenike_cell import CellGeometry, circle_intersection_area, se
 from engines.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
-from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id
+from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
 from engines.cases.jenike_sweep import sweep_points
 from engines.cases.stages import Stage
 
@@ -141,6 +141,16 @@ class JenikeCase:
     domain: tuple[float, float, float, float, float, float]
     seeds: tuple[int, ...]
     defining_parameters: dict = field(repr=False)
+
+    @property
+    def fill_height(self) -> float:
+        """Height of the levelled sample above the base (m): the height the force balance's planes refer to."""
+        return self.geometry.sample_height
+
+    @property
+    def gravity(self) -> float:
+        """Gravitational acceleration of the run (m/s^2)."""
+        return GRAVITY
 
     @property
     def test(self) -> str:
@@ -452,7 +462,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
         "test_contacts": asdict(test_contacts),
         "fill_contacts": asdict(fill_contacts),
-        "jenike": {key: value for key, value in jenike.items() if key not in ("sweep",)},
+        "jenike": without_fill_checks({key: value for key, value in jenike.items() if key not in ("sweep",)}),
     }
     return JenikeCase(
         particle=particle,

@@ -16,7 +16,9 @@ import math
 from dataclasses import asdict, dataclass, field
 
 from analysis.data.constants import GRAVITY
-from engines.cases.common import FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id
+from engines.cases.common import (
+    FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id, without_fill_checks,
+)
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
 from engines.cases.stages import Stage
@@ -24,7 +26,9 @@ from engines.cases.stages import Stage
 CASE_NAME = "silo_flat"
 
 #: Keys of ``silo_flat`` that only steer the analysis; they do not define (or rerun) the simulation.
-ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric")
+#: Keys that do not define a run: analysis settings, and the replicate count (each replicate is its own run, defined
+#: by its seed).
+ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates")
 
 
 @dataclass(frozen=True)
@@ -157,7 +161,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
             (c for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
             key=lambda c: sorted(c["materials"]),
         ),
-        "silo": {k: v for k, v in silo.items() if k not in (*ANALYSIS_ONLY_KEYS, "engine")},
+        "silo": without_fill_checks({k: v for k, v in silo.items() if k not in (*ANALYSIS_ONLY_KEYS, "engine")}),
     }
     # Normalise the contact pair order so [a, b] and [b, a] key the same run.
     defining["contacts"] = [{**c, "materials": sorted(c["materials"])} for c in defining["contacts"]]

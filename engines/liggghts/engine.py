@@ -31,7 +31,10 @@ from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
 from engines.liggghts.jenike import (
+    JENIKE_FLOOR_WALLS,
     PAIR_CONTACT_PREFIX,
+    SETTLED_CONTACT_PREFIX,
+    SETTLED_WALLS,
     WALL_CONTACT_PREFIX,
     WALL_MESHES,
     read_contact_dump,
@@ -39,7 +42,7 @@ from engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
-from engines.liggghts.settled import read_settled_fill
+from engines.liggghts.settled import read_settled_fill, read_settled_jenike_fill
 from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 
@@ -155,10 +158,14 @@ class LiggghtsEngine(Engine):
                 raise ValueError(f"{record.case} runs save no particle-wall contacts")
             return [read_contacts(path) for path in list_dumps(dumps, CONTACT_PREFIX, ".txt")]
         if kind == "pair":
-            return [_pair_frame(read_contact_dump(path)) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
+            return [read_jenike_pair_contacts(path) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
         return [_wall_frame(read_contact_dump(path)) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
 
     def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
+        if record.case == "jenike":
+            return read_settled_jenike_fill(
+                Path(run_dir) / "dumps", record.timestep_s, record.stage("settle"), SETTLED_WALLS, JENIKE_FLOOR_WALLS,
+                SETTLED_CONTACT_PREFIX, read_jenike_pair_contacts)
         if record.case not in FLOOR_WALLS:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
         return read_settled_fill(Path(run_dir) / "dumps", record.timestep_s, read_wall_forces(run_dir),
@@ -171,6 +178,11 @@ def _columns(table: dict, *names: str) -> np.ndarray:
 
 def _step(table: dict) -> int:
     return int(table["step"][0]) if table["step"].size else 0
+
+
+def read_jenike_pair_contacts(path: str | Path) -> ContactFrame:
+    """One Jenike pair-contact dump (:data:`engines.liggghts.jenike.CONTACT_COLUMNS`) as a frame."""
+    return _pair_frame(read_contact_dump(path))
 
 
 def _pair_frame(table: dict) -> ContactFrame:

@@ -41,6 +41,7 @@ from engines.liggghts.markers import parse_markers
 from engines.liggghts.run import (
     DUMP_PREFIX,
     RUN_OUTPUTS,
+    SETTLED_FILL_PREFIX,
     output_bytes,
     run_engine,
     set_aside_previous_attempt,
@@ -71,6 +72,13 @@ STAGES = ("filled", "levelled", "lid_placed", "consolidated", "sheared")
 JENIKE_STAGE_MARKERS = {"filled": "fill", "levelled": "settle", "consolidated": "consolidate", "sheared": "shear"}
 
 PAIR_CONTACT_PREFIX = "pair_contacts"
+#: The pair contacts of the levelled, settled fill (before the lid), beside ``settled_fill_<step>.txt``; their own
+#: prefix keeps them out of the consolidation and shear contact frames.
+SETTLED_CONTACT_PREFIX = "settled_contacts"
+#: The meshes whose force on the settled fill the levelled marker records, as ``<mesh>_f<x|y|z>`` (N, exerted BY
+#: the particles ON the mesh); the base is the floor.
+SETTLED_WALLS = ("base", "shear_ring", "mould")
+JENIKE_FLOOR_WALLS = ("base",)
 #: The meshes of the cell's one mesh wall, by their index in the wall contact dumps.
 WALL_MESHES = ("base", "shear_ring", "mould", "lid")
 WALL_CONTACT_PREFIX = "wall_contacts"
@@ -179,6 +187,14 @@ def jenike_deck_context(case: JenikeCase) -> dict:
                 "columns": len(CONTACT_COLUMNS),
             },
             "thermo_every": case.output_every * 10,
+            "settled_fill": {
+                "path": f"dumps/{SETTLED_FILL_PREFIX}_*.txt",
+                "contacts_path": f"dumps/{SETTLED_CONTACT_PREFIX}_*.txt",
+                "contact_compute": "pair_contacts",
+                "contact_columns": len(CONTACT_COLUMNS),
+                "walls": list(SETTLED_WALLS),
+                "marker_values": [[f"{wall}_f{axis}", f"{wall}_f{axis}"] for wall in SETTLED_WALLS for axis in "xyz"],
+            },
         }
     )
     assert context["particle"]["type"] == PARTICLE_TYPE

@@ -1,5 +1,6 @@
 """Real LIGGGHTS runs of a small Jenike cell: the normal force holds, bulk friction responds to particle friction,
-and the lid + shear ring estimate agrees with the bottom-ring estimate.
+and the lid + shear ring estimate agrees with the bottom-ring estimate; the levelled sample is at rest before the lid
+(force balance of its settled-fill snapshot).
 
 The cell is scaled down (inner diameter 40 mm, rings 8 + 10 mm, about 650 two-sphere clumps after levelling)
 and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, and two run side by side.
@@ -16,6 +17,7 @@ import pytest
 
 from engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
 from analysis.data.record import RunRecord
+from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals
 from engines.config import validate_config
@@ -168,3 +170,17 @@ def test_contact_dumps_carry_the_plate_load(runs):
     row = int(np.searchsorted(run.history["step"], contacts["step"][0]))
     measured = -run.history["bottom_fz"][row - 1 : row + 1].mean()
     assert load == pytest.approx(measured, rel=0.02)
+
+
+@pytest.mark.parametrize("name", list(RUNS))
+def test_the_levelled_sample_carries_its_weight_before_the_lid(name, runs):
+    run = runs[name]
+    settled = liggghts().settled_fill(run.run_dir, run.record)
+    assert settled.floor_walls == ("base",)
+    heights = [fraction * run.case.fill_height for fraction in (0.25, 0.5)]
+    balance = settled_fill_balance(settled, heights, run.case.gravity)
+    assert balance.n_clumps == run.record.n_clumps
+    assert balance.support_ratio == pytest.approx(1.0, abs=0.01)  # base + rings carry the sample's weight
+    for plane in balance.planes:
+        assert plane.closure == pytest.approx(1.0, abs=0.01), plane
+    assert balance_problems(balance, BalanceTolerances()) == []

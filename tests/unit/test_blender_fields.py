@@ -7,11 +7,17 @@ from analysis.numerics.grid import Grid
 from analysis.studies.blender.window_fields import (
     PlanarField,
     discharged_mass_history,
+    frame_fields,
     frames_in_window,
     mean_velocity_history,
     window_average_field,
 )
-from analysis.studies.blender.window_fields_io import read_planar_fields, write_planar_fields
+from analysis.studies.blender.window_fields_io import (
+    read_frame_fields,
+    read_planar_fields,
+    write_frame_fields,
+    write_planar_fields,
+)
 from analysis.studies.silo_recirculation.tracks import ClumpTracks
 from analysis.numerics.eulerian_rtd import silo_bins
 
@@ -47,6 +53,30 @@ def test_window_average_pools_clumps_of_all_frames_mass_weighted():
     np.testing.assert_allclose(field.v_x[:, 0], [0.0, 2.0])
     # solid fraction: mean mass per frame / (rho V): left (1 + 1) g / 2 / (1000 * 1e-6) = 1.0, right 3 g / 2 / 1e-3
     np.testing.assert_allclose(field.solid_fraction[:, 0], [1.0, 1.5])
+
+
+def test_frame_fields_give_each_frame_of_the_window_alone():
+    grid = silo_bins(width=0.02, depth=0.01, top=0.01, bin_size=0.01)
+    positions = np.array([
+        [[-0.005, 0.005, 0.005], [0.005, 0.005, 0.005]],
+        [[-0.005, 0.005, 0.005], [np.nan] * 3],          # clump 1 absent
+        [[0.5, 0.0, 0.0], [0.005, 0.005, 0.005]],         # frame outside the window
+    ])
+    velocities = np.array([
+        [[0.0, 0.0, -1.0], [2.0, 0.0, -2.0]],
+        [[0.0, 0.0, -4.0], [np.nan] * 3],
+        [[9.0, 9.0, 9.0], [9.0, 9.0, 9.0]],
+    ])
+    first, second = frame_fields(positions, velocities, [1.0e-3, 3.0e-3], [0.0, 0.1, 0.2], grid, (0.0, 0.1), 1000.0)
+    assert (first.window, first.n_frames, second.window, second.n_frames) == ((0.0, 0.0), 1, (0.1, 0.1), 1)
+    np.testing.assert_allclose(first.v_z[:, 0], [-1.0, -2.0])
+    np.testing.assert_allclose(first.v_x[:, 0], [0.0, 2.0])
+    np.testing.assert_allclose(second.v_z[:, 0], [-4.0, np.nan])
+    # solid fraction of one frame: 1 g / (1000 kg/m^3 x 1e-6 m^3) = 1.0, 3 g: 3.0; the empty bin 0
+    np.testing.assert_allclose(first.solid_fraction[:, 0], [1.0, 3.0])
+    np.testing.assert_allclose(second.solid_fraction[:, 0], [1.0, 0.0])
+    with pytest.raises(ValueError, match="no frame"):
+        frame_fields(positions, velocities, [1.0e-3, 3.0e-3], [0.0, 0.1, 0.2], grid, (0.3, 0.4), 1000.0)
 
 
 def test_a_bin_no_clump_entered_is_nan_and_a_grid_with_depth_bins_is_refused():
@@ -99,6 +129,19 @@ def test_planar_fields_round_trip(tmp_path):
     np.testing.assert_array_equal(loaded.v_z, steady.v_z)
     assert loaded.window == (1.0, 2.0) and len(loaded_windows) == 2
     np.testing.assert_array_equal(loaded_windows[1].v_x, windows[1].v_x)
+    # frame fields: the same store without a steady field
+    frames = read_frame_fields(write_frame_fields(tmp_path / "frames.npz", windows))
+    assert [f.window for f in frames] == [(0.0, 1.0), (1.0, 2.0)] and [f.n_frames for f in frames] == [3, 3]
+    np.testing.assert_array_equal(frames[0].v_z, windows[0].v_z)
+    other = PlanarField(x=np.array([0.5]), z=np.array([0.1]), v_x=np.zeros((1, 1)), v_z=np.zeros((1, 1)),
+                        solid_fraction=np.ones((1, 1)), window=(0.0, 0.0), n_frames=1)
+    with pytest.raises(ValueError, match="same bins"):
+        write_frame_fields(tmp_path / "bad.npz", [windows[0], other])
+    with pytest.raises(ValueError, match="steady field"):
+        write_planar_fields(tmp_path / "bad.npz", steady, [other])
+    with pytest.raises(ValueError, match="at least one"):
+        write_frame_fields(tmp_path / "bad.npz", [])
+    assert not (tmp_path / "bad.npz").exists()
 
 
 def test_mean_velocity_history_weights_the_clumps_above_the_outlet_by_mass():

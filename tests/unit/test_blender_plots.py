@@ -200,6 +200,20 @@ def test_plot_configuration_comparison(tmp_path, figures):
     assert second.patches[0].get_linewidth() == 2.0
 
 
+def test_plot_configuration_comparison_draws_one_standard_error_where_known(tmp_path, figures):
+    rows = [{"configuration": "a", "flow": 3.0, "flow_error": 0.5, "vrr_at_1_tm": 10.0},
+            {"configuration": "b", "flow": 2.0, "flow_error": math.nan, "vrr_at_1_tm": 12.0},
+            {"configuration": "c", "flow": 1.0, "flow_error": 0.25, "vrr_at_1_tm": 14.0}]
+    target = tmp_path / "comparison.png"
+    plot_configuration_comparison(rows, ["flow", "vrr_at_1_tm"], target, "errors")
+    flow, vrr = figures[0].axes
+    (bars,) = flow.containers[1:]  # after the bars: one error-bar set, for a and c only
+    segments = bars.lines[2][0].get_segments()
+    np.testing.assert_allclose([segment[:, 1] for segment in segments], [[2.5, 3.5], [0.75, 1.25]])
+    np.testing.assert_allclose([segment[0, 0] for segment in segments], [0.0, 2.0])
+    assert len(vrr.containers) == 1  # no error column: bars only
+
+
 # --------------------------------------------------------------------------- bad input
 
 

@@ -18,6 +18,7 @@ from analysis.studies.blender.study import (
     study_summary,
 )
 from analysis.io.tables import write_json
+from analysis.studies.blender.errors import sine_vrr_error
 
 V = 0.05          # downward speed [m/s]
 FILL = 0.2        # fill height [m]
@@ -80,6 +81,40 @@ def test_metrics_and_rtd_survive_a_json_round_trip(study, tmp_path):
     rtd = rtd_from_summary(loaded["rtd_curve"])
     np.testing.assert_array_equal(rtd.E, study.rtd.rtd.E)
     assert rtd.n_total == study.rtd.rtd.n_total
+
+
+def test_metrics_carry_the_errors_of_the_frames_and_tracers_through_json(study, tmp_path):
+    # four frames moving at 1, 2, 3, 4 V: batch means of 4 batches, the error of a mean of 1, 2, 3, 4 (times V)
+    frames = [uniform_field(k * V) for k in (1.0, 2.0, 3.0, 4.0)]
+    metrics = study_metrics("plug", study, 0.01, SETTINGS.comparison_fractions, mass_flow_rate_error=2e-4,
+                            frames=frames, resolution=SETTINGS.integration_step)
+    assert metrics.mass_flow_rate_error == 2e-4
+    assert metrics.interior_v_z_error == pytest.approx(V * math.sqrt(5.0 / 3.0) / 2.0, rel=1e-12)
+    assert metrics.exterior_v_z_error == pytest.approx(metrics.interior_v_z_error, rel=1e-12)
+    assert math.isnan(metrics.tube_v_z_error)  # no tube
+    # equal solid fractions: equal tracer weights, so n_eff = n and the tracers' part of t_m's error is
+    # std(ddof=1) / sqrt(n); the field's part is t_m times the flow rate's relative error, 2e-4 / 0.01
+    tau = study.rtd.residence_time[np.isfinite(study.rtd.residence_time)]
+    assert metrics.vrr_ceiling == pytest.approx(tau.size, rel=1e-12)
+    assert metrics.rtd_mean_error == pytest.approx(
+        math.hypot(np.std(tau, ddof=1) / math.sqrt(tau.size), 0.02 * metrics.rtd_mean), rel=1e-9)
+    assert metrics.vrr_errors == pytest.approx(
+        {1.0: sine_vrr_error(metrics.vrr_by_period[1.0], tau.size)}, rel=1e-12)
+    assert math.isfinite(metrics.ts_over_td_error) and math.isfinite(metrics.rtd_spread_error)
+    summary = study_summary(study, metrics)["metrics"]
+    assert list(summary)[:4] == ["configuration", "mass_flow_rate_kg_s", "mass_flow_rate_kg_s_error",
+                                 "exterior_v_z_m_s"]
+    assert summary["vrr_ceiling"] == metrics.vrr_ceiling and "recirculations_to_homogenise_error" not in summary
+    loaded = json.loads(write_json(tmp_path / "blender.json", {"metrics": summary}).read_text())
+    back = metrics_from_summary(loaded)
+    assert back.interior_v_z_error == metrics.interior_v_z_error and math.isnan(back.tube_v_z_error)
+    assert back.vrr_errors == metrics.vrr_errors and back.vrr_ceiling == metrics.vrr_ceiling
+    # without frames or a resolution those errors are unknown; a summary without errors reads back as unknown
+    bare = study_metrics("plug", study, 0.01, SETTINGS.comparison_fractions)
+    assert math.isnan(bare.interior_v_z_error) and math.isnan(bare.ts_over_td_error)
+    assert math.isnan(bare.mass_flow_rate_error) and math.isnan(bare.rtd_mean_error)
+    old = {key: value for key, value in summary.items() if not key.endswith("_error") and key != "vrr_ceiling"}
+    assert math.isnan(metrics_from_summary({"metrics": old}).rtd_mean_error)
 
 
 def test_key_heights_sit_one_bin_inside_the_insert_and_above_the_tube_and_stay_below_the_fill():

@@ -165,6 +165,24 @@ def test_comparison_markdown_is_heading_table_and_verdict():
     )
 
 
+def test_comparison_markdown_prints_value_and_error_and_marks_vrrs_at_the_ceiling():
+    rows = [{"configuration": "straight", "flow": 0.11682, "flow_error": 0.00213, "recirculations_to_homogenise": 4.61,
+             "vrr_at_1_tm": 300.0, "vrr_at_1_tm_error": 250.0, "vrr_ceiling": 400.0, "vrr_at_1_tm_at_ceiling": True},
+            {"configuration": "diverging", "flow": NAN, "flow_error": 0.1, "recirculations_to_homogenise": 5.0,
+             "vrr_at_1_tm": 12.5, "vrr_at_1_tm_error": NAN, "vrr_ceiling": 400.0, "vrr_at_1_tm_at_ceiling": False}]
+    assert comparison_markdown(1.0, rows, "straight", 0.1) == (
+        "# Insert configurations at 1 g\n\n"
+        "| configuration | flow | recirculations_to_homogenise | vrr_at_1_tm | vrr_ceiling |\n|---|---|---|---|---|\n"
+        "| straight | 0.1168 ± 0.0021 | 4.61 | 300 ± 250 (at ceiling) | 400 |\n"
+        "| diverging | n/a | 5 | 12.5 ± unknown | 400 |\n\n"
+        "Best blender: **straight** (fewest recirculations to homogenise within +-10%, ties broken by the highest "
+        "VRR at the shortest period).\n\n"
+        "Figures are value ± standard error. A VRR marked (at ceiling) lies within a factor 2 of its counting-noise "
+        "ceiling, so it is only a lower bound. Whether the differences between configurations exceed their "
+        "uncertainty: significance.csv.\n"
+    )
+
+
 # --------------------------------------------------------------------------- gravity scaling
 
 

@@ -12,7 +12,7 @@ import pytest
 from calibration.charts import plot_calibration_chart, plot_force_history, plot_lid_comparison, plot_polar_histogram
 from calibration.contact_diagnostics import angular_histogram
 from calibration.friction import BulkFriction, SteadyWindow
-from calibration.inversion import CalibrationCurve
+from calibration.inversion import CalibrationCurve, curves_from_table
 from calibration.shear import ShearSignals
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -89,6 +89,22 @@ def test_plot_calibration_chart_draws_each_curve_in_degrees_with_its_error_and_t
             (band,) = bands
             assert band.get_label() == "target 30 ± 1 deg"
             assert (band.get_y(), band.get_y() + band.get_height()) == (29.0, 31.0)
+    plt.close(figure)
+
+
+def test_plot_calibration_chart_draws_the_bulk_friction_errors_of_the_calibration_table(tmp_path):
+    # rows as the calibration table holds them (strings), each with its batch-means error bulk_friction_error
+    rows = [{"shape": "sphere2", "test": "wall", "wall_material": "aluminium", "rolling_friction": "0.1",
+             "particle_friction": str(p), "bulk_friction": str(mu), "bulk_friction_error": str(e),
+             "bulk_friction_stderr": str(e)}
+            for p, mu, e in ((0.1, 0.1, 0.002), (0.3, 0.3, 0.004), (0.5, 0.4, 0.006))]
+    path = tmp_path / "chart.png"
+    figure = plot_calibration_chart(curves_from_table(rows), path, "sphere2, aluminium wall friction", 9.5, 1.0)
+    (container,) = _curve_containers(figure.axes[0]).values()
+    mu, error = np.array([0.1, 0.3, 0.4]), np.array([0.002, 0.004, 0.006])
+    angle, angle_error = np.degrees(np.arctan(mu)), np.degrees(error / (1.0 + mu**2))
+    np.testing.assert_allclose(_error_segments(container),
+                               np.column_stack([[0.1, 0.3, 0.5], angle - angle_error, angle + angle_error]), rtol=1e-14)
     plt.close(figure)
 
 

@@ -14,6 +14,7 @@ from calibration.friction import (
     SteadyWindow,
     bulk_friction,
     bulk_friction_of_shear,
+    bulk_friction_summary,
     detect_steady_window,
     friction_angle,
     friction_coefficient,
@@ -158,6 +159,27 @@ def test_mean_and_error_batch_means_by_hand():
     mean, error = mean_and_standard_error(values)
     assert mean == 4.5
     assert error == pytest.approx(np.std(np.arange(10.0), ddof=1) / math.sqrt(10), rel=1e-14)
+
+
+def test_bulk_friction_error_is_the_batch_means_error_of_a_series_with_known_batch_means():
+    # 20 samples under a constant load of 10 N; shear force in 10 batches of two with means 1, 2, ..., 10 N
+    time = np.arange(20.0)
+    shear = np.repeat(np.arange(1.0, 11.0), 2) + np.tile([-0.5, 0.5], 10)
+    result = bulk_friction(time, shear, np.zeros(20), shear, 8.0, 2.0, window=(0.0, 19.0))
+    assert result.coefficient == pytest.approx(0.55, rel=1e-14)
+    error = np.std(np.arange(1.0, 11.0), ddof=1) / math.sqrt(10) / 10.0  # of the batch means of F / (F_N + W)
+    assert result.standard_error == pytest.approx(error, rel=1e-12)
+    assert result.bottom_standard_error == pytest.approx(error, rel=1e-12)
+    assert result.angle_standard_error_deg == pytest.approx(math.degrees(error / (1 + 0.55**2)), rel=1e-12)
+    summary = bulk_friction_summary(result, "steady")
+    assert summary == {
+        "bulk_friction": result.coefficient, "bulk_friction_error": result.standard_error,
+        "bulk_friction_stderr": result.standard_error, "bulk_friction_angle_deg": result.angle_deg,
+        "bulk_friction_angle_deg_error": result.angle_standard_error_deg,
+        "bottom_bulk_friction": result.bottom_coefficient, "bottom_bulk_friction_error": result.bottom_standard_error,
+        "ring_sides_relative_difference": result.relative_difference, "window_start_s": 0.0, "window_end_s": 19.0,
+        "window_samples": 20, "window_method": "steady",
+    }
 
 
 def test_mean_and_error_rejects_short_input():

@@ -14,6 +14,7 @@ from calibration.inversion import (
     UnreachableTarget,
     curves_from_table,
     invert_calibration,
+    inversion_error,
     invert_curve,
 )
 
@@ -69,6 +70,37 @@ def test_invert_monotone_chart_exact():
     assert inversion.reachable_range_deg == pytest.approx((_deg(0.2), _deg(0.7)), abs=1e-12)
     assert (inversion.shape, inversion.test, inversion.rolling_friction) == ("sphere2", "internal", 0.1)
     assert inversion.target_angle_deg == target and inversion.tolerance_deg == 1.0
+
+
+def test_inversion_error_propagates_the_angle_errors_through_the_local_slope():
+    angles, particle, errors = [10.0, 20.0, 30.0], [0.0, 0.5, 1.0], [0.3, 0.4, 0.5]  # slope 20 deg per unit
+    # midway in the first segment: sqrt(0.15^2 + 0.2^2) / 20 = 0.25 / 20
+    assert inversion_error(angles, particle, errors, 15.0) == pytest.approx(0.0125, rel=1e-14)
+    assert inversion_error(angles, particle, errors, 20.0) == pytest.approx(0.02, rel=1e-14)  # a point: its own error
+    assert inversion_error(angles, particle, errors, 30.0) == pytest.approx(0.025, rel=1e-14)  # the last point
+    # an unknown error counts only where it has weight
+    assert inversion_error(angles, particle, [0.3, math.nan, 0.5], 10.0) == pytest.approx(0.015, rel=1e-14)
+    assert math.isnan(inversion_error(angles, particle, [0.3, math.nan, 0.5], 15.0))
+    assert math.isnan(inversion_error(angles, particle, None, 15.0))
+    assert math.isnan(inversion_error([10.0], [0.5], [0.3], 10.0))
+
+
+def test_invert_curve_error_of_a_chart_with_bulk_friction_errors():
+    curve = CalibrationCurve(shape="sphere2", test="internal", rolling_friction=0.1, particle_friction=PARTICLE,
+                             bulk_friction=0.2 + 0.5 * PARTICLE, bulk_standard_error=np.full(PARTICLE.size, 0.01))
+    target = _deg(0.475)  # between the points p = 0.5 (mu 0.45) and p = 0.6 (mu 0.5)
+    inversion = invert_curve(curve, target, tolerance_deg=1.0)
+    low, high = _deg(0.45), _deg(0.5)
+    t = (target - low) / (high - low)
+    error_low, error_high = math.degrees(0.01 / (1 + 0.45**2)), math.degrees(0.01 / (1 + 0.5**2))
+    expected = math.hypot((1 - t) * error_low, t * error_high) / ((high - low) / 0.1)
+    assert inversion.standard_error == pytest.approx(expected, rel=1e-10)
+    np.testing.assert_allclose(curve.bulk_angle_standard_error_deg,
+                               np.degrees(0.01 / (1 + curve.bulk_friction**2)), rtol=1e-15)
+    result = invert_calibration([curve], {"internal": target}, shape="sphere2", rolling_friction=0.1)
+    assert result["particle_particle"]["sliding_friction_error"] == inversion.standard_error
+    assert yaml.safe_load(yaml.safe_dump(result)) == result
+    assert math.isnan(invert_curve(_linear_curve(), target).standard_error)  # no errors on the chart
 
 
 def test_invert_reproduces_chart_points():
@@ -172,7 +204,9 @@ def test_invert_calibration_dict():
     assert result["particle_particle"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
     assert result["particle_wall"]["aluminium"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
     assert result["particle_wall"]["perspex"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
-    assert set(result["particle_wall"]["perspex"]) == {"sliding_friction", "lower", "upper", "band_clipped"}
+    assert set(result["particle_wall"]["perspex"]) == {"sliding_friction", "sliding_friction_error", "lower", "upper",
+                                                       "band_clipped"}
+    assert result["particle_particle"]["sliding_friction_error"] is None  # the chart has no errors: YAML null
     assert result["targets_deg"] == targets
     expected_band = invert_curve(_linear_curve(), _deg(0.45), 1.0)
     assert result["particle_particle"]["lower"] == expected_band.lower
@@ -236,6 +270,16 @@ def test_curves_from_table_groups_and_sorts():
     perspex = curves[4]
     np.testing.assert_array_equal(perspex.particle_friction, [0.2, 0.5])
     np.testing.assert_array_equal(perspex.bulk_standard_error, [np.nan, 0.01])
+
+
+def test_curves_from_table_reads_the_error_under_its_current_name_first():
+    row = {"shape": "sphere", "test": "internal", "wall_material": "", "rolling_friction": 0.0, "bulk_friction": 0.3}
+    (curve,) = curves_from_table([
+        dict(row, particle_friction=0.1, bulk_friction_error="0.02", bulk_friction_stderr="0.5"),
+        dict(row, particle_friction=0.2, bulk_friction_stderr="0.03"),  # an older row: only the old name
+        dict(row, particle_friction=0.3, bulk_friction_error=""),
+    ])
+    np.testing.assert_array_equal(curve.bulk_standard_error, [0.02, 0.03, np.nan])
 
 
 def test_curves_from_table_errors():

@@ -7,6 +7,7 @@ import copy
 import pytest
 import yaml
 
+from engines.cases import cases_of
 from engines.cases.silo_flat import build_silo_case
 from engines.config import SCHEMA_PATH, ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_for
@@ -171,3 +172,22 @@ def test_file_errors_name_the_file(tmp_path):
     path.write_text("silo_flat:\n  depth: -1.0\n")
     with pytest.raises(ConfigError, match=rf"{path}: config key 'silo_flat.depth'"):
         load_config(path)
+
+
+@pytest.mark.parametrize("kind", ["silo_flat", "silo_recirculation", "blender"])
+def test_replicates_add_reseeded_runs_and_keep_the_first(raw_default_config, kind):
+    single = cases_of(validate_config(raw_default_config), kind)
+    raw = copy.deepcopy(raw_default_config)
+    raw["defaults"]["replicates"] = 3
+    replicated = cases_of(validate_config(raw), kind)
+    assert len(replicated) == 3 * len(single)
+    assert set(single) <= set(replicated)  # raising N keeps the runs already done
+    seeds = [getattr(case, "seeds", None) or case.silo.seeds for case in replicated.values()]
+    assert len(set(seeds)) == 3  # one engine seed set per replicate, shared by the configurations of one seed
+
+
+def test_replicates_must_be_at_least_one(raw_default_config):
+    raw = copy.deepcopy(raw_default_config)
+    raw["blender"]["replicates"] = 0
+    with pytest.raises(ConfigError, match="blender.replicates"):
+        validate_config(raw)

@@ -16,6 +16,7 @@ from analysis.numerics.flow import (
     discharged_mass_history,
     filling_bulk_density,
     mass_in_silo,
+    slab_bulk_density,
     steady_flow_rate,
     volumetric_flow_rate,
 )
@@ -159,6 +160,32 @@ def test_filling_bulk_density_errors():
         filling_bulk_density(positions[:, :2], 0.5, 2.0, 1.0, surface_margin=0.1)
     with pytest.raises(ValueError, match="clump_mass"):
         filling_bulk_density(positions, np.ones(3), 2.0, 1.0, surface_margin=0.1)
+
+
+def test_slab_bulk_density_of_slabs_with_known_masses():
+    # area 0.5 m2, z_m = 4 m, slabs of 1 m: masses 0.5, 1, 1.5, 2 kg give densities 1, 2, 3, 4 kg/m3
+    z = np.array([0.5, 1.0, 1.5, 2.2, 2.7, 3.9, -0.1, 4.0])  # 1.0 lies on an edge: the slab above
+    mass = np.array([0.5, 0.25, 0.75, 0.75, 0.75, 2.0, 9.0, 9.0])  # the last two lie outside [0, 4)
+    estimate = slab_bulk_density(z, mass, area=0.5, measured_height=4.0, slab_thickness=1.0)
+    assert (estimate.value, estimate.n, estimate.method, estimate.dof) == (2.5, 4, "slab spread", 3.0)
+    assert estimate.std_error == pytest.approx(math.sqrt(5.0 / 3.0) / 2.0, rel=1e-14)  # std(1..4) / sqrt(4)
+
+
+def test_slab_bulk_density_of_a_lattice_with_whole_layers_per_slab_has_no_spread():
+    spacing, clump_mass = 0.25, 0.5
+    positions = _cubic_lattice(spacing, 8, 4, 12)
+    # z_m = 10 a in slabs of at least 2 a: 5 slabs of two layers each
+    estimate = slab_bulk_density(positions[:, 2], clump_mass, 2.0 * 1.0, 10 * spacing, 2 * spacing)
+    assert (estimate.value, estimate.std_error, estimate.n) == (clump_mass / spacing**3, 0.0, 5)
+
+
+def test_slab_bulk_density_of_a_layer_thinner_than_two_slabs_has_an_unknown_error():
+    estimate = slab_bulk_density([0.1, 0.2], 1.0, area=1.0, measured_height=1.0, slab_thickness=0.6)
+    assert (estimate.value, estimate.n) == (2.0, 1) and math.isnan(estimate.std_error)
+    with pytest.raises(ValueError, match="slab_thickness"):
+        slab_bulk_density([0.1], 1.0, area=1.0, measured_height=1.0, slab_thickness=0.0)
+    with pytest.raises(ValueError, match="clump_mass"):
+        slab_bulk_density([0.1, 0.2], [1.0], area=1.0, measured_height=1.0, slab_thickness=0.5)
 
 
 # --------------------------------------------------------------------------- mass and history

@@ -10,9 +10,12 @@ import pytest
 from analysis.numerics.rtd import (
     RTD,
     RTDMoments,
+    appearance_times,
     johanson_rtd,
+    mean_residence_time,
     perfect_mixer_rtd,
     plug_flow_rtd,
+    residence_time_resolution,
     rtd_from_exit_times,
     rtd_moments,
 )
@@ -204,3 +207,89 @@ def test_johanson_symmetric_case_by_hand():
 def test_johanson_rejects_bad_parameters(v1, p, match):
     with pytest.raises(ValueError, match=match):
         johanson_rtd([0.0, 1.0], 1.0, v1, p)
+
+
+# --------------------------------------------------------------------------- uncertainty
+
+# Eight tracers with mean 5 s and population standard deviation 2 s: the sample variance is 32 / 7 s^2, so the
+# mean has the standard error sqrt(32 / 7 / 8) = sqrt(4 / 7) s. One more tracer never left (NaN).
+KNOWN_SAMPLE = np.array([2.0, 4.0, 4.0, 4.0, 5.0, np.nan, 5.0, 7.0, 9.0])
+
+
+def test_mean_residence_time_is_the_sample_mean_with_its_standard_error():
+    mean = mean_residence_time(KNOWN_SAMPLE)
+    assert (mean.value, mean.n, mean.dof, mean.method) == (5.0, 8, 7.0, "tracer sample")
+    assert mean.std_error == pytest.approx(math.sqrt(4.0 / 7.0), rel=1e-15)
+    one = mean_residence_time([np.nan, 3.0])  # a single tracer says nothing about the spread
+    assert (one.value, one.n) == (3.0, 1) and math.isnan(one.std_error)
+
+
+def test_rtd_t_mean_error_equals_that_of_the_sample():
+    rtd = rtd_from_exit_times(KNOWN_SAMPLE + 1.0, t_entry=1.0, bins=4)
+    assert (rtd.t_mean, rtd.variance) == (5.0, 4.0)
+    assert rtd.t_mean_error == pytest.approx(math.sqrt(4.0 / 7.0), rel=1e-15)
+    assert math.isnan(rtd_from_exit_times([2.0, np.nan], bins=1).t_mean_error)
+
+
+@pytest.mark.parametrize("sample, message", [
+    ([np.nan, np.nan], "no tracer left"),
+    ([], "no tracer left"),
+    ([1.0, np.inf], "infinite"),
+    ([[1.0, 2.0]], "1-D"),
+])
+def test_mean_residence_time_rejects_bad_samples(sample, message):
+    with pytest.raises(ValueError, match=message):
+        mean_residence_time(sample)
+
+
+def test_residence_time_resolution_is_the_frame_interval_over_sqrt_6():
+    # two events, each uniform over its frame interval: variance 2 x 0.03^2 / 12 = 0.03^2 / 6
+    assert residence_time_resolution(0.03) == 0.03 / math.sqrt(6.0)
+    assert residence_time_resolution(math.sqrt(6.0)) == pytest.approx(1.0, rel=1e-15)
+    assert residence_time_resolution(0.0) == 0.0
+    assert math.isnan(residence_time_resolution(math.nan))  # unknown stays unknown
+    for bad in (-0.01, math.inf):
+        with pytest.raises(ValueError, match="frame_interval must be a finite number >= 0"):
+            residence_time_resolution(bad)
+
+
+def test_appearance_times_combine_the_end_gaps_with_the_resolution():
+    # sorted 10, 13, 20, 27, 30 s (one tracer still inside): gaps 3 s at both ends; with a resolution of 4 s
+    # t_s = 10 +- 5 s and t_d = 30 +- 5 s, and t_s / t_d = 1/3 +- (1/3) sqrt((5/10)^2 + (5/30)^2) = sqrt(10) / 18
+    times = appearance_times([27.0, 10.0, np.nan, 30.0, 13.0, 20.0], resolution=4.0)
+    assert (times.t_first.value, times.t_first.std_error) == (10.0, 5.0)
+    assert (times.t_last.value, times.t_last.std_error) == (30.0, 5.0)
+    assert times.ts_over_td.value == 1.0 / 3.0
+    assert times.ts_over_td.std_error == pytest.approx(math.sqrt(10.0) / 18.0, rel=1e-15)
+    assert {estimate.n for estimate in (times.t_first, times.t_last, times.ts_over_td)} == {5}
+    assert times.t_first.method == "order-statistic gap"
+    # the same values as the RTD itself
+    rtd = rtd_from_exit_times([27.0, 10.0, np.nan, 30.0, 13.0, 20.0], bins=3)
+    assert (rtd.t_first, rtd.t_last, rtd.ts_over_td) == (10.0, 30.0, times.ts_over_td.value)
+
+
+def test_appearance_times_without_resolution_and_at_the_edges():
+    gaps_only = appearance_times([10.0, 13.0, 20.0, 27.0, 30.0])
+    assert (gaps_only.t_first.std_error, gaps_only.t_last.std_error) == (3.0, 3.0)
+    # t_s = 0 (a tracer out at once): the ratio is 0 with the absolute error of t_s over t_d, 1 / 2
+    at_zero = appearance_times([0.0, 1.0, 2.0])
+    assert (at_zero.ts_over_td.value, at_zero.ts_over_td.std_error) == (0.0, 0.5)
+    # plug flow: no gaps, the resolution alone
+    plug = appearance_times([7.5, 7.5, 7.5], resolution=0.1)
+    assert (plug.t_first.std_error, plug.t_last.std_error) == (0.1, 0.1)
+    assert plug.ts_over_td.std_error == pytest.approx(math.sqrt(2.0) * 0.1 / 7.5, rel=1e-15)
+    # one tracer out, or an unknown resolution: the errors are unknown, not zero
+    for times in (appearance_times([5.0, np.nan]), appearance_times([1.0, 2.0], resolution=math.nan)):
+        assert all(math.isnan(e.std_error) for e in (times.t_first, times.t_last, times.ts_over_td))
+
+
+@pytest.mark.parametrize("sample, resolution, message", [
+    ([np.nan], 0.0, "no tracer left"),
+    ([-1.0, 2.0], 0.0, "must be >= 0"),
+    ([0.0, 0.0], 0.0, "the longest is 0"),
+    ([1.0, 2.0], -0.1, "resolution must be"),
+    ([1.0, 2.0], math.inf, "resolution must be"),
+])
+def test_appearance_times_rejects_bad_input(sample, resolution, message):
+    with pytest.raises(ValueError, match=message):
+        appearance_times(sample, resolution)

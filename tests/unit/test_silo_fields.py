@@ -13,7 +13,8 @@ from analysis.data.contacts import ContactFrame
 from analysis.data.frames import ClumpFrame
 from analysis.data.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average
-from analysis.numerics.grid import Fields
+from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.profiles import flow_channel_boundary, velocity_profile
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.studies.silo_flat.field_comparisons import (
     MEASURED_PLANES,
@@ -24,6 +25,8 @@ from analysis.studies.silo_flat.field_comparisons import (
     parametric_rows,
 )
 from analysis.studies.silo_flat.field_study import (
+    COVERED_DENSITY_FRACTION,
+    FIELD_BATCHES,
     SURFACE_COLUMN_DIAMETERS,
     SiloDimensions,
     SiloFieldOptions,
@@ -44,11 +47,14 @@ from analysis.studies.silo_flat.fields import (
     FieldSettings,
     JanssenComparison,
     ProfileAnalysis,
+    ProfileUncertainty,
     analyse_profiles,
     centreline_velocity,
     clump_fields,
     compare_janssen,
+    mirror_bin_error,
     profile_mass_flow_rate,
+    profile_uncertainty,
     silo_grid,
 )
 from analysis.studies.silo_flat.measured import MeasuredProfile
@@ -115,6 +121,47 @@ def test_janssen_comparison_of_a_janssen_stress_field_is_exact():
     comparison = compare_janssen(stress, grid, surface, 667.0, 0.15, 0.04, 0.17, 0.2, 30.0, margin=0.01)
     np.testing.assert_allclose(comparison.simulated, comparison.janssen, rtol=1e-12)
     assert comparison.depth_below_surface.min() > 0.01 - 1e-12
+    np.testing.assert_allclose(comparison.height, surface - comparison.depth_below_surface, rtol=1e-12)
+    np.testing.assert_allclose(comparison.hydrostatic, 667.0 * GRAVITY * comparison.depth_below_surface, rtol=1e-12)
+    # no bin width, no bulk density error: both errors unknown
+    assert comparison.bin_pairs == 0
+    assert np.all(np.isnan(comparison.simulated_error)) and np.all(np.isnan(comparison.hydrostatic_error))
+
+
+def test_janssen_error_is_the_difference_of_mirror_bins_and_hydrostatic_carries_the_density_error():
+    grid = silo_grid(0.08, 0.012, 0.06, (0.01, 0.004, 0.006))  # 8 columns of 10 mm, 10 rows
+    # sigma_zz = c_i (k + 1) in column i, row k: the mirror bins of two columns have means (2, 5) on the left and
+    # (1, 4) on the right, from the walls inwards: differences 1 and 1
+    column_factor = np.array([2.0, 2.0, 5.0, 5.0, 4.0, 4.0, 1.0, 1.0])
+    stress = np.zeros(grid.shape + (3, 3))
+    stress[..., 2, 2] = column_factor[:, None, None] * (np.arange(grid.shape[2]) + 1.0)[None, None, :]
+    comparison = compare_janssen(stress, grid, 0.06, 600.0, 0.08, 0.012, 0.0, 0.0, 30.0, margin=0.0,
+                                 bin_width=0.02, bulk_density_error=12.0)
+    assert comparison.bin_pairs == 2
+    rows = np.arange(grid.shape[2]) + 1.0
+    np.testing.assert_allclose(comparison.simulated, 3.0 * rows, rtol=1e-14)
+    # sqrt(1^2 + 1^2) / (2 x 2 bins per side)
+    np.testing.assert_allclose(comparison.simulated_error, rows * math.sqrt(2.0) / 4.0, rtol=1e-14)
+    np.testing.assert_allclose(comparison.hydrostatic, 600.0 * GRAVITY * comparison.depth_below_surface, rtol=1e-14)
+    np.testing.assert_allclose(comparison.hydrostatic_error, 12.0 * GRAVITY * comparison.depth_below_surface,
+                               rtol=1e-14)
+    # the symmetric shape of a profile is not noise: a symmetric stress has no error
+    symmetric = stress.copy()
+    symmetric[..., 2, 2] = np.array([1.0, 2.0, 5.0, 9.0, 9.0, 5.0, 2.0, 1.0])[:, None, None]
+    assert np.all(compare_janssen(symmetric, grid, 0.06, 600.0, 0.08, 0.012, 0.0, 0.0, 30.0,
+                                  bin_width=0.02).simulated_error == 0.0)
+    # bins wider than half the silo: none
+    wide = compare_janssen(stress, grid, 0.06, 600.0, 0.08, 0.012, 0.0, 0.0, 30.0, bin_width=0.05)
+    assert wide.bin_pairs == 0 and np.all(np.isnan(wide.simulated_error))
+
+
+def test_mirror_bin_error_of_an_odd_profile_with_unequal_bins_by_hand():
+    # 7 values: halves [1, 2, 6] and, from the right wall, [3, 2, 4]; the middle value 100 is left out.
+    # One pair: d = 3 - 3 = 0. Two pairs, bins of 2 and 1 (numpy.array_split): d = 1.5 - 2.5 = -1 and 6 - 4 = 2
+    values = [1.0, 2.0, 6.0, 100.0, 4.0, 2.0, 3.0]
+    assert mirror_bin_error(values, 1) == 0.0
+    assert mirror_bin_error(values, 2) == pytest.approx(math.sqrt(5.0) / 4.0, rel=1e-14)
+    assert math.isnan(mirror_bin_error(values, 0)) and math.isnan(mirror_bin_error(values, 4))
 
 
 # --------------------------------------------------------------------------- the study of one run (field_study)
@@ -126,6 +173,58 @@ def _clumps(position, velocity, mass, time=0.0, step=0):
     return ClumpFrame(time=time, step=step, clump_id=np.arange(1, n + 1), position=position,
                       velocity=np.broadcast_to(np.asarray(velocity, dtype=float), (n, 3)), mass=np.full(n, mass),
                       n_spheres=np.full(n, 2))
+
+
+# --------------------------------------------------------------------------- errors of B(z) and the boundary
+
+
+PROFILE_GRID = Grid(origin=(-0.075, 0.0, 0.0), spacing=(0.002, 0.012, 0.01), shape=(75, 1, 6))  # z = 5 ... 55 mm
+
+
+def _gaussian_frame(B, density_above=1.0, A=0.2):
+    """One-layer fields of density 1 (``density_above`` from z = 30 mm up) whose v_z is the kinematic model's
+    Gaussian -A exp(-x^2 / (4 B z)) at every node row."""
+    x, z = PROFILE_GRID.x[:, None], PROFILE_GRID.z[None, :]
+    density = np.where(z < 0.03, 1.0, density_above) * np.ones_like(x)
+    momentum = np.zeros(PROFILE_GRID.shape + (3,))
+    momentum[:, 0, :, 2] = density * -A * np.exp(-x**2 / (4.0 * B * z))
+    return Fields.from_moments(PROFILE_GRID, density[:, None, :], momentum, np.zeros(PROFILE_GRID.shape + (3, 3)))
+
+
+def test_profile_uncertainty_is_the_spread_of_batch_fits_over_the_batches_that_cover_each_height():
+    heights = (0.015, 0.045)  # node rows: the profiles are exact Gaussians there
+    # Frames at t = 0 ... 6; the window (0.5, 6) holds six, cut into five batches of one frame, the oldest
+    # (B = 50 mm) left out. The last has density 0.3 above 30 mm: its fill no longer covers 45 mm.
+    b_values = (0.002, 0.05, 0.001, 0.002, 0.003, 0.004, 0.010)
+    series = [_gaussian_frame(b, density_above=0.3 if k == 6 else 1.0) for k, b in enumerate(b_values)]
+    times = np.arange(7.0)
+    uncertainty = profile_uncertainty(series, times, (0.5, 6.0), heights, (0.1,), covered_density=0.5,
+                                      n_batches=5)
+    assert uncertainty.n_batches == 5
+    np.testing.assert_array_equal(uncertainty.batches, [5, 4])
+    low = np.array([0.001, 0.002, 0.003, 0.004, 0.010])
+    expected_b = [np.std(low, ddof=1) / math.sqrt(5), math.sqrt(5.0 / 3.0) / 2.0 * 1e-3]  # 1,2,3,4 mm at 45 mm
+    np.testing.assert_allclose(uncertainty.kinematic_B_error, expected_b, rtol=1e-6)
+    resolution = 0.002 / math.sqrt(12.0)
+    assert uncertainty.boundary_resolution == pytest.approx(resolution, rel=1e-14)
+    for i, (z, used) in enumerate(zip(heights, (slice(2, 7), slice(2, 6)))):
+        bounds = [flow_channel_boundary(PROFILE_GRID.x, velocity_profile(f, z).v_z, (0.1,))
+                  for f in series[used]]
+        for side, errors in (("left", uncertainty.fcb_left_error), ("right", uncertainty.fcb_right_error)):
+            positions = np.array([getattr(b, side)[0] for b in bounds])
+            spread = np.std(positions, ddof=1) / math.sqrt(positions.size)
+            assert errors[i, 0] == pytest.approx(math.hypot(spread, resolution), rel=1e-12)
+
+
+def test_profile_uncertainty_of_a_window_with_one_frame_is_unknown():
+    series = [_gaussian_frame(0.002), _gaussian_frame(0.003)]
+    uncertainty = profile_uncertainty(series, np.array([0.0, 1.0]), (0.5, 1.5), (0.015,), (0.1,), 0.5)
+    assert uncertainty.n_batches == 0 and uncertainty.batches.tolist() == [0]
+    assert np.isnan(uncertainty.kinematic_B_error).all() and np.isnan(uncertainty.fcb_right_error).all()
+    with pytest.raises(ValueError, match="covered_density"):
+        profile_uncertainty(series, np.array([0.0, 1.0]), (0.5, 1.5), (0.015,), (0.1,), 0.0)
+    with pytest.raises(ValueError, match="n_batches"):
+        profile_uncertainty(series, np.array([0.0, 1.0]), (0.5, 1.5), (0.015,), (0.1,), 0.5, n_batches=1)
 
 
 def test_fill_surface_is_the_highest_particle_top_per_column_of_four_diameters():
@@ -216,6 +315,11 @@ def lattice_study():
 
 def test_silo_field_study_of_a_uniformly_sinking_lattice(lattice_study):
     frames, contacts, study = lattice_study
+    assert (FIELD_BATCHES, COVERED_DENSITY_FRACTION) == (10, 0.5)
+    # The window holds two frames: two batches of one, the fill (1250 kg/m3 > 0.5 x 600) covers both heights
+    assert study.uncertainty.n_batches == 2 and study.uncertainty.batches.tolist() == [2, 2]
+    # A uniform flow has no boundary inside the silo: unknown, not zero
+    assert np.isnan(study.uncertainty.fcb_left_error).all() and np.isnan(study.uncertainty.fcb_right_error).all()
     rho = 1e-5 / SPACING**3
     np.testing.assert_allclose(study.surface, 0.06, rtol=1e-12)  # top lattice row 59 mm + radius 1 mm
     assert study.top == pytest.approx(0.06, rel=1e-12)
@@ -250,6 +354,12 @@ def test_silo_field_study_contact_stress_janssen_and_force_chains(lattice_study)
     np.testing.assert_allclose(janssen.janssen, BULK_DENSITY * GRAVITY * janssen.depth_below_surface, rtol=1e-12)
     rows = (study.grid.z > 0.012) & (study.grid.z < 0.048)  # the rows z = 15 ... 45 mm
     np.testing.assert_array_equal(janssen.simulated, study.stress[..., 2, 2].mean(axis=(0, 1))[rows])
+    # Bins as wide as the kernel's support, 2 x 3 widths = 18 mm: one pair over the 5 columns (30 mm) of each half
+    assert janssen.bin_pairs == 1
+    columns = study.stress[..., 2, 2].mean(axis=1)[:, rows]
+    np.testing.assert_allclose(janssen.simulated_error, [mirror_bin_error(c, 1) for c in columns.T], rtol=1e-14)
+    np.testing.assert_allclose(janssen.hydrostatic, BULK_DENSITY * GRAVITY * janssen.depth_below_surface, rtol=1e-14)
+    assert np.isnan(janssen.hydrostatic_error).all()  # the study was given no bulk density error
     cap = 50 * 1e-5 * GRAVITY
     assert study.segments.cap == pytest.approx(cap, rel=1e-15)
     np.testing.assert_allclose(study.segments.normal_force, [FORCES[0], FORCES[1]], rtol=1e-12)  # 1 N is outside
@@ -279,12 +389,18 @@ def test_table_rows_lay_out_the_profiles_boundaries_and_kinematic_constant():
     assert len(rows) == 6
     assert rows[4] == {"z_m": 0.04, "x_m": 0.0, "v_z_m_s": -5.0, "v_x_m_s": 0.5, "u_kinematic_m_s": 11.0,
                        "v_z_front_wall_m_s": 5.0, "v_x_front_wall_m_s": -0.5}
-    boundaries = boundary_rows(profiles)
+    uncertainty = ProfileUncertainty(
+        kinematic_B_error=np.array([0.0001, np.nan]), fcb_left_error=np.array([[1e-3, 2e-3], [3e-3, 4e-3]]),
+        fcb_right_error=np.array([[5e-3, 6e-3], [7e-3, 8e-3]]), batches=np.array([10, 3]), n_batches=10,
+        boundary_resolution=0.001)
+    boundaries = boundary_rows(profiles, uncertainty)
     assert [(r["z_m"], r["fraction"]) for r in boundaries] == [(0.02, 0.05), (0.02, 0.1), (0.04, 0.05), (0.04, 0.1)]
-    assert boundaries[2] == {"z_m": 0.04, "fraction": 0.05, "x_left_m": -0.008, "x_right_m": 0.008}
-    kinematic = kinematic_rows(profiles)
-    assert kinematic[0] == {"z_m": 0.02, "B_m": 0.002} and kinematic[1]["z_m"] == 0.04
-    assert math.isnan(kinematic[1]["B_m"])
+    assert boundaries[2] == {"z_m": 0.04, "fraction": 0.05, "x_left_m": -0.008, "x_left_m_error": 3e-3,
+                             "x_right_m": 0.008, "x_right_m_error": 7e-3, "batches": 3}
+    kinematic = kinematic_rows(profiles, uncertainty)
+    assert kinematic[0] == {"z_m": 0.02, "B_m": 0.002, "B_m_error": 0.0001, "batches": 10}
+    assert kinematic[1]["z_m"] == 0.04 and kinematic[1]["batches"] == 3
+    assert math.isnan(kinematic[1]["B_m"]) and math.isnan(kinematic[1]["B_m_error"])
 
 
 def test_table_rows_of_the_centreline_and_janssen():
@@ -292,10 +408,15 @@ def test_table_rows_of_the_centreline_and_janssen():
     rows = centreline_rows([0.0, 0.01, 0.02], [0.02, 0.045], centre)
     assert rows[1] == {"time_s": 0.01, "v_z_at_20mm_m_s": -0.3, "v_z_at_45mm_m_s": -0.4}
     assert len(rows) == 3
-    comparison = JanssenComparison(np.array([0.01, 0.02]), np.array([50.0, 90.0]), np.array([55.0, 100.0]), 0.06)
+    comparison = JanssenComparison(np.array([0.01, 0.02]), np.array([50.0, 90.0]), np.array([55.0, 100.0]), 0.06,
+                                   height=np.array([0.05, 0.04]), simulated_error=np.array([2.0, 3.0]),
+                                   hydrostatic=np.array([60.0, 120.0]), hydrostatic_error=np.array([0.5, 1.0]),
+                                   bin_pairs=2)
     assert janssen_rows(comparison) == [
-        {"depth_below_surface_m": 0.01, "sigma_v_dem_Pa": 50.0, "sigma_v_janssen_Pa": 55.0},
-        {"depth_below_surface_m": 0.02, "sigma_v_dem_Pa": 90.0, "sigma_v_janssen_Pa": 100.0},
+        {"depth_below_surface_m": 0.01, "z_m": 0.05, "sigma_v_dem_Pa": 50.0, "sigma_v_dem_Pa_error": 2.0,
+         "sigma_v_janssen_Pa": 55.0, "hydrostatic_pa": 60.0, "hydrostatic_pa_error": 0.5},
+        {"depth_below_surface_m": 0.02, "z_m": 0.04, "sigma_v_dem_Pa": 90.0, "sigma_v_dem_Pa_error": 3.0,
+         "sigma_v_janssen_Pa": 100.0, "hydrostatic_pa": 120.0, "hydrostatic_pa_error": 1.0},
     ]
 
 
@@ -316,6 +437,9 @@ def test_instantaneous_rows_and_summary_of_the_lattice_study(lattice_study):
     assert summary["outflow_mass_flow_rate_kg_s"] == 2.0
     assert summary["profile_bulk_density_mass_flow_rate_kg_s"] == study.bulk_rate
     assert list(summary["kinematic_B_m"]) == ["0.03", "0.04"]
+    assert summary["kinematic_B_m_error"] == {"0.03": study.uncertainty.kinematic_B_error[0],
+                                              "0.04": study.uncertainty.kinematic_B_error[1]}
+    assert summary["error_batches"] == 2 and summary["janssen_error_bin_pairs"] == 1
     assert summary["surface_height_m"] == study.top and summary["contacts"] == 3
 
 
@@ -368,13 +492,20 @@ def test_parametric_profiles_at_the_highest_height_every_run_covers():
     assert parametric_profiles(runs, 0.02).height == 0.02
     np.testing.assert_allclose(profiles.x, tall.x, rtol=1e-12)
     np.testing.assert_allclose(profiles.v_z[1], -0.2 - 2.0 * tall.x, rtol=1e-12)  # interpolated onto the tall x
+    # the first flow.json predates the errors (the ratio's is null, JSON's NaN); the second has them all
     flows = [{"mass_flow_rate_kg_s": 0.1, "mass_flow_rate_stderr_kg_s": 0.001, "beverloo_ratio": 1.5,
-              "filling_bulk_density_kg_m3": 600.0}, {"mass_flow_rate_kg_s": 0.2, "mass_flow_rate_stderr_kg_s": 0.002,
-                                                     "beverloo_ratio": 1.4, "filling_bulk_density_kg_m3": 610.0}]
+              "beverloo_ratio_error": None, "filling_bulk_density_kg_m3": 600.0},
+             {"mass_flow_rate_kg_s": 0.2, "mass_flow_rate_kg_s_error": 0.004, "mass_flow_rate_stderr_kg_s": 0.002,
+              "beverloo_ratio": 1.4, "beverloo_ratio_error": 0.03, "filling_bulk_density_kg_m3": 610.0,
+              "filling_bulk_density_kg_m3_error": 5.0}]
     rows = parametric_rows("friction", ["mu=0", "mu=1"], ["r0", "r1"], flows, profiles)
     assert rows[1] == {"study": "friction", "label": "mu=1", "run_id": "r1", "profile_height_m": profiles.height,
-                       "mass_flow_rate_kg_s": 0.2, "mass_flow_rate_stderr_kg_s": 0.002, "beverloo_ratio": 1.4,
-                       "filling_bulk_density_kg_m3": 610.0, "centreline_v_z_m_s": pytest.approx(-0.2, rel=1e-12)}
+                       "mass_flow_rate_kg_s": 0.2, "mass_flow_rate_kg_s_error": 0.004,
+                       "mass_flow_rate_stderr_kg_s": 0.002, "beverloo_ratio": 1.4, "beverloo_ratio_error": 0.03,
+                       "filling_bulk_density_kg_m3": 610.0, "filling_bulk_density_kg_m3_error": 5.0,
+                       "centreline_v_z_m_s": pytest.approx(-0.2, rel=1e-12)}
     assert rows[0]["centreline_v_z_m_s"] == pytest.approx(-0.1, rel=1e-12)
+    assert all(math.isnan(rows[0][key]) for key in
+               ("mass_flow_rate_kg_s_error", "beverloo_ratio_error", "filling_bulk_density_kg_m3_error"))
     with pytest.raises(ValueError, match="averaged"):
         parametric_profiles([], 0.05)

@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 
 from analysis.numerics.force_chains import ForceChainSegments
-from analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis
+from analysis.numerics.flow import DischargeHistory, FlowRateFit
+from analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis, ProfileUncertainty
 from analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
 from analysis.studies.silo_flat.plots import (
     plot_centreline_velocity,
+    plot_discharge,
     plot_force_chains,
     plot_janssen,
     plot_kinematic_constant,
@@ -56,6 +58,19 @@ def _profiles():
         kinematic_u=np.array([[0.012, 0.018, 0.0, -0.018, -0.012], [0.003, 0.009, 0.0, -0.009, -0.003]]))
 
 
+def _uncertainty():
+    return ProfileUncertainty(
+        kinematic_B_error=np.array([0.0002, np.nan]), fcb_left_error=np.array([[0.001, 0.0015], [0.002, 0.0025]]),
+        fcb_right_error=np.array([[0.003, 0.0035], [0.004, np.nan]]), batches=np.array([10, 1]), n_batches=10,
+        boundary_resolution=0.0005)
+
+
+def _bars(container):
+    """The ((x0, y0), (x1, y1)) ends of each bar of an errorbar container; empty where the error is NaN."""
+    (bars,) = container.lines[2]
+    return [np.asarray(segment) for segment in bars.get_segments()]
+
+
 def _outline(width_mm, outlet_mm, top_mm):
     half, slot = width_mm / 2, outlet_mm / 2
     return [[[-half, top_mm], [-half, 0.0], [-slot, 0.0]], [[half, top_mm], [half, 0.0], [slot, 0.0]]]
@@ -78,6 +93,28 @@ def test_plot_profiles_over_silo_draws_each_profile_at_its_height_with_the_bound
         np.testing.assert_allclose(boundary.get_xydata(), [[1e3 * left, 1e3 * z], [1e3 * right, 1e3 * z]])
     assert [line.get_label() for line in lines[-2:]] == ["FCB at 10 % of centreline v_z",
                                                          f"v_z (1 mm = {1e-3 / scale:.3g} m/s)"]
+    assert axes.containers == []  # no uncertainty given: no error bars
+
+
+def test_plot_profiles_over_silo_draws_the_boundary_error_bars_in_mm(tmp_path, written):
+    path = tmp_path / "profiles.png"
+    figure = written(plot_profiles_over_silo(_profiles(), 0.05, 0.01, 0.04, path, "profiles",
+                                             uncertainty=_uncertainty()), path)
+    (axes,) = figure.axes
+    # outline, per height guide, profile and boundary, then the legend's two entries; the bars' caps come on top
+    assert len(axes.get_lines()) == 2 + 3 * len(HEIGHTS) + 2 + 2 * len(HEIGHTS)
+    containers = axes.containers
+    assert len(containers) == len(HEIGHTS)
+    for i, (z, container) in enumerate(zip(HEIGHTS, containers)):
+        assert container.has_xerr and not container.has_yerr
+        left, right = 1e3 * _profiles().fcb_left[i, -1], 1e3 * _profiles().fcb_right[i, -1]
+        left_error = 1e3 * _uncertainty().fcb_left_error[i, -1]  # 1.5 and 2.5 mm
+        left_bar, right_bar = _bars(container)
+        np.testing.assert_allclose(left_bar, [[left - left_error, 1e3 * z], [left + left_error, 1e3 * z]], rtol=1e-14)
+        if i == 0:  # 3.5 mm
+            np.testing.assert_allclose(right_bar, [[right - 3.5, 1e3 * z], [right + 3.5, 1e3 * z]], rtol=1e-14)
+        else:
+            assert right_bar.size == 0  # unknown error: no bar
 
 
 def test_plot_velocity_contour_fills_from_the_slowest_velocity_to_zero(tmp_path, written):
@@ -100,17 +137,37 @@ def test_plot_kinematic_constant_draws_b_against_height_in_mm(tmp_path, written)
     (line,) = axes.get_lines()
     np.testing.assert_allclose(line.get_xydata(), [[2.0, 10.0], [3.1, 30.0]])
     assert (axes.get_xlabel(), axes.get_ylabel()) == ("B [mm]", "z [mm]")
+    assert axes.containers == []
 
 
-def test_plot_janssen_draws_both_stresses_against_depth(tmp_path, written):
+def test_plot_kinematic_constant_draws_the_standard_error_of_b_as_horizontal_bars(tmp_path, written):
+    path = tmp_path / "B.png"
+    figure = written(plot_kinematic_constant(HEIGHTS, [0.002, 0.0031], path, "B", B_error=[0.0002, np.nan]), path)
+    (axes,) = figure.axes
+    (container,) = axes.containers
+    assert container.has_xerr and not container.has_yerr and container.get_label() == "± standard error"
+    first, second = _bars(container)
+    np.testing.assert_allclose(first, [[1.8, 10.0], [2.2, 10.0]], rtol=1e-14)
+    assert second.size == 0  # unknown error: no bar
+
+
+def test_plot_janssen_draws_the_dem_stress_with_its_error_janssen_and_hydrostatic_against_depth(tmp_path, written):
     comparison = JanssenComparison(depth_below_surface=np.array([0.005, 0.015]), simulated=np.array([40.0, 95.0]),
-                                   janssen=np.array([38.0, 100.0]), surface_height=0.05)
+                                   janssen=np.array([38.0, 100.0]), surface_height=0.05,
+                                   height=np.array([0.045, 0.035]), simulated_error=np.array([4.0, 6.0]),
+                                   hydrostatic=np.array([45.0, 135.0]), hydrostatic_error=np.array([0.5, 1.5]),
+                                   bin_pairs=2)
     path = tmp_path / "janssen.png"
     figure = written(plot_janssen(comparison, path, "stress"), path)
     (axes,) = figure.axes
     lines = {line.get_label(): line.get_xydata() for line in axes.get_lines()}
     np.testing.assert_allclose(lines["DEM (contact stress)"], [[40.0, 5.0], [95.0, 15.0]])
     np.testing.assert_allclose(lines["Janssen"], [[38.0, 5.0], [100.0, 15.0]])
+    np.testing.assert_allclose(lines["hydrostatic rho_b g h"], [[45.0, 5.0], [135.0, 15.0]])
+    (container,) = axes.containers
+    assert container.get_label() == "DEM ± standard error" and container.has_xerr and not container.has_yerr
+    np.testing.assert_allclose(_bars(container), [[[36.0, 5.0], [44.0, 5.0]], [[89.0, 15.0], [101.0, 15.0]]],
+                               rtol=1e-14)
     assert axes.yaxis_inverted()  # depth grows downwards
     assert (axes.get_xlabel(), axes.get_ylabel()) == ("vertical stress [Pa]", "depth below surface [mm]")
 
@@ -190,3 +247,12 @@ def test_plot_kinematic_horizontal_velocity_draws_dem_and_model_per_height(tmp_p
         np.testing.assert_allclose(model.get_xydata(), np.column_stack([1e3 * X, profiles.kinematic_u[i]]))
         assert axes.get_ylabel() == f"z = {1e3 * HEIGHTS[i]:g} mm\n[m/s]"
     assert [line.get_label() for line in figure.axes[0].get_lines()] == ["DEM v_x", "kinematic u = -B dv_z/dx"]
+
+
+def test_plot_discharge_states_the_given_flow_rate_error_in_its_legend(tmp_path, written):
+    history = DischargeHistory(time=np.array([0.0, 0.1, 0.2, 0.3]), discharged_mass=np.array([0.0, 0.01, 0.02, 0.03]))
+    fit = FlowRateFit(mass_flow_rate=0.1, standard_error=1e-6, t_start=0.1, t_end=0.3, n_points=3, intercept=0.0)
+    path = tmp_path / "discharge.png"
+    figure = written(plot_discharge(history, fit, None, path, "discharge", rate_error=0.0021), path)
+    labels = [line.get_label() for line in figure.axes[0].get_lines()]
+    assert "fit: 0.1 ± 0.0021 kg/s" in labels  # the batch-means error, not the fit's 1e-06

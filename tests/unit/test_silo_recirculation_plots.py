@@ -221,6 +221,36 @@ def test_plot_vrr_versus_recirculations_uses_each_curves_own_ceiling(tmp_path, f
                                                 ([2.0], [30.0])]
 
 
+def _error_bars(axes) -> list[list[tuple[float, float, float]]]:
+    """(x, lower end, upper end) of every error bar, one list per curve that has bars."""
+    return [[(float(x0), float(y0), float(y1)) for ((x0, y0), (_, y1)) in collection.get_segments()]
+            for collection in axes.collections if collection.get_gid() == "vrr_error"]
+
+
+def test_plot_vrr_versus_recirculations_draws_one_standard_error_bars(tmp_path, figures):
+    nr = np.array([0.5, 1.5, 2.5, 3.5])
+    curves = [("run a", nr, [2.0, 8.0, np.nan, np.inf], 100.0, [0.5, 2.0, 1.0, np.nan]),
+              ("run b", nr, [3.0, 6.0, 9.0, 12.0], None, [np.nan, 1.5, 3.0, 9.0]),
+              ("run c", nr, [4.0, 5.0, 6.0, 7.0])]
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_versus_recirculations(curves, target, "errors", noise_limit=50.0))
+    axes = _only_axes(figures)
+    # the plotted line is still the data
+    np.testing.assert_array_equal(_line(axes, "run a").get_xdata(), [0.5, 1.5])
+    np.testing.assert_array_equal(_line(axes, "run a").get_ydata(), [2.0, 8.0])
+    np.testing.assert_array_equal(_line(axes, "run b").get_ydata(), [3.0, 6.0, 9.0, 12.0])
+    # +- one error around each drawn VRR; none where the VRR (NaN, inf) or the error (NaN) is missing, none for
+    # run c; the bar of 12 +- 9 keeps its lower end at 3
+    assert _error_bars(axes) == [[(0.5, 1.5, 2.5), (1.5, 6.0, 10.0)],
+                                 [(1.5, 4.5, 7.5), (2.5, 6.0, 12.0), (3.5, 3.0, 21.0)]]
+    bars = [collection for collection in axes.collections if collection.get_gid() == "vrr_error"]
+    assert [to_hex(bar.get_colors()[0]) for bar in bars] == [to_hex(_line(axes, f"run {name}").get_color())
+                                                             for name in "ab"]
+    # the bars take no colour from the cycle and add nothing to the legend
+    assert [to_hex(_line(axes, f"run {name}").get_color()) for name in "abc"] == ["#1f77b4", "#ff7f0e", "#2ca02c"]
+    assert [text.get_text() for text in axes.get_legend().get_texts()][-3:] == ["run a", "run b", "run c"]
+
+
 def test_plot_vrr_versus_recirculations_rejects_bad_input(tmp_path):
     nr = np.arange(1.0, 4.0)
     with pytest.raises(ValueError, match="curves"):
@@ -232,7 +262,13 @@ def test_plot_vrr_versus_recirculations_rejects_bad_input(tmp_path):
     with pytest.raises(ValueError, match=r"curves\[0\] must be a tuple of 3 items"):
         plot_vrr_versus_recirculations([("a", nr)], tmp_path / "a.png", "t")
     with pytest.raises(ValueError, match=r"curves\[0\] must be a tuple of 3 items"):
-        plot_vrr_versus_recirculations([("a", nr, nr, 5.0, 1)], tmp_path / "a.png", "t")
+        plot_vrr_versus_recirculations([("a", nr, nr, 5.0, nr, 1)], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] error must be a 1-D array of the same length"):
+        plot_vrr_versus_recirculations([("a", nr, nr, 5.0, 1.0)], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] error must hold standard errors >= 0"):
+        plot_vrr_versus_recirculations([("a", nr, nr, None, [0.1, -0.1, 0.1])], tmp_path / "a.png", "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] error must hold standard errors >= 0"):
+        plot_vrr_versus_recirculations([("a", nr, nr, None, [0.1, np.inf, 0.1])], tmp_path / "a.png", "t")
     with pytest.raises(ValueError, match=r"curves\[1\] ceiling must be a finite number > 0"):
         plot_vrr_versus_recirculations([("a", nr, nr), ("b", nr, nr, 0.0)], tmp_path / "a.png", "t")
     with pytest.raises(ValueError, match="factor must be a finite number >= 1"):

@@ -138,6 +138,12 @@ def test_loop_timing_obeys_littles_law_on_the_conveyor(tracks, events, startup_f
     assert timing.residence_time == pytest.approx(PASS_TIME, rel=1e-12)  # Little's law: 75 / 10 s
     assert timing.residence_time == pytest.approx(timing.holdup / timing.throughput, rel=1e-12)
     assert timing.recirculations == pytest.approx(30.0 / 7.5, rel=1e-12)
+    assert timing.frame_interval == pytest.approx(FRAME_STEP, rel=1e-9)
+    # A steady conveyor does not fluctuate: the holdup is 75 at every frame, and every batch of the discharge
+    # spans a whole number of 0.1 s crossing periods from the same phase, so the batch rates are all equal.
+    assert timing.holdup_error == 0.0
+    assert timing.throughput_error == pytest.approx(0.0, abs=1e-9)
+    assert timing.residence_time_error == pytest.approx(0.0, abs=1e-9)
 
 
 def test_loop_timing_of_a_shorter_run():
@@ -518,6 +524,10 @@ def test_verify_eulerian_rtd_of_uniform_downflow(tracks):
 
 
 def test_residence_summary_counts_and_moments():
+    # mean 2 s, population std 1 s; the sample std sqrt(2) s over sqrt(2) tracers: the mean is 2 +- 1 s
     summary = residence_summary([1.0, 3.0, np.nan])
-    assert summary == {"n": 3, "n_exited": 2, "mean_s": 2.0, "std_s": 1.0}
-    assert residence_summary([np.nan]) == {"n": 1, "n_exited": 0, "mean_s": None, "std_s": None}
+    assert summary == {"n": 3, "n_exited": 2, "mean_s": 2.0, "mean_s_error": 1.0, "std_s": 1.0}
+    assert residence_summary([np.nan]) == {"n": 1, "n_exited": 0, "mean_s": None, "mean_s_error": None,
+                                           "std_s": None}
+    single = residence_summary([4.0, np.nan])
+    assert (single["mean_s"], single["std_s"]) == (4.0, 0.0) and math.isnan(single["mean_s_error"])

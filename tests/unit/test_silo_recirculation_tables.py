@@ -40,16 +40,23 @@ from analysis.studies.silo_recirculation.tables import (
     vrr_period_rows,
     vrr_rows,
 )
+from analysis.studies.silo_recirculation.tracers import TracerPasses
 from analysis.studies.silo_recirculation.vrr import RecirculationVRR
 
 NAN = math.nan
 EDGES = np.array([0.0, 1.0, 2.0, 3.0])
 CENTRES = np.array([0.5, 1.5, 2.5])
-TIMING = LoopTiming(t_open=0.0, t_end=3.0, residence_time=2.0, holdup=20.0, throughput=10.0, recirculations=1.5)
-# Particle RTD of 4 tracers, 3 out at 1.25, 2.0 and 2.75 s: bins [1, 2) and [2, 3] hold 1 and 2 of 4.
+# Errors passed through as they are; a frame interval of sqrt(6) s gives a residence-time resolution of 1 s.
+TIMING = LoopTiming(t_open=0.0, t_end=3.0, residence_time=2.0, holdup=20.0, throughput=10.0, recirculations=1.5,
+                    residence_time_error=0.125, holdup_error=0.5, throughput_error=0.25, frame_interval=math.sqrt(6.0))
+# Particle RTD of 4 tracers, 3 out at 1.25, 2.0 and 2.75 s: bins [1, 2) and [2, 3] hold 1 and 2 of 4. Its mean has
+# the standard error sqrt(0.375 / 2); the gaps at both ends are 0.75 s, so with the 1 s resolution t_s and t_d
+# have the error sqrt(0.75^2 + 1^2) = 1.25 s.
 SILO_RTD = RTD(time=np.array([1.5, 2.5]), edges=np.array([1.0, 2.0, 3.0]), E=np.array([0.25, 0.5]), t_mean=2.0,
                variance=0.375, t_first=1.25, t_last=2.75, n_exited=3, n_total=4)
-# Eulerian RTD of 4 virtual tracers out at 0.5, 1.5, 2.5 and 3.5 s.
+TRACER = TracerPasses(entry_time=np.array([1.0, 1.5, 2.0, 2.5]), exit_time=np.array([2.25, 3.5, 4.75, NAN]),
+                      pass_index=np.arange(4), clump_index=np.arange(4), clump_id=np.arange(4), entry_at="wrap")
+# Eulerian RTD of 4 virtual tracers out at 0.5, 1.5, 2.5 and 3.5 s (mean error sqrt(1.25 / 3)).
 EULERIAN_RTD = RTD(time=np.array([1.0, 3.0]), edges=np.array([0.0, 2.0, 4.0]), E=np.array([0.25, 0.25]), t_mean=2.0,
                    variance=1.25, t_first=0.5, t_last=3.5, n_exited=4, n_total=4)
 
@@ -85,7 +92,7 @@ TOP = LayoutResult(
     model_time_nr=np.array([0.0, 0.5]), model_concentration=np.array([0.0, 1.0]), model_homogenised_after=NAN,
     recirculation_number=np.array([0.25, 0.75, 1.25]),
 )
-PARTICLE_RTD = ParticleRTD(tracer=None, silo=SILO_RTD, loop=None, loop_E_on_windows=None, start_time=0.8, n_tracer=4,
+PARTICLE_RTD = ParticleRTD(tracer=TRACER, silo=SILO_RTD, loop=None, loop_E_on_windows=None, start_time=0.8, n_tracer=4,
                            johanson_V1=0.5, johanson_P=0.75, steady=None, silo_E_on_windows=None,
                            johanson_loop_E_on_windows=None)
 RESULT = BlendingResult(
@@ -120,8 +127,11 @@ def test_concentration_rows_list_every_window_of_every_layout_in_order():
 
 
 VRR_COLUMNS = ["layout", "recirculation_number", "vrr", "sigma_out", "n_windows", "sigma_in", "blue_fraction",
-               "vrr_predicted", "vrr_ceiling", "vrr_at_ceiling", "vrr_kind", "vrr_predicted_over_measured"]
+               "vrr_predicted", "vrr_ceiling", "vrr_at_ceiling", "vrr_kind", "vrr_predicted_over_measured",
+               "vrr_error"]
 SIGMA_TOP = math.sqrt(0.1875)
+# sqrt(2 / (N - 1)) VRR with N = 2 windows: sqrt(2) x 4 and sqrt(2) x 3
+HALF_ERROR, TOP_ERROR = math.sqrt(2.0) * 4.0, math.sqrt(2.0) * 3.0
 
 
 def with_throughput(throughput: float, result: BlendingResult = RESULT) -> BlendingResult:
@@ -132,10 +142,10 @@ def with_throughput(throughput: float, result: BlendingResult = RESULT) -> Blend
 def test_vrr_rows_put_the_layout_first_then_the_prediction_then_the_ceiling():
     # 10 clumps per window: ceiling 10, flagged from 5 on; VRRs 4 and 3 are values, compared with the prediction
     assert_rows(vrr_rows(RESULT), VRR_COLUMNS, [dict(zip(VRR_COLUMNS, row)) for row in [
-        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 10.0, False, "value", 4.0],
-        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 10.0, False, "none", NAN],
-        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 10.0, False, "value", math.inf],
-        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 10.0, False, "none", NAN],
+        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 10.0, False, "value", 4.0, HALF_ERROR],
+        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 10.0, False, "none", NAN, NAN],
+        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 10.0, False, "value", math.inf, TOP_ERROR],
+        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 10.0, False, "none", NAN, NAN],
     ]])
     assert all(type(row["vrr_at_ceiling"]) is bool for row in vrr_rows(RESULT))
 
@@ -144,10 +154,10 @@ def test_vrr_rows_mark_a_vrr_at_half_the_ceiling_as_a_lower_bound_not_compared()
     # 8 clumps per window: ceiling 8, flagged from 8 / 2 = 4 on, so VRR 4 (bottom half) is at the boundary and
     # flagged; VRR 3 (top 25 %) is not. The lower bound gets no prediction ratio.
     assert_rows(vrr_rows(with_throughput(8.0)), VRR_COLUMNS, [dict(zip(VRR_COLUMNS, row)) for row in [
-        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 8.0, True, "lower bound", NAN],
-        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 8.0, False, "none", NAN],
-        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 8.0, False, "value", math.inf],
-        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 8.0, False, "none", NAN],
+        ["bottom half", 0.5, 4.0, 0.25, 2, 0.5, 0.5, 16.0, 8.0, True, "lower bound", NAN, HALF_ERROR],
+        ["bottom half", 1.5, NAN, NAN, 0, 0.5, 0.5, NAN, 8.0, False, "none", NAN, NAN],
+        ["top 25 %", 0.5, 3.0, 0.25, 2, SIGMA_TOP, 0.25, math.inf, 8.0, False, "value", math.inf, TOP_ERROR],
+        ["top 25 %", 1.5, NAN, NAN, 0, SIGMA_TOP, 0.25, NAN, 8.0, False, "none", NAN, NAN],
     ]])
 
 
@@ -209,15 +219,23 @@ def test_clumps_per_window_is_throughput_times_window():
 def test_blending_summary_holds_timing_rtds_and_every_layout():
     summary = blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)
     half, top = summary.pop("layouts").values()
+    # t_s / t_d = 5 / 11 with t_s and t_d both +- 1.25 s: (5 / 11) sqrt((1.25 / 1.25)^2 + (1.25 / 2.75)^2)
+    ratio_error = (5.0 / 11.0) * math.sqrt(1.0 + (5.0 / 11.0) ** 2)
+    rounded = {"time_resolution_s": 1.0, "t_s_error": 1.25, "t_d_error": 1.25, "t_s_over_t_d_error": ratio_error}
+    for key, value in rounded.items():  # through sqrt(6) / sqrt(6): exact to round-off
+        assert summary["rtd_particle_ids"].pop(key) == pytest.approx(value, rel=1e-15)
     np.testing.assert_equal(summary, {
         "run_id": "recirculation_ab12", "flow_pattern": "mass flow", "residence_time_s": 2.0,
         "estimated_residence_time_s": 2.5, "holdup_clumps": 20.0, "throughput_clumps_per_s": 10.0,
         "recirculations": 1.5, "window_s": 1.0, "clumps_per_window": 10.0, "vrr_sampling_limit": 10.0,
         "vrr_ceiling_factor": 2.0,
+        "residence_time_s_error": 0.125, "holdup_clumps_error": 0.5, "throughput_clumps_per_s_error": 0.25,
+        "frame_interval_s": math.sqrt(6.0),
         "rtd_particle_ids": {"t_mean_s": 2.0, "variance_s2": 0.375, "t_s": 1.25, "t_d": 2.75,
-                             "t_s_over_t_d": 1.25 / 2.75, "n_tracer": 4, "fraction_exited": 0.75},
+                             "t_s_over_t_d": 1.25 / 2.75, "n_tracer": 4, "fraction_exited": 0.75,
+                             "t_mean_s_error": math.sqrt(0.375 / 2.0)},
         "rtd_eulerian": {"t_mean_s": 2.0, "variance_s2": 1.25, "t_s": 0.5, "t_d": 3.5, "fraction_exited": 1.0,
-                         "bin_size_m": 0.005},
+                         "bin_size_m": 0.005, "t_mean_s_error": math.sqrt(1.25 / 3.0)},
         "johanson": {"V1": 0.5, "P": 0.75},
     })
     assert list(blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)["layouts"]) == ["bottom half", "top 25 %"]
@@ -226,12 +244,13 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         "blue_fraction": 0.5, "sublayers": 1, "vrr_by_recirculation": [4.0, NAN], "vrr_predicted": [16.0, NAN],
         "vrr_at_ceiling": [False, False], "prediction_rms_error": math.sqrt(0.03125),
         "homogenised_after_recirculations": NAN, "model_homogenised_after_recirculations": 1.0,
+        "vrr_by_recirculation_error": [HALF_ERROR, NAN],
     })
     # RMS of (0.25 - 0, 0.25 - 0.5): sqrt(0.0625)
     np.testing.assert_equal(top, {
         "blue_fraction": 0.25, "sublayers": 2, "vrr_by_recirculation": [3.0, NAN], "vrr_predicted": [math.inf, NAN],
         "vrr_at_ceiling": [False, False], "prediction_rms_error": 0.25, "homogenised_after_recirculations": 2.0,
-        "model_homogenised_after_recirculations": NAN,
+        "model_homogenised_after_recirculations": NAN, "vrr_by_recirculation_error": [TOP_ERROR, NAN],
     })
 
 
@@ -252,12 +271,15 @@ def test_blending_summary_and_tables_write_as_json_and_csv(tmp_path):
     assert loaded["layouts"]["top 25 %"]["vrr_predicted"] == [None, None]
     assert loaded["layouts"]["top 25 %"]["model_homogenised_after_recirculations"] is None
     assert loaded["layouts"]["bottom half"]["vrr_at_ceiling"] == [False, False]
+    assert loaded["layouts"]["bottom half"]["vrr_by_recirculation_error"] == [HALF_ERROR, None]
+    assert loaded["residence_time_s_error"] == 0.125
     text = write_flow_table(tmp_path / "vrr.csv", vrr_rows(with_throughput(8.0))).read_text()
+    # the error column comes last, after the columns older readers know
     assert text.splitlines()[:3] == [
         "layout,recirculation_number,vrr,sigma_out,n_windows,sigma_in,blue_fraction,vrr_predicted,vrr_ceiling,"
-        "vrr_at_ceiling,vrr_kind,vrr_predicted_over_measured",
-        "bottom half,0.5,4.0,0.25,2,0.5,0.5,16.0,8.0,True,lower bound,",
-        "bottom half,1.5,,,0,0.5,0.5,,8.0,False,none,",
+        "vrr_at_ceiling,vrr_kind,vrr_predicted_over_measured,vrr_error",
+        "bottom half,0.5,4.0,0.25,2,0.5,0.5,16.0,8.0,True,lower bound,,5.656854249492381",
+        "bottom half,1.5,,,0,0.5,0.5,,8.0,False,none,,",
     ]
     text = write_flow_table(tmp_path / "concentration.csv", concentration_rows(RESULT)).read_text()
     assert text.splitlines()[:2] == [
@@ -282,15 +304,44 @@ def test_verification_rows_list_the_particles_then_each_bin_size():
     ]])
 
 
+UNKNOWN_DIFFERENCE = {"mean_difference_s": None, "mean_difference_s_error": NAN,
+                      "mean_difference_significance": "unknown", "means_agree": None}
+
+
 def test_verification_summary_names_bin_sizes_in_millimetres():
+    # particles 1 and 3 s: mean 2 s, s = sqrt(2) s, error sqrt(2) / sqrt(2) = 1 s; 5 mm: 2 and 4 s, 3 +- 1 s.
+    # The difference 1 s is within 2 x sqrt(1 + 1) s: the means agree.
     summary = verification_summary(CASE, VERIFICATION)
-    assert summary == {
-        "run_id": "recirculation_ab12", "residence_time_s": 2.0,
-        "particles": {"n": 3, "n_exited": 2, "mean_s": 2.0, "std_s": 1.0},
-        "eulerian": {"5 mm": {"n": 2, "n_exited": 2, "mean_s": 3.0, "std_s": 1.0},
-                     "10 mm": {"n": 1, "n_exited": 0, "mean_s": None, "std_s": None}},
-    }
+    np.testing.assert_equal(summary, {
+        "run_id": "recirculation_ab12", "residence_time_s": 2.0, "residence_time_s_error": 0.125, "n_tracers": 3,
+        "coverage_factor": 2.0,
+        "particles": {"n": 3, "n_exited": 2, "mean_s": 2.0, "mean_s_error": 1.0, "std_s": 1.0},
+        "eulerian": {"5 mm": {"n": 2, "n_exited": 2, "mean_s": 3.0, "mean_s_error": 1.0, "std_s": 1.0,
+                              "mean_difference_s": 1.0, "mean_difference_s_error": math.sqrt(2.0),
+                              "mean_difference_significance": "not significant", "means_agree": True},
+                     "10 mm": {"n": 1, "n_exited": 0, "mean_s": None, "mean_s_error": None, "std_s": None,
+                               **UNKNOWN_DIFFERENCE}},
+    })
     assert list(summary["eulerian"]) == ["5 mm", "10 mm"]
+
+
+def test_verification_summary_says_whether_each_bin_size_agrees_with_the_particles():
+    verification = dataclasses.replace(VERIFICATION, eulerian_residence={
+        0.005: np.array([2.0, 4.0]),  # 3 +- 1 s: 1 s from the particles' 2 +- 1 s, within 2 sqrt(2) s
+        0.01: np.array([6.0, 6.0]),  # 6 +- 0 s: 4 s away, more than 2 x 1 s
+        0.015: np.array([5.0, NAN]),  # one tracer out: no error, so the agreement is unknown
+        0.02: np.array([5.0, 7.0]),  # 6 +- 1 s: 4 s away, more than 2 sqrt(2) s
+    })
+    eulerian = verification_summary(CASE, verification)["eulerian"]
+    assert [(stats["mean_difference_significance"], stats["means_agree"]) for stats in eulerian.values()] == [
+        ("not significant", True), ("significant", False), ("unknown", None), ("significant", False)]
+    assert eulerian["10 mm"]["mean_difference_s"] == 4.0 and eulerian["10 mm"]["mean_difference_s_error"] == 1.0
+    assert eulerian["15 mm"]["mean_difference_s"] == 3.0 and math.isnan(eulerian["15 mm"]["mean_difference_s_error"])
+    # with k = 4: 20 mm's 4 s is within 4 sqrt(2) s, and 10 mm's 4 s is not more than 4 x 1 s
+    loose = verification_summary(CASE, verification, k=4.0)
+    assert loose["coverage_factor"] == 4.0
+    assert (loose["eulerian"]["20 mm"]["means_agree"], loose["eulerian"]["10 mm"]["means_agree"]) == (True, True)
+    assert loose["eulerian"]["20 mm"]["mean_difference_s_error"] == math.sqrt(2.0)
 
 
 @pytest.mark.parametrize("function", [concentration_rows, vrr_rows, model_rows])
@@ -311,17 +362,53 @@ def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
     assert list(rows[0]) == ["flow_pattern", "layout", "run_id", "residence_time_s", "t_s_over_t_d", "rtd_mean_ids_s",
                              "rtd_mean_eulerian_s", "vrr_nr1", "vrr_nr2", "vrr_nr3", "prediction_rms_error",
                              "homogenised_after_recirculations", "model_homogenised_after_recirculations",
-                             "vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3"]
+                             "vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3",
+                             "residence_time_s_error", "t_s_over_t_d_error", "rtd_mean_ids_s_error",
+                             "rtd_mean_eulerian_s_error", "vrr_nr1_error", "vrr_nr2_error", "vrr_nr3_error"]
     np.testing.assert_equal(rows[0], {
         "flow_pattern": "semi", "layout": "blue13", "run_id": "r1", "residence_time_s": 2.0, "t_s_over_t_d": 0.25,
         "rtd_mean_ids_s": 1.5, "rtd_mean_eulerian_s": 1.6, "vrr_nr1": 2.0, "vrr_nr2": NAN, "vrr_nr3": 1.9,
         "prediction_rms_error": 0.1, "homogenised_after_recirculations": 3, "model_homogenised_after_recirculations": 4,
         # ceiling 4: VRR 2 = 4 / 2 is flagged, 1.9 and the missing VRR are not
         "vrr_ceiling": 4.0, "vrr_at_ceiling_nr1": True, "vrr_at_ceiling_nr2": False, "vrr_at_ceiling_nr3": False,
+        # a summary written without errors: unknown, not zero
+        "residence_time_s_error": NAN, "t_s_over_t_d_error": NAN, "rtd_mean_ids_s_error": NAN,
+        "rtd_mean_eulerian_s_error": NAN, "vrr_nr1_error": NAN, "vrr_nr2_error": NAN, "vrr_nr3_error": NAN,
     })
-    ((label, nr, values, ceiling),) = curves
+    ((label, nr, values, ceiling, errors),) = curves
     assert (label, nr, ceiling) == ("semi blue13", [0.5, 1.5, 2.5], 4.0)
     np.testing.assert_equal(values, [2.0, NAN, 1.9])
+    np.testing.assert_equal(errors, [NAN, NAN, NAN])
+
+
+SUMMARY_WITH_ERRORS = {
+    **SUMMARY, "residence_time_s_error": 0.05,
+    "rtd_particle_ids": {**SUMMARY["rtd_particle_ids"], "t_s_over_t_d_error": 0.02, "t_mean_s_error": 0.1},
+    "rtd_eulerian": {**SUMMARY["rtd_eulerian"], "t_mean_s_error": 0.125},
+    "layouts": {"blue13": {**SUMMARY["layouts"]["blue13"], "vrr_by_recirculation_error": [1.0, None, 0.5]}},
+}
+
+
+def test_summary_rows_carry_the_errors_the_summary_holds():
+    rows, curves = summary_rows([SUMMARY_WITH_ERRORS])
+    errors = {key: value for key, value in rows[0].items() if key.endswith("_error") and key != "prediction_rms_error"}
+    np.testing.assert_equal(errors, {
+        "residence_time_s_error": 0.05, "t_s_over_t_d_error": 0.02, "rtd_mean_ids_s_error": 0.1,
+        "rtd_mean_eulerian_s_error": 0.125, "vrr_nr1_error": 1.0, "vrr_nr2_error": NAN, "vrr_nr3_error": 0.5,
+    })
+    np.testing.assert_equal(curves[0][4], [1.0, NAN, 0.5])
+
+
+def test_summary_rows_of_a_written_summary_give_the_errors_blending_summary_computed(tmp_path):
+    written = json.loads(write_json(tmp_path / "blending.json",
+                                    blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)).read_text())
+    rows, _ = summary_rows([written])
+    half = rows[0]
+    assert (half["residence_time_s"], half["residence_time_s_error"]) == (2.0, 0.125)
+    assert half["t_s_over_t_d_error"] == pytest.approx((5.0 / 11.0) * math.sqrt(1.0 + (5.0 / 11.0) ** 2), rel=1e-15)
+    assert half["rtd_mean_ids_s_error"] == math.sqrt(0.375 / 2.0)
+    assert half["rtd_mean_eulerian_s_error"] == math.sqrt(1.25 / 3.0)
+    assert half["vrr_nr1_error"] == HALF_ERROR and math.isnan(half["vrr_nr2_error"])
 
 
 def test_summary_rows_take_the_flags_the_summary_holds_and_the_factor_otherwise():

@@ -49,10 +49,27 @@ rule blender_fields:
         "../scripts/blender_fields.py"
 
 
+# The field of each frame of the steady window: the series whose batch means give the passage velocities' errors.
+rule blender_frame_fields:
+    input:
+        record=rules.blender_run.output.record,
+        case=rules.blender_deck.output.case,
+    output:
+        frames=f"{run_dir('blender')}/fields/steady_frames.npz",
+    params:
+        bin_size=config["blender"]["bin_size"],
+        on_damaged=config["dumps"]["on_damaged"],
+    log:
+        f"{run_dir('blender')}/logs/frame_fields.log",
+    script:
+        "../scripts/blender_frame_fields.py"
+
+
 rule blender_analysis:
     input:
         fields=rules.blender_fields.output.fields,
         flow=rules.blender_fields.output.flow,
+        frames=rules.blender_frame_fields.output.frames,
         case=rules.blender_deck.output.case,
     output:
         summary=f"{run_dir('blender')}/metrics/blender.json",
@@ -82,6 +99,7 @@ rule blender_comparison:
     output:
         table=f"{case_root('blender')}/comparison/configurations.csv",
         markdown=f"{case_root('blender')}/comparison/configurations.md",
+        significance=f"{case_root('blender')}/comparison/significance.csv",
         plot=report(f"{case_root('blender')}/comparison/configurations.png", caption="../report/blender_comparison.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "configurations"}),
         rtd_plot=report(f"{case_root('blender')}/comparison/rtd.png", caption="../report/blender_comparison_rtd.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "RTDs"}),
     params:

@@ -45,6 +45,7 @@ def calibration_targets():
         f"{CALIBRATION}/parameters.yaml",
         *[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
         *lid_comparison_targets(),
+        *[run_path("jenike", "metrics/fill_balance.json", run) for run in JENIKE_CASES],
     ]
 
 

@@ -157,7 +157,7 @@ def blender_targets(wildcards=None):
     ]
     if runs:
         targets += [f"{case_root('blender')}/comparison/{name}"
-                    for name in ("configurations.csv", "configurations.md", "configurations.png", "rtd.png")]
+                    for name in ("configurations.csv", "significance.csv", "configurations.md", "configurations.png", "rtd.png")]
     if len(config["blender"]["gravity_factors"]) > 1:
         targets += [f"{case_root('blender')}/gravity/scaling.csv", f"{case_root('blender')}/gravity/scaling.png"]
     return targets

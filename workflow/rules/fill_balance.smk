@@ -1,8 +1,9 @@
-# The settled fill's force balance of every silo-type run (flat-bottom silo, recirculating silo, blender): the load the
-# floor and each wall carry and the load across horizontal planes, against the weight. A fill that is not at rest,
-# or whose walls hold it down, stops the pipeline here with a message that says so.
+# The settled fill's force balance of every run (flat-bottom silo, recirculating silo, blender, and the Jenike cell's
+# levelled sample before its lid): the load the floor and each wall carry and the load across horizontal planes,
+# against the weight. A fill that is not at rest, or whose planes carry more than the weight above, stops the
+# pipeline here with a message that says so.
 
-FILL_BALANCE_CASES = ("silo_flat", RECIRCULATION, "blender")
+FILL_BALANCE_CASES = ("jenike", "silo_flat", RECIRCULATION, "blender")
 
 
 def fill_balance_params(kind):

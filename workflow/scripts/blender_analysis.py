@@ -4,7 +4,8 @@ import json
 from pathlib import Path
 
 from analysis.studies.blender.steady_field import BlenderField
-from analysis.studies.blender.window_fields_io import read_planar_fields
+from analysis.studies.blender.errors import steady_flow_rate_estimate
+from analysis.studies.blender.window_fields_io import read_frame_fields, read_planar_fields
 from analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_continuous_mode,
@@ -38,7 +39,10 @@ with logged_to(snakemake.log[0]) as log:
     study = analyse_blender(BlenderField.from_planar(steady), [BlenderField.from_planar(w) for w in windows],
                             window_times, heights, geometry.annulus_bounds, geometry.wall_x, settings)
     name = f"{case['configuration']} ({case['gravity_factor']:g} g)"
-    metrics = study_metrics(case["configuration"], study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions)
+    rate = steady_flow_rate_estimate(flow["time_since_open_s"], flow["discharged_mass_kg"], tuple(case["steady_window"]))
+    frames = [BlenderField.from_planar(frame) for frame in read_frame_fields(snakemake.input.frames)]
+    metrics = study_metrics(case["configuration"], study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions,
+                            mass_flow_rate_error=rate.std_error, frames=frames, resolution=settings.integration_step)
     write_json(snakemake.output.summary, blender_summary(case, flow, study, metrics))
     write_flow_table(snakemake.output.profiles, profile_rows(study.profiles))
     write_flow_table(snakemake.output.residence, residence_rows(study.pathlines))
@@ -56,7 +60,11 @@ with logged_to(snakemake.log[0]) as log:
     plot_discontinuous_mode(study.discontinuous, snakemake.output.discontinuous_plot,
                             f"Discontinuous mode ({settings.discontinuous_tracer_fraction:.0%} tracer on top): {name}")
     plot_continuous_mode({name: study.continuous}, snakemake.output.vrr_plot, f"Continuous mode, sine inputs: {name}")
-    log.info("%s: flow %.4g kg/s; exterior/interior/tube v_z %.3g/%.3g/%.3g m/s; RTD t_m %.3g s, sigma/t_m %.3g, "
-             "t_s/t_d %.3g; homogenised after %.3g passes; VRR %s", case["run_id"], metrics.mass_flow_rate,
-             metrics.exterior_v_z, metrics.interior_v_z, metrics.tube_v_z, metrics.rtd_mean, metrics.rtd_spread,
-             metrics.ts_over_td, metrics.recirculations_to_homogenise, metrics.vrr_by_period)
+    log.info("%s: flow %.4g +- %.2g kg/s (batch rate of %d batches); exterior/interior/tube v_z %.3g/%.3g/%.3g "
+             "+- %.2g/%.2g/%.2g m/s (batch means of %d frames); RTD t_m %.3g +- %.2g s, sigma/t_m %.3g +- %.2g, "
+             "t_s/t_d %.3g +- %.2g; homogenised after %.3g passes; VRR %s +- %s (ceiling %.4g)", case["run_id"],
+             metrics.mass_flow_rate, metrics.mass_flow_rate_error, rate.n, metrics.exterior_v_z, metrics.interior_v_z,
+             metrics.tube_v_z, metrics.exterior_v_z_error, metrics.interior_v_z_error, metrics.tube_v_z_error,
+             len(frames), metrics.rtd_mean, metrics.rtd_mean_error, metrics.rtd_spread, metrics.rtd_spread_error,
+             metrics.ts_over_td, metrics.ts_over_td_error, metrics.recirculations_to_homogenise,
+             metrics.vrr_by_period, metrics.vrr_errors, metrics.vrr_ceiling)

@@ -1,9 +1,16 @@
-"""Snakemake adapter: compare the insert configurations (at the lowest gravity factor run) in one table and plots."""
+"""Snakemake adapter: compare the insert configurations (at the lowest gravity factor run) in one table and plots,
+and say which differences between them exceed their uncertainty."""
 
 import json
 from pathlib import Path
 
-from analysis.studies.blender.comparison import best_blender, comparison_table
+from analysis.studies.blender.comparison import (
+    SIGNIFICANCE_COLUMNS,
+    best_blender,
+    comparison_table,
+    figure_columns,
+    significance_rows,
+)
 from analysis.studies.blender.plots import plot_configuration_comparison, plot_rtd_theta
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
 from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs
@@ -16,10 +23,17 @@ with logged_to(snakemake.log[0]) as log:
     metrics = [metrics_from_summary(summary) for summary in chosen]
     rows = comparison_table(metrics)
     best = best_blender(metrics)
+    significance = significance_rows(rows)
     write_flow_table(snakemake.output.table, rows)
     write_text(snakemake.output.markdown, comparison_markdown(lowest, rows, best, snakemake.params.tolerance))
-    plot_configuration_comparison(rows, [c for c in rows[0] if c != "configuration"], snakemake.output.plot,
-                                  f"Insert configurations at {lowest:g} g (best: {best})", best=best)
+    if significance:
+        write_flow_table(snakemake.output.significance, significance)
+    else:  # a single configuration: no pair to compare, a header-only table
+        write_text(snakemake.output.significance, ",".join(SIGNIFICANCE_COLUMNS) + "\n")
+    plot_configuration_comparison(rows, figure_columns(rows[0]), snakemake.output.plot,
+                                  f"Insert configurations at {lowest:g} g", best=best)
     plot_rtd_theta({s["configuration"]: rtd_from_summary(s["rtd_curve"]) for s in chosen}, snakemake.output.rtd_plot,
                    f"RTD of the configurations at {lowest:g} g")
-    log.info("best blender: %s; %s", best, rows)
+    log.info("best blender: %s; %s; significant differences: %s", best, rows,
+             [(r["figure"], r["configuration_a"], r["configuration_b"]) for r in significance
+              if r["significance"] == "significant"])

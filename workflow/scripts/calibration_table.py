@@ -11,7 +11,9 @@ with logged_to(snakemake.log[0]) as log:
     rows.sort(key=lambda row: (row["shape"], row["test"], row["rolling_friction"], row["restitution"],
                                row["rotation_blocked"], row["particle_friction"]))
     leading = ["shape", "test", "wall_material", "lid", "rolling_friction", "restitution", "rotation_blocked",
-               "particle_friction", "bulk_friction", "bulk_friction_stderr", "bulk_friction_angle_deg"]
-    rows = [{**{key: row[key] for key in leading}, **row} for row in rows]
+               "particle_friction", "bulk_friction", "bulk_friction_error", "bulk_friction_stderr",
+               "bulk_friction_angle_deg", "bulk_friction_angle_deg_error"]
+    # a summary written before the errors existed lacks their keys: its row leaves those cells empty
+    rows = [{**{key: row[key] for key in leading if key in row}, **row} for row in rows]
     write_flow_table(snakemake.output.table, rows)
     log.info("%d sweep points -> %s", len(rows), snakemake.output.table)

@@ -4,7 +4,7 @@ from pathlib import Path
 
 from analysis.io.tables import write_json
 from calibration.charts import plot_force_history
-from calibration.friction import bulk_friction_of_shear
+from calibration.friction import bulk_friction_of_shear, bulk_friction_summary
 from analysis.data.record import read_run_record
 from calibration.shear import shear_signals
 from engines.interface import engine_named
@@ -28,14 +28,7 @@ with logged_to(snakemake.log[0]) as log:
         "rotation_blocked": point["rotation_blocked"],
         "lid": point["lid"],
         "particle_friction": point["sliding_friction"],
-        "bulk_friction": friction.coefficient,
-        "bulk_friction_stderr": friction.standard_error,
-        "bulk_friction_angle_deg": friction.angle_deg,
-        "bottom_bulk_friction": friction.bottom_coefficient,
-        "ring_sides_relative_difference": friction.relative_difference,
-        "window_start_s": friction.window.t_start,
-        "window_end_s": friction.window.t_end,
-        "window_method": window_method,
+        **bulk_friction_summary(friction, window_method),
         "n_clumps": record.n_clumps,
     }
     write_json(snakemake.output.summary, summary)

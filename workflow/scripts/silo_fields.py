@@ -49,7 +49,8 @@ with logged_to(snakemake.log[0]) as log:
 
     study = analyse_silo_fields(frames, contacts, silo, options,
                                 steady_window=(flow["steady_window_start_s"], flow["steady_window_end_s"]),
-                                bulk_density=flow["filling_bulk_density_kg_m3"])
+                                bulk_density=flow["filling_bulk_density_kg_m3"],
+                                bulk_density_error=flow.get("filling_bulk_density_kg_m3_error"))
     log.info("grid %s cells of %s m, %d frames", study.grid.shape, study.grid.spacing, len(study.fields))
 
     # ParaView: a time series of every n-th frame, the time average, and the settled fill with its contact stress.
@@ -64,8 +65,8 @@ with logged_to(snakemake.log[0]) as log:
                      extra_arrays={"contact_stress": study.stress})
 
     write_flow_table(snakemake.output.profiles, profile_rows(study.profiles, study.front))
-    write_flow_table(snakemake.output.boundaries, boundary_rows(study.profiles))
-    write_flow_table(snakemake.output.kinematic, kinematic_rows(study.profiles))
+    write_flow_table(snakemake.output.boundaries, boundary_rows(study.profiles, study.uncertainty))
+    write_flow_table(snakemake.output.kinematic, kinematic_rows(study.profiles, study.uncertainty))
     write_flow_table(snakemake.output.instantaneous,
                      instantaneous_profile_rows(study.times, study.depth_series, study.heights))
     write_flow_table(snakemake.output.centreline, centreline_rows(study.times, study.heights, study.centreline))
@@ -75,11 +76,11 @@ with logged_to(snakemake.log[0]) as log:
     run = case["run_id"]
     plane = study.averaged_depth
     plot_profiles_over_silo(study.profiles, silo.width, silo.outlet_width, study.top, snakemake.output.profile_plot,
-                            f"Time-averaged v_z, {run}")
+                            f"Time-averaged v_z, {run}", uncertainty=study.uncertainty)
     plot_velocity_contour(plane.grid.x, plane.grid.z, plane.velocity[:, 0, :, 2], silo.width, silo.outlet_width,
                           snakemake.output.contour_plot, f"Depth-averaged v_z, {run}")
     plot_kinematic_constant(study.profiles.heights, study.profiles.kinematic_B, snakemake.output.kinematic_plot,
-                            "Kinematic constant B(z)")
+                            "Kinematic constant B(z)", B_error=study.uncertainty.kinematic_B_error)
     plot_kinematic_horizontal_velocity(study.profiles, snakemake.output.kinematic_u_plot,
                                        "Horizontal velocity: DEM against the kinematic model")
     plot_centreline_velocity(study.times, study.heights, study.centreline, snakemake.output.centreline_plot,

@@ -37,7 +37,9 @@ with logged_to(snakemake.log[0]) as log:
     write_discharge_history_csv(snakemake.output.history, metrics.history)
     write_json(snakemake.output.summary, {**row, "beverloo": beverloo, "steady_window": analysis["steady_window"]})
     plot_discharge(metrics.history, metrics.fit, metrics.beverloo_rate, snakemake.output.plot,
-                   title=f"Flat-bottom silo {case['run_id']}")
-    log.info("mass flow rate %.4g +- %.2g kg/s, Beverloo %.4g kg/s (ratio %.3f), bulk density %.1f kg/m3",
-             metrics.fit.mass_flow_rate, metrics.fit.standard_error, metrics.beverloo_rate,
-             metrics.beverloo_ratio, metrics.bulk_density.density)
+                   title=f"Flat-bottom silo {case['run_id']}", rate_error=metrics.mass_flow_rate_error)
+    log.info("mass flow rate %.4g +- %.2g kg/s (batch means; least-squares %.2g), Beverloo %.4g kg/s "
+             "(ratio %.3f +- %.2g), bulk density %.1f +- %.2g kg/m3",
+             metrics.fit.mass_flow_rate, metrics.mass_flow_rate_error, metrics.fit.standard_error,
+             metrics.beverloo_rate, metrics.beverloo_ratio, metrics.beverloo_ratio_error,
+             metrics.bulk_density.density, metrics.bulk_density_error)

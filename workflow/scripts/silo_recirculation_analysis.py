@@ -46,8 +46,9 @@ with logged_to(snakemake.log[0]) as log:
         lti["passes"], lti["tolerance"],
     )
     timing = result.timing
-    log.info("t_res %.4g s (holdup %.1f clumps, throughput %.1f clumps/s), run covers Nr = %.2f",
-             timing.residence_time, timing.holdup, timing.throughput, timing.recirculations)
+    log.info("t_res %.4g +- %.2g s (holdup %.1f +- %.2g clumps, throughput %.1f +- %.2g clumps/s), run covers "
+             "Nr = %.2f", timing.residence_time, timing.residence_time_error, timing.holdup, timing.holdup_error,
+             timing.throughput, timing.throughput_error, timing.recirculations)
     eulerian = settings["eulerian"]
     eulerian_rtd = main_run_eulerian_rtd(
         tracks, loaded.velocity, loaded.mass, result, case["width_m"], case["depth_m"], top, case["outlet_width_m"],
@@ -73,7 +74,7 @@ with logged_to(snakemake.log[0]) as log:
         tolerance=lti["tolerance"],
     )
     plot_vrr_versus_recirculations(
-        [(l.layout.name, l.vrr.recirculation_number, l.vrr.vrr) for l in result.layouts],
+        [(l.layout.name, l.vrr.recirculation_number, l.vrr.vrr, None, l.vrr.vrr_error) for l in result.layouts],
         out.vrr_plot, f"VRR per recirculation, {title}", noise_limit=clumps_per_window(result),
     )
     plot_rtd_comparison(

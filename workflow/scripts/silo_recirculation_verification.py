@@ -36,4 +36,5 @@ with logged_to(snakemake.log[0]) as log:
     plot_paths_comparison(result.particle_paths, result.pathlines[finest], case["width_m"], case["outlet_width_m"],
                           top, out.paths_plot,
                           f"Particle tracks (solid) and pathlines in {1000 * finest:g} mm bins (dashed)")
-    log.info("particles: %s; Eulerian: %s", summary["particles"], summary["eulerian"])
+    log.info("particles (%d tracers): %s; Eulerian: %s", summary["n_tracers"], summary["particles"],
+             summary["eulerian"])

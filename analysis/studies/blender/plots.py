@@ -402,6 +402,11 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         plt.close(figure)
 
 
+def _error_or_nan(error) -> float:
+    # a missing error (or one read back as empty) is unknown: no bar
+    return math.nan if error is None else float(error)
+
+
 def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str | os.PathLike, title: str,
                                   best: str | None = None) -> Path:
     """Bar charts of chosen metrics, one panel per metric and one bar per configuration.
@@ -411,7 +416,8 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     rows : list of dict
         :func:`analysis.studies.blender.comparison.comparison_table` rows (key ``"configuration"`` and the metrics).
     columns : sequence of str
-        Metric columns to draw, each a key of every row; NaN values leave the bar out.
+        Metric columns to draw, each a key of every row; NaN values leave the bar out. A column whose rows carry
+        ``<column>_error`` gets error bars of one standard error (none where the error is NaN or missing).
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
     title : str
@@ -438,6 +444,7 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     if best is not None and best not in names:
         raise ValueError(f"best must be one of the configurations {names}, got {best!r}")
     values = np.array([[float(row[column]) for column in columns] for row in rows])
+    errors = np.array([[_error_or_nan(row.get(f"{column}_error")) for column in columns] for row in rows])
     panels = len(columns)
     figure, axes_row = plt.subplots(1, panels, figsize=(2.6 * panels + 1.0, 3.8), squeeze=False)
     try:
@@ -445,6 +452,10 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
         for c, (axes, column) in enumerate(zip(axes_row[0], columns)):
             bars = axes.bar(positions, np.nan_to_num(values[:, c], nan=0.0, posinf=0.0, neginf=0.0),
                             color=[f"C{i}" for i in range(len(names))])
+            shown = np.isfinite(values[:, c]) & np.isfinite(errors[:, c])
+            if np.any(shown):
+                axes.errorbar(positions[shown], values[shown, c], yerr=errors[shown, c], fmt="none", ecolor="black",
+                              elinewidth=1.0, capsize=3.0)
             for bar, name, value in zip(bars, names, values[:, c]):
                 if not math.isfinite(value):
                     bar.set_visible(False)

@@ -8,7 +8,8 @@ of intervals on the right half (``0 <= x_lo < x_hi``); a bin belongs to an inter
 
 1. Velocity profiles and the normalised profile ``v_z / cross-section mean`` at a height
    (:func:`height_profile`), and at key heights for several time windows (:func:`profiles_over_time`).
-2. Mean ``v_z`` of each passage (:func:`passage_velocities`).
+2. Mean ``v_z`` of each passage (:func:`passage_velocities`; :func:`passage_mean_v_z` for the field of a single
+   frame, where a passage may be empty).
 3. The flow channel boundary at 10 % of the centreline velocity after subtracting the near-wall
    velocity, at every row (:func:`flow_channel_boundary_over_height`, wrapping
    :func:`analysis.numerics.profiles.flow_channel_boundary`).
@@ -34,6 +35,7 @@ __all__ = [
     "height_profile",
     "profiles_over_time",
     "passage_velocities",
+    "passage_mean_v_z",
     "flow_channel_boundary_over_height",
 ]
 
@@ -260,6 +262,37 @@ def passage_velocities(field: BlenderField, z_value: float, passages: Mapping) -
         counts[name] = int(np.count_nonzero(chosen))
         means[name] = float(np.mean(profile.v_z[chosen])) if counts[name] else math.nan
     return PassageVelocities(profile=profile, passages=intervals, mean_v_z=means, n_bins=counts)
+
+
+def passage_mean_v_z(field: BlenderField, z_value: float, passages: Mapping) -> dict[str, float]:
+    """Mean ``v_z`` of each passage at a height, as :func:`passage_velocities` but without the profile [m/s].
+
+    The field of a single frame may leave a passage, or the whole height, without particles: that passage's
+    mean is then NaN instead of an error, so that a series of frames can be averaged.
+
+    Parameters
+    ----------
+    field : BlenderField
+        A field (e.g. of one frame).
+    z_value : float
+        Height [m], within the bin rows.
+    passages : mapping name -> (x_lo, x_hi)
+        Clear intervals at that height [m].
+
+    Returns
+    -------
+    dict
+        Name -> mean ``v_z`` over the bins with particles whose centre's ``|x|`` lies in the interval [m/s]; NaN
+        without such a bin.
+    """
+    field = checked_field(field)
+    intervals = _passages(passages)
+    v_z = at_height(field, field.v_z, finite_number("z_value", z_value))
+    means = {}
+    for name, interval in intervals.items():
+        chosen = np.isfinite(v_z) & _in_interval(field.x, interval)
+        means[name] = float(np.mean(v_z[chosen])) if np.any(chosen) else math.nan
+    return means
 
 
 @dataclass(frozen=True, eq=False)

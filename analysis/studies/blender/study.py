@@ -16,6 +16,12 @@ import numpy as np
 from analysis.checks import positive_number
 from analysis.numerics.rtd import RTD
 from analysis.studies.blender.comparison import BlenderMetrics
+from analysis.studies.blender.errors import (
+    passage_velocity_estimates,
+    residence_time_error,
+    sine_vrr_error,
+    tracer_errors,
+)
 from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode, continuous_mode, discontinuous_mode
 from analysis.studies.blender.profiles import (
     ChannelBoundary,
@@ -191,39 +197,90 @@ def analyse_blender(
                         pathlines=pathlines, rtd=rtd, discontinuous=discontinuous, continuous=continuous)
 
 
-def study_metrics(name: str, study: BlenderStudy, mass_flow_rate: float, comparison_fractions) -> BlenderMetrics:
-    """The figures of merit of one run for the configuration comparison (passage means at the insert outlet)."""
+def study_metrics(name: str, study: BlenderStudy, mass_flow_rate: float, comparison_fractions, *,
+                  mass_flow_rate_error: float = math.nan, frames: Sequence[BlenderField] = (),
+                  resolution: float = math.nan) -> BlenderMetrics:
+    """The figures of merit of one run for the configuration comparison, with their standard errors.
+
+    The passage means are those at the insert outlet. The errors (:mod:`analysis.studies.blender.errors`): the
+    passage means' from the batch means of ``frames``
+    (:func:`~analysis.studies.blender.errors.passage_velocity_estimates`); those of ``t_m``, ``sigma / t_m`` and
+    ``t_s / t_d`` from the RTD's virtual tracers (:func:`~analysis.studies.blender.errors.tracer_errors`), ``t_m``'s
+    with the flow rate's relative error added (:func:`~analysis.studies.blender.errors.residence_time_error`); the
+    VRRs' from the same tracers (:func:`~analysis.studies.blender.errors.sine_vrr_error`), whose effective number
+    is also the VRR's counting-noise ceiling. The recirculations to homogenise have none.
+
+    Parameters
+    ----------
+    name : str
+        Configuration.
+    study : BlenderStudy
+        The run's study (:func:`analyse_blender`).
+    mass_flow_rate : float
+        Steady mass flow rate [kg/s].
+    comparison_fractions : iterable of float
+        Periods over ``t_m`` whose VRRs are reported [-].
+    mass_flow_rate_error : float, optional
+        Its standard error [kg/s] (:func:`~analysis.studies.blender.errors.steady_flow_rate_estimate`); NaN when
+        not known (then ``t_m``'s error is unknown too).
+    frames : sequence of BlenderField, optional
+        Fields of the single frames of the steady window, in time order; without them the passage means have
+        unknown errors.
+    resolution : float, optional
+        Time resolution of the tracers' exit detection, >= 0 [s] (the pathline integration step); NaN leaves
+        ``t_s / t_d`` without an error.
+    """
     means = study.outlet.mean_v_z
     rtd = study.rtd.rtd
+    interior = "interior" if "interior" in means else "open"
+    passages = (passage_velocity_estimates(frames, study.heights["insert outlet"], study.outlet.passages)
+                if len(frames) else {})
+
+    def passage_error(passage: str) -> float:
+        estimate = passages.get(passage)
+        return math.nan if estimate is None else estimate.std_error
+
+    tracers = tracer_errors(study.rtd.residence_time, study.rtd.weights, resolution)
+    vrr = {float(f): study.continuous.vrr_at(f) for f in comparison_fractions}
     return BlenderMetrics(
         name=name,
         mass_flow_rate=float(mass_flow_rate),
         exterior_v_z=float(means.get("exterior", math.nan)),
-        interior_v_z=float(means.get("interior", means.get("open", math.nan))),
+        interior_v_z=float(means.get(interior, math.nan)),
         tube_v_z=float(means.get("tube", math.nan)),
         rtd_mean=float(rtd.t_mean),
         rtd_spread=float(math.sqrt(rtd.variance) / rtd.t_mean),
         ts_over_td=float(rtd.ts_over_td),
         recirculations_to_homogenise=float(study.discontinuous.homogenised_after),
-        vrr_by_period={float(f): study.continuous.vrr_at(f) for f in comparison_fractions},
+        vrr_by_period=vrr,
+        mass_flow_rate_error=float(mass_flow_rate_error),
+        exterior_v_z_error=passage_error("exterior"),
+        interior_v_z_error=passage_error(interior),
+        tube_v_z_error=passage_error("tube"),
+        rtd_mean_error=residence_time_error(rtd.t_mean, tracers.t_mean, mass_flow_rate, mass_flow_rate_error),
+        rtd_spread_error=tracers.spread,
+        ts_over_td_error=tracers.ts_over_td,
+        vrr_errors={period: sine_vrr_error(value, tracers.n_effective) for period, value in vrr.items()},
+        vrr_ceiling=tracers.n_effective,
     )
 
 
 def study_summary(study: BlenderStudy, metrics: BlenderMetrics) -> dict:
-    """Plain-data summary of a run's study (for ``blender.json``)."""
+    """Plain-data summary of a run's study (for ``blender.json``); each figure's standard error sits beside it as
+    ``<key>_error`` (``vrr_by_period_error`` for the VRRs), with the VRRs' counting-noise ceiling ``vrr_ceiling``."""
     continuous = study.continuous
+    values = {}
+    for attribute, key in _METRIC_KEYS:
+        values[key] = getattr(metrics, attribute)
+        if attribute in _ERROR_ATTRIBUTES:
+            values[key + "_error"] = getattr(metrics, attribute + "_error")
     return {
         "metrics": {
             "configuration": metrics.name,
-            "mass_flow_rate_kg_s": metrics.mass_flow_rate,
-            "exterior_v_z_m_s": metrics.exterior_v_z,
-            "interior_v_z_m_s": metrics.interior_v_z,
-            "tube_v_z_m_s": metrics.tube_v_z,
-            "rtd_mean_s": metrics.rtd_mean,
-            "rtd_spread": metrics.rtd_spread,
-            "ts_over_td": metrics.ts_over_td,
-            "recirculations_to_homogenise": metrics.recirculations_to_homogenise,
+            **values,
             "vrr_by_period": {f"{period:g}": value for period, value in metrics.vrr_by_period.items()},
+            "vrr_by_period_error": {f"{period:g}": value for period, value in metrics.vrr_errors.items()},
+            "vrr_ceiling": metrics.vrr_ceiling,
         },
         "heights_m": study.heights,
         "passages_at_insert_outlet": {"mean_v_z_m_s": study.outlet.mean_v_z, "n_bins": study.outlet.n_bins},
@@ -258,13 +315,23 @@ _METRIC_KEYS = (
 )
 
 
+#: Figures of :data:`_METRIC_KEYS` with a standard error (``<attribute>_error``, written as ``<key>_error``).
+_ERROR_ATTRIBUTES = ("mass_flow_rate", "exterior_v_z", "interior_v_z", "tube_v_z", "rtd_mean", "rtd_spread",
+                     "ts_over_td")
+
+
 def metrics_from_summary(summary: Mapping) -> BlenderMetrics:
-    """The :class:`BlenderMetrics` of a run back from its :func:`study_summary` (as read from JSON)."""
+    """The :class:`BlenderMetrics` of a run back from its :func:`study_summary` (as read from JSON); errors and the
+    VRR ceiling a summary lacks (one written before they existed) are unknown (NaN)."""
     values = summary["metrics"]
     return BlenderMetrics(
         name=values["configuration"],
         **{field: _number(values[key]) for field, key in _METRIC_KEYS},
         vrr_by_period={float(period): _number(vrr) for period, vrr in values["vrr_by_period"].items()},
+        **{f"{field}_error": _number(values.get(f"{key}_error")) for field, key in _METRIC_KEYS
+           if field in _ERROR_ATTRIBUTES},
+        vrr_errors={float(period): _number(error) for period, error in values.get("vrr_by_period_error", {}).items()},
+        vrr_ceiling=_number(values.get("vrr_ceiling")),
     )
 
 

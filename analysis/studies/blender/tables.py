@@ -16,7 +16,8 @@ import numpy as np
 
 from analysis.io.tables import markdown_table
 from analysis.numerics.rtd import RTD
-from analysis.studies.blender.comparison import BlenderMetrics
+from analysis.numerics.uncertainty import CEILING_FACTOR, format_estimate
+from analysis.studies.blender.comparison import CEILING_SUFFIX, ERROR_SUFFIX, BlenderMetrics
 from analysis.studies.blender.gravity import gravity_scaling
 from analysis.studies.blender.modes import ContinuousMode
 from analysis.studies.blender.profiles import ProfilesOverTime
@@ -176,8 +177,24 @@ def lowest_gravity_runs(summaries: Sequence[Mapping]) -> tuple[float, list[Mappi
     return lowest, [summary for summary in summaries if summary["gravity_factor"] == lowest]
 
 
+def _estimate_cell(row: Mapping, column: str) -> str | float:
+    """A figure's cell: ``"value ± error"`` when the row has its error, marked when the VRR is at its ceiling."""
+    value = row.get(column, "")
+    if column + ERROR_SUFFIX not in row:
+        return value
+    value = _number(value)
+    cell = format_estimate(value, _number(row[column + ERROR_SUFFIX])) if math.isfinite(value) else "n/a"
+    return f"{cell} (at ceiling)" if row.get(column + CEILING_SUFFIX) else cell
+
+
 def comparison_markdown(gravity_factor: float, rows: Sequence[Mapping], best: str, tolerance: float) -> str:
     """The configuration comparison as a Markdown page (``configurations.md``).
+
+    A figure with a standard error prints as ``"value ± error"``
+    (:func:`analysis.numerics.uncertainty.format_estimate`: the error to 2 significant digits, the value to the
+    same place; ``"± unknown"`` for an unknown error, ``"n/a"`` for no value), a VRR within
+    :data:`~analysis.numerics.uncertainty.CEILING_FACTOR` of its counting-noise ceiling with ``"(at ceiling)"``;
+    the error and flag columns themselves are not shown.
 
     Parameters
     ----------
@@ -193,11 +210,20 @@ def comparison_markdown(gravity_factor: float, rows: Sequence[Mapping], best: st
     Returns
     -------
     str
-        A heading, the table and a sentence naming the best blender and the ranking rule.
+        A heading, the table and a sentence naming the best blender and the ranking rule; with errors, a sentence
+        on how to read them.
     """
-    return (f"# Insert configurations at {gravity_factor:g} g\n\n{markdown_table(list(rows))}\n"
+    rows = list(rows)
+    columns = [column for column in rows[0] if not column.endswith(ERROR_SUFFIX) and not column.endswith(CEILING_SUFFIX)]
+    shown = [{column: _estimate_cell(row, column) for column in columns} for row in rows]
+    page = (f"# Insert configurations at {gravity_factor:g} g\n\n{markdown_table(shown)}\n"
             f"Best blender: **{best}** (fewest recirculations to homogenise within +-{tolerance:.0%}, ties broken "
             "by the highest VRR at the shortest period).\n")
+    if any(column + ERROR_SUFFIX in rows[0] for column in columns):
+        page += ("\nFigures are value ± standard error. A VRR marked (at ceiling) lies within a factor "
+                 f"{CEILING_FACTOR:g} of its counting-noise ceiling, so it is only a lower bound. Whether the "
+                 "differences between configurations exceed their uncertainty: significance.csv.\n")
+    return page
 
 
 def gravity_rows(summaries: Sequence[Mapping], tolerance: float = 0.1) -> tuple[list[dict], list[tuple], list[tuple]]:

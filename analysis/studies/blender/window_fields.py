@@ -7,7 +7,8 @@ fields). SI units: positions in m, velocities in m/s, masses in kg, times in s.
 Fields are mass-weighted bin averages over all frames of a time window: for bin b,
 ``v_b = sum_k sum_{i in b at k} m_i v_i / sum_k sum_{i in b at k} m_i`` (clumps of many frames pooled, so a bin
 that is often empty still gets the mean of the clumps that passed through it), and the solid fraction is the
-mean clump mass in the bin over the window divided by ``rho_s`` times the bin volume.
+mean clump mass in the bin over the window divided by ``rho_s`` times the bin volume. The fields of the single
+frames of a window (:func:`frame_fields`) give the series whose batch means carry the errors of the steady figures.
 
 Discharged mass: in batch mode the mass above the outlet plane at the first frame minus that at each frame
 (clumps leave the domain below the outlet); in continuous mode the mass that crossed the outlet plane so far
@@ -25,7 +26,8 @@ from analysis.numerics.eulerian_rtd import bin_sums
 from analysis.numerics.grid import Grid
 from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events
 
-__all__ = ["PlanarField", "window_average_field", "discharged_mass_history", "frames_in_window", "mean_velocity_history"]
+__all__ = ["PlanarField", "window_average_field", "frame_fields", "discharged_mass_history", "frames_in_window",
+           "mean_velocity_history"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,6 +70,34 @@ def frames_in_window(times, window: tuple[float, float]) -> np.ndarray:
     return selected
 
 
+def _checked_inputs(positions, velocities, masses, grid: Grid, particle_density: float):
+    if grid.shape[1] != 1:
+        raise ValueError(f"a planar field needs one bin across the depth, got {grid.shape[1]}")
+    rho = positive_number("particle_density", particle_density)
+    return (np.asarray(positions, dtype=float), np.asarray(velocities, dtype=float), np.asarray(masses, dtype=float),
+            rho)
+
+
+def _pooled_field(positions, velocities, masses, times, grid: Grid, selected: np.ndarray, rho: float) -> PlanarField:
+    """The field of the frames ``selected``, their clumps pooled into one instant."""
+    n_frames = selected.size
+    # Pool the clumps of all frames into one instant: the bin mean is then sum(m v) / sum(m) over the window.
+    mass, momentum = bin_sums(positions[selected].reshape(1, -1, 3), velocities[selected].reshape(1, -1, 3),
+                              np.tile(masses, n_frames), grid)
+    shape = (grid.shape[0], grid.shape[2])
+    mass = mass[0].reshape(shape)
+    velocity = np.divide(momentum[0].reshape(*shape, 3), mass[..., None], out=np.full((*shape, 3), np.nan),
+                         where=mass[..., None] > 0.0)
+    origin, spacing = np.asarray(grid.origin), np.asarray(grid.spacing)
+    x = origin[0] + (np.arange(shape[0]) + 0.5) * spacing[0]
+    z = origin[2] + (np.arange(shape[1]) + 0.5) * spacing[2]
+    return PlanarField(
+        x=x, z=z, v_x=velocity[..., 0], v_z=velocity[..., 2],
+        solid_fraction=mass / (n_frames * rho * float(np.prod(spacing))),
+        window=(float(times[selected[0]]), float(times[selected[-1]])), n_frames=int(n_frames),
+    )
+
+
 def window_average_field(positions, velocities, masses, times, grid: Grid, window: tuple[float, float],
                          particle_density: float) -> PlanarField:
     """Depth-averaged mass-weighted velocity and solid fraction over the frames of a time window.
@@ -87,30 +117,33 @@ def window_average_field(positions, velocities, masses, times, grid: Grid, windo
     particle_density : float
         Solid density rho_s [kg/m^3].
     """
-    if grid.shape[1] != 1:
-        raise ValueError(f"a planar field needs one bin across the depth, got {grid.shape[1]}")
-    rho = positive_number("particle_density", particle_density)
-    positions = np.asarray(positions, dtype=float)
-    velocities = np.asarray(velocities, dtype=float)
-    masses = np.asarray(masses, dtype=float)
-    selected = frames_in_window(times, window)
-    n_frames = selected.size
-    # Pool the clumps of all frames into one instant: the bin mean is then sum(m v) / sum(m) over the window.
-    mass, momentum = bin_sums(positions[selected].reshape(1, -1, 3), velocities[selected].reshape(1, -1, 3),
-                              np.tile(masses, n_frames), grid)
-    shape = (grid.shape[0], grid.shape[2])
-    mass = mass[0].reshape(shape)
-    velocity = np.divide(momentum[0].reshape(*shape, 3), mass[..., None], out=np.full((*shape, 3), np.nan),
-                         where=mass[..., None] > 0.0)
-    origin, spacing = np.asarray(grid.origin), np.asarray(grid.spacing)
-    x = origin[0] + (np.arange(shape[0]) + 0.5) * spacing[0]
-    z = origin[2] + (np.arange(shape[1]) + 0.5) * spacing[2]
+    positions, velocities, masses, rho = _checked_inputs(positions, velocities, masses, grid, particle_density)
     times = np.asarray(times, dtype=float)
-    return PlanarField(
-        x=x, z=z, v_x=velocity[..., 0], v_z=velocity[..., 2],
-        solid_fraction=mass / (n_frames * rho * float(np.prod(spacing))),
-        window=(float(times[selected[0]]), float(times[selected[-1]])), n_frames=int(n_frames),
-    )
+    return _pooled_field(positions, velocities, masses, times, grid, frames_in_window(times, window), rho)
+
+
+def frame_fields(positions, velocities, masses, times, grid: Grid, window: tuple[float, float],
+                 particle_density: float) -> list[PlanarField]:
+    """The field of each frame of a time window, as :func:`window_average_field` of that frame alone.
+
+    The series of frames of the steady window gives the per-frame figures whose batch means carry the error of
+    the steady ones (:func:`analysis.studies.blender.errors.passage_velocity_estimates`).
+
+    Parameters
+    ----------
+    positions, velocities, masses, times, grid, window, particle_density
+        As in :func:`window_average_field`.
+
+    Returns
+    -------
+    list of PlanarField
+        One per frame with ``window[0] <= t <= window[1]``, in time order; each has ``window = (t, t)`` and
+        ``n_frames = 1``.
+    """
+    positions, velocities, masses, rho = _checked_inputs(positions, velocities, masses, grid, particle_density)
+    times = np.asarray(times, dtype=float)
+    return [_pooled_field(positions, velocities, masses, times, grid, np.array([index]), rho)
+            for index in frames_in_window(times, window)]
 
 
 def discharged_mass_history(tracks: ClumpTracks, masses, mode: str, outlet_z: float = 0.0,

@@ -7,6 +7,7 @@ functions and write their rows and plots.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -105,12 +106,24 @@ def parametric_profiles(averaged: Sequence[Fields], height: float) -> Parametric
 def parametric_rows(study: str, labels: Sequence[str], runs: Sequence[str], flows: Sequence[Mapping],
                     profiles: ParametricProfiles) -> list[dict]:
     """Rows of ``parametric/<study>.csv``: per run, its label, id, flow metrics (from its ``flow.json``) and
-    centreline v_z (m/s) at the profile height."""
+    centreline v_z (m/s) at the profile height.
+
+    The flow metrics' standard errors (``<key>_error``) come along as the run's ``flow.json`` has them; a
+    ``flow.json`` written before they existed gives NaN (unknown)."""
     return [
         {"study": study, "label": label, "run_id": run, "profile_height_m": profiles.height,
          "mass_flow_rate_kg_s": flow["mass_flow_rate_kg_s"],
+         "mass_flow_rate_kg_s_error": _error(flow, "mass_flow_rate_kg_s"),
          "mass_flow_rate_stderr_kg_s": flow["mass_flow_rate_stderr_kg_s"],
-         "beverloo_ratio": flow["beverloo_ratio"], "filling_bulk_density_kg_m3": flow["filling_bulk_density_kg_m3"],
+         "beverloo_ratio": flow["beverloo_ratio"], "beverloo_ratio_error": _error(flow, "beverloo_ratio"),
+         "filling_bulk_density_kg_m3": flow["filling_bulk_density_kg_m3"],
+         "filling_bulk_density_kg_m3_error": _error(flow, "filling_bulk_density_kg_m3"),
          "centreline_v_z_m_s": float(np.interp(0.0, profiles.x, profile))}
         for label, run, flow, profile in zip(labels, runs, flows, profiles.v_z)
     ]
+
+
+def _error(flow: Mapping, key: str) -> float:
+    """``flow["<key>_error"]`` as a float; NaN when it is missing or null (JSON's NaN)."""
+    error = flow.get(f"{key}_error")
+    return math.nan if error is None else float(error)

@@ -4,8 +4,13 @@
 the silo's dimensions (:class:`SiloDimensions`, from the case summary) and the ``silo_flat.fields`` settings
 (:class:`SiloFieldOptions`) and returns a :class:`SiloFieldStudy`: the coarse-grained fields and their time
 average, the velocity profiles, flow channel boundaries and kinematic constant, the centreline velocity, the
-profile flow rates, the Janssen comparison and the force-chain segments. The small functions after it lay the
-results out as table rows and the summary. Nothing here reads or writes files; the building blocks are in
+profile flow rates, the Janssen comparison and the force-chain segments, with the standard errors of B(z), of
+the flow channel boundary (batch means over :data:`FIELD_BATCHES` time windows,
+:func:`analysis.studies.silo_flat.fields.profile_uncertainty`) and of the DEM vertical stress (differences of
+mirror bins, as wide as the kernel's support, across the axis,
+:func:`analysis.studies.silo_flat.fields.compare_janssen`). The
+small functions after it lay the results out as table rows (each error as ``<column>_error`` beside its column)
+and the summary. Nothing here reads or writes files; the building blocks are in
 :mod:`analysis.studies.silo_flat.fields`. Coordinates as everywhere in siloflow: x across the width (0 on the
 axis), y front to back (0 at the front wall), z up (0 at the outlet).
 """
@@ -23,6 +28,7 @@ from analysis.data.frames import ClumpFrame
 from analysis.data.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.flow import column_surface_heights
+from analysis.numerics.coarse_graining import kernel_support_radius
 from analysis.numerics.force_chains import ForceChainSegments, force_chain_segments
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.profiles import profile_flow_rate, velocity_profile
@@ -30,17 +36,21 @@ from analysis.studies.silo_flat.fields import (
     FieldSettings,
     JanssenComparison,
     ProfileAnalysis,
+    ProfileUncertainty,
     analyse_profiles,
     centreline_velocity,
     clump_fields,
     compare_janssen,
     contact_stress_field,
     profile_mass_flow_rate,
+    profile_uncertainty,
     silo_grid,
     time_average,
 )
 
 __all__ = [
+    "COVERED_DENSITY_FRACTION",
+    "FIELD_BATCHES",
     "FORCE_CHAIN_CAP_WEIGHTS",
     "SURFACE_COLUMN_DIAMETERS",
     "SiloDimensions",
@@ -65,6 +75,15 @@ SURFACE_COLUMN_DIAMETERS = 4
 
 FORCE_CHAIN_CAP_WEIGHTS = 50
 """Force-chain colours are capped at this many particle weights (-), as in the study's pictures."""
+
+FIELD_BATCHES = 10
+"""Time windows of the averaging window whose spread gives the errors of B(z) and of the flow channel boundary
+(-): 10 to 20 batches is the usual compromise between the batches' independence and the error's own scatter."""
+
+COVERED_DENSITY_FRACTION = 0.5
+"""A profile height counts as covered by the fill while the density on the axis there is at least this fraction
+of the filling bulk density (-); a flowing fill dilates by far less, the free surface's kernel-smeared edge
+falls through it."""
 
 
 # --------------------------------------------------------------------------- inputs
@@ -263,7 +282,9 @@ class SiloFieldStudy:
     stress : numpy.ndarray
         Contact stress of the settled fill on the grid (Pa, compression positive).
     janssen : JanssenComparison
-        Mean vertical contact stress against Janssen's formula.
+        Mean vertical contact stress against Janssen's formula and hydrostatic, with its error.
+    uncertainty : ProfileUncertainty
+        Standard errors of the depth-averaged B(z) and flow channel boundary.
     segments : ForceChainSegments
         Force chains in the mid-depth slice.
     n_contacts : int
@@ -291,6 +312,7 @@ class SiloFieldStudy:
     janssen: JanssenComparison
     segments: ForceChainSegments
     n_contacts: int
+    uncertainty: ProfileUncertainty
 
 
 def analyse_silo_fields(
@@ -300,6 +322,7 @@ def analyse_silo_fields(
     options: SiloFieldOptions,
     steady_window: tuple[float, float],
     bulk_density: float,
+    bulk_density_error: float | None = math.nan,
 ) -> SiloFieldStudy:
     """Coarse-grained fields, profiles, flow channel boundary, kinematic constant, Janssen and force chains.
 
@@ -317,7 +340,10 @@ def analyse_silo_fields(
         Steady flow window since opening (s), the time average's window when ``options.average_window``
         is None.
     bulk_density : float
-        Filling bulk density (kg/m3), for the profile flow rate and Janssen's formula.
+        Filling bulk density (kg/m3), for the profile flow rate, Janssen's formula and the hydrostatic stress.
+    bulk_density_error : float or None, optional
+        Its standard error (kg/m3), for the hydrostatic stress's error; NaN or None (null in a flow.json written
+        before the error existed): unknown.
 
     Returns
     -------
@@ -343,6 +369,9 @@ def analyse_silo_fields(
     front = analyse_profiles(front_wall_slice(averaged), heights, options.fcb_fractions)
     depth_series = [depth_average(f) for f in fields]
     centre = centreline_velocity(depth_series, heights)
+    uncertainty = profile_uncertainty(depth_series, times, window, heights, options.fcb_fractions,
+                                      COVERED_DENSITY_FRACTION * bulk_density, FIELD_BATCHES,
+                                      options.subtract_wall_velocity, kernel_width=settings.width)
 
     # Mass flow rate through the lowest profile height, from the averaged momentum density, and the same with
     # the study's formula W = rho_b T integral(v_z dx) at the filling bulk density.
@@ -356,7 +385,9 @@ def analyse_silo_fields(
         stress, grid, float(np.nanmin(surface)), bulk_density, silo.width, silo.depth,
         math.tan(math.radians(options.side_wall_friction_angle_deg)),
         math.tan(math.radians(options.front_wall_friction_angle_deg)),
-        options.internal_friction_angle_deg, margin=settings.cutoff * settings.width)
+        options.internal_friction_angle_deg, margin=settings.cutoff * settings.width,
+        bin_width=2.0 * kernel_support_radius(settings.width, settings.cutoff, settings.kernel),
+        bulk_density_error=math.nan if bulk_density_error is None else float(bulk_density_error))
     segments = force_chain_segments(contacts, 0.5 * silo.depth, options.force_chain_slice,
                                     cap=force_chain_cap(silo.clump_mass))
     return SiloFieldStudy(
@@ -364,6 +395,7 @@ def analyse_silo_fields(
         window=window, averaged=averaged, averaged_depth=averaged_depth, surface=surface, top=top, heights=heights,
         profiles=profiles, front=front, depth_series=depth_series, centreline=centre, profile_rate=profile_rate,
         bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments, n_contacts=len(contacts),
+        uncertainty=uncertainty,
     )
 
 
@@ -382,17 +414,24 @@ def profile_rows(profiles: ProfileAnalysis, front: ProfileAnalysis) -> list[dict
     ]
 
 
-def boundary_rows(profiles: ProfileAnalysis) -> list[dict]:
-    """Rows of ``flow_channel_boundary.csv``: per height and fraction, the left and right boundary (m)."""
+def boundary_rows(profiles: ProfileAnalysis, uncertainty: ProfileUncertainty) -> list[dict]:
+    """Rows of ``flow_channel_boundary.csv``: per height and fraction, the left and right boundary (m) with their
+    standard errors (m) and the time windows behind them (``batches``)."""
     return [
-        {"z_m": z, "fraction": f, "x_left_m": profiles.fcb_left[i, j], "x_right_m": profiles.fcb_right[i, j]}
+        {"z_m": z, "fraction": f,
+         "x_left_m": profiles.fcb_left[i, j], "x_left_m_error": uncertainty.fcb_left_error[i, j],
+         "x_right_m": profiles.fcb_right[i, j], "x_right_m_error": uncertainty.fcb_right_error[i, j],
+         "batches": int(uncertainty.batches[i])}
         for i, z in enumerate(profiles.heights) for j, f in enumerate(profiles.fcb_fractions)
     ]
 
 
-def kinematic_rows(profiles: ProfileAnalysis) -> list[dict]:
-    """Rows of ``kinematic.csv``: the kinematic constant B (m) per height."""
-    return [{"z_m": z, "B_m": b} for z, b in zip(profiles.heights, profiles.kinematic_B)]
+def kinematic_rows(profiles: ProfileAnalysis, uncertainty: ProfileUncertainty) -> list[dict]:
+    """Rows of ``kinematic.csv``: the kinematic constant B (m) per height with its standard error (m) and the time
+    windows behind it (``batches``)."""
+    return [{"z_m": z, "B_m": b, "B_m_error": e, "batches": int(n)}
+            for z, b, e, n in zip(profiles.heights, profiles.kinematic_B, uncertainty.kinematic_B_error,
+                                  uncertainty.batches)]
 
 
 def instantaneous_profile_rows(times: Sequence[float], depth_series: Sequence[Fields],
@@ -419,10 +458,14 @@ def centreline_rows(times: Sequence[float], heights: Sequence[float], centreline
 
 
 def janssen_rows(comparison: JanssenComparison) -> list[dict]:
-    """Rows of ``janssen.csv``: per depth below the surface (m), the simulated and Janssen vertical stress (Pa)."""
+    """Rows of ``janssen.csv``: per depth below the surface (m) and height above the floor (m), the DEM vertical
+    stress with its standard error, Janssen's and the hydrostatic ``rho_b g h`` with its error (Pa)."""
     return [
-        {"depth_below_surface_m": h, "sigma_v_dem_Pa": s, "sigma_v_janssen_Pa": j}
-        for h, s, j in zip(comparison.depth_below_surface, comparison.simulated, comparison.janssen)
+        {"depth_below_surface_m": h, "z_m": z, "sigma_v_dem_Pa": s, "sigma_v_dem_Pa_error": se,
+         "sigma_v_janssen_Pa": j, "hydrostatic_pa": p, "hydrostatic_pa_error": pe}
+        for h, z, s, se, j, p, pe in zip(comparison.depth_below_surface, comparison.height, comparison.simulated,
+                                         comparison.simulated_error, comparison.janssen, comparison.hydrostatic,
+                                         comparison.hydrostatic_error)
     ]
 
 
@@ -442,6 +485,10 @@ def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
         "profile_over_outflow": study.profile_rate / outflow_rate,
         "profile_bulk_density_mass_flow_rate_kg_s": study.bulk_rate,
         "kinematic_B_m": {f"{z:g}": b for z, b in zip(study.profiles.heights, study.profiles.kinematic_B)},
+        "kinematic_B_m_error": {f"{z:g}": e for z, e in
+                                zip(study.profiles.heights, study.uncertainty.kinematic_B_error)},
+        "error_batches": study.uncertainty.n_batches,
+        "janssen_error_bin_pairs": study.janssen.bin_pairs,
         "surface_height_m": study.top,
         "contacts": study.n_contacts,
     }

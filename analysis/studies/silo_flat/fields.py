@@ -21,6 +21,7 @@ from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity
 from analysis.numerics.profiles import flow_channel_boundary, velocity_profile
+from analysis.numerics.uncertainty import batch_means, combine_independent
 
 
 @dataclass(frozen=True)
@@ -178,8 +179,135 @@ def analyse_profiles(
 
 
 @dataclass(frozen=True)
+class ProfileUncertainty:
+    """Standard errors of the kinematic constant and of the flow channel boundary (:func:`profile_uncertainty`).
+
+    Attributes
+    ----------
+    kinematic_B_error : numpy.ndarray
+        (heights,) standard error of B (m); NaN where fewer than two batches give a B.
+    fcb_left_error, fcb_right_error : numpy.ndarray
+        (heights, fractions) standard error of the boundary positions (m); NaN where fewer than two batches
+        locate the boundary.
+    batches : numpy.ndarray
+        (heights,) time windows whose fill covers each height (-); the errors rest on those of them that give a
+        value (a fit or a boundary).
+    n_batches : int
+        Time windows the averaging window was cut into (-); 0 when it holds fewer than two frames.
+    boundary_resolution : float
+        Standard deviation of the position of a boundary inside one grid cell, ``dx / sqrt(12)`` (m).
+    """
+
+    kinematic_B_error: np.ndarray
+    fcb_left_error: np.ndarray
+    fcb_right_error: np.ndarray
+    batches: np.ndarray
+    n_batches: int
+    boundary_resolution: float
+
+
+def _axis_density(fields: Fields, height: float) -> float:
+    """Density (kg/m3) of one-layer fields on the axis x = 0 at ``height`` (m), linear in z then in x."""
+    grid = fields.grid
+    column = np.array([np.interp(height, grid.z, fields.density[i, 0, :]) for i in range(grid.shape[0])])
+    return float(np.interp(0.0, grid.x, column))
+
+
+def _standard_error(values: np.ndarray) -> float:
+    """Standard error of the mean of independent values, NaN for fewer than two."""
+    if values.size < 2:
+        return math.nan
+    return batch_means(values, n_batches=values.size).std_error
+
+
+def profile_uncertainty(
+    depth_series: Sequence[Fields],
+    times: np.ndarray,
+    window: tuple[float, float],
+    heights: Sequence[float],
+    fractions: Sequence[float],
+    covered_density: float,
+    n_batches: int = 10,
+    subtract_wall_velocity: bool = False,
+    kernel_width: float = 0.0,
+) -> ProfileUncertainty:
+    """Errors of B(z) and of the flow channel boundary from batch means over time windows.
+
+    The frames inside ``window`` are cut into ``K = min(n_batches, frames)`` contiguous batches of
+    ``b = frames // K`` frames (the oldest ``frames % K`` frames left out, as in
+    :func:`analysis.numerics.uncertainty.batch_means`). Each batch is averaged like the whole window and
+    analysed with :func:`analyse_profiles`, giving one B and one boundary per height (and fraction). The error
+    is ``std(batch values, ddof=1) / sqrt(n)`` over the ``n`` batches that have a value at that height and whose
+    fill covers it: in every frame of the batch the density on the axis at that height is at least
+    ``covered_density``. A batch discharge empties the upper heights during the window; a batch in which the
+    free surface passes a height has a profile of a different flow there (its fit can diverge), so it is left
+    out rather than counted as scatter. The spread of the remaining batches still holds any slow drift of the
+    flow, which makes the error conservative.
+
+    The boundary's error adds, in quadrature, ``dx / sqrt(12)``: the standard deviation of a position known only
+    to lie in one grid cell of width ``dx`` (the velocity between nodes is interpolated, not resolved).
+
+    Parameters
+    ----------
+    depth_series : sequence of Fields
+        Depth average of each frame (one layer of nodes), on one grid.
+    times : numpy.ndarray
+        Time of each frame (s).
+    window : tuple of float
+        The averaging window ``(t0, t1)`` (s).
+    heights, fractions, subtract_wall_velocity, kernel_width
+        As for :func:`analyse_profiles` (m, -, bool, m).
+    covered_density : float
+        Density on the axis below which a height counts as above the free surface (kg/m3), > 0.
+    n_batches : int, optional
+        Time windows wanted, >= 2.
+
+    Returns
+    -------
+    ProfileUncertainty
+        All errors NaN (and ``n_batches = 0``) when the window holds fewer than two frames.
+    """
+    if covered_density <= 0.0 or not math.isfinite(covered_density):
+        raise ValueError(f"covered_density must be a finite number > 0, got {covered_density!r}")
+    if isinstance(n_batches, bool) or int(n_batches) != n_batches or n_batches < 2:
+        raise ValueError(f"n_batches must be an integer >= 2, got {n_batches!r}")
+    heights = np.asarray(heights, dtype=float)
+    fractions = tuple(fractions)
+    grid = depth_series[0].grid
+    chosen = [f for f, t in zip(depth_series, times) if window[0] <= t <= window[1]]
+    count = min(int(n_batches), len(chosen))
+    b_values = np.full((max(count, 1), heights.size), np.nan)
+    left = np.full((max(count, 1), heights.size, len(fractions)), np.nan)
+    right = np.full_like(left, np.nan)
+    covered = np.zeros((max(count, 1), heights.size), dtype=bool)
+    if count >= 2:
+        size = len(chosen) // count
+        chosen = chosen[len(chosen) - size * count:]
+        for k in range(count):
+            batch = chosen[k * size:(k + 1) * size]
+            analysis = analyse_profiles(average_fields(batch), heights, fractions, subtract_wall_velocity,
+                                        kernel_width)
+            b_values[k], left[k], right[k] = analysis.kinematic_B, analysis.fcb_left, analysis.fcb_right
+            covered[k] = [all(_axis_density(f, float(z)) >= covered_density for f in batch) for z in heights]
+    resolution = grid.spacing[0] / math.sqrt(12.0)
+    b_error = np.full(heights.size, np.nan)
+    left_error = np.full((heights.size, len(fractions)), np.nan)
+    right_error = np.full_like(left_error, np.nan)
+    for i in range(heights.size):
+        use = covered[:, i]
+        b_error[i] = _standard_error(b_values[use & np.isfinite(b_values[:, i]), i])
+        for j in range(len(fractions)):
+            for values, errors in ((left, left_error), (right, right_error)):
+                spread = _standard_error(values[use & np.isfinite(values[:, i, j]), i, j])
+                errors[i, j] = combine_independent([spread, resolution])
+    batches = covered.sum(axis=0) if count >= 2 else np.zeros(heights.size, dtype=int)
+    return ProfileUncertainty(b_error, left_error, right_error, batches.astype(int), count if count >= 2 else 0,
+                              resolution)
+
+
+@dataclass(frozen=True)
 class JanssenComparison:
-    """Mean vertical stress against depth below the fill surface, from the contacts and from Janssen.
+    """Mean vertical stress against depth below the fill surface: from the contacts, Janssen and hydrostatic.
 
     Attributes
     ----------
@@ -190,13 +318,63 @@ class JanssenComparison:
     janssen : numpy.ndarray
         Janssen's sigma_v(h) (Pa).
     surface_height : float
-        Fill surface height used (m).
+        Fill surface height used, H (m).
+    height : numpy.ndarray
+        Height of each row above the floor, ``z = H - h`` (m).
+    simulated_error : numpy.ndarray
+        Standard error of ``simulated`` from the differences of mirror bins across the axis (Pa); NaN when
+        unknown.
+    hydrostatic : numpy.ndarray
+        ``rho_b g h`` (Pa): the stress without any wall support.
+    hydrostatic_error : numpy.ndarray
+        ``g h`` times the error of rho_b (Pa); NaN when that is unknown.
+    bin_pairs : int
+        Mirror pairs of horizontal bins behind ``simulated_error`` (-); 0 when there is none.
     """
 
     depth_below_surface: np.ndarray
     simulated: np.ndarray
     janssen: np.ndarray
     surface_height: float
+    height: np.ndarray
+    simulated_error: np.ndarray
+    hydrostatic: np.ndarray
+    hydrostatic_error: np.ndarray
+    bin_pairs: int
+
+
+def mirror_bin_error(values, pairs: int) -> float:
+    """Standard error of the mean of a profile across a symmetric silo from the differences of mirror bins.
+
+    The stress across a symmetric, centrally filled silo has a systematic shape (high on the axis, low at the
+    walls that carry part of the weight) that is not noise, so the plain spread of bin means would overstate
+    the error of their mean. Mirror bins, at equal distances left and right of the axis, have the same expected
+    value, so their difference is noise alone. Each half of the ``n`` values (the first and the last ``n // 2``,
+    the middle one of an odd ``n`` left out) is cut into ``M = pairs`` contiguous bins of nearly equal size
+    (:func:`numpy.array_split`, counted from the walls); with ``d_m`` the difference of the left and right means
+    of pair ``m``, each bin's noise variance is estimated as ``sum(d_m^2) / (2 M)`` and the error of the mean
+    of the ``2 M`` bins is ``sqrt(sum(d_m^2)) / (2 M)`` (``M`` degrees of freedom).
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        The profile at nodes placed symmetrically about the axis, ordered in x, in any unit.
+    pairs : int
+        Bins per half, ``M`` (-).
+
+    Returns
+    -------
+    float
+        The error, in the unit of ``values``; NaN for ``M < 1`` or more bins than values per half.
+    """
+    values = np.asarray(values, dtype=float)
+    half = values.size // 2
+    if pairs < 1 or pairs > half:
+        return math.nan
+    left = [part.mean() for part in np.array_split(values[:half], pairs)]
+    right = [part.mean() for part in np.array_split(values[::-1][:half], pairs)]  # from the right wall inwards
+    differences = np.subtract(left, right)
+    return float(math.sqrt(float(np.dot(differences, differences))) / (2 * pairs))
 
 
 def compare_janssen(
@@ -211,11 +389,24 @@ def compare_janssen(
     internal_friction_angle_deg: float,
     margin: float = 0.0,
     gravity: float = GRAVITY,
+    bin_width: float | None = None,
+    bulk_density_error: float = math.nan,
 ) -> JanssenComparison:
-    """Cross-section mean vertical contact stress per grid row against Janssen's formula.
+    """Cross-section mean vertical contact stress per grid row against Janssen's formula and hydrostatic.
 
     Rows within ``margin`` (m) of the floor or of the surface are left out (boundary rows of the kernel);
-    ``gravity`` is g (m/s2) of the formula's unit weight rho_b g.
+    ``gravity`` is g (m/s2) of the unit weight rho_b g of Janssen's formula and of the hydrostatic stress
+    ``rho_b g h``.
+
+    The DEM stress comes from one contact frame (the settled fill), so its error cannot come from frames: it
+    comes from horizontal bins. The depth-averaged sigma_zz of the x columns of each row is cut, on each side of
+    the axis, into ``M = floor((nx // 2) dx / bin_width)`` bins and the error is that of
+    :func:`mirror_bin_error`: the differences of mirror bins, which the symmetric shape of the stress profile
+    does not enter. Bins at least as wide as the kernel's support (``2 cutoff w``) share few contacts, so their
+    noises are nearly independent. ``bin_width`` None, or bins wider than half the silo, give NaN errors.
+
+    ``bulk_density_error`` (kg/m3) gives the hydrostatic stress's error ``g h`` times it; Janssen's curve is left
+    without one, since its friction angles' uncertainty, not rho_b's, would dominate it.
     """
     sigma_zz = stress[..., 2, 2]
     mean = sigma_zz.mean(axis=(0, 1))
@@ -224,7 +415,19 @@ def compare_janssen(
     janssen = janssen_vertical_stress(
         h, bulk_density, width, depth, side_wall_friction, front_wall_friction, internal_friction_angle_deg, gravity
     )
-    return JanssenComparison(h, mean[rows], np.asarray(janssen, dtype=float), float(surface_height))
+    pairs = 0
+    if bin_width is not None:
+        half = grid.shape[0] // 2
+        pairs = min(half, int(math.floor(half * grid.spacing[0] / float(bin_width))))
+    columns = sigma_zz.mean(axis=1)[:, rows]  # (nx, rows): depth average of each x column
+    error = np.array([mirror_bin_error(columns[:, k], pairs) for k in range(columns.shape[1])])
+    hydrostatic = bulk_density * gravity * h
+    return JanssenComparison(
+        depth_below_surface=h, simulated=mean[rows], janssen=np.asarray(janssen, dtype=float),
+        surface_height=float(surface_height), height=grid.z[rows].copy(), simulated_error=error,
+        hydrostatic=hydrostatic, hydrostatic_error=gravity * h * float(bulk_density_error),
+        bin_pairs=max(pairs, 0),
+    )
 
 
 def time_average(fields: Sequence[Fields], times: np.ndarray, window: tuple[float, float]) -> Fields:

@@ -2,10 +2,24 @@
 
 Pure computation: the frames come in as :class:`analysis.data.frames.ClumpFrame` objects (or anything with
 ``time``, ``clump_id``, ``position`` and ``mass``), the results go out as dataclasses.
+
+Uncertainties (standard errors, in the unit of their figure; :mod:`analysis.numerics.uncertainty`):
+
+* filling bulk density: the spread of the density over horizontal slabs of :data:`SLAB_DIAMETERS` particle
+  diameters of the control volume (:func:`analysis.numerics.flow.slab_bulk_density`);
+* steady mass flow rate: batch means of the rate, the least-squares slopes of the discharged mass in
+  :data:`FLOW_RATE_BATCHES` contiguous batches of the steady window
+  (:func:`analysis.numerics.uncertainty.batch_rate`). The least-squares standard error of the one slope over the
+  window (``FlowRateFit.standard_error``) assumes independent residuals, but the residuals of a cumulative
+  mass about its line are strongly correlated (a random walk), so it is several times too small; it is kept
+  under its old name only;
+* volumetric flow rate, Beverloo's prediction and their ratio: first-order propagation of these two, which are
+  independent (the settled fill and the discharge); Beverloo's coefficients C and k are taken as exact.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -20,9 +34,17 @@ from analysis.numerics.flow import (
     discharged_mass_history,
     filling_bulk_density,
     mass_in_silo,
+    slab_bulk_density,
     steady_flow_rate,
     volumetric_flow_rate,
 )
+from analysis.numerics.uncertainty import Estimate, batch_rate, combine_independent
+
+SLAB_DIAMETERS = 4
+"""Thickness of the slabs whose spread gives the bulk density's error, in particle diameters (-)."""
+
+FLOW_RATE_BATCHES = 10
+"""Batches of the steady window whose slopes give the flow rate's error (-)."""
 
 
 class EscapedParticles(ValueError):
@@ -49,6 +71,10 @@ class SiloFlowMetrics:
         Particle diameter used in Beverloo's correlation (m).
     initial_mass : float
         Mass in the silo when the outlet opened (kg).
+    density_estimate : Estimate
+        The bulk density's spread over horizontal slabs (kg/m^3): its ``std_error`` is the density's error.
+    rate_estimate : Estimate
+        Batch rate of the steady window (kg/s): its ``std_error`` is the flow rate's error.
     """
 
     bulk_density: BulkDensity
@@ -58,11 +84,80 @@ class SiloFlowMetrics:
     beverloo_rate: float
     particle_diameter: float
     initial_mass: float
+    density_estimate: Estimate
+    rate_estimate: Estimate
 
     @property
     def beverloo_ratio(self) -> float:
         """Measured over predicted steady mass flow rate (-)."""
         return self.fit.mass_flow_rate / self.beverloo_rate
+
+    @property
+    def bulk_density_error(self) -> float:
+        """Standard error of the filling bulk density (kg/m^3); NaN when unknown."""
+        return self.density_estimate.std_error
+
+    @property
+    def mass_flow_rate_error(self) -> float:
+        """Standard error of the steady mass flow rate from batch means of the rate (kg/s); NaN when unknown."""
+        return self.rate_estimate.std_error
+
+    def _relative_density_error(self) -> float:
+        return self.bulk_density_error / self.bulk_density.density
+
+    def _relative_rate_error(self) -> float:
+        rate = self.fit.mass_flow_rate
+        return self.mass_flow_rate_error / abs(rate) if rate != 0.0 else math.nan
+
+    @property
+    def volumetric_flow_rate_error(self) -> float:
+        """Standard error of ``W / rho_b`` (m^3/s): the relative errors of W and rho_b in quadrature."""
+        relative = combine_independent([self._relative_rate_error(), self._relative_density_error()])
+        return abs(self.volumetric_flow_rate) * relative
+
+    @property
+    def beverloo_rate_error(self) -> float:
+        """Standard error of Beverloo's prediction (kg/s) through the measured bulk density it is proportional
+        to (C and k exact)."""
+        return self.beverloo_rate * self._relative_density_error()
+
+    @property
+    def beverloo_ratio_error(self) -> float:
+        """Standard error of the measured over predicted flow rate (-): ``W / W_B`` with ``W_B`` proportional to
+        rho_b, so the relative errors of W and rho_b in quadrature."""
+        relative = combine_independent([self._relative_rate_error(), self._relative_density_error()])
+        return abs(self.beverloo_ratio) * relative
+
+
+def steady_rate_estimate(history: DischargeHistory, fit: FlowRateFit, n_batches: int = FLOW_RATE_BATCHES) -> Estimate:
+    """Batch rate of the discharged mass over the fit's steady window, for the flow rate's standard error (kg/s).
+
+    The samples with ``fit.t_start <= t <= fit.t_end`` are cut into ``min(n_batches, n // 2)`` batches
+    (:func:`analysis.numerics.uncertainty.batch_rate`, two samples per slope at least). The value is the
+    least-squares slope of the whole window (``fit.mass_flow_rate``, the flow rate reported), the error that of
+    the mean of the batch slopes. A window of fewer than 4 samples (fewer than 2 batches) gives a NaN error.
+
+    Parameters
+    ----------
+    history : DischargeHistory
+        Discharged mass (kg) against time since opening (s).
+    fit : FlowRateFit
+        The steady flow rate fit and its window (s).
+    n_batches : int, optional
+        Batches wanted, >= 2.
+
+    Returns
+    -------
+    Estimate
+        ``method="batch rate"``, ``n`` the batches used (1 when there are too few samples).
+    """
+    time = np.asarray(history.time, dtype=float)
+    inside = (time >= fit.t_start) & (time <= fit.t_end)
+    batches = min(int(n_batches), int(np.count_nonzero(inside)) // 2)
+    if batches < 2:
+        return Estimate(value=fit.mass_flow_rate, std_error=math.nan, n=1, method="batch rate")
+    rate = batch_rate(time[inside], np.asarray(history.discharged_mass, dtype=float)[inside], n_batches=batches)
+    return Estimate(value=fit.mass_flow_rate, std_error=rate.std_error, n=rate.n, method=rate.method, dof=rate.dof)
 
 
 def vanished_above_outlet(previous_ids, previous_z, current_ids, outlet_plane: float = 0.0) -> np.ndarray:
@@ -144,6 +239,8 @@ def silo_flow_metrics(
         shape_coefficient=shape_coefficient,
         gravity=gravity,
     )
+    slabs = slab_bulk_density(settled.position[:, 2], settled.mass, width * depth, bulk.measured_height,
+                              SLAB_DIAMETERS * particle_diameter)
     return SiloFlowMetrics(
         bulk_density=bulk,
         history=history,
@@ -152,24 +249,39 @@ def silo_flow_metrics(
         beverloo_rate=beverloo,
         particle_diameter=particle_diameter,
         initial_mass=float(masses[0]),
+        density_estimate=slabs,
+        rate_estimate=steady_rate_estimate(history, fit),
     )
 
 
 def flow_table_row(run_id: str, particle_model: str, n_clumps: int, metrics: SiloFlowMetrics) -> dict:
-    """One row of ``metrics/flow.csv`` (column names carry their units)."""
+    """One row of ``metrics/flow.csv`` and ``metrics/flow.json`` (column names carry their units).
+
+    Each ``<key>_error`` is the standard error of ``<key>`` in its unit (NaN when unknown), as the module
+    docstring derives it; ``filling_bulk_density_slabs`` and ``mass_flow_rate_batches`` count the independent
+    samples behind the two measured errors. ``mass_flow_rate_stderr_kg_s`` is the least-squares error of the
+    slope, kept for the readers of the old key; it is not the flow rate's error.
+    """
     return {
         "run_id": run_id,
         "particle_model": particle_model,
         "n_clumps": n_clumps,
         "initial_mass_kg": metrics.initial_mass,
         "filling_bulk_density_kg_m3": metrics.bulk_density.density,
+        "filling_bulk_density_kg_m3_error": metrics.bulk_density_error,
+        "filling_bulk_density_slabs": metrics.density_estimate.n,
         "mass_flow_rate_kg_s": metrics.fit.mass_flow_rate,
+        "mass_flow_rate_kg_s_error": metrics.mass_flow_rate_error,
+        "mass_flow_rate_batches": metrics.rate_estimate.n,
         "mass_flow_rate_stderr_kg_s": metrics.fit.standard_error,
         "volumetric_flow_rate_m3_s": metrics.volumetric_flow_rate,
+        "volumetric_flow_rate_m3_s_error": metrics.volumetric_flow_rate_error,
         "steady_window_start_s": metrics.fit.t_start,
         "steady_window_end_s": metrics.fit.t_end,
         "beverloo_mass_flow_rate_kg_s": metrics.beverloo_rate,
+        "beverloo_mass_flow_rate_kg_s_error": metrics.beverloo_rate_error,
         "beverloo_ratio": metrics.beverloo_ratio,
+        "beverloo_ratio_error": metrics.beverloo_ratio_error,
         "particle_diameter_m": metrics.particle_diameter,
         "discharged_mass_kg": float(metrics.history.discharged_mass[-1]),
     }

@@ -27,6 +27,7 @@ def plot_discharge(
     beverloo_rate: float | None,
     path: str | os.PathLike,
     title: str,
+    rate_error: float | None = None,
 ) -> Figure:
     """Plot discharged mass against time with the fitted and Beverloo flow rates.
 
@@ -46,6 +47,9 @@ def plot_discharge(
         Destination PNG file (written atomically, 150 dpi).
     title : str
         Figure title.
+    rate_error : float, optional
+        Standard error of the flow rate [kg/s] for the legend (batch means of the rate); None: the
+        least-squares error of the fit, ``fit.standard_error``.
 
     Returns
     -------
@@ -53,6 +57,7 @@ def plot_discharge(
         The figure drawn, already closed (see the module docstring).
     """
     time = np.asarray(history.time, dtype=float)
+    error = fit.standard_error if rate_error is None else rate_error
     mass = np.asarray(history.discharged_mass, dtype=float)
 
     figure, axes = plt.subplots(figsize=(6.4, 4.4))
@@ -67,7 +72,7 @@ def plot_discharge(
             "-",
             color="tab:blue",
             linewidth=2,
-            label=f"fit: {fit.mass_flow_rate:.4g} ± {fit.standard_error:.2g} kg/s",
+            label=f"fit: {fit.mass_flow_rate:.4g} ± {error:.2g} kg/s",
         )
         if beverloo_rate is not None:
             midpoint_time = 0.5 * (fit.t_start + fit.t_end)
@@ -94,12 +99,14 @@ def plot_discharge(
 
 
 def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
-                            fcb_fraction_index: int = -1) -> Figure:
+                            fcb_fraction_index: int = -1, uncertainty=None) -> Figure:
     """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary in red.
 
     Each profile is drawn at its height z as z + s v_z(x), with the scale s chosen so that the fastest
     profile spans 80 % of the spacing between heights; the red dots mark the flow channel boundary at the
-    chosen fraction of the centreline velocity.
+    chosen fraction of the centreline velocity. With ``uncertainty`` (a
+    :class:`~analysis.studies.silo_flat.fields.ProfileUncertainty`) each dot gets a horizontal error bar of one
+    standard error (mm), one errorbar container per height (NaN errors draw nothing).
     """
     heights = profiles.heights
     spacing = np.min(np.diff(heights)) if heights.size > 1 else 0.02
@@ -114,6 +121,11 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
             axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
             left, right = profiles.fcb_left[i, fcb_fraction_index], profiles.fcb_right[i, fcb_fraction_index]
             axes.plot(1e3 * np.array([left, right]), [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
+            if uncertainty is not None:
+                errors = [uncertainty.fcb_left_error[i, fcb_fraction_index],
+                          uncertainty.fcb_right_error[i, fcb_fraction_index]]
+                axes.errorbar(1e3 * np.array([left, right]), [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
+                              fmt="none", ecolor="red", elinewidth=1.0, capsize=3)
         fraction = profiles.fcb_fractions[fcb_fraction_index]
         axes.plot([], [], "o", color="red", label=f"FCB at {100 * fraction:g} % of centreline v_z")
         axes.plot([], [], color="tab:blue", label=f"v_z (1 mm = {1e-3 / scale:.3g} m/s)")
@@ -147,11 +159,15 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
     return figure
 
 
-def plot_kinematic_constant(heights, B, path, title: str) -> Figure:
-    """Kinematic constant B (mm) against height above the outlet (mm)."""
+def plot_kinematic_constant(heights, B, path, title: str, B_error=None) -> Figure:
+    """Kinematic constant B (mm) against height above the outlet (mm), with horizontal error bars of one
+    standard error ``B_error`` (m, NaN draws none) when given."""
     figure, axes = plt.subplots(figsize=(5.0, 4.0))
     try:
         axes.plot(1e3 * np.asarray(B), 1e3 * np.asarray(heights), "o-")
+        if B_error is not None:
+            axes.errorbar(1e3 * np.asarray(B), 1e3 * np.asarray(heights), xerr=1e3 * np.asarray(B_error),
+                          fmt="none", ecolor="tab:blue", capsize=3, label="± standard error")
         axes.set_xlabel("B [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
@@ -163,11 +179,16 @@ def plot_kinematic_constant(heights, B, path, title: str) -> Figure:
 
 
 def plot_janssen(comparison, path, title: str) -> Figure:
-    """Mean vertical stress against depth below the surface: DEM contacts and Janssen's formula."""
+    """Mean vertical stress against depth below the surface: DEM contacts with horizontal error bars of one
+    standard error, Janssen's formula and the hydrostatic ``rho_b g h``."""
     figure, axes = plt.subplots(figsize=(5.0, 4.0))
     try:
-        axes.plot(comparison.simulated, 1e3 * comparison.depth_below_surface, "o", label="DEM (contact stress)")
-        axes.plot(comparison.janssen, 1e3 * comparison.depth_below_surface, "-", label="Janssen")
+        depth_mm = 1e3 * comparison.depth_below_surface
+        axes.plot(comparison.simulated, depth_mm, "o", label="DEM (contact stress)")
+        axes.errorbar(comparison.simulated, depth_mm, xerr=comparison.simulated_error, fmt="none",
+                      ecolor="tab:blue", capsize=2, label="DEM ± standard error")
+        axes.plot(comparison.janssen, depth_mm, "-", label="Janssen")
+        axes.plot(comparison.hydrostatic, depth_mm, ":", color="0.3", label="hydrostatic rho_b g h")
         axes.invert_yaxis()
         axes.set_xlabel("vertical stress [Pa]")
         axes.set_ylabel("depth below surface [mm]")

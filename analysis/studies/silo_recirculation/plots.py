@@ -116,39 +116,52 @@ def plot_outlet_concentration(curves, blue_fraction: float, path: str | os.PathL
         plt.close(figure)
 
 
-def _vrr_curves(curves, noise_limit: float | None) -> list[tuple[str, np.ndarray, np.ndarray, float | None]]:
-    """Checked (label, Nr, VRR, ceiling) curves; a curve without its own ceiling takes ``noise_limit``."""
+def _vrr_curves(curves, noise_limit: float | None) -> list[tuple[str, np.ndarray, np.ndarray, float | None,
+                                                                   np.ndarray]]:
+    """Checked (label, Nr, VRR, ceiling, VRR error) curves; a curve without its own ceiling takes ``noise_limit``,
+    one without errors gets NaN errors (no bars)."""
     checked = []
     for i, item in enumerate(non_empty_list("curves", curves)):
         entry = tuple(item) if isinstance(item, (tuple, list)) else ()
-        if len(entry) not in (3, 4):
-            raise ValueError(f"curves[{i}] must be a tuple of 3 items (label, Nr, VRR) or 4 (with the ceiling)")
+        if len(entry) not in (3, 4, 5):
+            raise ValueError(f"curves[{i}] must be a tuple of 3 items (label, Nr, VRR), 4 (with the ceiling) or 5 "
+                             "(with the ceiling and the VRR errors)")
         label, x, y = entry[:3]
-        ceiling = entry[3] if len(entry) == 4 else None
+        ceiling = entry[3] if len(entry) >= 4 else None
+        error = entry[4] if len(entry) == 5 else None
         x = finite_abscissa(f"curves[{i}] x", x)
         y = matching_ordinate(f"curves[{i}] y", y, x.size, f"curves[{i}] x")
         ceiling = noise_limit if ceiling is None else positive_number(f"curves[{i}] ceiling", ceiling)
-        checked.append((str(label), x, y, ceiling))
+        if error is None:
+            error = np.full(x.size, np.nan)
+        else:
+            error = matching_ordinate(f"curves[{i}] error", error, x.size, f"curves[{i}] x")
+            if np.any(error < 0.0) or np.any(np.isinf(error)):
+                raise ValueError(f"curves[{i}] error must hold standard errors >= 0 (NaN: none)")
+        checked.append((str(label), x, y, ceiling, error))
     return checked
 
 
 def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, noise_limit: float | None = None,
                                    factor: float = CEILING_FACTOR) -> Path:
     """Variance reduction ratio against the number of recirculations (log y axis), with the counting-noise
-    ceiling.
+    ceiling and the VRRs' standard errors.
 
     Points whose VRR is NaN, zero or negative are skipped; a VRR of +inf (no variance left at the
     outlet) is marked by an upward triangle at the top of the axes. Each ceiling is drawn as a dashed
     horizontal line; finite VRRs within ``factor`` of their curve's ceiling
     (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`) get an open marker: they are lower bounds,
-    set by the sampling noise, not measurements.
+    set by the sampling noise, not measurements. The points drawn that have a finite error get a bar of
+    +- one standard error (``gid="vrr_error"``); on the log axis a bar reaching 0 or below runs to the
+    bottom of the axes.
 
     Parameters
     ----------
     curves : list of tuple
-        ``(label, Nr, VRR)`` or ``(label, Nr, VRR, ceiling)``: number of recirculations [-] (finite), the
-        variance reduction ratio sigma_in^2 / sigma_out^2 [-] (same length), and the counting-noise ceiling
-        of that curve's VRR [-] (> 0; None or absent: ``noise_limit``).
+        ``(label, Nr, VRR)``, ``(label, Nr, VRR, ceiling)`` or ``(label, Nr, VRR, ceiling, error)``: number of
+        recirculations [-] (finite), the variance reduction ratio sigma_in^2 / sigma_out^2 [-] (same length),
+        the counting-noise ceiling of that curve's VRR [-] (> 0; None or absent: ``noise_limit``) and the
+        standard error of each VRR [-] (same length, >= 0; NaN: no bar; None or absent: no bars).
     path : str or os.PathLike
         Destination PNG file (written atomically, 150 dpi).
     title : str
@@ -168,8 +181,8 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
     Raises
     ------
     ValueError
-        Naming the argument: empty ``curves``, a curve not of 3 or 4 items, mismatched lengths,
-        non-positive ``noise_limit`` or ceiling, ``factor < 1``.
+        Naming the argument: empty ``curves``, a curve not of 3, 4 or 5 items, mismatched lengths,
+        non-positive ``noise_limit`` or ceiling, a negative or infinite error, ``factor < 1``.
     """
     if noise_limit is not None:
         noise_limit = positive_number("noise_limit", noise_limit)
@@ -178,10 +191,10 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         raise ValueError(f"factor must be a finite number >= 1, got {factor!r}")
     checked = _vrr_curves(curves, noise_limit)
     # One line per distinct ceiling: the layouts of one run share theirs.
-    ceilings = sorted({ceiling for *_, ceiling in checked if ceiling is not None})
+    ceilings = sorted({ceiling for *_, ceiling, _ in checked if ceiling is not None})
     flags = [np.zeros(0, dtype=bool) if ceiling is None else
              np.asarray(vrr_near_ceiling(positive_finite_points(x, y)[1], ceiling, factor), dtype=bool)
-             for _, x, y, ceiling in checked]
+             for _, x, y, ceiling, _ in checked]
     figure, axes = plt.subplots(figsize=(6.4, 4.2))
     try:
         axes.set_yscale("log")
@@ -189,10 +202,17 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         for ceiling in ceilings:
             axes.axhline(ceiling, color="tab:red", linestyle="--", linewidth=1.0, gid="ceiling",
                          label=f"counting-noise ceiling {ceiling:.3g}")
-        for (label, recirculations, vrr, _), at_ceiling in zip(checked, flags):
+        for (label, recirculations, vrr, _, error), at_ceiling in zip(checked, flags):
             x, y = positive_finite_points(recirculations, vrr)
             (line,) = axes.plot(x, y, "o-", markersize=4, linewidth=1.2,
                                 label=label if x.size else f"{label} (no finite VRR)")
+            drawn = np.isfinite(recirculations) & np.isfinite(vrr) & (vrr > 0.0)  # the points on the line
+            with_bar = drawn & np.isfinite(error)
+            if with_bar.any():
+                bars = axes.errorbar(recirculations[with_bar], vrr[with_bar], yerr=error[with_bar], fmt="none",
+                                     color=line.get_color(), elinewidth=1.0, capsize=2.5, label="_nolegend_")
+                for artist in bars.lines[2]:
+                    artist.set_gid("vrr_error")
             if at_ceiling.any():
                 axes.plot(x[at_ceiling], y[at_ceiling], "o", color=line.get_color(), markersize=7,
                           markerfacecolor="white", markeredgewidth=1.3, gid="at_ceiling", label="_nolegend_")

@@ -31,7 +31,7 @@ import numpy as np
 
 from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
-from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
+from analysis.numerics.rtd import RTD, johanson_rtd, mean_residence_time, rtd_from_exit_times
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
     batch_inlet_signal,
@@ -49,7 +49,7 @@ from analysis.studies.silo_recirculation.tracks import (
 )
 from analysis.studies.silo_recirculation.vrr import (
     RecirculationVRR,
-    holdup_residence_time,
+    littles_law,
     recirculation_number,
     vrr_by_recirculation,
 )
@@ -81,6 +81,12 @@ class LoopTiming:
         Outlet crossings per second in the steady part [1/s].
     recirculations : float
         ``(t_end - t_open) / t_res``: recirculations the run covers [-].
+    residence_time_error, holdup_error, throughput_error : float
+        Standard errors of ``residence_time`` [s], ``holdup`` [-] and ``throughput`` [1/s]
+        (:func:`analysis.studies.silo_recirculation.vrr.littles_law`); NaN when not known.
+    frame_interval : float
+        Median time between the saved frames of the steady part [s], the time resolution of every event;
+        NaN when not known.
     """
 
     t_open: float
@@ -89,6 +95,10 @@ class LoopTiming:
     holdup: float
     throughput: float
     recirculations: float
+    residence_time_error: float = math.nan
+    holdup_error: float = math.nan
+    throughput_error: float = math.nan
+    frame_interval: float = math.nan
 
 
 @dataclass(frozen=True, eq=False)
@@ -150,8 +160,10 @@ class BlendingResult:
 
 
 def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: float = 0.0,
-                startup_fraction: float = 0.1) -> LoopTiming:
-    """Holdup, throughput and mean residence time over the run after its first ``startup_fraction``."""
+                startup_fraction: float = 0.1, n_batches: int = 10) -> LoopTiming:
+    """Holdup, throughput and mean residence time over the run after its first ``startup_fraction``, with their
+    standard errors from ``n_batches`` batches of that steady part
+    (:func:`analysis.studies.silo_recirculation.vrr.littles_law`), and the frame interval."""
     if not 0.0 <= startup_fraction < 1.0:
         raise ValueError(f"startup_fraction must be in [0, 1), got {startup_fraction!r}")
     times = tracks.times
@@ -160,15 +172,21 @@ def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: floa
     steady = times >= t_start
     holdup_counts = clumps_above_outlet(tracks, outlet_z)[steady]
     exits = np.asarray(events.exit_times_all, dtype=float)
-    t_res = holdup_residence_time(holdup_counts, exits, t_start, t_end)
-    n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
+    little = littles_law(times[steady], holdup_counts, exits, t_start, t_end, n_batches)
+    t_res = little.residence_time.value
+    # the median, as the first interval (the outlet opening) may be cut short
+    frame_interval = float(np.median(np.diff(times[steady]))) if np.count_nonzero(steady) > 1 else math.nan
     return LoopTiming(
         t_open=t_open,
         t_end=t_end,
         residence_time=t_res,
-        holdup=float(np.mean(holdup_counts)),
-        throughput=n_exits / (t_end - t_start),
+        holdup=little.holdup.value,
+        throughput=little.throughput.value,
         recirculations=(t_end - t_open) / t_res,
+        residence_time_error=little.residence_time.std_error,
+        holdup_error=little.holdup.std_error,
+        throughput_error=little.throughput.std_error,
+        frame_interval=frame_interval,
     )
 
 
@@ -404,12 +422,20 @@ class VerificationResult:
 
 
 def residence_summary(times) -> dict:
-    """Count, count exited, mean and standard deviation (population) of a residence-time sample [s]; NaN = not out."""
+    """Count, count exited, mean, its standard error and the standard deviation of a residence-time sample.
+
+    ``n`` and ``n_exited`` [-], ``mean_s`` [s], ``mean_s_error`` (``s / sqrt(n_exited)`` with ``ddof = 1``,
+    :func:`analysis.numerics.rtd.mean_residence_time`, which states the assumption; NaN for one exited tracer)
+    [s] and ``std_s`` (population, ``ddof = 0``) [s]. NaN in ``times`` means not out; without any exited tracer
+    the moments are None.
+    """
     times = np.asarray(times, dtype=float)
     finite = times[np.isfinite(times)]
-    return {"n": int(times.size), "n_exited": int(finite.size),
-            "mean_s": float(finite.mean()) if finite.size else None,
-            "std_s": float(finite.std()) if finite.size else None}
+    if not finite.size:
+        return {"n": int(times.size), "n_exited": 0, "mean_s": None, "mean_s_error": None, "std_s": None}
+    mean = mean_residence_time(finite)
+    return {"n": int(times.size), "n_exited": int(finite.size), "mean_s": mean.value,
+            "mean_s_error": mean.std_error, "std_s": float(finite.std())}
 
 
 def _clump_path(tracks: ClumpTracks, column: int, t_from: float, t_to: float) -> np.ndarray:

@@ -10,6 +10,17 @@ Every measured VRR comes with its counting-noise ceiling (:func:`analysis.numeri
 ``clumps_per_window`` for a 0/1 batch) and a flag where it lies within a factor 2 of it
 (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`): such a VRR is a lower bound, so it is not compared with
 the LTI prediction as if it were a measurement.
+
+Standard errors follow the convention of the summary page: the error of a figure ``<key>`` is ``<key>_error``,
+in its unit, beside it (NaN, written null or empty, when not known). Their sources:
+
+- ``residence_time_s``: batch means of the holdup and batch rates of the discharge over the steady part,
+  propagated (:func:`analysis.studies.silo_recirculation.vrr.littles_law`);
+- ``t_s_over_t_d``: the order-statistic gaps of the tracer (tracer counting) and the frame interval (time
+  resolution), propagated (:func:`analysis.numerics.rtd.appearance_times`);
+- RTD means: ``s / sqrt(n)`` over the tracers that left (:attr:`analysis.numerics.rtd.RTD.t_mean_error`);
+- VRR: ``sqrt(2 / (N - 1)) VRR`` over the ``N`` windows of the recirculation
+  (:func:`analysis.studies.silo_recirculation.vrr.vrr_standard_error`).
 """
 
 from __future__ import annotations
@@ -19,8 +30,14 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from analysis.numerics.rtd import RTD, johanson_rtd
-from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_near_ceiling
+from analysis.numerics.rtd import RTD, appearance_times, johanson_rtd, residence_time_resolution
+from analysis.numerics.uncertainty import (
+    CEILING_FACTOR,
+    Significance,
+    combine_independent,
+    difference_significant,
+    vrr_near_ceiling,
+)
 from analysis.studies.silo_recirculation.study import BlendingResult, VerificationResult, residence_summary
 from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 
@@ -34,6 +51,7 @@ __all__ = [
     "clumps_per_window",
     "blending_summary",
     "verification_rows",
+    "mean_comparison",
     "verification_summary",
     "summary_rows",
 ]
@@ -90,20 +108,24 @@ def vrr_rows(result: BlendingResult, factor: float = CEILING_FACTOR) -> list[dic
         counting-noise ceiling for :func:`clumps_per_window` clumps per window [-]), ``vrr_at_ceiling`` (bool:
         the measured VRR is within ``factor`` of it), ``vrr_kind`` (``"value"``; ``"lower bound"`` when at the
         ceiling; ``"none"`` without a VRR) and ``vrr_predicted_over_measured`` (the prediction over a measured
-        value [-]; NaN where the measurement is only a lower bound or missing).
+        value [-]; NaN where the measurement is only a lower bound or missing), then ``vrr_error`` (standard error
+        of the measured VRR, ``sqrt(2 / (n_windows - 1)) vrr`` [-],
+        :func:`analysis.studies.silo_recirculation.vrr.vrr_standard_error`; NaN without a finite VRR).
     """
     particles_per_window = clumps_per_window(result)
     rows = []
     for layout in result.layouts:
         ceiling = layout.vrr.ceiling(particles_per_window)
         flags = layout.vrr.at_ceiling(particles_per_window, factor)
-        for row, predicted, at_ceiling in zip(layout.vrr.rows(), layout.vrr_predicted.vrr, flags):
+        errors = layout.vrr.vrr_error
+        for row, predicted, at_ceiling, error in zip(layout.vrr.rows(), layout.vrr_predicted.vrr, flags, errors):
             measured = row["vrr"]
             kind = "none" if math.isnan(measured) else "lower bound" if at_ceiling else "value"
             rows.append({
                 "layout": layout.layout.name, **row, "vrr_predicted": float(predicted), "vrr_ceiling": ceiling,
                 "vrr_at_ceiling": bool(at_ceiling), "vrr_kind": kind,
                 "vrr_predicted_over_measured": float(predicted) / measured if kind == "value" else math.nan,
+                "vrr_error": float(error),
             })
     return rows
 
@@ -243,23 +265,38 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         s^2], first and last residence times [s], fraction exited [-]), Johanson's ``V1`` and ``P`` [-], and per
         layout its VRRs with ``vrr_at_ceiling`` (bool per recirculation: a lower bound, within ``factor`` of the
         ceiling), prediction error and homogenisation Nr [-].
+
+        Standard errors (same unit, NaN when not known): ``residence_time_s_error``, ``holdup_clumps_error`` and
+        ``throughput_clumps_per_s_error`` (batch means and batch rates of the steady part), with the
+        ``frame_interval_s`` [s] of the record; in ``rtd_particle_ids`` ``t_mean_s_error`` (``s / sqrt(n)``),
+        ``t_s_error``, ``t_d_error`` and ``t_s_over_t_d_error`` (order-statistic gaps and time resolution) and the
+        ``time_resolution_s`` of one residence time (``frame_interval_s / sqrt(6)``) [s]; in ``rtd_eulerian``
+        ``t_mean_s_error``; per layout ``vrr_by_recirculation_error`` (``sqrt(2 / (N - 1)) VRR``).
     """
     timing = result.timing
     silo_rtd = result.rtd.silo
     particles_per_window = clumps_per_window(result)
+    resolution = residence_time_resolution(timing.frame_interval)
+    appearance = appearance_times(result.rtd.tracer.residence_time, resolution)
     return {
         "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
-        "residence_time_s": timing.residence_time, "estimated_residence_time_s": case["estimated_residence_time_s"],
-        "holdup_clumps": timing.holdup, "throughput_clumps_per_s": timing.throughput,
-        "recirculations": timing.recirculations, "window_s": result.window,
+        "residence_time_s": timing.residence_time, "residence_time_s_error": timing.residence_time_error,
+        "estimated_residence_time_s": case["estimated_residence_time_s"],
+        "holdup_clumps": timing.holdup, "holdup_clumps_error": timing.holdup_error,
+        "throughput_clumps_per_s": timing.throughput, "throughput_clumps_per_s_error": timing.throughput_error,
+        "frame_interval_s": timing.frame_interval, "recirculations": timing.recirculations, "window_s": result.window,
         "clumps_per_window": particles_per_window,
         "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window), "vrr_ceiling_factor": factor,
         "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
                              "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
-                             "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited},
+                             "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited,
+                             "t_mean_s_error": silo_rtd.t_mean_error, "t_s_error": appearance.t_first.std_error,
+                             "t_d_error": appearance.t_last.std_error,
+                             "t_s_over_t_d_error": appearance.ts_over_td.std_error, "time_resolution_s": resolution},
         "rtd_eulerian": {"t_mean_s": eulerian_rtd.t_mean, "variance_s2": eulerian_rtd.variance,
                          "t_s": eulerian_rtd.t_first, "t_d": eulerian_rtd.t_last,
-                         "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian_bin_size},
+                         "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian_bin_size,
+                         "t_mean_s_error": eulerian_rtd.t_mean_error},
         "johanson": {"V1": result.rtd.johanson_V1, "P": result.rtd.johanson_P},
         "layouts": {
             layout.layout.name: {
@@ -269,6 +306,7 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
                 "prediction_rms_error": layout.prediction_rms_error(),
                 "homogenised_after_recirculations": layout.homogenised_after,
                 "model_homogenised_after_recirculations": layout.model_homogenised_after,
+                "vrr_by_recirculation_error": layout.vrr.vrr_error,
             }
             for layout in result.layouts
         },
@@ -297,7 +335,54 @@ def verification_rows(result: VerificationResult) -> list[dict]:
     return rows
 
 
-def verification_summary(case: Mapping, result: VerificationResult) -> dict:
+def mean_comparison(particles: Mapping, eulerian: Mapping, k: float = 2.0) -> dict:
+    """Whether the Eulerian mean residence time agrees with the particles' within ``k`` combined standard errors.
+
+    Parameters
+    ----------
+    particles, eulerian : mapping
+        :func:`~analysis.studies.silo_recirculation.study.residence_summary` of the real tracer and of the
+        virtual tracers of one bin size (``mean_s`` and ``mean_s_error`` [s], None or NaN when not known).
+    k : float, optional
+        Coverage factor of :func:`analysis.numerics.uncertainty.difference_significant`, > 0 [-].
+
+    Returns
+    -------
+    dict
+        ``mean_difference_s`` (Eulerian minus particles [s]; None without both means),
+        ``mean_difference_s_error`` (``sqrt(u_E^2 + u_p^2)`` [s], the two samples independent; NaN when either
+        error is unknown), ``mean_difference_significance`` (``"significant"``, ``"not significant"`` or
+        ``"unknown"``) and ``means_agree`` (True when the difference is not significant, False when it is,
+        None when unknown).
+
+    Notes
+    -----
+    The particle error is ``s / sqrt(n)`` over the tracer passes, taken as independent draws. The virtual
+    tracers are not random draws: they sample the inlet on a lattice in one given velocity field, so their
+    mean is a quadrature over the inlet, and ``s / sqrt(n)`` is the error of sampling the inlet at ``n``
+    random points. It stands for the lattice's error: a regular lattice does better where the residence
+    time varies smoothly across the inlet and about as well where it jumps (paths splitting at a stagnant
+    zone), in the two dimensions of a thin silo's inlet. Neither error holds the noise of the flow itself
+    during the one release, which both sides largely share since the bin velocities come from the same
+    clumps at the same times, nor the discretisation of the velocity field by the bins: that bias is what the
+    comparison over bin sizes exists to show, and a "significant" difference measures it.
+    """
+    missing = particles["mean_s"] is None or eulerian["mean_s"] is None
+    if missing:
+        significance = Significance.UNKNOWN
+        difference, difference_error = None, math.nan
+    else:
+        errors = [math.nan if summary["mean_s_error"] is None else summary["mean_s_error"]
+                  for summary in (eulerian, particles)]
+        difference = eulerian["mean_s"] - particles["mean_s"]
+        difference_error = combine_independent(errors)
+        significance = difference_significant(eulerian["mean_s"], errors[0], particles["mean_s"], errors[1], k)
+    agree = {Significance.NOT_SIGNIFICANT: True, Significance.SIGNIFICANT: False}.get(significance)
+    return {"mean_difference_s": difference, "mean_difference_s_error": difference_error,
+            "mean_difference_significance": significance.value, "means_agree": agree}
+
+
+def verification_summary(case: Mapping, result: VerificationResult, k: float = 2.0) -> dict:
     """The summary of the Eulerian RTD verification (``verification.json``).
 
     Parameters
@@ -306,17 +391,29 @@ def verification_summary(case: Mapping, result: VerificationResult) -> dict:
         The run's case record (its ``run_id``).
     result : VerificationResult
         Particle tracks against Eulerian pathlines.
+    k : float, optional
+        Coverage factor of the agreement of the means (:func:`mean_comparison`), > 0 [-].
 
     Returns
     -------
     dict
-        ``run_id``, ``residence_time_s`` (holdup over throughput [s]), ``particles`` (the
-        :func:`~analysis.studies.silo_recirculation.study.residence_summary` of the real tracer [s]) and
-        ``eulerian`` (bin size as ``"<mm> mm"`` -> the same summary of its virtual tracers [s]).
+        ``run_id``, ``residence_time_s`` (holdup over throughput [s]) with ``residence_time_s_error`` [s],
+        ``n_tracers`` (the real tracer passes [-]), ``coverage_factor`` (``k`` [-]), ``particles`` (the
+        :func:`~analysis.studies.silo_recirculation.study.residence_summary` of the real tracer: counts,
+        ``mean_s`` with ``mean_s_error`` and ``std_s`` [s]) and ``eulerian`` (bin size as ``"<mm> mm"`` -> the
+        same summary of its virtual tracers, with the :func:`mean_comparison` against the particles:
+        ``mean_difference_s``, ``mean_difference_s_error``, ``mean_difference_significance``,
+        ``means_agree``).
     """
+    particles = residence_summary(result.particle_residence)
+    eulerian = {}
+    for bin_size, times in result.eulerian_residence.items():
+        summary = residence_summary(times)
+        eulerian[f"{1000 * bin_size:g} mm"] = {**summary, **mean_comparison(particles, summary, k)}
     return {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
-            "particles": residence_summary(result.particle_residence),
-            "eulerian": {f"{1000 * b:g} mm": residence_summary(t) for b, t in result.eulerian_residence.items()}}
+            "residence_time_s_error": result.timing.residence_time_error,
+            "n_tracers": int(np.asarray(result.particle_residence).size), "coverage_factor": float(k),
+            "particles": particles, "eulerian": eulerian}
 
 
 def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -> tuple[list[dict], list[tuple]]:
@@ -336,32 +433,49 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
         One row per run and layout: residence time (s), t_s/t_d, RTD means (s), ``vrr_nr<k>`` per recirculation
         (NaN where the JSON has null), the LTI prediction's RMS error and the recirculations to homogenise, then
         ``vrr_ceiling`` (the run's counting-noise ceiling, ``vrr_sampling_limit`` [-]; NaN if the summary has
-        none) and ``vrr_at_ceiling_nr<k>`` (bool: that VRR is only a lower bound).
+        none) and ``vrr_at_ceiling_nr<k>`` (bool: that VRR is only a lower bound), then the standard errors
+        ``residence_time_s_error`` [s], ``t_s_over_t_d_error`` [-], ``rtd_mean_ids_s_error`` [s],
+        ``rtd_mean_eulerian_s_error`` [s] and ``vrr_nr<k>_error`` [-] (NaN where the summary has none, e.g. one
+        written before the errors were).
     curves : list of tuple
-        ``(label, recirculation at mid-window, VRR, ceiling)`` per row, for
+        ``(label, recirculation at mid-window, VRR, ceiling, VRR error)`` per row, for
         :func:`analysis.studies.silo_recirculation.plots.plot_vrr_versus_recirculations` (``ceiling`` None if the
-        summary has none).
+        summary has none, the errors NaN where unknown).
     """
     rows, curves = [], []
     for summary in summaries:
         ceiling = summary.get("vrr_sampling_limit")
+        particle_rtd, eulerian_rtd = summary["rtd_particle_ids"], summary["rtd_eulerian"]
         for name, layout in summary["layouts"].items():
-            vrr = [v if v is not None else float("nan") for v in layout["vrr_by_recirculation"]]
+            vrr = [_number(v) for v in layout["vrr_by_recirculation"]]
+            errors = [_number(e) for e in layout.get("vrr_by_recirculation_error", [None] * len(vrr))]
             flags = layout.get("vrr_at_ceiling")
             if flags is None:
                 flags = ([False] * len(vrr) if ceiling is None else
                          [bool(flag) for flag in vrr_near_ceiling(vrr, ceiling, factor)])
-            curves.append((f"{summary['flow_pattern']} {name}", [k + 0.5 for k in range(len(vrr))], vrr, ceiling))
+            curves.append((f"{summary['flow_pattern']} {name}", [k + 0.5 for k in range(len(vrr))], vrr, ceiling,
+                           errors))
             rows.append({
                 "flow_pattern": summary["flow_pattern"], "layout": name, "run_id": summary["run_id"],
-                "residence_time_s": summary["residence_time_s"], "t_s_over_t_d": summary["rtd_particle_ids"]["t_s_over_t_d"],
-                "rtd_mean_ids_s": summary["rtd_particle_ids"]["t_mean_s"],
-                "rtd_mean_eulerian_s": summary["rtd_eulerian"]["t_mean_s"],
+                "residence_time_s": summary["residence_time_s"], "t_s_over_t_d": particle_rtd["t_s_over_t_d"],
+                "rtd_mean_ids_s": particle_rtd["t_mean_s"],
+                "rtd_mean_eulerian_s": eulerian_rtd["t_mean_s"],
                 **{f"vrr_nr{k + 1}": v for k, v in enumerate(vrr)},
                 "prediction_rms_error": layout["prediction_rms_error"],
                 "homogenised_after_recirculations": layout["homogenised_after_recirculations"],
                 "model_homogenised_after_recirculations": layout["model_homogenised_after_recirculations"],
                 "vrr_ceiling": float("nan") if ceiling is None else ceiling,
                 **{f"vrr_at_ceiling_nr{k + 1}": bool(flag) for k, flag in enumerate(flags)},
+                "residence_time_s_error": _number(summary.get("residence_time_s_error")),
+                "t_s_over_t_d_error": _number(particle_rtd.get("t_s_over_t_d_error")),
+                "rtd_mean_ids_s_error": _number(particle_rtd.get("t_mean_s_error")),
+                "rtd_mean_eulerian_s_error": _number(eulerian_rtd.get("t_mean_s_error")),
+                **{f"vrr_nr{k + 1}_error": e for k, e in enumerate(errors)},
             })
     return rows, curves
+
+
+def _number(value) -> float:
+    """A number read from JSON: null (NaN or inf written by :func:`analysis.io.tables.write_json`, or a key the
+    summary does not have) as NaN."""
+    return float("nan") if value is None else float(value)

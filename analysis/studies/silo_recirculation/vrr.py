@@ -14,6 +14,13 @@ Counting-noise ceiling
 Windows of ``n`` clumps cannot show a VRR above about ``n`` (:func:`analysis.numerics.uncertainty.vrr_ceiling`):
 the binomial noise of the blue count is left even in a perfectly mixed outflow. A VRR within a factor 2 of the
 ceiling (:meth:`RecirculationVRR.at_ceiling`) is a lower bound of the true VRR, not a measurement of it.
+
+Standard errors
+---------------
+``t_res`` (:func:`littles_law`): the mean holdup's batch-means error over the frames and the throughput's
+batch-rate error over the outlet crossings (:mod:`analysis.numerics.uncertainty`), propagated through the
+ratio. ``VRR_k`` (:func:`vrr_standard_error`): ``sqrt(2 / (N - 1)) VRR_k`` from the ``N`` windows of the
+recirculation.
 """
 
 from __future__ import annotations
@@ -24,14 +31,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.checks import finite_array, finite_number, positive_number
-from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_ceiling, vrr_near_ceiling
+from analysis.numerics.uncertainty import (
+    CEILING_FACTOR,
+    Estimate,
+    batch_means,
+    batch_rate,
+    combine_independent,
+    vrr_ceiling,
+    vrr_near_ceiling,
+)
 from analysis.studies.silo_recirculation.validation import event_times, integer_at_least, open_fraction
 
 __all__ = [
     "RecirculationVRR",
+    "LittlesLaw",
     "recirculation_number",
     "holdup_residence_time",
+    "littles_law",
     "vrr_by_recirculation",
+    "vrr_standard_error",
     "sampling_noise_vrr_limit",
 ]
 
@@ -78,6 +96,12 @@ class RecirculationVRR:
             }
             for nr, v, s, n in zip(self.recirculation_number, self.vrr, self.sigma_out, self.n_windows)
         ]
+
+    @property
+    def vrr_error(self) -> np.ndarray:
+        """Standard error of each VRR, ``sqrt(2 / (N - 1)) VRR`` with ``N`` = :attr:`n_windows` [-]
+        (:func:`vrr_standard_error`, which states the assumption); NaN where the VRR is NaN or inf."""
+        return vrr_standard_error(self.vrr, self.n_windows)
 
     def ceiling(self, clumps_per_window: float) -> float:
         """Counting-noise ceiling of these VRRs for windows of ``clumps_per_window`` clumps [-].
@@ -181,6 +205,98 @@ def holdup_residence_time(n_in_silo, exit_times, t_start: float, t_end: float) -
     return float(np.mean(holdup)) * (t_end - t_start) / n_exits
 
 
+@dataclass(frozen=True)
+class LittlesLaw:
+    """Mean holdup, throughput and ``t_res`` = holdup / throughput of a steady window, with standard errors.
+
+    Attributes
+    ----------
+    holdup : Estimate
+        Mean clumps in the silo [-]; error from batch means of the holdup series.
+    throughput : Estimate
+        Outlet crossings per second [1/s]; error from batch rates of the cumulative crossings.
+    residence_time : Estimate
+        ``t_res`` [s] (:func:`holdup_residence_time`); error propagated from the two.
+    """
+
+    holdup: Estimate
+    throughput: Estimate
+    residence_time: Estimate
+
+
+def littles_law(frame_times, n_in_silo, exit_times, t_start: float, t_end: float,
+                n_batches: int = 10) -> LittlesLaw:
+    """Mean holdup, throughput and mean residence time of a steady window, each with its standard error.
+
+    Values: the mean of ``n_in_silo``, ``n_exits / (t_end - t_start)`` (crossings with
+    ``t_start <= t <= t_end``) and :func:`holdup_residence_time`. Errors:
+
+    - holdup: :func:`analysis.numerics.uncertainty.batch_means` of the holdup series. The holdup is counted
+      exactly at every frame (each clump is tracked), so it has no counting noise of its own; what makes its
+      mean uncertain is how it wanders over the window.
+    - throughput: :func:`analysis.numerics.uncertainty.batch_rate` of the cumulative number of crossings at
+      the frame times (the slope of the discharge over ``n_batches`` parts of the window).
+    - ``t_res``: ``t_res sqrt((u_H / H)^2 + (u_Q / Q)^2)``, holdup and throughput taken as independent.
+
+    Each batch must be longer than the time over which the holdup and the discharge rate stay correlated
+    (a fraction of ``t_res`` in a steady silo) for the errors to be honest. With fewer than
+    ``2 n_batches`` frames the errors are NaN (unknown).
+
+    Parameters
+    ----------
+    frame_times : array_like, shape (n,)
+        Times of the frames in the window [s], strictly increasing.
+    n_in_silo : array_like, shape (n,)
+        Clumps in the silo at those frames, >= 0 [-].
+    exit_times : array_like, shape (m,)
+        Outlet crossing times [s]; NaN ignored.
+    t_start, t_end : float
+        The window [s], ``t_end > t_start``.
+    n_batches : int, optional
+        Batches of the batch means and batch rates, >= 2.
+
+    Returns
+    -------
+    LittlesLaw
+
+    Raises
+    ------
+    ValueError
+        As :func:`holdup_residence_time`, and on frame times of another length than ``n_in_silo``, not
+        strictly increasing, or ``n_batches`` not an integer >= 2.
+    """
+    times = finite_array("frame_times", frame_times, ndim=1)
+    holdup = finite_array("n_in_silo", n_in_silo, ndim=1)
+    if times.shape != holdup.shape:
+        raise ValueError(f"frame_times must have the shape of n_in_silo {holdup.shape}, got {times.shape}")
+    if np.any(np.diff(times) <= 0.0):
+        raise ValueError("frame_times must be strictly increasing")
+    n_batches = integer_at_least("n_batches", n_batches, 2)
+    residence_time = holdup_residence_time(holdup, exit_times, t_start, t_end)
+    exits = np.sort(event_times("exit_times", exit_times))
+    exits = exits[np.isfinite(exits)]
+    n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
+    mean_holdup = float(np.mean(holdup))
+    throughput = n_exits / (float(t_end) - float(t_start))
+    if times.size >= 2 * n_batches:
+        holdup_error = batch_means(holdup, n_batches).std_error
+        # crossings up to and including each frame time: any offset drops out of the slopes
+        cumulative = np.searchsorted(exits, times, side="right").astype(float)
+        throughput_error = batch_rate(times, cumulative, n_batches).std_error
+    else:
+        holdup_error = throughput_error = math.nan
+    relative = combine_independent([holdup_error / mean_holdup if mean_holdup > 0.0 else math.nan,
+                                    throughput_error / throughput])
+    dof = n_batches - 1
+    return LittlesLaw(
+        holdup=Estimate(value=mean_holdup, std_error=holdup_error, n=n_batches, method="batch means", dof=dof),
+        throughput=Estimate(value=throughput, std_error=throughput_error, n=n_batches, method="batch rate",
+                            dof=dof),
+        residence_time=Estimate(value=residence_time, std_error=residence_time * relative, n=n_batches,
+                                method="propagated batch means", dof=dof),
+    )
+
+
 def vrr_by_recirculation(
     window_centres,
     concentration,
@@ -250,6 +366,53 @@ def vrr_by_recirculation(
         sigma_in=math.sqrt(sigma_in2),
         blue_fraction=p,
     )
+
+
+def vrr_standard_error(vrr, n_windows):
+    """Standard error of a VRR measured from ``N`` outlet windows: ``sqrt(2 / (N - 1)) VRR`` [-].
+
+    Assumption: the ``N`` window concentrations of the recirculation are independent, normally distributed
+    draws about a common mean. The sample variance of ``N`` such values has the relative standard error
+    ``sqrt(2 / (N - 1))`` (its distribution is ``sigma^2 chi^2_(N-1) / (N - 1)``), and ``VRR = sigma_in^2 /
+    sigma_out^2`` inherits it to first order. Neighbouring windows of a slowly varying outflow are correlated
+    and the concentration drifts within a recirculation, so the effective number of independent windows is
+    smaller than ``N`` and the error is then a lower estimate. It says nothing about the counting-noise
+    ceiling: a VRR near it is a lower bound whatever its error
+    (:meth:`RecirculationVRR.at_ceiling`).
+
+    Parameters
+    ----------
+    vrr : float or array_like
+        VRR(s), >= 0, NaN (no VRR) or inf (no output variance) [-].
+    n_windows : int or array_like
+        Windows behind each VRR, integers >= 0 [-]; broadcast with ``vrr``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The error [-] (a float for scalars); NaN where ``N < 2`` or the VRR is NaN or inf.
+
+    Raises
+    ------
+    ValueError
+        On a negative VRR, a window count that is negative or not an integer, or shapes that do not
+        broadcast.
+    """
+    values = np.asarray(vrr, dtype=float)
+    if np.any(values < 0.0):
+        raise ValueError("vrr must be >= 0 (NaN for no VRR, inf for no output variance)")
+    counts = np.asarray(n_windows, dtype=float)
+    if np.any(~np.isfinite(counts)) or np.any(counts < 0.0) or np.any(counts != np.round(counts)):
+        raise ValueError("n_windows must hold integers >= 0 (windows per recirculation)")
+    try:
+        values, counts = np.broadcast_arrays(values, counts)
+    except ValueError:
+        raise ValueError(f"vrr and n_windows must broadcast together, got shapes {values.shape} and "
+                         f"{counts.shape}") from None
+    known = np.isfinite(values) & (counts >= 2.0)
+    error = np.full(values.shape, np.nan)
+    error[known] = np.sqrt(2.0 / (counts[known] - 1.0)) * values[known]
+    return float(error) if error.ndim == 0 else error
 
 
 def sampling_noise_vrr_limit(blue_fraction: float, particles_per_window: float) -> float:
