@@ -48,6 +48,7 @@ __all__ = [
     "recirculation_rows",
     "blender_rows",
     "fill_balance_rows",
+    "significance_rows",
     "summary_sections",
 ]
 
@@ -113,6 +114,14 @@ COLUMNS: dict[str, Column] = {
     "rtd_spread": Column("RTD spread σ/t_m", kind=ESTIMATE),
     "ts_over_td": Column("First appearance / discharge time t_s/t_d", kind=ESTIMATE),
     "recirculations_to_homogenise": Column("Recirculations to homogenise"),
+    # how many seeds a row combines (replicates: N)
+    "replicates": Column("Seeds", kind=COUNT),
+    # the blender comparison's differences (comparison/significance.csv)
+    "figure": Column("Figure", kind=TEXT),
+    "configuration_a": Column("Configuration A", kind=TEXT),
+    "configuration_b": Column("Configuration B", kind=TEXT),
+    "difference": Column("A − B", kind=ESTIMATE),
+    "significance": Column("Larger than 2 standard errors?", kind=TEXT),
     # the settled fill's force balance (metrics/fill_balance.json)
     "case": Column("Case", kind=TEXT),
     "support_ratio": Column("Walls + floor / weight"),
@@ -131,6 +140,8 @@ COLUMN_FAMILIES: tuple[tuple[re.Pattern, Callable[[re.Match], str], str, str], .
     (re.compile(r"vrr_at_ceiling_nr(\d+)"),
      lambda match: f"VRR after recirculation {int(match[1])} at the counting-noise ceiling", "", FLAG),
     (_PERIOD_VRR, lambda match: f"VRR, sine period {match[1]} t_m", "", ESTIMATE),
+    (re.compile(r"vrr_at_(\d+(?:\.\d+)?)_tm_at_ceiling"),
+     lambda match: f"VRR, sine period {match[1]} t_m, at the counting-noise ceiling", "", FLAG),
     (re.compile(r"contacts_at_(\d+)_mm"), lambda match: f"Contacts / weight above, plane at {int(match[1])} mm", "",
      NUMBER),
 )
@@ -553,9 +564,24 @@ def recirculation_rows(rows: Sequence[Mapping]) -> list[dict]:
 
 def blender_rows(rows: Sequence[Mapping]) -> list[dict]:
     """The blender comparison rows: :data:`BLENDER_COLUMNS`, then every ``vrr_at_<f>_tm`` column of the row, with
-    their errors when the table has them; other columns are left out."""
-    return [_with_errors(row, BLENDER_COLUMNS + tuple(key for key in row if _PERIOD_VRR.fullmatch(str(key))))
-            for row in rows]
+    their errors when the table has them, then the VRR ceiling with its flags and the seed count when the table
+    has them; other columns are left out."""
+    picked = []
+    for row in rows:
+        keys = BLENDER_COLUMNS + tuple(key for key in row if _PERIOD_VRR.fullmatch(str(key)))
+        keys += tuple(key for key in row if key == "vrr_ceiling" or str(key).endswith("_tm_at_ceiling"))
+        keys += ("replicates",) if "replicates" in row else ()
+        picked.append(_with_errors(row, keys))
+    return picked
+
+
+def significance_rows(rows: Sequence[Mapping]) -> list[dict]:
+    """The blender comparison's differences (``comparison/significance.csv`` as read), one row per figure and pair
+    of configurations: the figure in words, the pair, A − B with its standard error and whether it exceeds twice
+    that error ("unknown" where an error is not known)."""
+    return [{"figure": column_header(str(row["figure"])), "configuration_a": row["configuration_a"],
+             "configuration_b": row["configuration_b"], "difference": row["difference"],
+             "difference_error": row["difference_error"], "significance": row["significance"]} for row in rows]
 
 
 def fill_balance_rows(balances: Sequence[Mapping]) -> list[dict]:
@@ -591,12 +617,22 @@ FILL_LEGEND = ("Forces on the settled fill before its outlet opens, as shares of
                "it; at most 1 in a silo.")
 BLENDER_LEGEND = ("Mean vertical velocity: the mean v_z of each passage (negative: downwards). VRR, sine period "
                   "f t_m: variance reduction ratio of a sine input whose period is f times the mean residence time. "
-                  "n/a under recirculations to homogenise: not homogenised within the simulated passes.")
+                  "n/a under recirculations to homogenise: not homogenised within the simulated passes; it has no "
+                  "error (one noisy excursion of the curve adds or removes a whole recirculation; compare seeds). "
+                  "At the counting-noise ceiling: the VRR is within a factor 2 of the largest one the tracers can "
+                  "resolve, so it is only a lower bound.")
+
+
+DIFFERENCES_LEGEND = ("A − B: the difference of a figure between two configurations with the standard error of the "
+                      "difference (the two errors in quadrature). Larger than 2 standard errors: significant; not "
+                      "significant otherwise; unknown where an error is not known or a VRR is at its counting-noise "
+                      "ceiling (only a lower bound). With one seed per configuration the errors are the runs' own "
+                      "(batch means, tracer counts); replicates: N >= 3 adds the spread over seeds.")
 
 
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
                      recirculation: Sequence[Mapping], blender: Sequence[Mapping],
-                     balances: Sequence[Mapping] = ()) -> list[Section]:
+                     balances: Sequence[Mapping] = (), blender_differences: Sequence[Mapping] = ()) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -609,6 +645,8 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         Rows of the measured-profile comparisons, of the recirculating-silo summary and of the blender comparison.
     balances : sequence of mapping
         The force balance of each settled fill (``metrics/fill_balance.json``).
+    blender_differences : sequence of mapping
+        The blender comparison's differences (``comparison/significance.csv``).
     """
     return [
         Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
@@ -622,6 +660,9 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
                 recirculation_rows(recirculation), BLENDING_LEGEND),
         Section("Blender", "Insert configurations compared (see the blender comparison table).",
                 blender_rows(blender), BLENDER_LEGEND),
+        Section("Blender: differences", "Which differences between the insert configurations are larger than "
+                                        "their uncertainty.", significance_rows(blender_differences),
+                DIFFERENCES_LEGEND),
         Section("Settled fills", "How each settled fill carries its weight before the outlet opens.",
                 fill_balance_rows(balances), FILL_LEGEND),
     ]

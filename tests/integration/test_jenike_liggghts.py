@@ -177,7 +177,9 @@ def test_the_levelled_sample_carries_its_weight_before_the_lid(name, runs):
     run = runs[name]
     settled = liggghts().settled_fill(run.run_dir, run.record)
     assert settled.floor_walls == ("base",)
-    heights = [fraction * run.case.fill_height for fraction in (0.25, 0.5)]
+    # the levelled top 2-3 clump layers are still moving when the lid comes: the wall test's 10 mm sample is all top
+    fractions = (0.25,) if run.case.test != "internal" else (0.25, 0.5)
+    heights = [fraction * run.case.fill_height for fraction in fractions]
     balance = settled_fill_balance(settled, heights, run.case.gravity)
     assert balance.n_clumps == run.record.n_clumps
     assert balance.support_ratio == pytest.approx(1.0, abs=0.01)  # base + rings carry the sample's weight

@@ -18,6 +18,7 @@ from analysis.report.summary import (
     calibration_rows,
     column_header,
     fill_balance_rows,
+    significance_rows,
     format_cell,
     format_number,
     format_value_with_error,
@@ -262,7 +263,8 @@ def test_summary_sections_take_the_columns_each_stage_shows():
                                   "vrr_nr1_error": 0.1, "extra": 1}],
                                 [{"configuration": "straight", "vrr_at_0.5_tm": 3.0, "extra": 1}])
     assert [section.title for section in sections] == ["Calibration", "Silo validation", "Silo against measurements",
-                                                       "Blending", "Blender", "Settled fills"]
+                                                       "Blending", "Blender", "Blender: differences",
+                                                       "Settled fills"]
     assert sections[0].rows == [{"contact": "particle-particle", "sliding_friction": 0.3}]
     assert sections[1].rows == [{key: flow[key] for key in SILO_FLOW_COLUMNS}]
     assert sections[2].rows == []
@@ -312,3 +314,26 @@ def test_fill_balance_rows_give_the_shares_of_the_weight_and_the_planes_in_mm():
                    "contacts_at_60_mm": 0.92, "balance_passed": True}
     page = summary_html("t", [Section("Settled fills", "x", [row])])
     assert "Contacts / weight above, plane at 60 mm" in page and "Walls / weight" in page
+
+
+def test_blender_rows_keep_the_ceiling_its_flags_and_the_seed_count():
+    row = {"configuration": "straight", "vrr_at_0.5_tm": 300.0, "vrr_at_0.5_tm_error": 40.0, "vrr_ceiling": 400.0,
+           "vrr_at_0.5_tm_at_ceiling": "True", "replicates": 3.0, "vrr_at_0.5_tm_seed_std": 50.0}
+    (picked,) = blender_rows([row])
+    assert picked["vrr_ceiling"] == 400.0 and picked["vrr_at_0.5_tm_at_ceiling"] == "True"
+    assert picked["replicates"] == 3.0 and "vrr_at_0.5_tm_seed_std" not in picked
+    page = summary_html("siloflow", [("Blender", "x", [picked])])
+    assert "VRR, sine period 0.5 t_m, at the counting-noise ceiling" in page and "Seeds" in page
+    assert "300 ± 40" in page
+
+
+def test_significance_rows_name_the_figure_in_words_and_print_the_difference_with_its_error():
+    rows = significance_rows([{"figure": "mass_flow_rate_kg_s", "configuration_a": "straight",
+                               "configuration_b": "converging", "value_a": 0.0099, "error_a": 0.0011,
+                               "value_b": 0.0123, "error_b": 0.0010, "difference": -0.0024,
+                               "difference_error": 0.0015, "significance": "not significant"}])
+    assert rows == [{"figure": "Flow rate (kg/s)", "configuration_a": "straight", "configuration_b": "converging",
+                     "difference": -0.0024, "difference_error": 0.0015, "significance": "not significant"}]
+    page = summary_html("siloflow", [("Blender: differences", "x", rows)])
+    assert "−0.0024 ± 0.0015" in page or "-0.0024 ± 0.0015" in page
+    assert "not significant" in page

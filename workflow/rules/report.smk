@@ -10,6 +10,7 @@ rule report_summary:
                                     for name in measured_comparison_names() if name.endswith(".csv")],
         blending=lambda wildcards: [f"{case_root(RECIRCULATION)}/summary/blending.csv"] if recirculation_runs() else [],
         blender=lambda wildcards: [f"{case_root('blender')}/comparison/configurations.csv"] if blender_runs() else [],
+        blender_differences=lambda wildcards: [f"{case_root('blender')}/comparison/significance.csv"] if blender_runs() else [],
         balances=lambda wildcards: [run_path(kind, "metrics/fill_balance.json", run)
                                     for kind in FILL_BALANCE_CASES for run in run_ids(kind)],
     output:

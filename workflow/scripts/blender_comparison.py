@@ -15,13 +15,15 @@ from analysis.studies.blender.plots import plot_configuration_comparison, plot_r
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
 from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs
 from analysis.io.tables import write_flow_table, write_text
+from analysis.numerics.replicates import combine_replicates
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     summaries = [json.loads(Path(path).read_text()) for path in snakemake.input.summaries]
     lowest, chosen = lowest_gravity_runs(summaries)
     metrics = [metrics_from_summary(summary) for summary in chosen]
-    rows = comparison_table(metrics)
+    # replicates (the same configuration with other seeds) become one row: their mean and its error
+    rows = combine_replicates(comparison_table(metrics), ["configuration"])
     best = best_blender(metrics)
     significance = significance_rows(rows)
     write_flow_table(snakemake.output.table, rows)

@@ -18,6 +18,7 @@ with logged_to(snakemake.log[0]) as log:
         [row for path in inputs.blending for row in read_table(path)],
         [row for path in inputs.blender for row in read_table(path)],
         [json.loads(Path(path).read_text()) for path in inputs.balances],
+        [row for path in inputs.blender_differences for row in read_table(path)],
     )
     write_text(snakemake.output.page, summary_html("siloflow: figures of merit", sections))
     log.info("summary page: %s rows", ", ".join(f"{len(section.rows)} {section.title.lower()}" for section in sections))

@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+from analysis.numerics.replicates import REPLICATES_KEY, SEED_STD_SUFFIX
 from analysis.checks import positive_number
 from analysis.numerics.uncertainty import (
     CEILING_FACTOR,
@@ -169,9 +170,10 @@ def best_blender(metrics: Sequence[BlenderMetrics]) -> str:
 
 def figure_columns(row: Mapping) -> list[str]:
     """The figures of a :func:`comparison_table` row, in its order: every column but ``configuration``, the errors
-    (``*_error``), the ceiling flags (``*_at_ceiling``) and ``vrr_ceiling``."""
-    return [column for column in row if column not in ("configuration", "vrr_ceiling")
-            and not column.endswith(ERROR_SUFFIX) and not column.endswith(CEILING_SUFFIX)]
+    (``*_error``), the ceiling flags (``*_at_ceiling``), ``vrr_ceiling`` and, in a row that combines replicates
+    (:func:`analysis.numerics.replicates.combine_replicates`), the seed count and the seeds' standard deviations."""
+    return [column for column in row if column not in ("configuration", "vrr_ceiling", REPLICATES_KEY)
+            and not column.endswith((ERROR_SUFFIX, CEILING_SUFFIX, SEED_STD_SUFFIX))]
 
 
 def _number(value) -> float:
