@@ -27,7 +27,8 @@ extremes ``t_s`` and ``t_d`` are order statistics: their sampling error is about
 inward, and each event time is known only to the frame interval of the record
 (:func:`residence_time_resolution`); :func:`appearance_times` combines the two and propagates them to
 ``t_s / t_d``. Tracers still inside at the end (NaN) are left out, which biases ``t_m`` and ``t_d`` low; that
-bias is not part of the errors.
+bias is not part of the errors. Cutting every tracer at one horizon it was followed for removes it from the
+mean (:func:`mean_residence_time_within`), which Little's law then reproduces on the same passes.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ __all__ = [
     "rtd_from_exit_times",
     "rtd_moments",
     "mean_residence_time",
+    "mean_residence_time_within",
     "residence_time_resolution",
     "appearance_times",
     "perfect_mixer_rtd",
@@ -362,6 +364,37 @@ def mean_residence_time(residence_times) -> Estimate:
     spread = seed_spread(finite)
     return Estimate(value=spread.mean, std_error=spread.std_error, n=spread.n, method="tracer sample",
                     dof=spread.n - 1 if spread.n > 1 else math.inf)
+
+
+def mean_residence_time_within(residence_times, horizon: float) -> Estimate:
+    """Mean residence time of the tracers that left within ``horizon`` of their entry, with its standard error [s].
+
+    :func:`mean_residence_time` of the residence times ``t <= horizon``: ``E[t | t <= h]``, the mean of the RTD
+    truncated at ``h``; longer ones and NaN (still inside) are left out. With every tracer followed for at least
+    ``horizon``, a NaN one is known to stay longer, so this mean is not censored (that of all that left is).
+
+    Parameters
+    ----------
+    residence_times : array_like, shape (n_total,)
+        Residence time of each tracer [s]; NaN for a tracer that did not leave.
+    horizon : float
+        Longest residence time counted ``h``, > 0 [s].
+
+    Returns
+    -------
+    Estimate
+        As :func:`mean_residence_time` (``n`` the tracers counted, error ``s / sqrt(n)``, NaN for one).
+
+    Raises
+    ------
+    ValueError
+        On a bad ``horizon``, a non-1-D array, infinite values, or no tracer out within ``horizon``.
+    """
+    h = positive_number("horizon", horizon)
+    times = _exited(residence_times)  # the checks, and NaN (still inside) out
+    if not np.any(times <= h):
+        raise ValueError(f"residence_times: no tracer left within the horizon {h!r} s")
+    return mean_residence_time(times[times <= h])
 
 
 def residence_time_resolution(frame_interval: float) -> float:

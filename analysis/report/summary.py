@@ -101,7 +101,9 @@ COLUMNS: dict[str, Column] = {
     # recirculating silo
     "flow_pattern": Column("Flow pattern", kind=TEXT),
     "layout": Column("Batch layout", kind=TEXT),
-    "residence_time_s": Column("Residence time", "s", ESTIMATE),
+    "residence_time_s": Column("Hold-up residence time (stagnant zones included)", "s", ESTIMATE),
+    "transit_residence_time_s": Column("Transit residence time, Little's law", "s", ESTIMATE),
+    "rtd_mean_ids_transit_s": Column("Transit residence time, tracer mean", "s", ESTIMATE),
     "t_s_over_t_d": Column("First appearance / discharge time t_s/t_d", kind=ESTIMATE),
     "prediction_rms_error": Column("LTI prediction RMS error (blue fraction)"),
     "vrr_ceiling": Column("VRR counting-noise ceiling"),
@@ -524,6 +526,8 @@ MEASURED_COLUMNS = ("z_m", "window", "n_points", "mean_error_percent", "rms_erro
 #: The columns of the recirculating-silo summary table on the summary page.
 RECIRCULATION_COLUMNS = ("flow_pattern", "layout", "residence_time_s", "t_s_over_t_d", "vrr_nr1", "vrr_nr2", "vrr_nr3",
                          "vrr_nr4", "prediction_rms_error")
+#: Little's law on the clumps that pass within the run, two ways, shown when the summary table has them.
+RECIRCULATION_TRANSIT_COLUMNS = ("transit_residence_time_s", "rtd_mean_ids_transit_s")
 #: The counting-noise ceiling of the VRR and the flags of the VRRs at it, shown when the summary table has them.
 RECIRCULATION_CEILING_COLUMNS = ("vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3",
                                  "vrr_at_ceiling_nr4")
@@ -556,10 +560,11 @@ def measured_rows(rows: Sequence[Mapping]) -> list[dict]:
 
 
 def recirculation_rows(rows: Sequence[Mapping]) -> list[dict]:
-    """The recirculating-silo summary rows cut to :data:`RECIRCULATION_COLUMNS` (missing ones as None), then
-    those of :data:`RECIRCULATION_CEILING_COLUMNS` the row has, with their errors when the table has them."""
-    return [_with_errors(row, RECIRCULATION_COLUMNS + tuple(key for key in RECIRCULATION_CEILING_COLUMNS if key in row))
-            for row in rows]
+    """The recirculating-silo summary rows cut to :data:`RECIRCULATION_COLUMNS` (missing ones as None), then those of
+    :data:`RECIRCULATION_TRANSIT_COLUMNS`, :data:`RECIRCULATION_CEILING_COLUMNS` and the seed count the row has, with
+    their errors when the table has them."""
+    optional = RECIRCULATION_TRANSIT_COLUMNS + RECIRCULATION_CEILING_COLUMNS + ("replicates",)
+    return [_with_errors(row, RECIRCULATION_COLUMNS + tuple(key for key in optional if key in row)) for row in rows]
 
 
 def blender_rows(rows: Sequence[Mapping]) -> list[dict]:
@@ -605,7 +610,10 @@ SILO_LEGEND = ("Flow rate: slope of the discharged mass over the steady window. 
                "correlation's prediction at the filling bulk density; the ratio's uncertainty is the flow "
                "rate's alone.")
 MEASURED_LEGEND = "Errors of the simulated vertical velocity against each measured profile."
-BLENDING_LEGEND = ("Residence time: hold-up over throughput. t_s/t_d: first appearance of the tracer over the "
+BLENDING_LEGEND = ("Hold-up residence time: all clumps above the outlet over the throughput, stagnant zones "
+                   "included (Nr is counted in it). Transit residence time: the clumps that pass within the run, by "
+                   "Little's law (their hold-up over their throughput) and as the tracer's mean; the two agree "
+                   "within their errors when the run is steady. t_s/t_d: first appearance of the tracer over the "
                    "time to discharge all of it. VRR after recirculation n: variance reduction ratio "
                    "σ_in²/σ_out² of the outlet blue fraction during pass n. At the counting-noise ceiling: the VRR "
                    "is close to the largest one the windows' particle counts can measure, so it is only a lower "

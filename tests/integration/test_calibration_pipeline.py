@@ -1,17 +1,27 @@
 """The calibration stage with the real engine, chained into a silo run through `parameters: calibrated`.
 
-Two tiny shear tests (internal friction, particle friction 0.1 and 0.5) make a two-point chart; a target
-between their bulk friction angles is inverted, and a tiny silo runs with the chosen parameters.
+Three tiny shear tests (internal friction, particle friction 0.1, 0.2 and 0.3) make a three-point chart (three, so
+that the calibration can estimate the error of reading its bend as straight lines; in this small, fast-sheared cell
+bulk friction peaks near particle friction 0.3: 0.5 gave 0.56 against 0.61 at 0.3); a target between their bulk
+friction angles is inverted, and a tiny silo runs with the chosen parameters; a third shear test
+at the chosen friction checks that it reproduces the target angle.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import math
 
 import pytest
 import yaml
 
+from calibration.friction import bulk_friction_of_shear
+from calibration.shear import shear_signals
+from engines.cases import cases_of
+from engines.cases.jenike import build_jenike_case
+from engines.config import validate_config
+from engines.interface import EngineOptions, engine_for
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
@@ -22,7 +32,7 @@ TINY_CALIBRATION = {
         "fill": {"settle_time": 0.1},
         "consolidation": {"time": 0.05},
         "shear": {"velocity": 0.03, "displacement": 0.004},
-        "sweep": {"shapes": ["sphere2"], "tests": ["internal"], "sliding_friction": [0.1, 0.5], "rolling_friction": [0.0]},
+        "sweep": {"shapes": ["sphere2"], "tests": ["internal"], "sliding_friction": [0.1, 0.2, 0.3], "rolling_friction": [0.0]},
     },
     "calibration": {"targets_deg": {"internal": 24.0, "aluminium": 9.5}, "tolerance_deg": 1.0, "shape": "sphere2",
                     "rolling_friction": 0.0},
@@ -46,11 +56,11 @@ def calibrated_pipeline(tmp_path_factory):
 def test_table_has_one_row_per_point_and_friction_grows(calibrated_pipeline):
     table = list(csv.DictReader((calibrated_pipeline / "results" / "calibration" / "bulk_friction.csv").open()))
     assert sorted((r["lid"], float(r["particle_friction"])) for r in table) == [
-        ("rigid", 0.1), ("rigid", 0.5), ("servo", 0.1), ("servo", 0.5)
+        ("rigid", 0.1), ("rigid", 0.2), ("rigid", 0.3), ("servo", 0.1), ("servo", 0.2), ("servo", 0.3)
     ]
     rows = [r for r in table if r["lid"] == "rigid"]
-    low, high = (float(r["bulk_friction"]) for r in rows)
-    assert high > low > 0.0
+    low, middle, high = (float(r["bulk_friction"]) for r in sorted(rows, key=lambda r: float(r["particle_friction"])))
+    assert high > middle > low > 0.0
     for row in rows:
         assert float(row["ring_sides_relative_difference"]) < 0.10
 
@@ -79,7 +89,7 @@ def test_the_silo_ran_with_the_calibrated_parameters(calibrated_pipeline):
 def test_lids_are_compared_on_the_same_points(calibrated_pipeline):
     calibration = calibrated_pipeline / "results" / "calibration"
     rows = list(csv.DictReader((calibration / "lid_comparison.csv").open()))
-    assert [float(r["particle_friction"]) for r in rows] == [0.1, 0.5]
+    assert [float(r["particle_friction"]) for r in rows] == [0.1, 0.2, 0.3]
     for row in rows:
         assert float(row["bulk_friction_servo_lid"]) > 0.0
     assert (calibration / "charts" / "lid_comparison.png").exists()
@@ -92,3 +102,33 @@ def test_diagnostics_of_the_middle_point(calibrated_pipeline):
     assert summary["mean_angular_speed_rad_s"] > 0.0
     assert (diagnostics.parent.parent / "plots" / "mobilised_friction.png").exists()
     assert (diagnostics.parent.parent / "plots" / "angular_velocity.png").exists()
+
+
+def test_the_chosen_friction_reproduces_the_target_angle(calibrated_pipeline):
+    """A further shear test at the chosen sliding friction gives the target bulk friction angle within the
+    calibration's stated uncertainty: the target's tolerance plus two standard errors of the run's own angle and of
+    the chosen friction (the chart points' errors and its interpolation error, through the chart's slope). On a
+    two-point chart 0.1-0.5 the chosen 0.228 gave 28.3 deg against a 24 deg target: hence three points below the
+    peak."""
+    config = validate_config(TINY_CALIBRATION)
+    parameters = yaml.safe_load((calibrated_pipeline / "results" / "calibration" / "parameters.yaml").read_text())
+    chosen = parameters["particle_particle"]
+    template = next(case for case in cases_of(config, "jenike").values() if case.lid_kind == config["jenike"]["lid"])
+    case = build_jenike_case(config, {**template.point, "sliding_friction": chosen["sliding_friction"]})
+    engine = engine_for(config, "jenike")
+    run_dir = calibrated_pipeline / "check" / case.run_id
+    engine.write_inputs(case, run_dir)
+    record = engine.run(case, run_dir, EngineOptions())
+    signals = shear_signals(engine.wall_forces(run_dir, record), record.labels["shear_start_s"],
+                            record.labels["shear_end_s"])
+    friction, _ = bulk_friction_of_shear(signals)
+    angle = math.degrees(math.atan(friction.coefficient))
+    angle_error = math.degrees(friction.standard_error / (1.0 + friction.coefficient ** 2))
+    target = TINY_CALIBRATION["calibration"]["targets_deg"]["internal"]
+    slope = (chosen["upper"] - chosen["lower"]) / (2.0 * TINY_CALIBRATION["calibration"]["tolerance_deg"])  # per deg
+    assert chosen["sliding_friction_error"] is not None  # a three-point chart knows its interpolation error
+    friction_error_deg = chosen["sliding_friction_error"] / slope
+    allowed = 2.0 * math.hypot(angle_error, friction_error_deg) + TINY_CALIBRATION["calibration"]["tolerance_deg"]
+    print(f"chosen mu {chosen['sliding_friction']:.4f}: bulk angle {angle:.2f} +- {angle_error:.2f} deg, "
+          f"target {target} deg, allowed {allowed:.2f} deg")
+    assert abs(angle - target) <= allowed

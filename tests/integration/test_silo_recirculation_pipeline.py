@@ -10,12 +10,14 @@ from __future__ import annotations
 import copy
 import csv
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
+from analysis.numerics.uncertainty import Significance, difference_significant
 from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from engines.cases.silo_recirculation import recirculation_cases
@@ -124,6 +126,28 @@ def test_make_run_outputs_exist_and_the_prediction_tracks_the_measurement(blendi
         assert layout["prediction_rms_error"] < 0.7 * (p * (1.0 - p)) ** 0.5
     rows = list(csv.DictReader((workdir / case_root("silo_recirculation") / "summary" / "blending.csv").open()))
     assert len(rows) == 5
+
+
+def test_littles_law_holds_on_the_real_run(blending_pipeline):
+    _, runs, _ = blending_pipeline
+    summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
+    tracer = summary["rtd_particle_ids"]
+    transit, transit_error = summary["transit_residence_time_s"], summary["transit_residence_time_s_error"]
+    mean, mean_error = tracer["t_mean_transit_s"], tracer["t_mean_transit_s_error"]
+    for value in (transit, transit_error, mean, mean_error, summary["transit_horizon_s"],
+                  summary["slow_holdup_clumps"], summary["residence_time_s_error"]):
+        assert value is not None and math.isfinite(value)
+    assert tracer["n_transit"] >= 2
+    # The same clumps (passes out within the horizon), the same control volume and events: the holdup over the
+    # throughput and the tracer's mean agree within three combined standard errors (a 3-sigma check, as one
+    # seed's tracer is a single cohort).
+    assert difference_significant(transit, transit_error, mean, mean_error, k=3.0) is Significance.NOT_SIGNIFICANT
+    assert summary["littles_law_difference_s"] == transit - mean
+    # Transit is part of the throughput; the clumps that never leave are part of the slow holdup, which the
+    # holdup residence time counts on top of the transit clumps (so it is the larger).
+    assert 0.0 < summary["transit_fraction"] <= 1.0
+    assert summary["slow_holdup_clumps"] >= summary["stagnant_clumps"] >= 0
+    assert summary["residence_time_s"] >= transit - 3.0 * math.hypot(transit_error, summary["residence_time_s_error"])
 
 
 def test_thin_silo_compares_tracks_with_three_bin_sizes(blending_pipeline):

@@ -14,6 +14,7 @@ from calibration.inversion import (
     UnreachableTarget,
     curves_from_table,
     invert_calibration,
+    interpolation_error,
     inversion_error,
     invert_curve,
 )
@@ -98,7 +99,9 @@ def test_invert_curve_error_of_a_chart_with_bulk_friction_errors():
     np.testing.assert_allclose(curve.bulk_angle_standard_error_deg,
                                np.degrees(0.01 / (1 + curve.bulk_friction**2)), rtol=1e-15)
     result = invert_calibration([curve], {"internal": target}, shape="sphere2", rolling_friction=0.1)
-    assert result["particle_particle"]["sliding_friction_error"] == inversion.standard_error
+    # the chart's bend adds its interpolation error in quadrature
+    assert result["particle_particle"]["sliding_friction_error"] == pytest.approx(
+        math.hypot(inversion.standard_error, inversion.interpolation_error), rel=1e-12)
     assert yaml.safe_load(yaml.safe_dump(result)) == result
     assert math.isnan(invert_curve(_linear_curve(), target).standard_error)  # no errors on the chart
 
@@ -307,3 +310,18 @@ def test_unreachable_targets_can_be_recorded_instead_of_raised():
     assert result["particle_particle"]["sliding_friction"] == pytest.approx(0.5, abs=1e-12)
     assert "aluminium" not in result["particle_wall"]
     assert "45.0 deg is unreachable" in result["unreachable"]["aluminium"]
+
+
+def test_interpolation_error_is_zero_on_a_straight_chart_and_the_parabola_gap_where_it_bends():
+    # p = 0.1, 0.3, 0.5 at 10, 20, 40 deg: target 15 deg in the first segment, third point 40 deg.
+    angles, particle = [10.0, 20.0, 40.0], [0.1, 0.3, 0.5]
+    line = 0.2  # halfway along the first segment
+    coefficients = np.polyfit(angles, particle, 2)
+    assert interpolation_error(angles, particle, 15.0) == pytest.approx(abs(np.polyval(coefficients, 15.0) - line),
+                                                                        rel=1e-12)
+    # by hand: the parabola through the three points is p(x) = a x^2 + b x + c with a = -1/3000, b = 0.03,
+    # c = -1/6; at 15 deg it gives 0.208333, 1/120 above the line
+    assert interpolation_error(angles, particle, 15.0) == pytest.approx(1.0 / 120.0, rel=1e-9)
+    assert interpolation_error(angles, particle, 20.0) == pytest.approx(0.0, abs=1e-12)  # a chart point
+    assert interpolation_error([10.0, 20.0, 30.0], [0.1, 0.2, 0.3], 15.0) == pytest.approx(0.0, abs=1e-12)
+    assert math.isnan(interpolation_error([10.0, 20.0], [0.1, 0.3], 15.0))  # two points cannot show a bend

@@ -13,6 +13,7 @@ from analysis.numerics.rtd import (
     appearance_times,
     johanson_rtd,
     mean_residence_time,
+    mean_residence_time_within,
     perfect_mixer_rtd,
     plug_flow_rtd,
     residence_time_resolution,
@@ -240,6 +241,29 @@ def test_rtd_t_mean_error_equals_that_of_the_sample():
 def test_mean_residence_time_rejects_bad_samples(sample, message):
     with pytest.raises(ValueError, match=message):
         mean_residence_time(sample)
+
+
+def test_mean_residence_time_within_a_horizon_leaves_the_slower_and_unexited_out():
+    # KNOWN_SAMPLE up to 5 s: 2, 4, 4, 4, 5, 5 (mean 4, squared deviations 4 + 0 + 0 + 0 + 1 + 1 = 6, so
+    # s^2 = 6 / 5 and the error sqrt(6 / 5 / 6) = sqrt(1 / 5)); 7, 9 and the NaN are out
+    within = mean_residence_time_within(KNOWN_SAMPLE, 5.0)
+    assert (within.value, within.n, within.method) == (4.0, 6, "tracer sample")
+    assert within.std_error == pytest.approx(math.sqrt(0.2), rel=1e-15)
+    # a horizon beyond the longest residence time gives the plain mean
+    whole = mean_residence_time_within(KNOWN_SAMPLE, 100.0)
+    assert (whole.value, whole.std_error) == (mean_residence_time(KNOWN_SAMPLE).value,
+                                              mean_residence_time(KNOWN_SAMPLE).std_error)
+
+
+@pytest.mark.parametrize("sample, horizon, message", [
+    ([3.0, np.nan], 2.0, "no tracer left within"),
+    ([1.0, 2.0], 0.0, "horizon"),
+    ([1.0, np.inf], 2.0, "infinite"),
+    ([[1.0, 2.0]], 2.0, "1-D"),
+])
+def test_mean_residence_time_within_rejects_bad_input(sample, horizon, message):
+    with pytest.raises(ValueError, match=message):
+        mean_residence_time_within(sample, horizon)
 
 
 def test_residence_time_resolution_is_the_frame_interval_over_sqrt_6():

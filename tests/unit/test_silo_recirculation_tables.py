@@ -40,8 +40,10 @@ from analysis.studies.silo_recirculation.tables import (
     vrr_period_rows,
     vrr_rows,
 )
+from analysis.numerics.uncertainty import Estimate
 from analysis.studies.silo_recirculation.tracers import TracerPasses
-from analysis.studies.silo_recirculation.vrr import RecirculationVRR
+from analysis.studies.silo_recirculation.transit import TransitLittlesLaw
+from analysis.studies.silo_recirculation.vrr import LittlesLaw, RecirculationVRR
 
 NAN = math.nan
 EDGES = np.array([0.0, 1.0, 2.0, 3.0])
@@ -233,10 +235,13 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         "frame_interval_s": math.sqrt(6.0),
         "rtd_particle_ids": {"t_mean_s": 2.0, "variance_s2": 0.375, "t_s": 1.25, "t_d": 2.75,
                              "t_s_over_t_d": 1.25 / 2.75, "n_tracer": 4, "fraction_exited": 0.75,
-                             "t_mean_s_error": math.sqrt(0.375 / 2.0)},
+                             "t_mean_s_error": math.sqrt(0.375 / 2.0), "t_mean_transit_s": NAN,
+                             "t_mean_transit_s_error": NAN, "n_transit": None},
         "rtd_eulerian": {"t_mean_s": 2.0, "variance_s2": 1.25, "t_s": 0.5, "t_d": 3.5, "fraction_exited": 1.0,
                          "bin_size_m": 0.005, "t_mean_s_error": math.sqrt(1.25 / 3.0)},
         "johanson": {"V1": 0.5, "P": 0.75},
+        # no Little's law on the transit clumps in this result: unknown, not zero
+        **NO_TRANSIT,
     })
     assert list(blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)["layouts"]) == ["bottom half", "top 25 %"]
     # RMS of (0.5 - 0.25, 0.75 - 0.75) over the two windows with data: sqrt(0.0625 / 2)
@@ -252,6 +257,58 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         "vrr_at_ceiling": [False, False], "prediction_rms_error": 0.25, "homogenised_after_recirculations": 2.0,
         "model_homogenised_after_recirculations": NAN, "vrr_by_recirculation_error": [TOP_ERROR, NAN],
     })
+
+
+NO_TRANSIT = {
+    "transit_horizon_s": NAN, "transit_holdup_clumps": NAN, "transit_holdup_clumps_error": NAN,
+    "transit_throughput_clumps_per_s": NAN, "transit_throughput_clumps_per_s_error": NAN,
+    "transit_residence_time_s": NAN, "transit_residence_time_s_error": NAN, "transit_fraction": NAN,
+    "transit_fraction_error": NAN, "slow_holdup_clumps": NAN, "slow_holdup_clumps_error": NAN,
+    "stagnant_clumps": None, "littles_law_difference_s": NAN, "littles_law_difference_s_error": NAN,
+    "littles_law_significance": "unknown", "littles_law_coverage_factor": 2.0,
+}
+# Little's law on the transit clumps: 12 +- 0.3 in transit at 10 +- 0.4 per second, 1.2 s (relative errors 0.025
+# and 0.04); 20 in all at 12.5 per second; the tracer's mean up to the 3 s horizon 1.1 +- 0.05 s over 30 tracers.
+TRANSIT = TransitLittlesLaw(
+    horizon=3.0, t_from=3.0, t_to=6.0,
+    transit=LittlesLaw(holdup=Estimate(12.0, 0.3, 10, "batch means", 9),
+                       throughput=Estimate(10.0, 0.4, 10, "batch rate", 9),
+                       residence_time=Estimate(1.2, 1.2 * math.hypot(0.025, 0.04), 10, "propagated batch means", 9)),
+    whole=LittlesLaw(holdup=Estimate(20.0, 0.5, 10, "batch means", 9),
+                     throughput=Estimate(12.5, 0.5, 10, "batch rate", 9),
+                     residence_time=Estimate(1.6, 0.1, 10, "propagated batch means", 9)),
+    transit_fraction=Estimate(0.8, 0.04, 100, "binomial"), slow_holdup=Estimate(8.0, 0.25, 10, "batch means", 9),
+    stagnant_clumps=5,
+)
+TRACER_TRANSIT_MEAN = Estimate(1.1, 0.05, 30, "tracer sample", 29)
+
+
+def test_blending_summary_reports_littles_law_on_the_transit_clumps_beside_the_holdup_residence_time():
+    result = dataclasses.replace(RESULT, transit=TRANSIT, tracer_transit_mean=TRACER_TRANSIT_MEAN)
+    summary = blending_summary(CASE, result, EULERIAN_RTD, 0.005)
+    transit_error = 1.2 * math.hypot(0.025, 0.04)
+    expected = {
+        "transit_horizon_s": 3.0, "transit_holdup_clumps": 12.0, "transit_holdup_clumps_error": 0.3,
+        "transit_throughput_clumps_per_s": 10.0, "transit_throughput_clumps_per_s_error": 0.4,
+        "transit_residence_time_s": 1.2, "transit_residence_time_s_error": transit_error,
+        "transit_fraction": 0.8, "transit_fraction_error": 0.04, "slow_holdup_clumps": 8.0,
+        "slow_holdup_clumps_error": 0.25, "stagnant_clumps": 5,
+        "littles_law_difference_s": 1.2 - 1.1, "littles_law_difference_s_error": math.hypot(transit_error, 0.05),
+        "littles_law_coverage_factor": 2.0,
+    }
+    np.testing.assert_equal({key: summary[key] for key in expected}, expected)
+    # 0.1 s against 2 x sqrt(0.0566^2 + 0.05^2) = 0.151 s: Little's law holds
+    assert summary["littles_law_significance"] == "not significant"
+    assert {key: summary["rtd_particle_ids"][key] for key in ("t_mean_transit_s", "t_mean_transit_s_error",
+                                                               "n_transit")} == {
+        "t_mean_transit_s": 1.1, "t_mean_transit_s_error": 0.05, "n_transit": 30}
+    # the holdup residence time (stagnant zones included) stays what it was
+    assert summary["residence_time_s"] == 2.0
+    # ... but not within one: 0.1 s > 0.0755 s
+    tight = blending_summary(CASE, result, EULERIAN_RTD, 0.005, k=1.0)
+    assert (tight["littles_law_significance"], tight["littles_law_coverage_factor"]) == ("significant", 1.0)
+    wide_apart = dataclasses.replace(result, tracer_transit_mean=Estimate(0.8, 0.05, 30, "tracer sample", 29))
+    assert blending_summary(CASE, wide_apart, EULERIAN_RTD, 0.005)["littles_law_significance"] == "significant"
 
 
 def test_blending_summary_flags_vrrs_at_the_ceiling_with_its_factor():
@@ -364,7 +421,9 @@ def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
                              "homogenised_after_recirculations", "model_homogenised_after_recirculations",
                              "vrr_ceiling", "vrr_at_ceiling_nr1", "vrr_at_ceiling_nr2", "vrr_at_ceiling_nr3",
                              "residence_time_s_error", "t_s_over_t_d_error", "rtd_mean_ids_s_error",
-                             "rtd_mean_eulerian_s_error", "vrr_nr1_error", "vrr_nr2_error", "vrr_nr3_error"]
+                             "rtd_mean_eulerian_s_error", "vrr_nr1_error", "vrr_nr2_error", "vrr_nr3_error",
+                             "transit_residence_time_s", "transit_residence_time_s_error", "rtd_mean_ids_transit_s",
+                             "rtd_mean_ids_transit_s_error"]
     np.testing.assert_equal(rows[0], {
         "flow_pattern": "semi", "layout": "blue13", "run_id": "r1", "residence_time_s": 2.0, "t_s_over_t_d": 0.25,
         "rtd_mean_ids_s": 1.5, "rtd_mean_eulerian_s": 1.6, "vrr_nr1": 2.0, "vrr_nr2": NAN, "vrr_nr3": 1.9,
@@ -374,6 +433,9 @@ def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
         # a summary written without errors: unknown, not zero
         "residence_time_s_error": NAN, "t_s_over_t_d_error": NAN, "rtd_mean_ids_s_error": NAN,
         "rtd_mean_eulerian_s_error": NAN, "vrr_nr1_error": NAN, "vrr_nr2_error": NAN, "vrr_nr3_error": NAN,
+        # nor the transit figures
+        "transit_residence_time_s": NAN, "transit_residence_time_s_error": NAN, "rtd_mean_ids_transit_s": NAN,
+        "rtd_mean_ids_transit_s_error": NAN,
     })
     ((label, nr, values, ceiling, errors),) = curves
     assert (label, nr, ceiling) == ("semi blue13", [0.5, 1.5, 2.5], 4.0)
@@ -395,6 +457,7 @@ def test_summary_rows_carry_the_errors_the_summary_holds():
     np.testing.assert_equal(errors, {
         "residence_time_s_error": 0.05, "t_s_over_t_d_error": 0.02, "rtd_mean_ids_s_error": 0.1,
         "rtd_mean_eulerian_s_error": 0.125, "vrr_nr1_error": 1.0, "vrr_nr2_error": NAN, "vrr_nr3_error": 0.5,
+        "transit_residence_time_s_error": NAN, "rtd_mean_ids_transit_s_error": NAN,
     })
     np.testing.assert_equal(curves[0][4], [1.0, NAN, 0.5])
 
@@ -409,6 +472,15 @@ def test_summary_rows_of_a_written_summary_give_the_errors_blending_summary_comp
     assert half["rtd_mean_ids_s_error"] == math.sqrt(0.375 / 2.0)
     assert half["rtd_mean_eulerian_s_error"] == math.sqrt(1.25 / 3.0)
     assert half["vrr_nr1_error"] == HALF_ERROR and math.isnan(half["vrr_nr2_error"])
+    assert math.isnan(half["transit_residence_time_s"]) and math.isnan(half["rtd_mean_ids_transit_s_error"])
+    result = dataclasses.replace(RESULT, transit=TRANSIT, tracer_transit_mean=TRACER_TRANSIT_MEAN)
+    written = json.loads(write_json(tmp_path / "transit.json",
+                                    blending_summary(CASE, result, EULERIAN_RTD, 0.005)).read_text())
+    half = summary_rows([written])[0][0]
+    assert (half["transit_residence_time_s"], half["transit_residence_time_s_error"]) == (
+        1.2, 1.2 * math.hypot(0.025, 0.04))
+    assert (half["rtd_mean_ids_transit_s"], half["rtd_mean_ids_transit_s_error"]) == (1.1, 0.05)
+    assert written["stagnant_clumps"] == 5 and written["littles_law_significance"] == "not significant"
 
 
 def test_summary_rows_take_the_flags_the_summary_holds_and_the_factor_otherwise():

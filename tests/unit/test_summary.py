@@ -337,3 +337,15 @@ def test_significance_rows_name_the_figure_in_words_and_print_the_difference_wit
     page = summary_html("siloflow", [("Blender: differences", "x", rows)])
     assert "−0.0024 ± 0.0015" in page or "-0.0024 ± 0.0015" in page
     assert "not significant" in page
+
+
+def test_recirculation_rows_add_the_transit_times_and_seed_count_when_the_table_has_them():
+    row = {"flow_pattern": "internal_flow", "layout": "blue13", "residence_time_s": 0.836,
+           "residence_time_s_error": 0.013, "transit_residence_time_s": 0.436, "transit_residence_time_s_error": 0.012,
+           "rtd_mean_ids_transit_s": 0.416, "rtd_mean_ids_transit_s_error": 0.011, "replicates": 3}
+    (picked,) = recirculation_rows([row])
+    assert picked["transit_residence_time_s"] == 0.436 and picked["rtd_mean_ids_transit_s_error"] == 0.011
+    assert picked["replicates"] == 3
+    page = summary_html("siloflow", [("Blending", "x", [picked])])
+    assert "Hold-up residence time (stagnant zones included) (s)" in page
+    assert "0.436 ± 0.012" in page and "0.416 ± 0.011" in page

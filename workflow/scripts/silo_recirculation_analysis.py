@@ -49,6 +49,12 @@ with logged_to(snakemake.log[0]) as log:
     log.info("t_res %.4g +- %.2g s (holdup %.1f +- %.2g clumps, throughput %.1f +- %.2g clumps/s), run covers "
              "Nr = %.2f", timing.residence_time, timing.residence_time_error, timing.holdup, timing.holdup_error,
              timing.throughput, timing.throughput_error, timing.recirculations)
+    transit, tracer_transit = result.transit, result.tracer_transit_mean
+    log.info("Little's law on the passes out within %.3g s: %.4g +- %.2g s (holdup %.1f, %.3f of the throughput); "
+             "tracer mean within it %.4g +- %.2g s; slow holdup %.1f clumps (%d never left), which t_res counts "
+             "and the tracer mean cannot", transit.horizon, transit.transit.residence_time.value,
+             transit.transit.residence_time.std_error, transit.transit.holdup.value, transit.transit_fraction.value,
+             tracer_transit.value, tracer_transit.std_error, transit.slow_holdup.value, transit.stagnant_clumps)
     eulerian = settings["eulerian"]
     eulerian_rtd = main_run_eulerian_rtd(
         tracks, loaded.velocity, loaded.mass, result, case["width_m"], case["depth_m"], top, case["outlet_width_m"],

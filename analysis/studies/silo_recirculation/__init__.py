@@ -5,6 +5,8 @@
 - ``concentration``: batch layers, outlet concentration measured and predicted (renewal equation).
 - ``vrr``: recirculation number, holdup residence time, VRR per recirculation.
 - ``tracers``: the tracer passes of the particle RTD. ``validation``: argument checks they share.
+- ``transit``: Little's law on the passes that leave within a horizon (the tracer's clumps) and the stagnant
+  holdup that makes holdup / throughput exceed the tracer's mean.
 - ``study``: the composed study of one run; ``plots`` and ``rtd_plots``: its figures (``rtd_plots`` is shared
   with the blender).
 """

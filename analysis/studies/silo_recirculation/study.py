@@ -8,8 +8,10 @@ Steps (SEED_DIGEST section 4):
 
 1. Events: re-entries at the top and outlet crossings of every clump
    (:func:`analysis.studies.silo_recirculation.tracks.recirculation_events`);
-   the mean residence time ``t_res`` = holdup / throughput over the steady part of the run (after the first
-   ``startup_fraction`` of it).
+   the holdup residence time ``t_res`` = holdup / throughput over the steady part of the run (after the first
+   ``startup_fraction`` of it). It counts every clump above the outlet, the stagnant zones included: the
+   turnover time of the contents, in which ``Nr`` is counted, and not the mean of a tracer that can leave
+   within the run (step 5).
 2. Direct measurement, per batch layout: colours from the heights at the opening, outlet concentration in windows
    of ``window_fraction t_res``, ``Nr = (t - t_open) / t_res``, VRR per recirculation, and the first-exit
    concentration of the initial contents.
@@ -20,6 +22,12 @@ Steps (SEED_DIGEST section 4):
    concentration with the measured loop RTD; continuous mode (sine and square VRR against period), discontinuous
    mode (layered batch fed over one t_res and recirculated), and Johanson's triangular RTD fitted to the first
    appearance and the mode of the measured one.
+5. Little's law on the same clumps as the tracer
+   (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`): over a horizon ``h`` (a third of
+   the run, :func:`analysis.studies.silo_recirculation.transit.transit_horizon`) the holdup of the passes lasting
+   at most ``h`` over their throughput against the tracer's mean of its residence times up to ``h``
+   (:func:`analysis.numerics.rtd.mean_residence_time_within`); the holdup of the slower rest (stagnant zones) is
+   what makes ``t_res`` exceed the tracer's ``t_m``.
 """
 
 from __future__ import annotations
@@ -31,7 +39,14 @@ import numpy as np
 
 from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
-from analysis.numerics.rtd import RTD, johanson_rtd, mean_residence_time, rtd_from_exit_times
+from analysis.numerics.rtd import (
+    RTD,
+    johanson_rtd,
+    mean_residence_time,
+    mean_residence_time_within,
+    rtd_from_exit_times,
+)
+from analysis.numerics.uncertainty import Estimate
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
     batch_inlet_signal,
@@ -41,6 +56,7 @@ from analysis.studies.silo_recirculation.concentration import (
     predicted_concentration_from_first_pass,
 )
 from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_passes
+from analysis.studies.silo_recirculation.transit import TransitLittlesLaw, transit_horizon, transit_littles_law
 from analysis.studies.silo_recirculation.tracks import (
     ClumpTracks,
     RecirculationEvents,
@@ -74,7 +90,9 @@ class LoopTiming:
     t_open, t_end : float
         First and last frame (outlet opening, end of run) [s].
     residence_time : float
-        Holdup over throughput in the steady part [s].
+        Holdup over throughput in the steady part [s]: the holdup residence time of everything above the outlet,
+        stagnant zones included (the turnover time; the mean residence time of the clumps that pass through is
+        :attr:`BlendingResult.transit`).
     holdup : float
         Mean number of clumps above the outlet plane in the steady part [-].
     throughput : float
@@ -148,7 +166,12 @@ class ParticleRTD:
 
 @dataclass(frozen=True, eq=False)
 class BlendingResult:
-    """Everything measured and predicted for one recirculation run."""
+    """Everything measured and predicted for one recirculation run.
+
+    ``transit`` is Little's law on the passes lasting at most its horizon and ``tracer_transit_mean`` the
+    tracer's mean residence time up to the same horizon [s]: the two agree, while ``timing.residence_time``
+    also counts the stagnant clumps (``transit.slow_holdup``). None when not computed.
+    """
 
     timing: LoopTiming
     events: RecirculationEvents
@@ -157,13 +180,22 @@ class BlendingResult:
     layouts: list[LayoutResult] = field(default_factory=list)
     vrr_sine: VRRTable | None = None
     vrr_square: VRRTable | None = None
+    transit: TransitLittlesLaw | None = None
+    tracer_transit_mean: Estimate | None = None
+
+
+#: Part of the run, from the outlet opening, left out of every steady-state figure [-].
+STARTUP_FRACTION = 0.1
 
 
 def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: float = 0.0,
-                startup_fraction: float = 0.1, n_batches: int = 10) -> LoopTiming:
-    """Holdup, throughput and mean residence time over the run after its first ``startup_fraction``, with their
+                startup_fraction: float = STARTUP_FRACTION, n_batches: int = 10) -> LoopTiming:
+    """Holdup, throughput and holdup residence time over the run after its first ``startup_fraction``, with their
     standard errors from ``n_batches`` batches of that steady part
-    (:func:`analysis.studies.silo_recirculation.vrr.littles_law`), and the frame interval."""
+    (:func:`analysis.studies.silo_recirculation.vrr.littles_law`), and the frame interval.
+
+    The holdup is every clump above the outlet, so with stagnant zones the residence time exceeds the mean of a
+    tracer that leaves within the run (see :func:`transit_timing`)."""
     if not 0.0 <= startup_fraction < 1.0:
         raise ValueError(f"startup_fraction must be in [0, 1), got {startup_fraction!r}")
     times = tracks.times
@@ -190,6 +222,23 @@ def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: floa
     )
 
 
+def transit_timing(tracks: ClumpTracks, events: RecirculationEvents, timing: LoopTiming, tracer: TracerPasses,
+                   horizon_fraction: float = 1.0 / 3.0, outlet_z: float = 0.0,
+                   n_batches: int = 10) -> tuple[TransitLittlesLaw, Estimate]:
+    """Little's law on the passes lasting at most a horizon, and the tracer's mean over the same passes.
+
+    The horizon is :func:`analysis.studies.silo_recirculation.transit.transit_horizon` (``horizon_fraction`` of
+    the run, at most the time the last tracer pass was followed); Little's law over the steady part
+    (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`) and the tracer's residence times
+    up to it (:func:`analysis.numerics.rtd.mean_residence_time_within`) then refer to the same control volume,
+    entry and exit events and clumps, and agree within their errors in a steady run.
+    """
+    horizon = transit_horizon(timing.t_open, timing.t_end, tracer.entry_time, horizon_fraction)
+    t_start = timing.t_open + STARTUP_FRACTION * (timing.t_end - timing.t_open)
+    little = transit_littles_law(tracks, events, horizon, t_start, outlet_z, n_batches)
+    return little, mean_residence_time_within(tracer.residence_time, horizon)
+
+
 def _johanson_parameters(rtd: RTD) -> tuple[float, float]:
     """Johanson's V1 (first appearance) and P (mode) in throughput units, clipped to the model's range."""
     v1 = min(max(rtd.t_first / rtd.t_mean, 0.0), 0.99)
@@ -210,7 +259,10 @@ def particle_rtd(events: RecirculationEvents, timing: LoopTiming, tracer_fractio
                  bins: int, window: float, horizon_recirculations: float = 2.0) -> ParticleRTD:
     """RTD from particle ids: the first ``tracer_fraction`` x holdup passes re-entering after ``Nr = tracer_start``.
 
-    The silo RTD of the study uses that tracer, with the re-entry at the top as the entry. The LTI models need a
+    The silo RTD of the study uses that tracer, with the re-entry at the top as the entry; its mean ``t_m`` is over
+    the tracer passes that left by the end of the run, so it leaves out the clumps held in the stagnant zones
+    and is shorter than the holdup residence time ``timing.residence_time`` (:func:`transit_timing` compares
+    like with like). The LTI models need a
     smoother RTD than a 10 % tracer gives: they take every pass entering between the tracer's start and
     ``horizon_recirculations`` t_res before the end of the run (at least the tracer's count), for the silo
     (re-entry to outlet) and for the whole loop (previous outlet crossing to exit, which the renewal equation
@@ -249,7 +301,8 @@ def _with_little_tail(passes: TracerPasses, step: float, mean_loop_time: float, 
 
     Passes still in the loop at the end of the run (slow paths along the walls) are missing from the histogram;
     normalising it would shorten the mean loop time and make the renewal prediction recycle too fast. In a
-    closed loop the mean loop time is known exactly, every clump over the throughput (Little's law), so the
+    closed loop the mean loop time is known exactly, every clump over the throughput (Little's law, assuming
+    the stagnant zones exchange clumps with the flow rather than hold them for ever), so the
     missing fraction ``f_c`` is put back as ``f_c exp(-(t - T) / tau) / tau`` after the longest observed loop
     time ``T``, with ``tau`` chosen so that the whole RTD has that mean. Without a censored part, or when the
     observed part already has the mean, the histogram is returned as it is.
@@ -381,8 +434,9 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
     results = [analyse_layout(layout, initial_height, events, timing, window, rtd, passes, tolerance)
                for layout in layouts]
     sine, square = continuous_mode(rtd, period_fractions)
+    transit, tracer_transit_mean = transit_timing(tracks, events, timing, rtd.tracer, outlet_z=outlet_z)
     return BlendingResult(timing=timing, events=events, window=window, rtd=rtd, layouts=results, vrr_sine=sine,
-                          vrr_square=square)
+                          vrr_square=square, transit=transit, tracer_transit_mean=tracer_transit_mean)
 
 
 def snapshot_frames(times, t_open: float, residence_time: float, recirculation_numbers) -> list[int]:

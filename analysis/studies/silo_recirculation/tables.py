@@ -15,12 +15,25 @@ Standard errors follow the convention of the summary page: the error of a figure
 in its unit, beside it (NaN, written null or empty, when not known). Their sources:
 
 - ``residence_time_s``: batch means of the holdup and batch rates of the discharge over the steady part,
-  propagated (:func:`analysis.studies.silo_recirculation.vrr.littles_law`);
+  propagated (:func:`analysis.studies.silo_recirculation.vrr.littles_law`); the same for
+  ``transit_residence_time_s`` over the transit window
+  (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`);
 - ``t_s_over_t_d``: the order-statistic gaps of the tracer (tracer counting) and the frame interval (time
   resolution), propagated (:func:`analysis.numerics.rtd.appearance_times`);
-- RTD means: ``s / sqrt(n)`` over the tracers that left (:attr:`analysis.numerics.rtd.RTD.t_mean_error`);
+- RTD means: ``s / sqrt(n)`` over the tracers that left (:attr:`analysis.numerics.rtd.RTD.t_mean_error`), or
+  that left within the transit horizon (``t_mean_transit_s``);
 - VRR: ``sqrt(2 / (N - 1)) VRR`` over the ``N`` windows of the recirculation
   (:func:`analysis.studies.silo_recirculation.vrr.vrr_standard_error`).
+
+Two residence times
+-------------------
+``residence_time_s`` is the *holdup* residence time, every clump above the outlet over the throughput: it
+counts the stagnant zones of the flat-bottom silo, whose clumps stay longer than the run, and is the time scale
+of ``Nr``. The tracer's ``rtd_particle_ids.t_mean_s`` is the mean over the tracers that left by the end of the
+run, blind to those clumps, so it is shorter. Little's law is checked on the same clumps:
+``transit_residence_time_s`` (holdup of the passes lasting at most ``transit_horizon_s`` over their
+throughput) against ``rtd_particle_ids.t_mean_transit_s`` (the tracer's residence times up to the same
+horizon), with their difference ``littles_law_difference_s``; ``slow_holdup_clumps`` is the rest of the holdup.
 """
 
 from __future__ import annotations
@@ -50,6 +63,7 @@ __all__ = [
     "vrr_period_rows",
     "clumps_per_window",
     "blending_summary",
+    "transit_summary",
     "verification_rows",
     "mean_comparison",
     "verification_summary",
@@ -239,7 +253,7 @@ def clumps_per_window(result: BlendingResult) -> float:
 
 
 def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float,
-                     factor: float = CEILING_FACTOR) -> dict:
+                     factor: float = CEILING_FACTOR, k: float = 2.0) -> dict:
     """The summary of one recirculation run (``blending.json``).
 
     Parameters
@@ -254,6 +268,9 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         Bin edge of the Eulerian RTD's velocity field [m].
     factor : float, optional
         A measured VRR at or above ``vrr_sampling_limit / factor`` is flagged as at the ceiling, >= 1 [-].
+    k : float, optional
+        Coverage factor of the Little's law check (:func:`analysis.numerics.uncertainty.difference_significant`),
+        > 0 [-].
 
     Returns
     -------
@@ -272,12 +289,25 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         ``t_s_error``, ``t_d_error`` and ``t_s_over_t_d_error`` (order-statistic gaps and time resolution) and the
         ``time_resolution_s`` of one residence time (``frame_interval_s / sqrt(6)``) [s]; in ``rtd_eulerian``
         ``t_mean_s_error``; per layout ``vrr_by_recirculation_error`` (``sqrt(2 / (N - 1)) VRR``).
+
+        Little's law on the clumps that pass through (:attr:`BlendingResult.transit`; NaN, and None for the
+        counts, when the result has none): ``transit_horizon_s`` ``h`` [s], ``transit_holdup_clumps`` [-],
+        ``transit_throughput_clumps_per_s`` [1/s] and ``transit_residence_time_s`` [s] of the passes lasting at
+        most ``h``, ``transit_fraction`` of the crossings they make [-], ``slow_holdup_clumps`` (the rest of
+        the holdup: stagnant zones and slow creep [-]) and ``stagnant_clumps`` (above the outlet all run [-]),
+        each number with its ``_error``; in ``rtd_particle_ids`` ``t_mean_transit_s`` with its error (the
+        tracer's residence times up to ``h`` [s]) and ``n_transit`` (those tracers [-]); and
+        ``littles_law_difference_s`` (``transit_residence_time_s - t_mean_transit_s`` [s]) with its error
+        (the two independent) and ``littles_law_significance`` (beyond ``k`` errors: ``"significant"``,
+        ``"not significant"`` or ``"unknown"``) with ``littles_law_coverage_factor`` ``k`` [-].
     """
     timing = result.timing
     silo_rtd = result.rtd.silo
     particles_per_window = clumps_per_window(result)
     resolution = residence_time_resolution(timing.frame_interval)
     appearance = appearance_times(result.rtd.tracer.residence_time, resolution)
+    transit = transit_summary(result, k)
+    transit_tracer = transit.pop("rtd_particle_ids")
     return {
         "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
         "residence_time_s": timing.residence_time, "residence_time_s_error": timing.residence_time_error,
@@ -292,7 +322,8 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
                              "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited,
                              "t_mean_s_error": silo_rtd.t_mean_error, "t_s_error": appearance.t_first.std_error,
                              "t_d_error": appearance.t_last.std_error,
-                             "t_s_over_t_d_error": appearance.ts_over_td.std_error, "time_resolution_s": resolution},
+                             "t_s_over_t_d_error": appearance.ts_over_td.std_error, "time_resolution_s": resolution,
+                             **transit_tracer},
         "rtd_eulerian": {"t_mean_s": eulerian_rtd.t_mean, "variance_s2": eulerian_rtd.variance,
                          "t_s": eulerian_rtd.t_first, "t_d": eulerian_rtd.t_last,
                          "fraction_exited": eulerian_rtd.fraction_exited, "bin_size_m": eulerian_bin_size,
@@ -310,6 +341,42 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
             }
             for layout in result.layouts
         },
+        **transit,
+    }
+
+
+def transit_summary(result: BlendingResult, k: float = 2.0) -> dict:
+    """The Little's law keys of :func:`blending_summary` (its docstring lists them), those of the tracer under
+    ``"rtd_particle_ids"``; NaN (None for counts) when ``result.transit`` is None."""
+    little, mean = result.transit, result.tracer_transit_mean
+    if little is None or mean is None:
+        nan = math.nan
+        return {
+            "transit_horizon_s": nan, "transit_holdup_clumps": nan, "transit_holdup_clumps_error": nan,
+            "transit_throughput_clumps_per_s": nan, "transit_throughput_clumps_per_s_error": nan,
+            "transit_residence_time_s": nan, "transit_residence_time_s_error": nan, "transit_fraction": nan,
+            "transit_fraction_error": nan, "slow_holdup_clumps": nan, "slow_holdup_clumps_error": nan,
+            "stagnant_clumps": None, "littles_law_difference_s": nan, "littles_law_difference_s_error": nan,
+            "littles_law_significance": Significance.UNKNOWN.value, "littles_law_coverage_factor": float(k),
+            "rtd_particle_ids": {"t_mean_transit_s": nan, "t_mean_transit_s_error": nan, "n_transit": None},
+        }
+    transit = little.transit
+    residence = transit.residence_time
+    significance = difference_significant(residence.value, residence.std_error, mean.value, mean.std_error, k)
+    return {
+        "transit_horizon_s": little.horizon,
+        "transit_holdup_clumps": transit.holdup.value, "transit_holdup_clumps_error": transit.holdup.std_error,
+        "transit_throughput_clumps_per_s": transit.throughput.value,
+        "transit_throughput_clumps_per_s_error": transit.throughput.std_error,
+        "transit_residence_time_s": residence.value, "transit_residence_time_s_error": residence.std_error,
+        "transit_fraction": little.transit_fraction.value, "transit_fraction_error": little.transit_fraction.std_error,
+        "slow_holdup_clumps": little.slow_holdup.value, "slow_holdup_clumps_error": little.slow_holdup.std_error,
+        "stagnant_clumps": little.stagnant_clumps,
+        "littles_law_difference_s": residence.value - mean.value,
+        "littles_law_difference_s_error": combine_independent([residence.std_error, mean.std_error]),
+        "littles_law_significance": significance.value, "littles_law_coverage_factor": float(k),
+        "rtd_particle_ids": {"t_mean_transit_s": mean.value, "t_mean_transit_s_error": mean.std_error,
+                             "n_transit": mean.n},
     }
 
 
@@ -436,7 +503,11 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
         none) and ``vrr_at_ceiling_nr<k>`` (bool: that VRR is only a lower bound), then the standard errors
         ``residence_time_s_error`` [s], ``t_s_over_t_d_error`` [-], ``rtd_mean_ids_s_error`` [s],
         ``rtd_mean_eulerian_s_error`` [s] and ``vrr_nr<k>_error`` [-] (NaN where the summary has none, e.g. one
-        written before the errors were).
+        written before the errors were), then Little's law on the same clumps: ``transit_residence_time_s``
+        (holdup of the passes lasting at most the transit horizon over their throughput [s]) and
+        ``rtd_mean_ids_transit_s`` (the tracer's mean up to that horizon [s]), each with its ``_error`` (NaN
+        for a summary without them). ``residence_time_s`` is the holdup residence time, stagnant zones
+        included; ``rtd_mean_ids_s`` the mean of the tracers that left in the run.
     curves : list of tuple
         ``(label, recirculation at mid-window, VRR, ceiling, VRR error)`` per row, for
         :func:`analysis.studies.silo_recirculation.plots.plot_vrr_versus_recirculations` (``ceiling`` None if the
@@ -471,6 +542,10 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
                 "rtd_mean_ids_s_error": _number(particle_rtd.get("t_mean_s_error")),
                 "rtd_mean_eulerian_s_error": _number(eulerian_rtd.get("t_mean_s_error")),
                 **{f"vrr_nr{k + 1}_error": e for k, e in enumerate(errors)},
+                "transit_residence_time_s": _number(summary.get("transit_residence_time_s")),
+                "transit_residence_time_s_error": _number(summary.get("transit_residence_time_s_error")),
+                "rtd_mean_ids_transit_s": _number(particle_rtd.get("t_mean_transit_s")),
+                "rtd_mean_ids_transit_s_error": _number(particle_rtd.get("t_mean_transit_s_error")),
             })
     return rows, curves
 

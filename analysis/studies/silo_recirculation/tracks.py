@@ -471,9 +471,12 @@ def clumps_above_outlet(tracks: ClumpTracks, outlet_z: float) -> np.ndarray:
     """Number of clumps above the outlet plane in each frame (the holdup of the silo).
 
     Counts the present clumps with ``z > outlet_z``, which includes clumps falling from the top
-    of the domain onto the pile after re-entry: with passes beginning at the re-entry, this is the
-    holdup whose ratio to the throughput is the mean pass residence time (Little's law,
-    :func:`holdup_residence_time`).
+    of the domain onto the pile after re-entry (passes begin at the re-entry, so the fall is part of
+    every pass) and the clumps of the stagnant zones: its ratio to the throughput is the holdup
+    residence time (Little's law,
+    :func:`analysis.studies.silo_recirculation.vrr.holdup_residence_time`), which exceeds the mean of
+    the passes that leave within a run by the stagnant part
+    (:mod:`analysis.studies.silo_recirculation.transit`).
 
     Parameters
     ----------

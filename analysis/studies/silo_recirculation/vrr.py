@@ -4,8 +4,9 @@ Pure functions on numpy arrays; no file I/O. SI units: times in s; concentration
 
 Recirculation number and VRR
 ----------------------------
-``Nr = (t - t_open) / t_res`` with the mean residence time ``t_res`` = holdup / throughput
-(Little's law, :func:`holdup_residence_time`). The windows of recirculation k are those with
+``Nr = (t - t_open) / t_res`` with the holdup residence time ``t_res`` = holdup / throughput
+(Little's law, :func:`holdup_residence_time`): the turnover time of everything above the outlet, stagnant
+zones included. The windows of recirculation k are those with
 ``k - 1 <= Nr < k``; ``VRR_k = p (1 - p) / var(c)`` over them (:func:`vrr_by_recirculation`), the
 input variance being that of the 0/1 batch with blue fraction ``p``.
 
@@ -165,9 +166,12 @@ def holdup_residence_time(n_in_silo, exit_times, t_start: float, t_end: float) -
     """Mean residence time ``t_res`` = mean holdup / throughput (Little's law) [s].
 
     ``t_res = mean(n_in_silo) / (n_exits / (t_end - t_start))``, with ``n_exits`` the crossings with
-    ``t_start <= t <= t_end``. In a steady flow it equals the mean pass residence time (re-entry to
-    outlet) when the holdup counts the clumps above the outlet
-    (:func:`analysis.studies.silo_recirculation.tracks.clumps_above_outlet`).
+    ``t_start <= t <= t_end``. In a steady flow it equals the mean residence time (re-entry to outlet) of
+    *all* entering clumps when the holdup counts the clumps above the outlet
+    (:func:`analysis.studies.silo_recirculation.tracks.clumps_above_outlet`), the few that settle into a
+    stagnant zone for longer than any run included. A tracer's mean over the passes that left within a
+    finite run is shorter by the stagnant holdup over the throughput; Little's law on the passes that can
+    leave within a horizon is :func:`analysis.studies.silo_recirculation.transit.transit_littles_law`.
 
     Parameters
     ----------
