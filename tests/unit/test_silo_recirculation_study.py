@@ -531,3 +531,12 @@ def test_residence_summary_counts_and_moments():
                                            "std_s": None}
     single = residence_summary([4.0, np.nan])
     assert (single["mean_s"], single["std_s"]) == (4.0, 0.0) and math.isnan(single["mean_s_error"])
+
+
+def test_a_target_vrr_sizes_the_concentration_window_from_the_throughput(tracks):
+    # the conveyor passes 10 clumps/s: a VRR of 12 needs more than 24 clumps per window, 25 clumps = 2.5 s
+    sized = analyse_blending(
+        tracks, LAYOUTS[:1], BOTTOM, TOP, WINDOW_FRACTION, TRACER_FRACTION, TRACER_START, RTD_BINS, PERIOD_FRACTIONS,
+        PASSES, TOLERANCE, outlet_z=OUTLET, window_target_vrr=12.0,
+    )
+    assert sized.window == pytest.approx(2.5, rel=1e-12)

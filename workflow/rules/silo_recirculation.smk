@@ -70,7 +70,8 @@ rule silo_recirculation_analysis:
         per_layout=directory(f"{run_dir(RECIRCULATION)}/plots/layouts"),
     params:
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
-                                    ("layouts", "lti", "concentration_window", "tracer", "eulerian", "snapshots")},
+                                    ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
+                                     "eulerian", "snapshots")},
     log:
         f"{run_dir(RECIRCULATION)}/logs/analysis.log",
     script:

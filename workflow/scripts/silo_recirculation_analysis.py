@@ -43,7 +43,7 @@ with logged_to(snakemake.log[0]) as log:
     result = analyse_blending(
         tracks, layouts, bottom, top, settings["concentration_window"], settings["tracer"]["volume_fraction"],
         settings["tracer"]["start_recirculations"], settings["tracer"]["bins"], lti["period_fractions"],
-        lti["passes"], lti["tolerance"],
+        lti["passes"], lti["tolerance"], window_target_vrr=settings["concentration_window_target_vrr"],
     )
     timing = result.timing
     log.info("t_res %.4g +- %.2g s (holdup %.1f +- %.2g clumps, throughput %.1f +- %.2g clumps/s), run covers "

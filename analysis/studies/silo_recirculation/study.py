@@ -46,7 +46,7 @@ from analysis.numerics.rtd import (
     mean_residence_time_within,
     rtd_from_exit_times,
 )
-from analysis.numerics.uncertainty import Estimate
+from analysis.numerics.uncertainty import Estimate, window_duration_for_precision
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
     batch_inlet_signal,
@@ -400,7 +400,8 @@ def continuous_mode(rtd: ParticleRTD, period_fractions, samples_per_shortest_per
 
 def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_top: float, window_fraction: float,
                      tracer_fraction: float, tracer_start: float, rtd_bins: int, period_fractions, passes: int,
-                     tolerance: float, outlet_z: float = 0.0) -> BlendingResult:
+                     tolerance: float, outlet_z: float = 0.0, window_target_vrr: float | None = None
+                     ) -> BlendingResult:
     """The whole direct + RTD + LTI analysis of one recirculation run (see the module docstring).
 
     Parameters
@@ -425,10 +426,18 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
         Relative band that counts as homogenised [-].
     outlet_z : float, optional
         Height of the outlet plane [m].
+    window_target_vrr : float or None, optional
+        When given, the concentration window is sized from it instead of ``window_fraction``: long enough that a VRR
+        of this size lies a factor :data:`~analysis.numerics.uncertainty.CEILING_FACTOR` below the counting-noise
+        ceiling of the windows (:func:`~analysis.numerics.uncertainty.window_duration_for_precision` at the measured
+        throughput) [-].
     """
     events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
     timing = loop_timing(tracks, events, outlet_z)
-    window = window_fraction * timing.residence_time
+    if window_target_vrr is None:
+        window = window_fraction * timing.residence_time
+    else:
+        window = window_duration_for_precision(window_target_vrr, timing.throughput)
     rtd = particle_rtd(events, timing, tracer_fraction, tracer_start, rtd_bins, window)
     initial_height = tracks.position[0, :, 2]
     results = [analyse_layout(layout, initial_height, events, timing, window, rtd, passes, tolerance)
