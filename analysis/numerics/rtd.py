@@ -19,16 +19,8 @@ Models: the perfect mixer ``E = exp(-t/tau)/tau``, plug flow (a narrow pulse at 
 a triangular reading of Johanson's two-parameter blending model. Carson and Royal's recycling of a
 measured first-pass curve (repeated convolution) is :func:`analysis.numerics.lti.carson_royal_recycle`.
 
-Uncertainty of a measured RTD
------------------------------
-The tracers are taken as independent draws from the RTD. The mean residence time then has the standard error
-``s / sqrt(n)`` over the ``n`` tracers that left (:attr:`RTD.t_mean_error`, :func:`mean_residence_time`). The
-extremes ``t_s`` and ``t_d`` are order statistics: their sampling error is about the gap to the next value
-inward, and each event time is known only to the frame interval of the record
-(:func:`residence_time_resolution`); :func:`appearance_times` combines the two and propagates them to
-``t_s / t_d``. Tracers still inside at the end (NaN) are left out, which biases ``t_m`` and ``t_d`` low; that
-bias is not part of the errors. Cutting every tracer at one horizon it was followed for removes it from the
-mean (:func:`mean_residence_time_within`), which Little's law then reproduces on the same passes.
+Uncertainty of a measured RTD: :attr:`RTD.t_mean_error` here; the statistics of tracer residence times (means
+with their errors, first and last appearance) are in :mod:`analysis.numerics.residence_statistics`.
 """
 
 from __future__ import annotations
@@ -40,18 +32,12 @@ import numpy as np
 from scipy.integrate import trapezoid
 
 from analysis.checks import finite_array, positive_number
-from analysis.numerics.uncertainty import Estimate, combine_independent, seed_spread
 
 __all__ = [
     "RTD",
     "RTDMoments",
-    "AppearanceTimes",
     "rtd_from_exit_times",
     "rtd_moments",
-    "mean_residence_time",
-    "mean_residence_time_within",
-    "residence_time_resolution",
-    "appearance_times",
     "perfect_mixer_rtd",
     "plug_flow_rtd",
     "johanson_rtd",
@@ -134,7 +120,7 @@ class RTD:
     def t_mean_error(self) -> float:
         """Standard error of :attr:`t_mean`, ``s / sqrt(n_exited)`` with the sample standard deviation ``s``
         (``ddof = 1``) of the residence times that left, i.e. ``sqrt(variance / (n_exited - 1))`` [s]; NaN for a
-        single tracer. Assumes independent tracers (see :func:`mean_residence_time`)."""
+        single tracer. Assumes independent tracers (see :func:`analysis.numerics.residence_statistics.mean_residence_time`)."""
         if self.n_exited < 2:
             return math.nan
         return math.sqrt(self.variance / (self.n_exited - 1))
@@ -300,192 +286,6 @@ def rtd_moments(time, E) -> RTDMoments:
     mean = float(trapezoid(t * e, t)) / area
     variance = float(trapezoid((t - mean) ** 2 * e, t)) / area
     return RTDMoments(area=area, mean=mean, variance=variance)
-
-
-# --------------------------------------------------------------------------- uncertainty
-
-
-@dataclass(frozen=True)
-class AppearanceTimes:
-    """First appearance ``t_s``, time to discharge all the tracer ``t_d`` and their ratio, with standard errors.
-
-    Attributes
-    ----------
-    t_first, t_last : Estimate
-        ``t_s`` and ``t_d`` [s].
-    ts_over_td : Estimate
-        ``t_s / t_d`` [-].
-    """
-
-    t_first: Estimate
-    t_last: Estimate
-    ts_over_td: Estimate
-
-
-def _exited(residence_times) -> np.ndarray:
-    """The finite residence times of a sample (NaN: not out), refusing infinite values and an empty result."""
-    times = np.asarray(residence_times, dtype=float)
-    if times.ndim != 1:
-        raise ValueError(f"residence_times must be a 1-D array, got shape {times.shape}")
-    if np.any(np.isinf(times)):
-        raise ValueError("residence_times must not contain infinite values (use NaN for tracers still inside)")
-    finite = times[np.isfinite(times)]
-    if finite.size == 0:
-        raise ValueError("residence_times: no tracer left (all entries are NaN or none given)")
-    return finite
-
-
-def mean_residence_time(residence_times) -> Estimate:
-    """Mean residence time of a tracer sample and its standard error ``s / sqrt(n)`` [s].
-
-    ``s`` is the sample standard deviation (``ddof = 1``) of the ``n`` residence times that are not NaN. The
-    error assumes the tracers are independent draws from the RTD: tracers released together that share one
-    realisation of the flow are correlated, and then the error is too small. Tracers still inside (NaN) are
-    left out, which biases the mean low; the error does not include that bias.
-
-    Parameters
-    ----------
-    residence_times : array_like, shape (n_total,)
-        Residence time of each tracer [s]; NaN for a tracer that did not leave.
-
-    Returns
-    -------
-    Estimate
-        ``method="tracer sample"``, ``n`` the tracers that left, ``dof = n - 1``; the error is NaN for one
-        tracer.
-
-    Raises
-    ------
-    ValueError
-        On a non-1-D array, infinite values, or no finite residence time.
-    """
-    finite = _exited(residence_times)
-    # seed_spread is the mean and standard error of independent samples; here the samples are tracers
-    spread = seed_spread(finite)
-    return Estimate(value=spread.mean, std_error=spread.std_error, n=spread.n, method="tracer sample",
-                    dof=spread.n - 1 if spread.n > 1 else math.inf)
-
-
-def mean_residence_time_within(residence_times, horizon: float) -> Estimate:
-    """Mean residence time of the tracers that left within ``horizon`` of their entry, with its standard error [s].
-
-    :func:`mean_residence_time` of the residence times ``t <= horizon``: ``E[t | t <= h]``, the mean of the RTD
-    truncated at ``h``; longer ones and NaN (still inside) are left out. With every tracer followed for at least
-    ``horizon``, a NaN one is known to stay longer, so this mean is not censored (that of all that left is).
-
-    Parameters
-    ----------
-    residence_times : array_like, shape (n_total,)
-        Residence time of each tracer [s]; NaN for a tracer that did not leave.
-    horizon : float
-        Longest residence time counted ``h``, > 0 [s].
-
-    Returns
-    -------
-    Estimate
-        As :func:`mean_residence_time` (``n`` the tracers counted, error ``s / sqrt(n)``, NaN for one).
-
-    Raises
-    ------
-    ValueError
-        On a bad ``horizon``, a non-1-D array, infinite values, or no tracer out within ``horizon``.
-    """
-    h = positive_number("horizon", horizon)
-    times = _exited(residence_times)  # the checks, and NaN (still inside) out
-    if not np.any(times <= h):
-        raise ValueError(f"residence_times: no tracer left within the horizon {h!r} s")
-    return mean_residence_time(times[times <= h])
-
-
-def residence_time_resolution(frame_interval: float) -> float:
-    """Standard error of a residence time whose entry and exit are each known only to one frame interval [s].
-
-    An event between two saved frames ``Delta`` apart is taken as anywhere in that interval with equal
-    probability (variance ``Delta^2 / 12``), whatever interpolation placed it; a residence time is the
-    difference of two such independent events, so its error is ``Delta / sqrt(6)``. This bounds the error
-    from above: interpolating between the frames places an event better when the motion is smooth.
-
-    Parameters
-    ----------
-    frame_interval : float
-        Time between saved frames ``Delta``, >= 0, or NaN when not known [s].
-
-    Returns
-    -------
-    float
-        ``Delta / sqrt(6)`` [s]; NaN for an unknown interval.
-
-    Raises
-    ------
-    ValueError
-        If ``frame_interval`` is negative or infinite.
-    """
-    interval = float(frame_interval)
-    if math.isinf(interval) or interval < 0.0:
-        raise ValueError(f"frame_interval must be a finite number >= 0 or NaN (unknown), got {frame_interval!r}")
-    return interval / math.sqrt(6.0)
-
-
-def appearance_times(residence_times, resolution: float = 0.0) -> AppearanceTimes:
-    """``t_s``, ``t_d`` and ``t_s / t_d`` of a tracer sample, each with its standard error.
-
-    ``t_s`` and ``t_d`` are the shortest and the longest of the ``n`` residence times that are not NaN (as in
-    :func:`rtd_from_exit_times`). Two errors are combined in quadrature (:func:`combine_independent`):
-
-    - tracer counting: an extreme of ``n`` draws scatters from sample to sample by about the gap to the next
-      value inward, ``t_(2) - t_(1)`` for ``t_s`` and ``t_(n) - t_(n-1)`` for ``t_d`` (exact in expectation for
-      a density that is flat at the extreme, where both are ``1 / (n f)``; for an exponential tail the
-      standard deviation of the maximum is ``pi / sqrt(6)``, about 1.3, times the expected gap);
-    - time resolution: ``resolution`` (:func:`residence_time_resolution` of the frame interval).
-
-    ``t_s`` and ``t_d`` are taken as independent (the two ends of a sample), so the relative error of the
-    ratio is the quadrature sum of theirs. Tracers still inside (NaN) are left out: ``t_d`` is then only the
-    longest residence time observed, a lower bound that the error does not cover.
-
-    Parameters
-    ----------
-    residence_times : array_like, shape (n_total,)
-        Residence time of each tracer [s]; NaN for a tracer that did not leave.
-    resolution : float, optional
-        Standard error of one residence time from the time resolution of the record, >= 0, or NaN when not
-        known [s].
-
-    Returns
-    -------
-    AppearanceTimes
-        Errors NaN (unknown) when fewer than two tracers left or the resolution is NaN;
-        ``method="order-statistic gap"``, ``n`` the tracers that left.
-
-    Raises
-    ------
-    ValueError
-        On a non-1-D array, infinite values, no finite residence time, a negative residence time or a
-        longest one of 0, or a bad ``resolution``.
-    """
-    finite = np.sort(_exited(residence_times))
-    if finite[0] < 0.0:
-        raise ValueError("residence_times must be >= 0")
-    if not finite[-1] > 0.0:
-        raise ValueError("residence_times: the longest is 0, so t_s / t_d is undefined")
-    resolution = float(resolution)
-    if math.isinf(resolution) or resolution < 0.0:
-        raise ValueError(f"resolution must be a finite number >= 0 or NaN (unknown), got {resolution!r}")
-    n = int(finite.size)
-    first, last = float(finite[0]), float(finite[-1])
-    if n < 2:
-        first_error = last_error = math.nan
-    else:
-        first_error = combine_independent([finite[1] - finite[0], resolution])
-        last_error = combine_independent([finite[-1] - finite[-2], resolution])
-    ratio = first / last
-    # relative errors add in quadrature for a ratio; t_s = 0 has no relative error but an absolute one
-    ratio_error = combine_independent([first_error / last, ratio * last_error / last])
-    method = "order-statistic gap"
-    return AppearanceTimes(
-        t_first=Estimate(value=first, std_error=first_error, n=n, method=method),
-        t_last=Estimate(value=last, std_error=last_error, n=n, method=method),
-        ts_over_td=Estimate(value=ratio, std_error=ratio_error, n=n, method=method),
-    )
 
 
 # --------------------------------------------------------------------------- models

@@ -10,15 +10,17 @@ import pytest
 from analysis.numerics.rtd import (
     RTD,
     RTDMoments,
-    appearance_times,
     johanson_rtd,
-    mean_residence_time,
-    mean_residence_time_within,
     perfect_mixer_rtd,
     plug_flow_rtd,
-    residence_time_resolution,
     rtd_from_exit_times,
     rtd_moments,
+)
+from analysis.numerics.residence_statistics import (
+    appearance_times,
+    mean_residence_time,
+    mean_residence_time_within,
+    residence_time_resolution,
 )
 
 

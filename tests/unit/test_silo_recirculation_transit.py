@@ -23,7 +23,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.rtd import mean_residence_time
+from analysis.numerics.residence_statistics import mean_residence_time
 from analysis.studies.silo_recirculation.study import loop_timing, transit_timing
 from analysis.studies.silo_recirculation.tracers import tracer_passes
 from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events

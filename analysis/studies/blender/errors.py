@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.checks import finite_array, finite_number
-from analysis.numerics.rtd import appearance_times
+from analysis.numerics.residence_statistics import appearance_times
 from analysis.numerics.uncertainty import Estimate, batch_means, batch_rate, combine_independent
 from analysis.studies.blender.profiles import passage_mean_v_z
 from analysis.studies.blender.steady_field import checked_field

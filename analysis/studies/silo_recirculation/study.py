@@ -39,13 +39,8 @@ import numpy as np
 
 from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
-from analysis.numerics.rtd import (
-    RTD,
-    johanson_rtd,
-    mean_residence_time,
-    mean_residence_time_within,
-    rtd_from_exit_times,
-)
+from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
+from analysis.numerics.residence_statistics import mean_residence_time, mean_residence_time_within
 from analysis.numerics.uncertainty import Estimate, window_duration_for_precision
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,

@@ -43,7 +43,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from analysis.numerics.rtd import RTD, appearance_times, johanson_rtd, residence_time_resolution
+from analysis.numerics.rtd import RTD, johanson_rtd
+from analysis.numerics.residence_statistics import appearance_times, residence_time_resolution
 from analysis.numerics.uncertainty import (
     CEILING_FACTOR,
     Significance,
