@@ -22,25 +22,28 @@ from __future__ import annotations
 
 import html
 import math
-import numbers
 import re
 from collections.abc import Callable, Mapping, Sequence
-from decimal import ROUND_HALF_UP, Decimal
 from typing import NamedTuple
 
-import numpy as np
+from analysis.report.cells import (
+    COUNT,
+    ESTIMATE,
+    FLAG,
+    NO_UNCERTAINTY,
+    NUMBER,
+    TEXT,
+    format_cell,
+    is_missing,
+)
 
 __all__ = [
     "COLUMNS",
     "COLUMN_FAMILIES",
-    "NO_UNCERTAINTY",
     "Column",
     "Section",
     "column_for",
     "column_header",
-    "format_number",
-    "format_value_with_error",
-    "format_cell",
     "summary_html",
     "calibration_rows",
     "silo_flow_rows",
@@ -52,18 +55,8 @@ __all__ = [
     "summary_sections",
 ]
 
-#: Column kinds: free text, a whole count, a number shown as it is, a figure of merit that should carry its
-#: standard error, a yes/no flag.
-TEXT, COUNT, NUMBER, ESTIMATE, FLAG = "text", "count", "number", "estimate", "flag"
-#: What a figure of merit without an uncertainty shows after its value.
-NO_UNCERTAINTY = "±?"
 #: Suffix of the key that carries the standard error of a column.
 ERROR_SUFFIX = "_error"
-#: Significant digits of a number printed without an uncertainty.
-SIGNIFICANT_DIGITS = 4
-#: Decimal exponents outside [-3, 5] print as mantissa × 10^n (a column of zeros or digits is unreadable).
-_PLAIN_EXPONENTS = range(-3, 6)
-_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 
 class Column(NamedTuple):
@@ -171,162 +164,6 @@ def column_header(key: str) -> str:
     """The header text of a row key: its words, then its unit in parentheses if it has one."""
     column = column_for(key)
     return f"{column.header} ({column.unit})" if column.unit else column.header
-
-
-# --------------------------------------------------------------------------- numbers
-
-
-def _missing(value) -> bool:
-    return value is None or (isinstance(value, numbers.Real) and not math.isfinite(float(value)))
-
-
-def _decimal(value: float) -> Decimal:
-    # Through repr: the digits a person sees, so 2.675 rounds up as written, not as its binary neighbour.
-    return Decimal(repr(float(value)))
-
-
-def _rounded(value: Decimal, decimals: int) -> Decimal:
-    result = value.quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_UP)
-    return result if result != 0 else abs(result)  # no "-0.00"
-
-
-def _plain(value: Decimal) -> str:
-    return format(value, "f")
-
-
-def _times_ten_to(exponent: int) -> str:
-    return f"× 10{str(exponent).translate(_SUPERSCRIPT)}"
-
-
-def format_number(value) -> str:
-    """A number with :data:`SIGNIFICANT_DIGITS` significant digits (whole digits are never cut).
-
-    Magnitudes below 10⁻³ or from 10⁶ print as ``1.235 × 10⁻⁷``; NaN, infinities and None as "n/a".
-
-    Examples
-    --------
-    >>> format_number(0.123456), format_number(535.9231), format_number(123456.7), format_number(1.2345e-7)
-    ('0.1235', '535.9', '123457', '1.235 × 10⁻⁷')
-    """
-    if _missing(value):
-        return "n/a"
-    number = _decimal(value)
-    if number == 0:
-        return "0"
-    exponent = number.adjusted()
-    if exponent not in _PLAIN_EXPONENTS:
-        return f"{format_number(float(number.scaleb(-exponent)))} {_times_ten_to(exponent)}"
-    rounded = _rounded(number, max(0, SIGNIFICANT_DIGITS - 1 - exponent))
-    if rounded.adjusted() > exponent:  # 9.9996 rounds to 10.000: one digit too many
-        rounded = _rounded(number, max(0, SIGNIFICANT_DIGITS - 2 - exponent))
-    return _plain(rounded)
-
-
-def _with_error(value: Decimal, error: Decimal) -> str:
-    """``value ± error``, both finite, error > 0, in plain decimal notation."""
-    exponent = error.adjusted()
-    decimals = 1 - exponent
-    rounded_error = _rounded(error, decimals)
-    if rounded_error.adjusted() > exponent:  # 0.0999 rounds to 0.100: keep 2 significant digits, 0.10
-        decimals -= 1
-        rounded_error = _rounded(error, decimals)
-    return f"{_plain(_rounded(value, decimals))} ± {_plain(rounded_error)}"
-
-
-def format_value_with_error(value, error) -> str:
-    """A value with its standard error: the error to 2 significant digits, the value to the same decimal place.
-
-    Parameters
-    ----------
-    value : float or None
-        The value (any unit); None or non-finite prints "n/a".
-    error : float or None
-        Its standard error (same unit, >= 0). None, NaN or infinite (not estimated) prints the value alone
-        (:func:`format_number`) followed by :data:`NO_UNCERTAINTY`; 0 prints "value ± 0".
-
-    Returns
-    -------
-    str
-        E.g. ``"0.1168 ± 0.0021"``; magnitudes below 10⁻³ or from 10⁶ as ``"(1.230 ± 0.045) × 10⁻⁷"``.
-
-    Raises
-    ------
-    ValueError
-        If the error is negative.
-
-    Examples
-    --------
-    >>> format_value_with_error(0.116844, 0.002134), format_value_with_error(535.92, 12.4)
-    ('0.1168 ± 0.0021', '536 ± 12')
-    """
-    if _missing(value):
-        return "n/a"
-    if error is not None and float(error) < 0.0:
-        raise ValueError(f"a standard error must be >= 0, got {error!r}")
-    if _missing(error):
-        return f"{format_number(value)} {NO_UNCERTAINTY}"
-    if float(error) == 0.0:
-        return f"{format_number(value)} ± 0"
-    number, uncertainty = _decimal(value), _decimal(error)
-    exponent = max(number.adjusted() if number != 0 else uncertainty.adjusted(), uncertainty.adjusted())
-    if exponent not in _PLAIN_EXPONENTS:
-        scaled = _with_error(number.scaleb(-exponent), uncertainty.scaleb(-exponent))
-        return f"({scaled}) {_times_ten_to(exponent)}"
-    return _with_error(number, uncertainty)
-
-
-def _is_scalar(value) -> bool:
-    return value is None or isinstance(value, (str, bool, np.bool_, numbers.Real))
-
-
-def _flag(value) -> str:
-    if _missing(value):
-        return "n/a"
-    # A flag read back from a CSV table is the text "True"/"False" (or 1.0/0.0).
-    text = str(value).strip().lower()
-    if text in ("true", "yes", "1", "1.0"):
-        return "yes"
-    if text in ("false", "no", "0", "0.0"):
-        return "no"
-    raise ValueError(f"{value!r} is not a flag (yes/no)")
-
-
-def format_cell(value, kind: str = NUMBER, error=None, has_error: bool = False) -> str:
-    """A table cell as escaped HTML text.
-
-    Parameters
-    ----------
-    value : str, bool, number or None
-        The cell value. NaN and None print "n/a", booleans "yes"/"no", numbers by :func:`format_number`.
-    kind : str
-        The column kind (:data:`TEXT`, :data:`COUNT`, :data:`NUMBER`, :data:`ESTIMATE`, :data:`FLAG`).
-    error : float or None
-        The value's standard error (same unit).
-    has_error : bool
-        Whether the column carries errors (then a number prints with :func:`format_value_with_error`, as it
-        does for the kind :data:`ESTIMATE`).
-
-    Raises
-    ------
-    TypeError
-        If the value is not a scalar (a mapping or a list must be formatted as text by its row builder).
-    """
-    if not _is_scalar(value):
-        raise TypeError(f"a {type(value).__name__} is not a table cell value: format it as text first, got "
-                        f"{value!r:.80}")
-    if kind == FLAG or isinstance(value, (bool, np.bool_)):
-        return _flag(value)
-    if isinstance(value, str):
-        return html.escape(value)
-    if _missing(value):
-        return "n/a"
-    if kind == TEXT:
-        return html.escape(f"{value:g}")
-    if kind == ESTIMATE or has_error or error is not None:
-        return html.escape(format_value_with_error(value, error))
-    if isinstance(value, numbers.Integral) or (kind == COUNT and float(value).is_integer()):
-        return str(int(value))
-    return html.escape(format_number(value))
 
 
 # --------------------------------------------------------------------------- tables
@@ -472,7 +309,7 @@ def _with_errors(row: Mapping, keys: Sequence[str], aliases: Mapping[str, str] |
 
 def _config_number(value) -> str:
     # Settings read from the configuration print as they were written (0.1, not 0.1000).
-    return "n/a" if _missing(value) else f"{float(value):g}"
+    return "n/a" if is_missing(value) else f"{float(value):g}"
 
 
 def _degrees(value) -> str:
@@ -548,7 +385,7 @@ def silo_flow_rows(flows: Sequence[Mapping]) -> list[dict]:
     for flow in flows:
         row = _with_errors(flow, SILO_FLOW_COLUMNS, SILO_FLOW_ERROR_ALIASES)
         rate_error, prediction = row.get("mass_flow_rate_kg_s_error"), row.get("beverloo_mass_flow_rate_kg_s")
-        if "beverloo_ratio_error" not in row and not _missing(rate_error) and not _missing(prediction) and prediction:
+        if "beverloo_ratio_error" not in row and not is_missing(rate_error) and not is_missing(prediction) and prediction:
             row["beverloo_ratio_error"] = float(rate_error) / abs(float(prediction))
         rows.append(row)
     return rows

@@ -8,14 +8,13 @@ import numpy as np
 import pytest
 import yaml
 
+from calibration.inversion_errors import interpolation_error, inversion_error
 from calibration.inversion import (
     CalibrationCurve,
     Inversion,
     UnreachableTarget,
     curves_from_table,
     invert_calibration,
-    interpolation_error,
-    inversion_error,
     invert_curve,
 )
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from analysis.io.tables import read_table, write_flow_table
+from analysis.report.cells import format_cell, format_number, format_value_with_error
 from analysis.report.summary import (
     BLENDER_COLUMNS,
     COLUMNS,
@@ -19,9 +20,6 @@ from analysis.report.summary import (
     column_header,
     fill_balance_rows,
     significance_rows,
-    format_cell,
-    format_number,
-    format_value_with_error,
     recirculation_rows,
     silo_flow_rows,
     summary_html,
