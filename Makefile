@@ -32,10 +32,8 @@ run: install
 	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete --rerun-triggers mtime params input
 	$(PYTHON) -m snakemake --report results/report.html --configfile $(CONFIG)
 
-# Two test files at a time (pytest-xdist, whole files per worker so module fixtures run once): the engine runs of one
-# overlap the Python analysis and Snakemake planning of the other.
 test: install
-	$(PYTHON) -m pytest -n $(CORES) --dist loadfile tests
+	$(PYTHON) -m pytest tests
 
 test-unit: install
 	$(PYTHON) -m pytest tests/unit

@@ -118,6 +118,7 @@ def test_engine_error_quotes_the_log_and_keeps_the_run_directory(tmp_path, tiny_
 def test_an_unsettled_fill_fails_without_a_run_record(tmp_path, tiny_config):
     require_liggghts()
     tiny_config["silo_flat"]["settle"] = {"kinetic_energy_threshold": 1e-30, "check_interval": 0.01, "max_time": 0.02}
+    tiny_config["silo_flat"]["fill_height"] = 0.02  # half the clumps: only the refusal matters here
     case = build_silo_case(tiny_config)
     engine = liggghts()
     engine.write_inputs(case, tmp_path)
@@ -125,12 +126,6 @@ def test_an_unsettled_fill_fails_without_a_run_record(tmp_path, tiny_config):
         engine.run(case, tmp_path, EngineOptions())
     assert not (tmp_path / "run.json").exists()
     assert (tmp_path / "deck" / "case.json").exists()
-
-
-def test_thesis_config_plans_without_error(tmp_path):
-    result = run_snakemake(tmp_path, "-n", "--cores", "2", "--configfile", str(REPO_ROOT / "config" / "thesis.yaml"))
-    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
-    assert "silo_run" in result.stdout
 
 
 def test_invalid_config_stops_the_workflow_with_the_key_named(tmp_path):
