@@ -31,6 +31,14 @@ def finite_number(name: str, value) -> float:
     return value
 
 
+def increasing_times(name: str, values) -> np.ndarray:
+    """A finite, strictly increasing 1-D float array of times (frame times); it may be empty."""
+    times = finite_array(name, values, ndim=1)
+    if np.any(np.diff(times) <= 0.0):
+        raise ValueError(f"{name} must be strictly increasing")
+    return times
+
+
 def uniform_step(name: str, time: np.ndarray, tolerance: float = 1.0e-6) -> float:
     """The step of a uniform, increasing time axis (steps equal to ``tolerance`` relative)."""
     if time.size < 2:
@@ -104,3 +112,9 @@ def per_particle_values(name: str, values, n: int) -> np.ndarray:
     if not np.all(np.isfinite(array)) or np.any(array < 0.0):
         raise ValueError(f"{name} must contain finite numbers >= 0")
     return array
+
+
+def number_or_nan(value) -> float:
+    """A number read back from JSON or a table, where null or an empty cell (a NaN when written, or a figure not
+    known) is NaN."""
+    return math.nan if value is None else float(value)

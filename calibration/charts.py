@@ -110,14 +110,10 @@ def plot_calibration_chart(
                 axes.axhline(target, color="0.35", linestyle="--", linewidth=1.0, label=f"target {target:g} deg")
 
         for curve in ordered:
-            angles = curve.bulk_angle_deg
-            error = None
-            if curve.bulk_standard_error is not None:
-                error = np.degrees(curve.bulk_standard_error / (1.0 + curve.bulk_friction**2))
             axes.errorbar(
                 curve.particle_friction,
-                angles,
-                yerr=error,
+                curve.bulk_angle_deg,
+                yerr=curve.bulk_angle_standard_error_deg,
                 marker="o",
                 markersize=4,
                 linewidth=1.5,

@@ -36,6 +36,7 @@ __all__ = [
     "mean_and_standard_error",
     "bulk_friction",
     "friction_angle",
+    "friction_angle_error",
     "friction_coefficient",
     "bulk_friction_of_shear",
     "bulk_friction_summary",
@@ -109,9 +110,8 @@ class BulkFriction:
 
     @property
     def angle_standard_error_deg(self) -> float:
-        """Standard error of ``angle_deg`` [deg], to first order ``degrees(se / (1 + mu^2))`` since
-        ``d atan(mu) / d mu = 1 / (1 + mu^2)``."""
-        return math.degrees(self.standard_error / (1.0 + self.coefficient**2))
+        """Standard error of ``angle_deg`` [deg] (:func:`friction_angle_error`)."""
+        return friction_angle_error(self.coefficient, self.standard_error)
 
 
 # --------------------------------------------------------------------------- validation
@@ -480,6 +480,27 @@ def friction_angle(mu):
         raise ValueError(f"mu must be finite and >= 0, got {mu!r}")
     angle = np.degrees(np.arctan(array))
     return float(angle) if angle.ndim == 0 else angle
+
+
+def friction_angle_error(mu, standard_error):
+    """Standard error of a friction angle ``atan(mu)`` from that of the coefficient, to first order.
+
+    ``d atan(mu) / d mu = 1 / (1 + mu^2)``, so the error is ``degrees(se / (1 + mu^2))``.
+
+    Parameters
+    ----------
+    mu : float or array_like
+        Friction coefficient(s) [-].
+    standard_error : float or array_like
+        Their standard error(s) [-], NaN where unknown; broadcast with ``mu``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The angle's standard error(s) [deg] (a float for scalars), NaN where ``standard_error`` is.
+    """
+    error = np.degrees(np.asarray(standard_error, dtype=float) / (1.0 + np.asarray(mu, dtype=float) ** 2))
+    return float(error) if error.ndim == 0 else error
 
 
 def friction_coefficient(angle_deg):

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.numerics.uncertainty import combine_independent
+from calibration.friction import friction_angle_error
 from calibration.inversion_errors import interpolation_error, inversion_error
 
 __all__ = [
@@ -156,11 +157,11 @@ class CalibrationCurve:
 
     @property
     def bulk_angle_standard_error_deg(self) -> np.ndarray | None:
-        """Standard errors of :attr:`bulk_angle_deg` [deg], ``degrees(se / (1 + mu^2))`` to first order; None
-        without ``bulk_standard_error``, NaN where it is NaN."""
+        """Standard errors of :attr:`bulk_angle_deg` [deg] (:func:`calibration.friction.friction_angle_error`);
+        None without ``bulk_standard_error``, NaN where it is NaN."""
         if self.bulk_standard_error is None:
             return None
-        return np.degrees(self.bulk_standard_error / (1.0 + self.bulk_friction**2))
+        return friction_angle_error(self.bulk_friction, self.bulk_standard_error)
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,13 @@ from analysis.numerics.uncertainty import combine_independent
 __all__ = ["inversion_error", "interpolation_error"]
 
 
+def _segment(angles: np.ndarray, target_angle_deg: float) -> tuple[int, float]:
+    """The chart segment ``[theta_i, theta_{i+1}]`` that holds the target (the one to the right of a chart point,
+    the last one at the last point) and the target's fraction ``t`` of its angle span [-]; two points at least."""
+    i = int(np.clip(np.searchsorted(angles, target_angle_deg, side="right") - 1, 0, angles.size - 2))
+    return i, (target_angle_deg - angles[i]) / (angles[i + 1] - angles[i])
+
+
 def inversion_error(angles, particle, angle_errors, target_angle_deg: float) -> float:
     """Standard error of the particle friction read off a piecewise linear chart at a target angle [-].
 
@@ -45,8 +52,7 @@ def inversion_error(angles, particle, angle_errors, target_angle_deg: float) -> 
     if angle_errors is None or angles.size < 2:
         return math.nan
     errors = np.asarray(angle_errors, dtype=float)
-    i = int(np.clip(np.searchsorted(angles, target_angle_deg, side="right") - 1, 0, angles.size - 2))
-    t = (target_angle_deg - angles[i]) / (angles[i + 1] - angles[i])
+    i, t = _segment(angles, target_angle_deg)
     slope = (angles[i + 1] - angles[i]) / (particle[i + 1] - particle[i])
     # a point with weight 0 does not enter, even when its error is unknown
     terms = [weight * errors[k] for weight, k in ((1.0 - t, i), (t, i + 1)) if weight != 0.0]
@@ -80,8 +86,7 @@ def interpolation_error(angles, particle, target_angle_deg: float) -> float:
     particle = np.asarray(particle, dtype=float)
     if angles.size < 3:
         return math.nan
-    i = int(np.clip(np.searchsorted(angles, target_angle_deg, side="right") - 1, 0, angles.size - 2))
-    t = (target_angle_deg - angles[i]) / (angles[i + 1] - angles[i])
+    i, t = _segment(angles, target_angle_deg)
     if i == 0:
         third = 2
     elif i + 1 == angles.size - 1:

@@ -150,10 +150,15 @@ def residence_time_resolution(frame_interval: float) -> float:
     ValueError
         If ``frame_interval`` is negative or infinite.
     """
-    interval = float(frame_interval)
-    if math.isinf(interval) or interval < 0.0:
-        raise ValueError(f"frame_interval must be a finite number >= 0 or NaN (unknown), got {frame_interval!r}")
-    return interval / math.sqrt(6.0)
+    return _known_or_nan("frame_interval", frame_interval) / math.sqrt(6.0)
+
+
+def _known_or_nan(name: str, value) -> float:
+    """``value`` as a float that is finite and >= 0, or NaN (unknown)."""
+    number = float(value)
+    if math.isinf(number) or number < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0 or NaN (unknown), got {value!r}")
+    return number
 
 
 def appearance_times(residence_times, resolution: float = 0.0) -> AppearanceTimes:
@@ -197,9 +202,7 @@ def appearance_times(residence_times, resolution: float = 0.0) -> AppearanceTime
         raise ValueError("residence_times must be >= 0")
     if not finite[-1] > 0.0:
         raise ValueError("residence_times: the longest is 0, so t_s / t_d is undefined")
-    resolution = float(resolution)
-    if math.isinf(resolution) or resolution < 0.0:
-        raise ValueError(f"resolution must be a finite number >= 0 or NaN (unknown), got {resolution!r}")
+    resolution = _known_or_nan("resolution", resolution)
     n = int(finite.size)
     first, last = float(finite[0]), float(finite[-1])
     if n < 2:

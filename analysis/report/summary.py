@@ -21,7 +21,6 @@ Conventions of the page
 from __future__ import annotations
 
 import html
-import math
 import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import NamedTuple

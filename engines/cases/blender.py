@@ -80,11 +80,6 @@ class BlenderCase:
         return self.silo.fill_height
 
     @property
-    def gravity(self) -> float:
-        """Magnitude of gravity in this run: the gravity factor times g (m/s^2)."""
-        return self.gravity_factor * GRAVITY
-
-    @property
     def run_id(self) -> str:
         """Directory name: configuration, gravity factor and a hash of every defining parameter."""
         return run_id(f"{self.configuration}-g{self.gravity_factor:g}", self.defining_parameters)

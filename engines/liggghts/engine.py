@@ -12,9 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
-
-from analysis.data.contacts import ContactFrame, WallContactFrame
 from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.record import RunRecord
@@ -31,13 +28,10 @@ from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
 from engines.liggghts.jenike import (
-    JENIKE_FLOOR_WALLS,
     PAIR_CONTACT_PREFIX,
-    SETTLED_CONTACT_PREFIX,
-    SETTLED_WALLS,
     WALL_CONTACT_PREFIX,
-    WALL_MESHES,
-    read_contact_dump,
+    read_jenike_pair_contacts,
+    read_jenike_wall_contacts,
     run_jenike,
     write_jenike_inputs,
 )
@@ -159,55 +153,12 @@ class LiggghtsEngine(Engine):
             return [read_contacts(path) for path in list_dumps(dumps, CONTACT_PREFIX, ".txt")]
         if kind == "pair":
             return [read_jenike_pair_contacts(path) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
-        return [_wall_frame(read_contact_dump(path)) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
+        return [read_jenike_wall_contacts(path) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
 
     def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
         if record.case == "jenike":
-            return read_settled_jenike_fill(
-                Path(run_dir) / "dumps", record.timestep_s, record.stage("settle"), SETTLED_WALLS, JENIKE_FLOOR_WALLS,
-                SETTLED_CONTACT_PREFIX, read_jenike_pair_contacts)
+            return read_settled_jenike_fill(Path(run_dir) / "dumps", record.timestep_s, record.stage("settle"))
         if record.case not in FLOOR_WALLS:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
         return read_settled_fill(Path(run_dir) / "dumps", record.timestep_s, read_wall_forces(run_dir),
                                  FLOOR_WALLS[record.case])
-
-
-def _columns(table: dict, *names: str) -> np.ndarray:
-    return np.column_stack([table[name] for name in names]) if names else np.empty((0, 3))
-
-
-def _step(table: dict) -> int:
-    return int(table["step"][0]) if table["step"].size else 0
-
-
-def read_jenike_pair_contacts(path: str | Path) -> ContactFrame:
-    """One Jenike pair-contact dump (:data:`engines.liggghts.jenike.CONTACT_COLUMNS`) as a frame."""
-    return _pair_frame(read_contact_dump(path))
-
-
-def _pair_frame(table: dict) -> ContactFrame:
-    """A Jenike pair-contact dump (both centres, both ids, normal and tangential force on the first) as a frame."""
-    return ContactFrame(
-        step=_step(table),
-        position_i=_columns(table, "x1", "y1", "z1"),
-        position_j=_columns(table, "x2", "y2", "z2"),
-        id_i=table["id1"].astype(np.int64),
-        id_j=table["id2"].astype(np.int64),
-        force=_columns(table, "fn_x", "fn_y", "fn_z") + _columns(table, "ft_x", "ft_y", "ft_z"),
-    )
-
-
-def _wall_frame(table: dict) -> WallContactFrame:
-    """A Jenike wall-contact dump (contact point, centre, mesh index, triangle, atom id, forces) as a frame."""
-    mesh = table["id1"].astype(int)
-    if mesh.size and (mesh.min() < 0 or mesh.max() >= len(WALL_MESHES)):
-        raise ValueError(f"wall contact dump at step {_step(table)}: mesh index outside 0..{len(WALL_MESHES) - 1}")
-    return WallContactFrame(
-        step=_step(table),
-        point=_columns(table, "x1", "y1", "z1"),
-        centre=_columns(table, "x2", "y2", "z2"),
-        wall=np.array(WALL_MESHES, dtype=object)[mesh] if mesh.size else np.empty(0, dtype=object),
-        particle_id=table["id3"].astype(np.int64),
-        normal_force=_columns(table, "fn_x", "fn_y", "fn_z"),
-        tangential_force=_columns(table, "ft_x", "ft_y", "ft_z"),
-    )

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.data.contacts import ContactFrame, WallContactFrame
 from engines.cases.geometry import write_stl
 from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
 from analysis.data.record import RunRecord
@@ -287,6 +288,52 @@ def read_contact_dump(path: str | Path) -> dict[str, np.ndarray]:
     contacts = {name: table[:, i] for i, name in enumerate(CONTACT_COLUMNS)}
     contacts["step"] = np.full(count, step)
     return contacts
+
+
+def _columns(table: dict, *names: str) -> np.ndarray:
+    return np.column_stack([table[name] for name in names]) if names else np.empty((0, 3))
+
+
+def _step(table: dict) -> int:
+    return int(table["step"][0]) if table["step"].size else 0
+
+
+def read_jenike_pair_contacts(path: str | Path) -> ContactFrame:
+    """One pair-contact dump (:data:`CONTACT_COLUMNS`) as a frame."""
+    return _pair_frame(read_contact_dump(path))
+
+
+def read_jenike_wall_contacts(path: str | Path) -> WallContactFrame:
+    """One wall-contact dump (:data:`CONTACT_COLUMNS`, the mesh named by :data:`WALL_MESHES`) as a frame."""
+    return _wall_frame(read_contact_dump(path))
+
+
+def _pair_frame(table: dict) -> ContactFrame:
+    """A Jenike pair-contact dump (both centres, both ids, normal and tangential force on the first) as a frame."""
+    return ContactFrame(
+        step=_step(table),
+        position_i=_columns(table, "x1", "y1", "z1"),
+        position_j=_columns(table, "x2", "y2", "z2"),
+        id_i=table["id1"].astype(np.int64),
+        id_j=table["id2"].astype(np.int64),
+        force=_columns(table, "fn_x", "fn_y", "fn_z") + _columns(table, "ft_x", "ft_y", "ft_z"),
+    )
+
+
+def _wall_frame(table: dict) -> WallContactFrame:
+    """A Jenike wall-contact dump (contact point, centre, mesh index, triangle, atom id, forces) as a frame."""
+    mesh = table["id1"].astype(int)
+    if mesh.size and (mesh.min() < 0 or mesh.max() >= len(WALL_MESHES)):
+        raise ValueError(f"wall contact dump at step {_step(table)}: mesh index outside 0..{len(WALL_MESHES) - 1}")
+    return WallContactFrame(
+        step=_step(table),
+        point=_columns(table, "x1", "y1", "z1"),
+        centre=_columns(table, "x2", "y2", "z2"),
+        wall=np.array(WALL_MESHES, dtype=object)[mesh] if mesh.size else np.empty(0, dtype=object),
+        particle_id=table["id3"].astype(np.int64),
+        normal_force=_columns(table, "fn_x", "fn_y", "fn_z"),
+        tangential_force=_columns(table, "ft_x", "ft_y", "ft_z"),
+    )
 
 
 # ---------------------------------------------------------------------------------------------- running

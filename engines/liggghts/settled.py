@@ -29,6 +29,12 @@ from analysis.data.frames import ParticleFrame
 from analysis.data.settled import SettledFill
 from engines.liggghts.contacts import ContactDumpError, parse_local_table, read_contacts
 from engines.liggghts.dumps import frame_from_arrays, list_dumps
+from engines.liggghts.jenike import (
+    JENIKE_FLOOR_WALLS,
+    SETTLED_CONTACT_PREFIX,
+    SETTLED_WALLS,
+    read_jenike_pair_contacts,
+)
 from engines.liggghts.run import CONTACT_PREFIX, SETTLED_FILL_PREFIX
 
 __all__ = ["SETTLED_COLUMNS", "read_settled_spheres", "read_settled_fill", "read_settled_jenike_fill"]
@@ -110,8 +116,9 @@ def read_settled_fill(
 
 
 def read_settled_jenike_fill(
-    dumps_dir: str | Path, timestep: float, marker: Mapping[str, float], walls: Sequence[str],
-    floor_walls: tuple[str, ...], contacts_prefix: str, read_pair_contacts: Callable[[Path], ContactFrame],
+    dumps_dir: str | Path, timestep: float, marker: Mapping[str, float], walls: Sequence[str] = SETTLED_WALLS,
+    floor_walls: tuple[str, ...] = JENIKE_FLOOR_WALLS, contacts_prefix: str = SETTLED_CONTACT_PREFIX,
+    read_pair_contacts: Callable[[Path], ContactFrame] = read_jenike_pair_contacts,
 ) -> SettledFill:
     """The levelled, settled fill of a Jenike run (before the lid), with each mesh's force from the ``levelled``
     marker.
@@ -121,12 +128,12 @@ def read_settled_jenike_fill(
     marker : mapping
         The marker's values; ``<wall>_f<x|y|z>`` is the force of the particles ON mesh ``wall`` [N] (negated here:
         :class:`SettledFill` holds the walls' forces on the particles).
-    walls : sequence of str
-        The meshes the marker names.
-    floor_walls : tuple of str
-        Those of ``walls`` that are the floor.
-    contacts_prefix, read_pair_contacts
-        The file prefix of the snapshot's pair contacts and their reader.
+    walls : sequence of str, optional
+        The meshes the marker names (the Jenike deck's :data:`~engines.liggghts.jenike.SETTLED_WALLS`).
+    floor_walls : tuple of str, optional
+        Those of ``walls`` that are the floor (the base).
+    contacts_prefix, read_pair_contacts : optional
+        The file prefix of the snapshot's pair contacts and their reader (the Jenike deck's).
 
     Raises
     ------

@@ -8,7 +8,6 @@ is unlocked and called again; it resumes, and both runs end with the same clumps
 from __future__ import annotations
 
 import csv
-import json
 import math
 import os
 import signal

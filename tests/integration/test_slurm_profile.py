@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import pytest
 
 from engines.config import REPO_ROOT
 from tests.conftest import run_snakemake

@@ -26,7 +26,7 @@ from analysis.studies.blender.plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from analysis.io.plots import save_png
+from tests.plot_data import saved_figures
 from test_blender_analysis import PASSAGES, X_FULL, Z_ROWS, channel_field, metrics, shear_field, uniform_field
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -35,15 +35,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 @pytest.fixture
 def figures(monkeypatch):
     """The figures the writers save (kept so that their line data can be checked)."""
-    saved = []
-
-    def keep(figure, path, tight=False):
-        saved.append(figure)
-        return save_png(figure, path, tight=tight)
-
-    monkeypatch.setattr(blender_plots, "save_png", keep)
-    monkeypatch.setattr(rtd_plots, "save_png", keep)
-    return saved
+    return saved_figures(monkeypatch, blender_plots, rtd_plots)
 
 
 def assert_png(target, returned):

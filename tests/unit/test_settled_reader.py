@@ -7,8 +7,7 @@ import pytest
 
 from analysis.data.forces import WallForceHistory
 from engines.liggghts.contacts import ContactDumpError
-from engines.liggghts.engine import read_jenike_pair_contacts
-from engines.liggghts.jenike import SETTLED_CONTACT_PREFIX
+from engines.liggghts.jenike import SETTLED_CONTACT_PREFIX, read_jenike_pair_contacts
 from engines.liggghts.settled import SETTLED_COLUMNS, read_settled_fill, read_settled_jenike_fill
 
 STEP = 200

@@ -12,7 +12,7 @@ from matplotlib.path import Path as MplPath
 
 import analysis.studies.silo_recirculation.plots as plots
 import analysis.studies.silo_recirculation.rtd_plots as rtd_plots
-from analysis.io.plots import save_png
+from tests.plot_data import saved_figures
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
     plot_outlet_concentration,
@@ -42,15 +42,7 @@ def _assert_png(target, returned):
 @pytest.fixture
 def figures(monkeypatch):
     """The figures the writers save, kept (after they are written) so that their plotted data can be checked."""
-    saved = []
-
-    def keep(figure, path, tight=False):
-        saved.append(figure)
-        return save_png(figure, path, tight=tight)
-
-    monkeypatch.setattr(plots, "save_png", keep)
-    monkeypatch.setattr(rtd_plots, "save_png", keep)
-    return saved
+    return saved_figures(monkeypatch, plots, rtd_plots)
 
 
 def _only_axes(figures):

@@ -137,6 +137,16 @@ def test_without_slow_clumps_the_transit_time_is_the_holdup_residence_time(name)
     assert (little.transit_fraction.value, little.slow_holdup.value, little.stagnant_clumps) == (1.0, 0.0, 0)
 
 
+def test_transit_timing_starts_where_the_steady_part_of_the_timing_does():
+    tracks = loop_tracks(*LOOPS["plug flow"][:2])
+    events = recirculation_events(tracks, OUTLET, BOTTOM, TOP)
+    timing = loop_timing(tracks, events, OUTLET, startup_fraction=0.5)
+    assert timing.steady_start == 4.5
+    little, _ = transit_timing(tracks, events, timing, tracer_passes(events, 1.0, 20))
+    # horizon 3 s: the window starts at the steady part (4.5 s), later than t_open + h
+    assert (little.horizon, little.t_from, little.t_to) == (3.0, 4.5, 6.0)
+
+
 def test_passes_in_progress_counts_entry_inclusive_exit_exclusive():
     times = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
     # passes [0.5, 2.5), [1.0, 1.0) (no time inside), [1.0, 3.0) and [3.5, 10)

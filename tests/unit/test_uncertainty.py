@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from analysis.numerics.uncertainty import (
-    CEILING_FACTOR,
     Estimate,
     SeedSpread,
     Significance,
@@ -21,6 +20,9 @@ from analysis.numerics.uncertainty import (
     proportion_error,
     proportion_interval,
     seed_spread,
+)
+from analysis.numerics.vrr_noise import (
+    CEILING_FACTOR,
     vrr_ceiling,
     vrr_near_ceiling,
     window_clumps_for_precision,

@@ -40,6 +40,8 @@ rule blender_fields:
     output:
         fields=f"{run_dir('blender')}/fields/fields.npz",
         flow=f"{run_dir('blender')}/metrics/flow.json",
+        # each frame of the steady window: the series whose batch means give the passage velocities' errors
+        frames=f"{run_dir('blender')}/fields/steady_frames.npz",
     params:
         bin_size=config["blender"]["bin_size"],
         on_damaged=config["dumps"]["on_damaged"],
@@ -49,27 +51,11 @@ rule blender_fields:
         "../scripts/blender_fields.py"
 
 
-# The field of each frame of the steady window: the series whose batch means give the passage velocities' errors.
-rule blender_frame_fields:
-    input:
-        record=rules.blender_run.output.record,
-        case=rules.blender_deck.output.case,
-    output:
-        frames=f"{run_dir('blender')}/fields/steady_frames.npz",
-    params:
-        bin_size=config["blender"]["bin_size"],
-        on_damaged=config["dumps"]["on_damaged"],
-    log:
-        f"{run_dir('blender')}/logs/frame_fields.log",
-    script:
-        "../scripts/blender_frame_fields.py"
-
-
 rule blender_analysis:
     input:
         fields=rules.blender_fields.output.fields,
         flow=rules.blender_fields.output.flow,
-        frames=rules.blender_frame_fields.output.frames,
+        frames=rules.blender_fields.output.frames,
         case=rules.blender_deck.output.case,
     output:
         summary=f"{run_dir('blender')}/metrics/blender.json",

@@ -1,12 +1,19 @@
-"""Snakemake adapter: steady and windowed depth-averaged fields and the discharge rate of one blender run."""
+"""Snakemake adapter: steady and windowed depth-averaged fields, the field of every frame of the steady window (the
+series whose batch means give the errors of the steady passage velocities) and the discharge rate of one blender
+run."""
 
 import json
 from pathlib import Path
 
 import numpy as np
 
-from analysis.studies.blender.window_fields import discharged_mass_history, mean_velocity_history, window_average_field
-from analysis.studies.blender.window_fields_io import write_planar_fields
+from analysis.studies.blender.window_fields import (
+    discharged_mass_history,
+    frame_fields,
+    mean_velocity_history,
+    window_average_field,
+)
+from analysis.studies.blender.window_fields_io import write_frame_fields, write_planar_fields
 from analysis.data.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_tracks
 from analysis.numerics.eulerian_rtd import silo_bins
@@ -34,6 +41,9 @@ with logged_to(snakemake.log[0]) as log:
     edges = np.linspace(0.0, steady_window[1], case["profile_windows"] + 1)
     windows = [averaged((start, end)) for start, end in zip(edges[:-1], edges[1:])]
     write_planar_fields(snakemake.output.fields, steady, windows)
+    steady_frames = frame_fields(tracks.position, recorded.velocity, recorded.mass, since_open, grid, steady_window,
+                                 density)
+    write_frame_fields(snakemake.output.frames, steady_frames)
 
     time, discharged = discharged_mass_history(tracks, recorded.mass, case["mode"], case["outlet_z"], case["domain_z"])
     fit = steady_flow_rate(time - record.open_time_s, discharged, window=steady_window)
@@ -44,5 +54,6 @@ with logged_to(snakemake.log[0]) as log:
         "time_since_open_s": (time - record.open_time_s).tolist(), "discharged_mass_kg": discharged.tolist(),
         "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case["outlet_z"]).tolist(),
     })
-    log.info("%s: %d frames, steady window %s s (%d frames), mass flow rate %.5g +- %.2g kg/s", case["run_id"],
-             tracks.n_times, steady_window, steady.n_frames, fit.mass_flow_rate, fit.standard_error)
+    log.info("%s: %d frames, steady window %s s (%d frames, %d frame fields), mass flow rate %.5g +- %.2g kg/s",
+             case["run_id"], tracks.n_times, steady_window, steady.n_frames, len(steady_frames), fit.mass_flow_rate,
+             fit.standard_error)

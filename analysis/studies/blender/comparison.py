@@ -13,21 +13,16 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 from analysis.numerics.replicates import REPLICATES_KEY, SEED_STD_SUFFIX
-from analysis.checks import positive_number
-from analysis.numerics.uncertainty import (
-    CEILING_FACTOR,
-    Significance,
-    combine_independent,
-    difference_significant,
-    vrr_near_ceiling,
-)
+from analysis.checks import number_or_nan, positive_number
+from analysis.numerics.uncertainty import Significance, combine_independent, difference_significant
+from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling
 
 __all__ = ["BlenderMetrics", "comparison_table", "best_blender", "figure_columns", "significance_rows",
            "ERROR_SUFFIX", "CEILING_SUFFIX", "SIGNIFICANCE_COLUMNS"]
 
 #: Suffix of the column that carries the standard error of a figure.
 ERROR_SUFFIX = "_error"
-#: Suffix of the flag of a VRR within :data:`analysis.numerics.uncertainty.CEILING_FACTOR` of its ceiling.
+#: Suffix of the flag of a VRR within :data:`analysis.numerics.vrr_noise.CEILING_FACTOR` of its ceiling.
 CEILING_SUFFIX = "_at_ceiling"
 #: Columns of :func:`significance_rows`, in order.
 SIGNIFICANCE_COLUMNS = ("figure", "configuration_a", "configuration_b", "value_a", "error_a", "value_b", "error_b",
@@ -113,6 +108,10 @@ def _vrr_column(period) -> str:
     return f"vrr_at_{float(period):g}_tm"
 
 
+def _known_ceiling(ceiling) -> bool:
+    return math.isfinite(float(ceiling)) and ceiling > 0.0
+
+
 def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
     """One row per configuration with a stable column order (for :func:`analysis.io.tables.write_flow_table`).
 
@@ -122,12 +121,12 @@ def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
     ``vrr_at_<f>_tm_error`` for each period fraction f in increasing order (all configurations must share them).
     When any configuration knows its VRR ceiling, ``vrr_ceiling`` [-] (NaN where unknown) and a flag
     ``vrr_at_<f>_tm_at_ceiling`` per period follow: True where the VRR lies within
-    :data:`~analysis.numerics.uncertainty.CEILING_FACTOR` of the ceiling
-    (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`; such a VRR is only a lower bound), None where the
+    :data:`~analysis.numerics.vrr_noise.CEILING_FACTOR` of the ceiling
+    (:func:`analysis.numerics.vrr_noise.vrr_near_ceiling`; such a VRR is only a lower bound), None where the
     ceiling is unknown.
     """
     items = _metrics(metrics)
-    with_ceiling = any(math.isfinite(float(item.vrr_ceiling)) and item.vrr_ceiling > 0.0 for item in items)
+    with_ceiling = any(_known_ceiling(item.vrr_ceiling) for item in items)
     rows = []
     for item in items:
         row = {"configuration": item.name}
@@ -141,7 +140,7 @@ def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
             row[_vrr_column(period) + ERROR_SUFFIX] = float(item.vrr_errors.get(period, math.nan))
         if with_ceiling:
             ceiling = float(item.vrr_ceiling)
-            known = math.isfinite(ceiling) and ceiling > 0.0
+            known = _known_ceiling(ceiling)
             row["vrr_ceiling"] = ceiling if known else math.nan
             for period in periods:
                 row[_vrr_column(period) + CEILING_SUFFIX] = (
@@ -174,11 +173,6 @@ def figure_columns(row: Mapping) -> list[str]:
     (:func:`analysis.numerics.replicates.combine_replicates`), the seed count and the seeds' standard deviations."""
     return [column for column in row if column not in ("configuration", "vrr_ceiling", REPLICATES_KEY)
             and not column.endswith((ERROR_SUFFIX, CEILING_SUFFIX, SEED_STD_SUFFIX))]
-
-
-def _number(value) -> float:
-    # a missing error (or one read back as empty) is unknown
-    return math.nan if value is None else float(value)
 
 
 def significance_rows(rows: Sequence[Mapping], k: float = 2.0) -> list[dict]:
@@ -227,9 +221,9 @@ def significance_rows(rows: Sequence[Mapping], k: float = 2.0) -> list[dict]:
     for figure in figures:
         for i, a in enumerate(rows):
             for b in rows[i + 1:]:
-                value_a, value_b = _number(a[figure]), _number(b[figure])
-                error_a = _number(a.get(figure + ERROR_SUFFIX))
-                error_b = _number(b.get(figure + ERROR_SUFFIX))
+                value_a, value_b = number_or_nan(a[figure]), number_or_nan(b[figure])
+                error_a = number_or_nan(a.get(figure + ERROR_SUFFIX))
+                error_b = number_or_nan(b.get(figure + ERROR_SUFFIX))
                 finite = math.isfinite(value_a) and math.isfinite(value_b)
                 at_ceiling = bool(a.get(figure + CEILING_SUFFIX)) or bool(b.get(figure + CEILING_SUFFIX))
                 outcome = (difference_significant(value_a, error_a, value_b, error_b, k) if finite and not at_ceiling

@@ -41,7 +41,7 @@ import numpy as np
 
 from analysis.checks import finite_array, finite_number
 from analysis.numerics.residence_statistics import appearance_times
-from analysis.numerics.uncertainty import Estimate, batch_means, batch_rate, combine_independent
+from analysis.numerics.uncertainty import Estimate, batch_count, batch_means, batch_rate, combine_independent
 from analysis.studies.blender.profiles import passage_mean_v_z
 from analysis.studies.blender.steady_field import checked_field
 from analysis.studies.blender.window_fields import frames_in_window
@@ -64,9 +64,7 @@ a well-estimated spread of their means (many)."""
 
 def _batches(n_samples: int, per_batch: int, n_batches: int) -> int:
     """The batches that ``n_samples`` allow with at least ``per_batch`` samples each, at most ``n_batches``."""
-    if isinstance(n_batches, bool) or not isinstance(n_batches, (int, np.integer)) or n_batches < 2:
-        raise ValueError(f"n_batches must be an integer >= 2, got {n_batches!r}")
-    return min(int(n_batches), n_samples // per_batch)
+    return min(batch_count(n_batches), n_samples // per_batch)
 
 
 def steady_flow_rate_estimate(time, discharged, window: tuple[float, float],
@@ -344,10 +342,10 @@ def sine_vrr_error(vrr, n_effective: float):
     It vanishes for an undamped input (``VRR = 1``, a long period passes whatever the sample) and reaches about
     ``sqrt(2) VRR`` at ``VRR = n_eff``: the counting-noise ceiling of this estimate, where the noise of ``phi``
     (``|phi|^2`` about ``1 / n_eff``) is as large as ``phi`` itself, so that a VRR near ``n_eff`` is set by the
-    sample and only a lower bound (flag it with :func:`analysis.numerics.uncertainty.vrr_near_ceiling` against
+    sample and only a lower bound (flag it with :func:`analysis.numerics.vrr_noise.vrr_near_ceiling` against
     the ceiling ``n_eff``). The tracers carry the input's concentration, not a 0/1 colour, so the outlet noise is
     ``sigma_in^2 / n_eff`` rather than the binomial ``p (1 - p) / n`` of
-    :func:`analysis.numerics.uncertainty.vrr_ceiling`, and the ceiling is ``n_eff`` whatever the input's mean and
+    :func:`analysis.numerics.vrr_noise.vrr_ceiling`, and the ceiling is ``n_eff`` whatever the input's mean and
     amplitude.
 
     Parameters

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.checks import finite_array, positive_number  # noqa: E402
+from analysis.checks import finite_array, number_or_nan, positive_number  # noqa: E402
 from analysis.io.plots import non_empty_list, positive_finite_points, save_png, tuple_entry  # noqa: E402
 from analysis.numerics.rtd import RTD  # noqa: E402
 from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity  # noqa: E402
@@ -402,11 +402,6 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         plt.close(figure)
 
 
-def _error_or_nan(error) -> float:
-    # a missing error (or one read back as empty) is unknown: no bar
-    return math.nan if error is None else float(error)
-
-
 def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str | os.PathLike, title: str,
                                   best: str | None = None) -> Path:
     """Bar charts of chosen metrics, one panel per metric and one bar per configuration.
@@ -444,7 +439,7 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
     if best is not None and best not in names:
         raise ValueError(f"best must be one of the configurations {names}, got {best!r}")
     values = np.array([[float(row[column]) for column in columns] for row in rows])
-    errors = np.array([[_error_or_nan(row.get(f"{column}_error")) for column in columns] for row in rows])
+    errors = np.array([[number_or_nan(row.get(f"{column}_error")) for column in columns] for row in rows])
     panels = len(columns)
     figure, axes_row = plt.subplots(1, panels, figsize=(2.6 * panels + 1.0, 3.8), squeeze=False)
     try:

@@ -233,6 +233,17 @@ class PassageVelocities:
     n_bins: dict
 
 
+def _passage_means(x: np.ndarray, v_z: np.ndarray, intervals: Mapping) -> tuple[dict, dict]:
+    """Name -> plain mean of the finite ``v_z`` whose bin centre's ``|x|`` lies in the interval (NaN without one),
+    and name -> number of those bins."""
+    means, counts = {}, {}
+    for name, interval in intervals.items():
+        chosen = np.isfinite(v_z) & _in_interval(x, interval)
+        counts[name] = int(np.count_nonzero(chosen))
+        means[name] = float(np.mean(v_z[chosen])) if counts[name] else math.nan
+    return means, counts
+
+
 def passage_velocities(field: BlenderField, z_value: float, passages: Mapping) -> PassageVelocities:
     """Mean ``v_z`` of each passage (e.g. exterior annulus, interior annulus, tube) at a height.
 
@@ -256,11 +267,7 @@ def passage_velocities(field: BlenderField, z_value: float, passages: Mapping) -
     """
     intervals = _passages(passages)
     profile = height_profile(field, z_value, intervals)
-    means, counts = {}, {}
-    for name, interval in intervals.items():
-        chosen = profile.is_open & _in_interval(profile.x, interval)
-        counts[name] = int(np.count_nonzero(chosen))
-        means[name] = float(np.mean(profile.v_z[chosen])) if counts[name] else math.nan
+    means, counts = _passage_means(profile.x, profile.v_z, intervals)
     return PassageVelocities(profile=profile, passages=intervals, mean_v_z=means, n_bins=counts)
 
 
@@ -287,12 +294,7 @@ def passage_mean_v_z(field: BlenderField, z_value: float, passages: Mapping) -> 
     """
     field = checked_field(field)
     intervals = _passages(passages)
-    v_z = at_height(field, field.v_z, finite_number("z_value", z_value))
-    means = {}
-    for name, interval in intervals.items():
-        chosen = np.isfinite(v_z) & _in_interval(field.x, interval)
-        means[name] = float(np.mean(v_z[chosen])) if np.any(chosen) else math.nan
-    return means
+    return _passage_means(field.x, at_height(field, field.v_z, finite_number("z_value", z_value)), intervals)[0]
 
 
 @dataclass(frozen=True, eq=False)

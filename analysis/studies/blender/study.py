@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
-from analysis.checks import positive_number
+from analysis.checks import number_or_nan, positive_number
 from analysis.numerics.rtd import RTD
 from analysis.studies.blender.comparison import BlenderMetrics
 from analysis.studies.blender.errors import (
@@ -303,11 +303,6 @@ def study_summary(study: BlenderStudy, metrics: BlenderMetrics) -> dict:
     }
 
 
-def _number(value) -> float:
-    # JSON keeps NaN as null (e.g. the tube velocity of a blender without a tube)
-    return math.nan if value is None else float(value)
-
-
 _METRIC_KEYS = (
     ("mass_flow_rate", "mass_flow_rate_kg_s"), ("exterior_v_z", "exterior_v_z_m_s"), ("interior_v_z", "interior_v_z_m_s"),
     ("tube_v_z", "tube_v_z_m_s"), ("rtd_mean", "rtd_mean_s"), ("rtd_spread", "rtd_spread"), ("ts_over_td", "ts_over_td"),
@@ -316,8 +311,8 @@ _METRIC_KEYS = (
 
 
 #: Figures of :data:`_METRIC_KEYS` with a standard error (``<attribute>_error``, written as ``<key>_error``).
-_ERROR_ATTRIBUTES = ("mass_flow_rate", "exterior_v_z", "interior_v_z", "tube_v_z", "rtd_mean", "rtd_spread",
-                     "ts_over_td")
+_ERROR_ATTRIBUTES = tuple(item.name.removesuffix("_error") for item in fields(BlenderMetrics)
+                          if item.name.endswith("_error"))
 
 
 def metrics_from_summary(summary: Mapping) -> BlenderMetrics:
@@ -326,12 +321,12 @@ def metrics_from_summary(summary: Mapping) -> BlenderMetrics:
     values = summary["metrics"]
     return BlenderMetrics(
         name=values["configuration"],
-        **{field: _number(values[key]) for field, key in _METRIC_KEYS},
-        vrr_by_period={float(period): _number(vrr) for period, vrr in values["vrr_by_period"].items()},
-        **{f"{field}_error": _number(values.get(f"{key}_error")) for field, key in _METRIC_KEYS
+        **{field: number_or_nan(values[key]) for field, key in _METRIC_KEYS},
+        vrr_by_period={float(period): number_or_nan(vrr) for period, vrr in values["vrr_by_period"].items()},
+        **{f"{field}_error": number_or_nan(values.get(f"{key}_error")) for field, key in _METRIC_KEYS
            if field in _ERROR_ATTRIBUTES},
-        vrr_errors={float(period): _number(error) for period, error in values.get("vrr_by_period_error", {}).items()},
-        vrr_ceiling=_number(values.get("vrr_ceiling")),
+        vrr_errors={float(period): number_or_nan(error) for period, error in values.get("vrr_by_period_error", {}).items()},
+        vrr_ceiling=number_or_nan(values.get("vrr_ceiling")),
     )
 
 
@@ -344,6 +339,6 @@ def rtd_summary(rtd: RTD) -> dict:
 
 def rtd_from_summary(curve: Mapping) -> RTD:
     """The :class:`analysis.numerics.rtd.RTD` written by :func:`rtd_summary` (as read from JSON, NaN as null)."""
-    arrays = {key: np.array([_number(v) for v in curve[key]]) for key in ("time", "E", "edges")}
-    numbers = {key: _number(curve[key]) for key in ("t_mean", "variance", "t_first", "t_last")}
+    arrays = {key: np.array([number_or_nan(v) for v in curve[key]]) for key in ("time", "E", "edges")}
+    numbers = {key: number_or_nan(curve[key]) for key in ("t_mean", "variance", "t_first", "t_last")}
     return RTD(**arrays, **numbers, n_exited=int(curve["n_exited"]), n_total=int(curve["n_total"]))

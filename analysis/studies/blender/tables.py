@@ -14,9 +14,11 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from analysis.checks import number_or_nan
 from analysis.io.tables import markdown_table
 from analysis.numerics.rtd import RTD
-from analysis.numerics.uncertainty import CEILING_FACTOR, format_estimate
+from analysis.numerics.uncertainty import format_estimate
+from analysis.numerics.vrr_noise import CEILING_FACTOR
 from analysis.studies.blender.comparison import CEILING_SUFFIX, ERROR_SUFFIX, BlenderMetrics
 from analysis.studies.blender.gravity import gravity_scaling
 from analysis.studies.blender.modes import ContinuousMode
@@ -38,11 +40,6 @@ __all__ = [
 
 #: Steady quantities of a run summary's ``metrics`` tested for ``sqrt(g)`` scaling, in table order.
 GRAVITY_QUANTITIES = ("mass_flow_rate_kg_s", "exterior_v_z_m_s", "interior_v_z_m_s")
-
-
-def _number(value) -> float:
-    # write_json keeps NaN as null (e.g. a passage without bins); read back, it is NaN again.
-    return math.nan if value is None else float(value)
 
 
 def blender_summary(case: Mapping, flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics) -> dict:
@@ -182,8 +179,8 @@ def _estimate_cell(row: Mapping, column: str) -> str | float:
     value = row.get(column, "")
     if column + ERROR_SUFFIX not in row:
         return value
-    value = _number(value)
-    cell = format_estimate(value, _number(row[column + ERROR_SUFFIX])) if math.isfinite(value) else "n/a"
+    value = number_or_nan(value)
+    cell = format_estimate(value, number_or_nan(row[column + ERROR_SUFFIX])) if math.isfinite(value) else "n/a"
     return f"{cell} (at ceiling)" if row.get(column + CEILING_SUFFIX) else cell
 
 
@@ -193,7 +190,7 @@ def comparison_markdown(gravity_factor: float, rows: Sequence[Mapping], best: st
     A figure with a standard error prints as ``"value ± error"``
     (:func:`analysis.numerics.uncertainty.format_estimate`: the error to 2 significant digits, the value to the
     same place; ``"± unknown"`` for an unknown error, ``"n/a"`` for no value), a VRR within
-    :data:`~analysis.numerics.uncertainty.CEILING_FACTOR` of its counting-noise ceiling with ``"(at ceiling)"``;
+    :data:`~analysis.numerics.vrr_noise.CEILING_FACTOR` of its counting-noise ceiling with ``"(at ceiling)"``;
     the error and flag columns themselves are not shown.
 
     Parameters
@@ -261,7 +258,7 @@ def gravity_rows(summaries: Sequence[Mapping], tolerance: float = 0.1) -> tuple[
         if 1.0 not in factors or len(factors) < 2:
             skipped.append((configuration, factors))
             continue
-        quantities = {key: [_number(s["metrics"][key]) for s in runs] for key in GRAVITY_QUANTITIES}
+        quantities = {key: [number_or_nan(s["metrics"][key]) for s in runs] for key in GRAVITY_QUANTITIES}
         quantities = {k: v for k, v in quantities.items() if np.all(np.isfinite(v))}
         scaling = gravity_scaling(factors, quantities, tolerance=tolerance)
         rows += [{"configuration": configuration, **row} for row in scaling.rows]

@@ -7,12 +7,12 @@ functions and write their rows and plots.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.checks import number_or_nan
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.grid import Fields
 from analysis.numerics.profiles import velocity_profile
@@ -125,5 +125,4 @@ def parametric_rows(study: str, labels: Sequence[str], runs: Sequence[str], flow
 
 def _error(flow: Mapping, key: str) -> float:
     """``flow["<key>_error"]`` as a float; NaN when it is missing or null (JSON's NaN)."""
-    error = flow.get(f"{key}_error")
-    return math.nan if error is None else float(error)
+    return number_or_nan(flow.get(f"{key}_error"))

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.checks import number_or_nan
 from analysis.data.contacts import ContactFrame
 from analysis.data.frames import ClumpFrame
 from analysis.data.constants import GRAVITY
@@ -387,7 +388,7 @@ def analyse_silo_fields(
         math.tan(math.radians(options.front_wall_friction_angle_deg)),
         options.internal_friction_angle_deg, margin=settings.cutoff * settings.width,
         bin_width=2.0 * kernel_support_radius(settings.width, settings.cutoff, settings.kernel),
-        bulk_density_error=math.nan if bulk_density_error is None else float(bulk_density_error))
+        bulk_density_error=number_or_nan(bulk_density_error))
     segments = force_chain_segments(contacts, 0.5 * silo.depth, options.force_chain_slice,
                                     cap=force_chain_cap(silo.clump_mass))
     return SiloFieldStudy(

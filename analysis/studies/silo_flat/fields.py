@@ -21,7 +21,7 @@ from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity
 from analysis.numerics.profiles import flow_channel_boundary, velocity_profile
-from analysis.numerics.uncertainty import batch_means, combine_independent
+from analysis.numerics.uncertainty import batch_count, batch_means, combine_independent
 
 
 @dataclass(frozen=True)
@@ -107,10 +107,14 @@ def profile_mass_flow_rate(depth_averaged: Fields, height: float, depth: float) 
     flowing zone is accounted for.
     """
     grid = depth_averaged.grid
-    momentum = depth_averaged.momentum_density[:, 0, :, 2]
-    column = np.array([np.interp(height, grid.z, momentum[i, :]) for i in range(grid.shape[0])])
+    column = _row_at_height(grid, depth_averaged.momentum_density[:, 0, :, 2], height)
     # Cells tile the width, so the midpoint sum over cell centres integrates over [-W/2, W/2].
     return float(-depth * np.sum(column) * grid.spacing[0])
+
+
+def _row_at_height(grid: Grid, values: np.ndarray, height: float) -> np.ndarray:
+    """(nx,) values of an (nx, nz) array of one-layer fields at ``height`` (m), linear in z per column."""
+    return np.array([np.interp(height, grid.z, values[i, :]) for i in range(grid.shape[0])])
 
 
 @dataclass(frozen=True)
@@ -209,8 +213,7 @@ class ProfileUncertainty:
 def _axis_density(fields: Fields, height: float) -> float:
     """Density (kg/m3) of one-layer fields on the axis x = 0 at ``height`` (m), linear in z then in x."""
     grid = fields.grid
-    column = np.array([np.interp(height, grid.z, fields.density[i, 0, :]) for i in range(grid.shape[0])])
-    return float(np.interp(0.0, grid.x, column))
+    return float(np.interp(0.0, grid.x, _row_at_height(grid, fields.density[:, 0, :], height)))
 
 
 def _standard_error(values: np.ndarray) -> float:
@@ -269,30 +272,29 @@ def profile_uncertainty(
     """
     if covered_density <= 0.0 or not math.isfinite(covered_density):
         raise ValueError(f"covered_density must be a finite number > 0, got {covered_density!r}")
-    if isinstance(n_batches, bool) or int(n_batches) != n_batches or n_batches < 2:
-        raise ValueError(f"n_batches must be an integer >= 2, got {n_batches!r}")
+    n_batches = batch_count(n_batches)
     heights = np.asarray(heights, dtype=float)
     fractions = tuple(fractions)
-    grid = depth_series[0].grid
-    chosen = [f for f, t in zip(depth_series, times) if window[0] <= t <= window[1]]
-    count = min(int(n_batches), len(chosen))
-    b_values = np.full((max(count, 1), heights.size), np.nan)
-    left = np.full((max(count, 1), heights.size, len(fractions)), np.nan)
-    right = np.full_like(left, np.nan)
-    covered = np.zeros((max(count, 1), heights.size), dtype=bool)
-    if count >= 2:
-        size = len(chosen) // count
-        chosen = chosen[len(chosen) - size * count:]
-        for k in range(count):
-            batch = chosen[k * size:(k + 1) * size]
-            analysis = analyse_profiles(average_fields(batch), heights, fractions, subtract_wall_velocity,
-                                        kernel_width)
-            b_values[k], left[k], right[k] = analysis.kinematic_B, analysis.fcb_left, analysis.fcb_right
-            covered[k] = [all(_axis_density(f, float(z)) >= covered_density for f in batch) for z in heights]
-    resolution = grid.spacing[0] / math.sqrt(12.0)
+    resolution = depth_series[0].grid.spacing[0] / math.sqrt(12.0)
     b_error = np.full(heights.size, np.nan)
     left_error = np.full((heights.size, len(fractions)), np.nan)
     right_error = np.full_like(left_error, np.nan)
+    chosen = _in_window(depth_series, times, window)
+    count = min(n_batches, len(chosen))
+    if count < 2:
+        return ProfileUncertainty(b_error, left_error, right_error, np.zeros(heights.size, dtype=int), 0,
+                                  resolution)
+    b_values = np.full((count, heights.size), np.nan)
+    left = np.full((count, heights.size, len(fractions)), np.nan)
+    right = np.full_like(left, np.nan)
+    covered = np.zeros((count, heights.size), dtype=bool)
+    size = len(chosen) // count
+    chosen = chosen[len(chosen) - size * count:]  # the oldest frames left out, as in batch_means
+    for k in range(count):
+        batch = chosen[k * size:(k + 1) * size]
+        analysis = analyse_profiles(average_fields(batch), heights, fractions, subtract_wall_velocity, kernel_width)
+        b_values[k], left[k], right[k] = analysis.kinematic_B, analysis.fcb_left, analysis.fcb_right
+        covered[k] = [all(_axis_density(f, float(z)) >= covered_density for f in batch) for z in heights]
     for i in range(heights.size):
         use = covered[:, i]
         b_error[i] = _standard_error(b_values[use & np.isfinite(b_values[:, i]), i])
@@ -300,9 +302,7 @@ def profile_uncertainty(
             for values, errors in ((left, left_error), (right, right_error)):
                 spread = _standard_error(values[use & np.isfinite(values[:, i, j]), i, j])
                 errors[i, j] = combine_independent([spread, resolution])
-    batches = covered.sum(axis=0) if count >= 2 else np.zeros(heights.size, dtype=int)
-    return ProfileUncertainty(b_error, left_error, right_error, batches.astype(int), count if count >= 2 else 0,
-                              resolution)
+    return ProfileUncertainty(b_error, left_error, right_error, covered.sum(axis=0).astype(int), count, resolution)
 
 
 @dataclass(frozen=True)
@@ -430,9 +430,14 @@ def compare_janssen(
     )
 
 
+def _in_window(fields: Sequence[Fields], times: np.ndarray, window: tuple[float, float]) -> list[Fields]:
+    """The fields whose time lies in [t0, t1], in order."""
+    return [f for f, t in zip(fields, times) if window[0] <= t <= window[1]]
+
+
 def time_average(fields: Sequence[Fields], times: np.ndarray, window: tuple[float, float]) -> Fields:
     """Mass-weighted average of the fields whose time lies in [t0, t1]."""
-    chosen = [f for f, t in zip(fields, times) if window[0] <= t <= window[1]]
+    chosen = _in_window(fields, times, window)
     if not chosen:
         raise ValueError(f"no frame in the averaging window {window} s")
     return average_fields(chosen)

@@ -109,11 +109,14 @@ class SiloFlowMetrics:
         rate = self.fit.mass_flow_rate
         return self.mass_flow_rate_error / abs(rate) if rate != 0.0 else math.nan
 
+    def _relative_rate_and_density_error(self) -> float:
+        """The relative errors of W and rho_b in quadrature: that of W / rho_b, and of W / W_B (W_B ~ rho_b)."""
+        return combine_independent([self._relative_rate_error(), self._relative_density_error()])
+
     @property
     def volumetric_flow_rate_error(self) -> float:
         """Standard error of ``W / rho_b`` (m^3/s): the relative errors of W and rho_b in quadrature."""
-        relative = combine_independent([self._relative_rate_error(), self._relative_density_error()])
-        return abs(self.volumetric_flow_rate) * relative
+        return abs(self.volumetric_flow_rate) * self._relative_rate_and_density_error()
 
     @property
     def beverloo_rate_error(self) -> float:
@@ -125,8 +128,7 @@ class SiloFlowMetrics:
     def beverloo_ratio_error(self) -> float:
         """Standard error of the measured over predicted flow rate (-): ``W / W_B`` with ``W_B`` proportional to
         rho_b, so the relative errors of W and rho_b in quadrature."""
-        relative = combine_independent([self._relative_rate_error(), self._relative_density_error()])
-        return abs(self.beverloo_ratio) * relative
+        return abs(self.beverloo_ratio) * self._relative_rate_and_density_error()
 
 
 def steady_rate_estimate(history: DischargeHistory, fit: FlowRateFit, n_batches: int = FLOW_RATE_BATCHES) -> Estimate:

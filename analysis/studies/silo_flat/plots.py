@@ -119,12 +119,13 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
         for i, z in enumerate(heights):
             axes.axhline(1e3 * z, color="0.8", linewidth=0.6)
             axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
-            left, right = profiles.fcb_left[i, fcb_fraction_index], profiles.fcb_right[i, fcb_fraction_index]
-            axes.plot(1e3 * np.array([left, right]), [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
+            boundary_mm = 1e3 * np.array([profiles.fcb_left[i, fcb_fraction_index],
+                                          profiles.fcb_right[i, fcb_fraction_index]])
+            axes.plot(boundary_mm, [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
             if uncertainty is not None:
                 errors = [uncertainty.fcb_left_error[i, fcb_fraction_index],
                           uncertainty.fcb_right_error[i, fcb_fraction_index]]
-                axes.errorbar(1e3 * np.array([left, right]), [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
+                axes.errorbar(boundary_mm, [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
                               fmt="none", ecolor="red", elinewidth=1.0, capsize=3)
         fraction = profiles.fcb_fractions[fcb_fraction_index]
         axes.plot([], [], "o", color="red", label=f"FCB at {100 * fraction:g} % of centreline v_z")

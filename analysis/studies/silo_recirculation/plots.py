@@ -8,7 +8,7 @@ Geometry (as in :mod:`analysis.studies.silo_flat.plots`): width W along x with w
 plane at z = 0, a slot outlet of width B0 centred on x = 0, and below it a channel of the same width
 down to z = -L_channel; clumps leaving the channel re-enter at the top. Lengths are given in m and drawn
 in mm. Batches are coloured blue and white; "concentration" is the blue fraction [-]. The number of
-recirculations is Nr = t / t_res (t_res: mean residence time of one pass).
+recirculations is Nr = t / t_res (t_res: the holdup residence time, holdup over throughput).
 
 Tolerance bands follow :func:`analysis.numerics.lti.recirculations_to_homogenise`: relative, i.e. the band is
 ``blue_fraction * (1 +- tolerance)``.
@@ -32,12 +32,11 @@ from analysis.io.plots import (  # noqa: E402
     finite_abscissa,
     matching_ordinate,
     non_empty_list,
-    positive_finite_points,
     save_png,
     silo_outline,
     tuple_entry,
 )
-from analysis.numerics.uncertainty import CEILING_FACTOR, vrr_near_ceiling  # noqa: E402
+from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling  # noqa: E402
 from analysis.studies.silo_recirculation.rtd_plots import BLUE, tolerance_band  # noqa: E402
 
 __all__ = [
@@ -150,7 +149,7 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
     Points whose VRR is NaN, zero or negative are skipped; a VRR of +inf (no variance left at the
     outlet) is marked by an upward triangle at the top of the axes. Each ceiling is drawn as a dashed
     horizontal line; finite VRRs within ``factor`` of their curve's ceiling
-    (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`) get an open marker: they are lower bounds,
+    (:func:`analysis.numerics.vrr_noise.vrr_near_ceiling`) get an open marker: they are lower bounds,
     set by the sampling noise, not measurements. The points drawn that have a finite error get a bar of
     +- one standard error (``gid="vrr_error"``); on the log axis a bar reaching 0 or below runs to the
     bottom of the axes.
@@ -168,7 +167,7 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         Figure title.
     noise_limit : float or None, optional
         Counting-noise ceiling (VRR of a perfectly mixed outflow sampled in windows of the same size,
-        :func:`analysis.numerics.uncertainty.vrr_ceiling`) of the curves without their own [-] (> 0);
+        :func:`analysis.numerics.vrr_noise.vrr_ceiling`) of the curves without their own [-] (> 0);
         None: those curves have none.
     factor : float, optional
         VRRs at or above ``ceiling / factor`` are drawn open, >= 1 [-].
@@ -192,9 +191,6 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
     checked = _vrr_curves(curves, noise_limit)
     # One line per distinct ceiling: the layouts of one run share theirs.
     ceilings = sorted({ceiling for *_, ceiling, _ in checked if ceiling is not None})
-    flags = [np.zeros(0, dtype=bool) if ceiling is None else
-             np.asarray(vrr_near_ceiling(positive_finite_points(x, y)[1], ceiling, factor), dtype=bool)
-             for _, x, y, ceiling, _ in checked]
     figure, axes = plt.subplots(figsize=(6.4, 4.2))
     try:
         axes.set_yscale("log")
@@ -202,25 +198,30 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         for ceiling in ceilings:
             axes.axhline(ceiling, color="tab:red", linestyle="--", linewidth=1.0, gid="ceiling",
                          label=f"counting-noise ceiling {ceiling:.3g}")
-        for (label, recirculations, vrr, _, error), at_ceiling in zip(checked, flags):
-            x, y = positive_finite_points(recirculations, vrr)
+        any_at_ceiling = False
+        for label, recirculations, vrr, ceiling, error in checked:
+            # the points a log axis can show (positive_finite_points; the Nr are finite), with their errors
+            drawn = np.isfinite(vrr) & (vrr > 0.0)
+            x, y, y_error = recirculations[drawn], vrr[drawn], error[drawn]
             (line,) = axes.plot(x, y, "o-", markersize=4, linewidth=1.2,
                                 label=label if x.size else f"{label} (no finite VRR)")
-            drawn = np.isfinite(recirculations) & np.isfinite(vrr) & (vrr > 0.0)  # the points on the line
-            with_bar = drawn & np.isfinite(error)
+            with_bar = np.isfinite(y_error)
             if with_bar.any():
-                bars = axes.errorbar(recirculations[with_bar], vrr[with_bar], yerr=error[with_bar], fmt="none",
+                bars = axes.errorbar(x[with_bar], y[with_bar], yerr=y_error[with_bar], fmt="none",
                                      color=line.get_color(), elinewidth=1.0, capsize=2.5, label="_nolegend_")
                 for artist in bars.lines[2]:
                     artist.set_gid("vrr_error")
+            at_ceiling = (np.zeros(0, dtype=bool) if ceiling is None else
+                          np.asarray(vrr_near_ceiling(y, ceiling, factor), dtype=bool))
             if at_ceiling.any():
+                any_at_ceiling = True
                 axes.plot(x[at_ceiling], y[at_ceiling], "o", color=line.get_color(), markersize=7,
                           markerfacecolor="white", markeredgewidth=1.3, gid="at_ceiling", label="_nolegend_")
             infinite = recirculations[np.isposinf(vrr)]
             if infinite.size:
                 axes.plot(infinite, np.full(infinite.size, 0.97), "^", color=line.get_color(), markersize=6,
                           transform=axes.get_xaxis_transform(), clip_on=False, gid="infinite")
-        if any(at_ceiling.any() for at_ceiling in flags):
+        if any_at_ceiling:
             axes.plot([], [], "o", color="0.3", markersize=7, markerfacecolor="white",
                       label=f"within x{factor:g} of the ceiling: lower bound")
         axes.set_xlabel("number of recirculations Nr = t / t_res [-]")

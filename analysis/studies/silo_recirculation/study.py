@@ -26,8 +26,8 @@ Steps (SEED_DIGEST section 4):
    (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`): over a horizon ``h`` (a third of
    the run, :func:`analysis.studies.silo_recirculation.transit.transit_horizon`) the holdup of the passes lasting
    at most ``h`` over their throughput against the tracer's mean of its residence times up to ``h``
-   (:func:`analysis.numerics.rtd.mean_residence_time_within`); the holdup of the slower rest (stagnant zones) is
-   what makes ``t_res`` exceed the tracer's ``t_m``.
+   (:func:`analysis.numerics.residence_statistics.mean_residence_time_within`); the holdup of the slower rest
+   (stagnant zones) is what makes ``t_res`` exceed the tracer's ``t_m``.
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
 from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
 from analysis.numerics.residence_statistics import mean_residence_time, mean_residence_time_within
-from analysis.numerics.uncertainty import Estimate, window_duration_for_precision
+from analysis.numerics.uncertainty import Estimate
+from analysis.numerics.vrr_noise import window_duration_for_precision
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
     batch_inlet_signal,
@@ -76,6 +77,10 @@ class Layout:
     blue_at: str = "bottom"
 
 
+#: Part of the run, from the outlet opening, left out of every steady-state figure [-].
+STARTUP_FRACTION = 0.1
+
+
 @dataclass(frozen=True, eq=False)
 class LoopTiming:
     """Steady-state timing of a recirculation run.
@@ -100,6 +105,8 @@ class LoopTiming:
     frame_interval : float
         Median time between the saved frames of the steady part [s], the time resolution of every event;
         NaN when not known.
+    startup_fraction : float
+        Part of the run, from ``t_open``, left out of the steady part [-] (:attr:`steady_start`).
     """
 
     t_open: float
@@ -112,6 +119,12 @@ class LoopTiming:
     holdup_error: float = math.nan
     throughput_error: float = math.nan
     frame_interval: float = math.nan
+    startup_fraction: float = STARTUP_FRACTION
+
+    @property
+    def steady_start(self) -> float:
+        """Start of the steady part, ``t_open + startup_fraction (t_end - t_open)`` [s]."""
+        return self.t_open + self.startup_fraction * (self.t_end - self.t_open)
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,10 +192,6 @@ class BlendingResult:
     tracer_transit_mean: Estimate | None = None
 
 
-#: Part of the run, from the outlet opening, left out of every steady-state figure [-].
-STARTUP_FRACTION = 0.1
-
-
 def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: float = 0.0,
                 startup_fraction: float = STARTUP_FRACTION, n_batches: int = 10) -> LoopTiming:
     """Holdup, throughput and holdup residence time over the run after its first ``startup_fraction``, with their
@@ -214,6 +223,7 @@ def loop_timing(tracks: ClumpTracks, events: RecirculationEvents, outlet_z: floa
         holdup_error=little.holdup.std_error,
         throughput_error=little.throughput.std_error,
         frame_interval=frame_interval,
+        startup_fraction=startup_fraction,
     )
 
 
@@ -223,14 +233,14 @@ def transit_timing(tracks: ClumpTracks, events: RecirculationEvents, timing: Loo
     """Little's law on the passes lasting at most a horizon, and the tracer's mean over the same passes.
 
     The horizon is :func:`analysis.studies.silo_recirculation.transit.transit_horizon` (``horizon_fraction`` of
-    the run, at most the time the last tracer pass was followed); Little's law over the steady part
-    (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`) and the tracer's residence times
-    up to it (:func:`analysis.numerics.rtd.mean_residence_time_within`) then refer to the same control volume,
-    entry and exit events and clumps, and agree within their errors in a steady run.
+    the run, at most the time the last tracer pass was followed); Little's law over the steady part of ``timing``
+    (from :attr:`LoopTiming.steady_start`, :func:`analysis.studies.silo_recirculation.transit.transit_littles_law`)
+    and the tracer's residence times up to it
+    (:func:`analysis.numerics.residence_statistics.mean_residence_time_within`) then refer to the same control
+    volume, entry and exit events and clumps, and agree within their errors in a steady run.
     """
     horizon = transit_horizon(timing.t_open, timing.t_end, tracer.entry_time, horizon_fraction)
-    t_start = timing.t_open + STARTUP_FRACTION * (timing.t_end - timing.t_open)
-    little = transit_littles_law(tracks, events, horizon, t_start, outlet_z, n_batches)
+    little = transit_littles_law(tracks, events, horizon, timing.steady_start, outlet_z, n_batches)
     return little, mean_residence_time_within(tracer.residence_time, horizon)
 
 
@@ -423,8 +433,8 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
         Height of the outlet plane [m].
     window_target_vrr : float or None, optional
         When given, the concentration window is sized from it instead of ``window_fraction``: long enough that a VRR
-        of this size lies a factor :data:`~analysis.numerics.uncertainty.CEILING_FACTOR` below the counting-noise
-        ceiling of the windows (:func:`~analysis.numerics.uncertainty.window_duration_for_precision` at the measured
+        of this size lies a factor :data:`~analysis.numerics.vrr_noise.CEILING_FACTOR` below the counting-noise
+        ceiling of the windows (:func:`~analysis.numerics.vrr_noise.window_duration_for_precision` at the measured
         throughput) [-].
     """
     events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
@@ -483,9 +493,9 @@ def residence_summary(times) -> dict:
     """Count, count exited, mean, its standard error and the standard deviation of a residence-time sample.
 
     ``n`` and ``n_exited`` [-], ``mean_s`` [s], ``mean_s_error`` (``s / sqrt(n_exited)`` with ``ddof = 1``,
-    :func:`analysis.numerics.rtd.mean_residence_time`, which states the assumption; NaN for one exited tracer)
-    [s] and ``std_s`` (population, ``ddof = 0``) [s]. NaN in ``times`` means not out; without any exited tracer
-    the moments are None.
+    :func:`analysis.numerics.residence_statistics.mean_residence_time`, which states the assumption; NaN for one
+    exited tracer) [s] and ``std_s`` (population, ``ddof = 0``) [s]. NaN in ``times`` means not out; without any
+    exited tracer the moments are None.
     """
     times = np.asarray(times, dtype=float)
     finite = times[np.isfinite(times)]

@@ -6,9 +6,9 @@ no file I/O. The column names and their order are the file formats the summary, 
 change only together with their readers (new columns are appended, never renamed). SI units: times in s, E in
 1/s, lengths in m; concentrations and VRRs are dimensionless.
 
-Every measured VRR comes with its counting-noise ceiling (:func:`analysis.numerics.uncertainty.vrr_ceiling`,
+Every measured VRR comes with its counting-noise ceiling (:func:`analysis.numerics.vrr_noise.vrr_ceiling`,
 ``clumps_per_window`` for a 0/1 batch) and a flag where it lies within a factor 2 of it
-(:func:`analysis.numerics.uncertainty.vrr_near_ceiling`): such a VRR is a lower bound, so it is not compared with
+(:func:`analysis.numerics.vrr_noise.vrr_near_ceiling`): such a VRR is a lower bound, so it is not compared with
 the LTI prediction as if it were a measurement.
 
 Standard errors follow the convention of the summary page: the error of a figure ``<key>`` is ``<key>_error``,
@@ -19,7 +19,7 @@ in its unit, beside it (NaN, written null or empty, when not known). Their sourc
   ``transit_residence_time_s`` over the transit window
   (:func:`analysis.studies.silo_recirculation.transit.transit_littles_law`);
 - ``t_s_over_t_d``: the order-statistic gaps of the tracer (tracer counting) and the frame interval (time
-  resolution), propagated (:func:`analysis.numerics.rtd.appearance_times`);
+  resolution), propagated (:func:`analysis.numerics.residence_statistics.appearance_times`);
 - RTD means: ``s / sqrt(n)`` over the tracers that left (:attr:`analysis.numerics.rtd.RTD.t_mean_error`), or
   that left within the transit horizon (``t_mean_transit_s``);
 - VRR: ``sqrt(2 / (N - 1)) VRR`` over the ``N`` windows of the recirculation
@@ -43,15 +43,11 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from analysis.checks import number_or_nan
 from analysis.numerics.rtd import RTD, johanson_rtd
 from analysis.numerics.residence_statistics import appearance_times, residence_time_resolution
-from analysis.numerics.uncertainty import (
-    CEILING_FACTOR,
-    Significance,
-    combine_independent,
-    difference_significant,
-    vrr_near_ceiling,
-)
+from analysis.numerics.uncertainty import Significance, combine_independent, difference_significant
+from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling
 from analysis.studies.silo_recirculation.study import BlendingResult, VerificationResult, residence_summary
 from analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 
@@ -236,7 +232,7 @@ def vrr_period_rows(result: BlendingResult) -> list[dict]:
 def clumps_per_window(result: BlendingResult) -> float:
     """Mean outlet crossings per concentration window, throughput x window [-].
 
-    The ``n`` of :func:`analysis.numerics.uncertainty.vrr_ceiling`: the largest VRR that windows of that many
+    The ``n`` of :func:`analysis.numerics.vrr_noise.vrr_ceiling`: the largest VRR that windows of that many
     crossings can measure (the exact ceiling of windows of unequal size is the harmonic mean of their crossings,
     at most a few per cent lower in a steady flow).
 
@@ -319,7 +315,7 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
         "clumps_per_window": particles_per_window,
         "vrr_sampling_limit": sampling_noise_vrr_limit(0.5, particles_per_window), "vrr_ceiling_factor": factor,
         "rtd_particle_ids": {"t_mean_s": silo_rtd.t_mean, "variance_s2": silo_rtd.variance, "t_s": silo_rtd.t_first,
-                             "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.t_first / silo_rtd.t_last,
+                             "t_d": silo_rtd.t_last, "t_s_over_t_d": silo_rtd.ts_over_td,
                              "n_tracer": result.rtd.n_tracer, "fraction_exited": silo_rtd.fraction_exited,
                              "t_mean_s_error": silo_rtd.t_mean_error, "t_s_error": appearance.t_first.std_error,
                              "t_d_error": appearance.t_last.std_error,
@@ -519,8 +515,8 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
         ceiling = summary.get("vrr_sampling_limit")
         particle_rtd, eulerian_rtd = summary["rtd_particle_ids"], summary["rtd_eulerian"]
         for name, layout in summary["layouts"].items():
-            vrr = [_number(v) for v in layout["vrr_by_recirculation"]]
-            errors = [_number(e) for e in layout.get("vrr_by_recirculation_error", [None] * len(vrr))]
+            vrr = [number_or_nan(v) for v in layout["vrr_by_recirculation"]]
+            errors = [number_or_nan(e) for e in layout.get("vrr_by_recirculation_error", [None] * len(vrr))]
             flags = layout.get("vrr_at_ceiling")
             if flags is None:
                 flags = ([False] * len(vrr) if ceiling is None else
@@ -538,20 +534,16 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
                 "model_homogenised_after_recirculations": layout["model_homogenised_after_recirculations"],
                 "vrr_ceiling": float("nan") if ceiling is None else ceiling,
                 **{f"vrr_at_ceiling_nr{k + 1}": bool(flag) for k, flag in enumerate(flags)},
-                "residence_time_s_error": _number(summary.get("residence_time_s_error")),
-                "t_s_over_t_d_error": _number(particle_rtd.get("t_s_over_t_d_error")),
-                "rtd_mean_ids_s_error": _number(particle_rtd.get("t_mean_s_error")),
-                "rtd_mean_eulerian_s_error": _number(eulerian_rtd.get("t_mean_s_error")),
+                "residence_time_s_error": number_or_nan(summary.get("residence_time_s_error")),
+                "t_s_over_t_d_error": number_or_nan(particle_rtd.get("t_s_over_t_d_error")),
+                "rtd_mean_ids_s_error": number_or_nan(particle_rtd.get("t_mean_s_error")),
+                "rtd_mean_eulerian_s_error": number_or_nan(eulerian_rtd.get("t_mean_s_error")),
                 **{f"vrr_nr{k + 1}_error": e for k, e in enumerate(errors)},
-                "transit_residence_time_s": _number(summary.get("transit_residence_time_s")),
-                "transit_residence_time_s_error": _number(summary.get("transit_residence_time_s_error")),
-                "rtd_mean_ids_transit_s": _number(particle_rtd.get("t_mean_transit_s")),
-                "rtd_mean_ids_transit_s_error": _number(particle_rtd.get("t_mean_transit_s_error")),
+                "transit_residence_time_s": number_or_nan(summary.get("transit_residence_time_s")),
+                "transit_residence_time_s_error": number_or_nan(summary.get("transit_residence_time_s_error")),
+                "rtd_mean_ids_transit_s": number_or_nan(particle_rtd.get("t_mean_transit_s")),
+                "rtd_mean_ids_transit_s_error": number_or_nan(particle_rtd.get("t_mean_transit_s_error")),
             })
     return rows, curves
 
 
-def _number(value) -> float:
-    """A number read from JSON: null (NaN or inf written by :func:`analysis.io.tables.write_json`, or a key the
-    summary does not have) as NaN."""
-    return float("nan") if value is None else float(value)

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number
+from analysis.checks import finite_number, increasing_times
 from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 
 __all__ = [
@@ -52,6 +52,7 @@ __all__ = [
     "clump_tracks",
     "recirculation_tracks",
     "recirculation_events",
+    "above_outlet",
     "clumps_above_outlet",
 ]
 
@@ -214,11 +215,9 @@ def _clump_ids(name: str, values) -> np.ndarray:
 
 
 def _increasing_times(name: str, values) -> np.ndarray:
-    times = finite_array(name, values, ndim=1)
+    times = increasing_times(name, values)
     if times.size == 0:
         raise ValueError(f"{name} must not be empty")
-    if np.any(np.diff(times) <= 0.0):
-        raise ValueError(f"{name} must be strictly increasing")
     return times
 
 
@@ -490,7 +489,24 @@ def clumps_above_outlet(tracks: ClumpTracks, outlet_z: float) -> np.ndarray:
     numpy.ndarray of int64, shape (n_t,)
         Clumps above the outlet plane per frame [-].
     """
+    return np.count_nonzero(above_outlet(tracks, outlet_z), axis=1).astype(np.int64)
+
+
+def above_outlet(tracks: ClumpTracks, outlet_z: float) -> np.ndarray:
+    """Which clumps are above the outlet plane in each frame, ``z > outlet_z``; an absent clump (NaN) is not.
+
+    Parameters
+    ----------
+    tracks : ClumpTracks
+        Clump centres [m].
+    outlet_z : float
+        Height of the outlet plane [m].
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (n_t, n_c)
+    """
     _, position = _checked_tracks(tracks)
     outlet = finite_number("outlet_z", outlet_z)
     z = np.where(np.isfinite(position[:, :, 2]), position[:, :, 2], -np.inf)  # absent: not counted
-    return np.count_nonzero(z > outlet, axis=1).astype(np.int64)
+    return z > outlet

@@ -24,9 +24,9 @@ clumps by a horizon ``h`` (:func:`transit_littles_law`): over frames in ``[t_ope
 lasting at most ``h`` that is in progress has a known entry and exit, so the *transit holdup* (passes in
 progress with ``exit - entry <= h``) over the *transit throughput* (their exits) is, by Little's law,
 ``E[t | t <= h]``, the mean the tracer gives when its residence times are cut at the same ``h``
-(:func:`analysis.numerics.rtd.mean_residence_time_within`). The rest of the holdup (``slow_holdup``) is the
-stagnant and slowly creeping material: ``t_res = f t_transit + H_slow / Q`` with ``f`` the fraction of the
-throughput that passes within ``h``.
+(:func:`analysis.numerics.residence_statistics.mean_residence_time_within`). The rest of the holdup
+(``slow_holdup``) is the stagnant and slowly creeping material: ``t_res = f t_transit + H_slow / Q`` with ``f``
+the fraction of the throughput that passes within ``h``.
 """
 
 from __future__ import annotations
@@ -38,7 +38,8 @@ import numpy as np
 
 from analysis.checks import finite_array, finite_number, positive_number
 from analysis.numerics.uncertainty import Estimate, batch_means, proportion_error
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationEvents, clumps_above_outlet
+from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationEvents, above_outlet
+from analysis.checks import increasing_times
 from analysis.studies.silo_recirculation.validation import event_times, integer_at_least
 from analysis.studies.silo_recirculation.vrr import LittlesLaw, littles_law
 
@@ -109,9 +110,7 @@ def passes_in_progress(frame_times, entry_time, exit_time) -> np.ndarray:
         On times not strictly increasing, passes of unequal length, non-finite times or an exit before its
         entry.
     """
-    times = finite_array("frame_times", frame_times, ndim=1)
-    if np.any(np.diff(times) <= 0.0):
-        raise ValueError("frame_times must be strictly increasing")
+    times = increasing_times("frame_times", frame_times)
     entry = finite_array("entry_time", entry_time, ndim=1)
     exit_ = finite_array("exit_time", exit_time, ndim=1)
     if entry.shape != exit_.shape:
@@ -130,9 +129,11 @@ def stagnant_clumps(tracks: ClumpTracks, outlet_z: float = 0.0) -> int:
 
     A clump absent from a frame is not counted (it cannot be shown to have stayed).
     """
-    outlet = finite_number("outlet_z", outlet_z)
-    z = np.asarray(tracks.position, dtype=float)[:, :, 2]
-    above = np.where(np.isfinite(z), z, -np.inf) > outlet
+    return _always_above(above_outlet(tracks, outlet_z))
+
+
+def _always_above(above: np.ndarray) -> int:
+    """Clumps above the outlet in every frame of an :func:`above_outlet` mask [-]."""
     return int(np.count_nonzero(above.all(axis=0)))
 
 
@@ -232,7 +233,8 @@ def transit_littles_law(tracks: ClumpTracks, events: RecirculationEvents, horizo
     residence = exit_ - entry
     short = np.isfinite(residence) & (residence <= h)
     transit_holdup = passes_in_progress(times, entry[short], exit_[short])[in_window]
-    whole_holdup = clumps_above_outlet(tracks, outlet_z)[in_window]
+    above = above_outlet(tracks, outlet_z)  # one pass over the tracks for the whole holdup and the stagnant clumps
+    whole_holdup = np.count_nonzero(above[in_window], axis=1)
     frames = times[in_window]
     transit = littles_law(frames, transit_holdup, exit_[short], t_from, t_to, n_batches)
     crossings = event_times("events.exit_times_all", events.exit_times_all)
@@ -247,4 +249,4 @@ def transit_littles_law(tracks: ClumpTracks, events: RecirculationEvents, horizo
                            dof=n_batches - 1)
     return TransitLittlesLaw(horizon=h, t_from=t_from, t_to=t_to, transit=transit, whole=whole,
                              transit_fraction=fraction, slow_holdup=slow_holdup,
-                             stagnant_clumps=stagnant_clumps(tracks, outlet_z))
+                             stagnant_clumps=_always_above(above))

@@ -12,7 +12,7 @@ input variance being that of the 0/1 batch with blue fraction ``p``.
 
 Counting-noise ceiling
 ----------------------
-Windows of ``n`` clumps cannot show a VRR above about ``n`` (:func:`analysis.numerics.uncertainty.vrr_ceiling`):
+Windows of ``n`` clumps cannot show a VRR above about ``n`` (:func:`analysis.numerics.vrr_noise.vrr_ceiling`):
 the binomial noise of the blue count is left even in a perfectly mixed outflow. A VRR within a factor 2 of the
 ceiling (:meth:`RecirculationVRR.at_ceiling`) is a lower bound of the true VRR, not a measurement of it.
 
@@ -31,16 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, positive_number
-from analysis.numerics.uncertainty import (
-    CEILING_FACTOR,
-    Estimate,
-    batch_means,
-    batch_rate,
-    combine_independent,
-    vrr_ceiling,
-    vrr_near_ceiling,
-)
+from analysis.checks import finite_array, finite_number, increasing_times, positive_number
+from analysis.numerics.uncertainty import Estimate, batch_means, batch_rate, combine_independent
+from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_ceiling, vrr_near_ceiling
 from analysis.studies.silo_recirculation.validation import event_times, integer_at_least, open_fraction
 
 __all__ = [
@@ -107,7 +100,7 @@ class RecirculationVRR:
     def ceiling(self, clumps_per_window: float) -> float:
         """Counting-noise ceiling of these VRRs for windows of ``clumps_per_window`` clumps [-].
 
-        :func:`analysis.numerics.uncertainty.vrr_ceiling` with the input variance of the 0/1 batch,
+        :func:`analysis.numerics.vrr_noise.vrr_ceiling` with the input variance of the 0/1 batch,
         ``p (1 - p)``: the ceiling is ``clumps_per_window`` itself.
 
         Parameters
@@ -128,7 +121,7 @@ class RecirculationVRR:
             Outlet crossings per window ``n``, > 0 [-].
         factor : float, optional
             ``VRR >= ceiling / factor`` is flagged, >= 1 [-]
-            (:func:`analysis.numerics.uncertainty.vrr_near_ceiling`).
+            (:func:`analysis.numerics.vrr_noise.vrr_near_ceiling`).
 
         Returns
         -------
@@ -193,12 +186,20 @@ def holdup_residence_time(n_in_silo, exit_times, t_start: float, t_end: float) -
     ValueError
         On an empty or negative holdup, a bad window, or no crossing in the window.
     """
+    mean_holdup, _, n_exits, duration = _steady_window(n_in_silo, exit_times, t_start, t_end)
+    return mean_holdup * duration / n_exits
+
+
+def _steady_window(n_in_silo, exit_times, t_start: float, t_end: float) -> tuple[float, np.ndarray, int, float]:
+    """The checks of :func:`holdup_residence_time`; the mean holdup, the finite crossing times, the crossings in
+    the window and its duration ``t_end - t_start``."""
     holdup = finite_array("n_in_silo", n_in_silo, ndim=1)
     if holdup.size == 0:
         raise ValueError("n_in_silo must not be empty")
     if np.any(holdup < 0.0):
         raise ValueError("n_in_silo must contain counts >= 0")
     exits = event_times("exit_times", exit_times)
+    exits = exits[np.isfinite(exits)]
     t_start = finite_number("t_start", t_start)
     t_end = finite_number("t_end", t_end)
     if t_end <= t_start:
@@ -206,7 +207,7 @@ def holdup_residence_time(n_in_silo, exit_times, t_start: float, t_end: float) -
     n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
     if n_exits == 0:
         raise ValueError(f"exit_times: no outlet crossing in [t_start, t_end] = [{t_start!r}, {t_end!r}] s")
-    return float(np.mean(holdup)) * (t_end - t_start) / n_exits
+    return float(np.mean(holdup)), exits, n_exits, t_end - t_start
 
 
 @dataclass(frozen=True)
@@ -269,23 +270,18 @@ def littles_law(frame_times, n_in_silo, exit_times, t_start: float, t_end: float
         As :func:`holdup_residence_time`, and on frame times of another length than ``n_in_silo``, not
         strictly increasing, or ``n_batches`` not an integer >= 2.
     """
-    times = finite_array("frame_times", frame_times, ndim=1)
+    times = increasing_times("frame_times", frame_times)  # also with too few frames for batch_rate to check
     holdup = finite_array("n_in_silo", n_in_silo, ndim=1)
     if times.shape != holdup.shape:
         raise ValueError(f"frame_times must have the shape of n_in_silo {holdup.shape}, got {times.shape}")
-    if np.any(np.diff(times) <= 0.0):
-        raise ValueError("frame_times must be strictly increasing")
     n_batches = integer_at_least("n_batches", n_batches, 2)
-    residence_time = holdup_residence_time(holdup, exit_times, t_start, t_end)
-    exits = np.sort(event_times("exit_times", exit_times))
-    exits = exits[np.isfinite(exits)]
-    n_exits = int(np.count_nonzero((exits >= t_start) & (exits <= t_end)))
-    mean_holdup = float(np.mean(holdup))
-    throughput = n_exits / (float(t_end) - float(t_start))
+    mean_holdup, exits, n_exits, duration = _steady_window(holdup, exit_times, t_start, t_end)
+    residence_time = mean_holdup * duration / n_exits  # holdup_residence_time
+    throughput = n_exits / duration
     if times.size >= 2 * n_batches:
         holdup_error = batch_means(holdup, n_batches).std_error
         # crossings up to and including each frame time: any offset drops out of the slopes
-        cumulative = np.searchsorted(exits, times, side="right").astype(float)
+        cumulative = np.searchsorted(np.sort(exits), times, side="right").astype(float)
         throughput_error = batch_rate(times, cumulative, n_batches).std_error
     else:
         holdup_error = throughput_error = math.nan
@@ -425,7 +421,7 @@ def sampling_noise_vrr_limit(blue_fraction: float, particles_per_window: float) 
     A perfectly mixed outflow still gives window concentrations with the binomial variance
     ``p (1 - p) / n``, so ``sigma_in^2`` over it, i.e. ``n``, is the VRR of perfect mixing as measured
     (a reference line for plots of :func:`vrr_by_recirculation`). The counting-noise ceiling of
-    :func:`analysis.numerics.uncertainty.vrr_ceiling` for a 0/1 batch input, kept under this name for its callers.
+    :func:`analysis.numerics.vrr_noise.vrr_ceiling` for a 0/1 batch input, kept under this name for its callers.
 
     Parameters
     ----------

@@ -1,0 +1,18 @@
+"""Helpers of the plot unit tests: keep the figures the writers save, so that their plotted data can be checked."""
+
+from __future__ import annotations
+
+from analysis.io.plots import save_png
+
+
+def saved_figures(monkeypatch, *modules) -> list:
+    """The list that each figure saved through ``save_png`` of ``modules`` is appended to (after it is written)."""
+    saved = []
+
+    def keep(figure, path, tight=False):
+        saved.append(figure)
+        return save_png(figure, path, tight=tight)
+
+    for module in modules:
+        monkeypatch.setattr(module, "save_png", keep)
+    return saved
