@@ -139,9 +139,10 @@ class Engine(ABC):
         """Contact forces at the saved instants, oldest first: ``pair`` (particle-particle) or ``wall``."""
 
     @abstractmethod
-    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
-        """The fill at rest after its settle stage: spheres with the walls' force on each, the pair contacts of the
-        same step, and each wall's force (for the force balance of :mod:`analysis.numerics.force_balance`).
+    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
+        """The fill at rest after its settle stage, at each step of its snapshot (consecutive steps, oldest first):
+        spheres with the walls' force on each, the pair contacts and each wall's force of that step (for the force
+        balance of :mod:`analysis.numerics.force_balance`, which averages the steps).
 
         Raises
         ------

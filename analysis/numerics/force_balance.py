@@ -22,8 +22,8 @@ import numpy as np
 from analysis.data.frames import clumps_from_frame
 from analysis.data.settled import SettledFill
 
-__all__ = ["PlaneLoad", "FillBalance", "plane_loads", "fill_balance", "settled_fill_balance", "BalanceTolerances",
-           "balance_problems"]
+__all__ = ["PlaneLoad", "FillBalance", "plane_loads", "fill_balance", "settled_fill_balance", "mean_balance",
+           "BalanceTolerances", "balance_problems"]
 
 
 @dataclass(frozen=True)
@@ -272,17 +272,32 @@ def fill_balance(
     )
 
 
-def settled_fill_balance(settled: SettledFill, heights: Sequence[float], gravity: float) -> FillBalance:
-    """The force balance of an engine's settled fill (:func:`fill_balance` on its spheres, contacts and walls).
+def settled_fill_balance(settled: SettledFill | Sequence[SettledFill], heights: Sequence[float],
+                         gravity: float) -> FillBalance:
+    """The force balance of an engine's settled fill (:func:`fill_balance` on its spheres, contacts and walls),
+    averaged over the steps of its snapshot (:func:`mean_balance`).
 
     A clump's centre of mass is the mean of its sphere centres (exact for the symmetric templates of siloflow's
     particle models); its mass is its own (see :func:`analysis.data.frames.clumps_from_frame`).
 
+    Parameters
+    ----------
+    settled : SettledFill or sequence of SettledFill
+        The fill at one step, or at consecutive steps (an engine's fill at rest alternates about equilibrium
+        from step to step; the mean of two steps removes it).
+
     Raises
     ------
     ValueError
-        When a contact names a sphere that is not in the frame.
+        When no step is given, or a contact names a sphere that is not in the frame.
     """
+    steps = [settled] if isinstance(settled, SettledFill) else list(settled)
+    if not steps:
+        raise ValueError("the settled fill has no step: nothing to balance")
+    return mean_balance([_step_balance(step, heights, gravity) for step in steps])
+
+
+def _step_balance(settled: SettledFill, heights: Sequence[float], gravity: float) -> FillBalance:
     frame = settled.frame
     clumps = clumps_from_frame(frame)
     sphere_clump = np.searchsorted(clumps.clump_id, frame.clump_id)
@@ -300,6 +315,55 @@ def settled_fill_balance(settled: SettledFill, heights: Sequence[float], gravity
     return fill_balance(sphere_clump, clumps.mass, clumps.position[:, 2], settled.wall_force,
                         rows(np.asarray(contacts.id_i, dtype=np.int64)), rows(np.asarray(contacts.id_j, dtype=np.int64)),
                         contacts.force, heights, gravity, settled.wall_forces, settled.floor_walls)
+
+
+def mean_balance(balances: Sequence[FillBalance]) -> FillBalance:
+    """The mean of the balances of one fill at several steps: every force the mean of its values.
+
+    Parameters
+    ----------
+    balances : sequence of FillBalance
+        The same fill (same clumps, walls and planes) at several steps.
+
+    Returns
+    -------
+    FillBalance
+        Forces averaged; the clump count and each plane's count of clumps above from the last step.
+
+    Raises
+    ------
+    ValueError
+        When there is no balance, or they differ in clumps, walls, floor or planes.
+    """
+    balances = list(balances)
+    if not balances:
+        raise ValueError("no balance to average")
+    last = balances[-1]
+    for other in balances[:-1]:
+        if (other.n_clumps != last.n_clumps or set(other.wall_support) != set(last.wall_support)
+                or other.floor_walls != last.floor_walls
+                or [plane.height for plane in other.planes] != [plane.height for plane in last.planes]):
+            raise ValueError("the balances to average are not of one fill: clumps, walls, floor or planes differ")
+
+    def mean(values) -> float:
+        return float(np.mean(list(values)))
+
+    planes = [
+        PlaneLoad(height=plane.height, clumps_above=plane.clumps_above,
+                  weight_above=mean(b.planes[index].weight_above for b in balances),
+                  contact_force=mean(b.planes[index].contact_force for b in balances),
+                  wall_force=mean(b.planes[index].wall_force for b in balances))
+        for index, plane in enumerate(last.planes)
+    ]
+    return FillBalance(
+        weight=mean(b.weight for b in balances),
+        n_clumps=last.n_clumps,
+        support=mean(b.support for b in balances),
+        wall_support={name: mean(b.wall_support[name] for b in balances) for name in last.wall_support},
+        wall_horizontal={name: mean(b.wall_horizontal[name] for b in balances) for name in last.wall_horizontal},
+        floor_walls=last.floor_walls,
+        planes=planes,
+    )
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,9 @@ from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
 from engines.liggghts.jenike import (
+    JENIKE_FLOOR_WALLS,
     PAIR_CONTACT_PREFIX,
+    SETTLED_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,
     read_jenike_pair_contacts,
     read_jenike_wall_contacts,
@@ -36,7 +38,7 @@ from engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
-from engines.liggghts.settled import read_settled_fill, read_settled_jenike_fill
+from engines.liggghts.settled import read_settled_fill
 from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 
@@ -155,10 +157,11 @@ class LiggghtsEngine(Engine):
             return [read_jenike_pair_contacts(path) for path in list_dumps(dumps, PAIR_CONTACT_PREFIX, ".txt")]
         return [read_jenike_wall_contacts(path) for path in list_dumps(dumps, WALL_CONTACT_PREFIX, ".txt")]
 
-    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> SettledFill:
+    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
+        dumps = Path(run_dir) / "dumps"
         if record.case == "jenike":
-            return read_settled_jenike_fill(Path(run_dir) / "dumps", record.timestep_s, record.stage("settle"))
+            return read_settled_fill(dumps, record.timestep_s, JENIKE_FLOOR_WALLS, SETTLED_CONTACT_PREFIX,
+                                     read_jenike_pair_contacts)
         if record.case not in FLOOR_WALLS:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
-        return read_settled_fill(Path(run_dir) / "dumps", record.timestep_s, read_wall_forces(run_dir),
-                                 FLOOR_WALLS[record.case])
+        return read_settled_fill(dumps, record.timestep_s, FLOOR_WALLS[record.case])

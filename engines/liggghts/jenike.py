@@ -43,6 +43,8 @@ from engines.liggghts.run import (
     DUMP_PREFIX,
     RUN_OUTPUTS,
     SETTLED_FILL_PREFIX,
+    SETTLED_SNAPSHOT_STEPS,
+    SETTLED_WALLS_PATH,
     output_bytes,
     run_engine,
     set_aside_previous_attempt,
@@ -76,8 +78,8 @@ PAIR_CONTACT_PREFIX = "pair_contacts"
 #: The pair contacts of the levelled, settled fill (before the lid), beside ``settled_fill_<step>.txt``; their own
 #: prefix keeps them out of the consolidation and shear contact frames.
 SETTLED_CONTACT_PREFIX = "settled_contacts"
-#: The meshes whose force on the settled fill the levelled marker records, as ``<mesh>_f<x|y|z>`` (N, exerted BY
-#: the particles ON the mesh); the base is the floor.
+#: The meshes whose force on the settled fill the snapshot records (``dumps/settled_walls.txt``, exerted ON the
+#: particles); the base is the floor.
 SETTLED_WALLS = ("base", "shear_ring", "mould")
 JENIKE_FLOOR_WALLS = ("base",)
 #: The meshes of the cell's one mesh wall, by their index in the wall contact dumps.
@@ -194,7 +196,9 @@ def jenike_deck_context(case: JenikeCase) -> dict:
                 "contact_compute": "pair_contacts",
                 "contact_columns": len(CONTACT_COLUMNS),
                 "walls": list(SETTLED_WALLS),
-                "marker_values": [[f"{wall}_f{axis}", f"{wall}_f{axis}"] for wall in SETTLED_WALLS for axis in "xyz"],
+                "walls_path": SETTLED_WALLS_PATH,
+                "steps": SETTLED_SNAPSHOT_STEPS,
+                "timestep": case.timestep,
             },
         }
     )

@@ -40,6 +40,11 @@ DUMP_PREFIX = "particles"
 CONTACT_PREFIX = "contacts"
 #: The settled fill's spheres with their wall forces (``dump custom``), one file ``settled_fill_<step>.txt``.
 SETTLED_FILL_PREFIX = "settled_fill"
+#: Every wall's force on the particles at the settled fill's steps (``fix ave/time``, the wall force file's format).
+SETTLED_WALLS_PATH = "dumps/settled_walls.txt"
+#: Steps of the run that writes the settled fill's snapshot at its last two steps: the kick of the run's set-up has
+#: died away to 1e-3 of the weight after 100 (``settled_fill_snapshot`` in ``templates/liggghts/macros.j2``).
+SETTLED_SNAPSHOT_STEPS = 200
 
 
 

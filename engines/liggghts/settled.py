@@ -1,16 +1,14 @@
-"""The settled fill's snapshot written by the silo-type decks (``settled_fill_snapshot`` in
-``templates/liggghts/macros.j2``), read into a neutral :class:`SettledFill`.
+"""The settled fill's snapshot written by the silo-type and Jenike decks (``settled_fill_snapshot`` in
+``templates/liggghts/macros.j2``), read into neutral :class:`SettledFill` objects, one per step.
 
-The deck writes, at one ``run 0`` after the settle stage, a text ``dump custom`` of the spheres
+The deck writes, at each of the two steps after the settle stage (``run 2``), a text ``dump custom`` of the spheres
 (``dumps/settled_fill_<step>.txt``: ``id type id_multisphere x y z vx vy vz radius mass`` and the summed force of
-every wall fix on the sphere, ``v_settled_wall_fx/fy/fz``, from their ``store_force``), and the pair contacts
-(``dumps/contacts_<step>.txt``, read by :mod:`engines.liggghts.contacts`). Values are written with 12 significant
-digits. The per-wall split comes from the wall force history (:mod:`engines.liggghts.forces`), at its last sample
-up to the snapshot.
-
-The Jenike deck writes the same sphere dump of its levelled fill before the lid is placed, with its pair contacts
-in its own column layout (``dumps/settled_contacts_<step>.txt``) and each mesh's force in the ``levelled`` stage
-marker (:func:`read_settled_jenike_fill`).
+every wall fix on the sphere, ``v_settled_wall_fx/fy/fz``, from their ``store_force``), the pair contacts
+(``dumps/contacts_<step>.txt`` of the silos, read by :mod:`engines.liggghts.contacts`; the Jenike deck's
+``dumps/settled_contacts_<step>.txt`` in its own column layout) with 12 significant digits, and every wall's force
+on the particles (``dumps/settled_walls.txt``, the format of the wall force history, :mod:`engines.liggghts.forces`:
+6 digits). Two steps, because a LIGGGHTS fill at rest alternates about equilibrium from step to step (the macro
+says by how much); :func:`analysis.numerics.force_balance.settled_fill_balance` averages them.
 
 Why not a library reader: the text dump is the header of a ``dump local`` plus a table; the contact reader's
 strict parser (which names the file and the fault of a truncated dump) reads both.
@@ -18,26 +16,20 @@ strict parser (which names the file and the fault of a truncated dump) reads bot
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from analysis.data.contacts import ContactFrame
-from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.settled import SettledFill
 from engines.liggghts.contacts import ContactDumpError, parse_local_table, read_contacts
 from engines.liggghts.dumps import frame_from_arrays, list_dumps
-from engines.liggghts.jenike import (
-    JENIKE_FLOOR_WALLS,
-    SETTLED_CONTACT_PREFIX,
-    SETTLED_WALLS,
-    read_jenike_pair_contacts,
-)
-from engines.liggghts.run import CONTACT_PREFIX, SETTLED_FILL_PREFIX
+from engines.liggghts.forces import QUANTITIES, read_wall_force_file
+from engines.liggghts.run import CONTACT_PREFIX, SETTLED_FILL_PREFIX, SETTLED_WALLS_PATH
 
-__all__ = ["SETTLED_COLUMNS", "read_settled_spheres", "read_settled_fill", "read_settled_jenike_fill"]
+__all__ = ["SETTLED_COLUMNS", "read_settled_spheres", "read_settled_fill"]
 
 #: The columns of the settled fill's sphere dump, in the deck's order.
 SETTLED_COLUMNS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass",
@@ -78,75 +70,56 @@ def read_settled_spheres(path: str | Path, timestep: float) -> tuple[ParticleFra
     return frame, table[:, 11:14].copy()
 
 
-def _snapshot(dumps_dir: Path, timestep: float, contacts_prefix: str, read_pair_contacts: Callable[[Path], ContactFrame]):
-    """The newest sphere dump of the snapshot, the walls' force on each sphere and the contacts of its step."""
+def read_settled_fill(
+    dumps_dir: str | Path, timestep: float, floor_walls: tuple[str, ...], contacts_prefix: str = CONTACT_PREFIX,
+    read_pair_contacts: Callable[[Path], ContactFrame] = read_contacts,
+) -> tuple[SettledFill, ...]:
+    """The settled fill at each step of its snapshot, oldest first: the sphere dump, the pair contacts and every
+    wall's force of that step.
+
+    Parameters
+    ----------
+    dumps_dir : str or Path
+        The run's ``dumps`` directory.
+    timestep : float
+        The run's time step [s].
+    floor_walls : tuple of str
+        The walls of ``settled_walls.txt`` that make the floor (plates, gate, base).
+    contacts_prefix, read_pair_contacts : optional
+        The file prefix of the snapshot's pair contacts and their reader (the silos' by default; the Jenike deck's
+        :data:`~engines.liggghts.jenike.SETTLED_CONTACT_PREFIX` and
+        :func:`~engines.liggghts.jenike.read_jenike_pair_contacts`).
+
+    Raises
+    ------
+    FileNotFoundError
+        When the run wrote no settled fill dump, no contact dump at its step, or no wall forces (a deck from before
+        the two-step snapshot: render the run again).
+    ValueError
+        When the wall forces have no row at a dump's step.
+    ContactDumpError
+        When a dump is damaged (see :func:`read_settled_spheres`).
+    """
+    dumps_dir = Path(dumps_dir)
     paths = list_dumps(dumps_dir, SETTLED_FILL_PREFIX, ".txt")
     if not paths:
         raise FileNotFoundError(f"{dumps_dir}: no {SETTLED_FILL_PREFIX}_<step>.txt (a deck from before the force "
                                 "balance? render the run again)")
-    frame, wall_force = read_settled_spheres(paths[-1], timestep)
-    contacts_path = dumps_dir / f"{contacts_prefix}_{frame.step}.txt"
-    if not contacts_path.exists():
-        raise FileNotFoundError(f"{contacts_path}: the contacts of the settled fill (step {frame.step}) are missing")
-    return frame, wall_force, read_pair_contacts(contacts_path)
-
-
-def read_settled_fill(
-    dumps_dir: str | Path, timestep: float, history: WallForceHistory | None, floor_walls: tuple[str, ...]
-) -> SettledFill:
-    """The settled fill of a silo-type run: its sphere dump, the contacts of the same step and, from ``history``
-    (None: no per-wall split), each wall's force at its last sample up to the snapshot.
-
-    Raises
-    ------
-    FileNotFoundError
-        When the run wrote no settled fill dump, or no contact dump at its step.
-    ContactDumpError
-        When a dump is damaged (see :func:`read_settled_spheres`).
-    """
-    frame, wall_force, contacts = _snapshot(Path(dumps_dir), timestep, CONTACT_PREFIX, read_contacts)
-    wall_forces = {}
-    if history is not None:
-        before = np.flatnonzero(history.time <= frame.time * (1.0 + 1e-12))
-        if before.size:
-            sample = int(before[-1])
-            wall_forces = {name: history.force[name][sample] for name in history.walls}
-    return SettledFill(frame=frame, wall_force=wall_force, contacts=contacts, wall_forces=wall_forces,
-                       floor_walls=floor_walls if wall_forces else ())
-
-
-def read_settled_jenike_fill(
-    dumps_dir: str | Path, timestep: float, marker: Mapping[str, float], walls: Sequence[str] = SETTLED_WALLS,
-    floor_walls: tuple[str, ...] = JENIKE_FLOOR_WALLS, contacts_prefix: str = SETTLED_CONTACT_PREFIX,
-    read_pair_contacts: Callable[[Path], ContactFrame] = read_jenike_pair_contacts,
-) -> SettledFill:
-    """The levelled, settled fill of a Jenike run (before the lid), with each mesh's force from the ``levelled``
-    marker.
-
-    Parameters
-    ----------
-    marker : mapping
-        The marker's values; ``<wall>_f<x|y|z>`` is the force of the particles ON mesh ``wall`` [N] (negated here:
-        :class:`SettledFill` holds the walls' forces on the particles).
-    walls : sequence of str, optional
-        The meshes the marker names (the Jenike deck's :data:`~engines.liggghts.jenike.SETTLED_WALLS`).
-    floor_walls : tuple of str, optional
-        Those of ``walls`` that are the floor (the base).
-    contacts_prefix, read_pair_contacts : optional
-        The file prefix of the snapshot's pair contacts and their reader (the Jenike deck's).
-
-    Raises
-    ------
-    FileNotFoundError
-        When the run wrote no snapshot.
-    KeyError
-        When the marker lacks a wall's force (a deck from before the force balance).
-    """
-    frame, wall_force, contacts = _snapshot(Path(dumps_dir), timestep, contacts_prefix, read_pair_contacts)
-    missing = [f"{wall}_fz" for wall in walls if f"{wall}_fz" not in marker]
-    if missing:
-        raise KeyError(f"the levelled marker has no {missing[0]} (a deck from before the force balance? render the "
-                       "run again)")
-    wall_forces = {wall: -np.array([float(marker[f"{wall}_f{axis}"]) for axis in "xyz"]) for wall in walls}
-    return SettledFill(frame=frame, wall_force=wall_force, contacts=contacts, wall_forces=wall_forces,
-                       floor_walls=tuple(floor_walls))
+    walls_path = dumps_dir / Path(SETTLED_WALLS_PATH).name
+    if not walls_path.exists():
+        raise FileNotFoundError(f"{walls_path}: the walls' forces of the settled fill are missing (a deck from before "
+                                "the two-step snapshot? render the run again)")
+    _, walls, steps, values = read_wall_force_file(walls_path)
+    fills = []
+    for path in paths:
+        frame, wall_force = read_settled_spheres(path, timestep)
+        contacts_path = dumps_dir / f"{contacts_prefix}_{frame.step}.txt"
+        if not contacts_path.exists():
+            raise FileNotFoundError(f"{contacts_path}: the contacts of the settled fill (step {frame.step}) are missing")
+        row = np.flatnonzero(steps == frame.step)
+        if not row.size:
+            raise ValueError(f"{walls_path} has no row at step {frame.step}, the step of {path.name}")
+        forces = values[row[0]].reshape(len(walls), len(QUANTITIES))[:, :3]
+        fills.append(SettledFill(frame=frame, wall_force=wall_force, contacts=read_pair_contacts(contacts_path),
+                                 wall_forces=dict(zip(walls, forces)), floor_walls=tuple(floor_walls)))
+    return tuple(fills)

@@ -176,7 +176,7 @@ def test_contact_dumps_carry_the_plate_load(runs):
 def test_the_levelled_sample_carries_its_weight_before_the_lid(name, runs):
     run = runs[name]
     settled = liggghts().settled_fill(run.run_dir, run.record)
-    assert settled.floor_walls == ("base",)
+    assert [step.floor_walls for step in settled] == [("base",), ("base",)]
     # the levelled top 2-3 clump layers are still moving when the lid comes: the wall test's 10 mm sample is all top
     fractions = (0.25,) if run.case.test != "internal" else (0.25, 0.5)
     heights = [fraction * run.case.fill_height for fraction in fractions]
@@ -186,3 +186,5 @@ def test_the_levelled_sample_carries_its_weight_before_the_lid(name, runs):
     for plane in balance.planes:
         assert plane.closure == pytest.approx(1.0, abs=0.01), plane
     assert balance_problems(balance, BalanceTolerances()) == []
+    # the walls' own sums (6 digits) and the spheres' wall forces are of the same two steps
+    assert sum(balance.wall_support.values()) == pytest.approx(balance.support, rel=1e-4)

@@ -12,6 +12,7 @@ from analysis.numerics.force_balance import (
     BalanceTolerances,
     balance_problems,
     fill_balance,
+    mean_balance,
     plane_loads,
     settled_fill_balance,
 )
@@ -119,6 +120,50 @@ def test_the_settled_fill_adapter_finds_clumps_and_contact_spheres_by_id():
                          id_j=np.array([11]), force=np.zeros((1, 3)))
     with pytest.raises(ValueError, match=r"contacts name spheres \[99\]"):
         settled_fill_balance(SettledFill(frame=frame, wall_force=wall, contacts=stray), [2.0], G)
+
+
+def test_two_steps_that_alternate_about_rest_average_to_the_balance_at_rest():
+    """The floor and the contacts carry 1 N more, then 1 N less, than at rest: each step fails, their mean is exact."""
+    sphere_clump, mass, z, wall, i, j, force = stack()
+    frame = ParticleFrame(time=1.0, step=10, id=np.arange(1, 7), type=np.ones(6),
+                          clump_id=np.array([7, 7, 8, 8, 9, 9]),
+                          position=np.column_stack([np.zeros(6), np.zeros(6), [0.5, 1.5, 2.5, 3.5, 4.5, 5.5]]),
+                          velocity=np.zeros((6, 3)), angular_velocity=None, radius=np.full(6, 0.5), mass=np.full(6, M))
+    steps = []
+    for offset in (1.0, -1.0):
+        step_wall = wall.copy()
+        step_wall[0, 2] += offset
+        step_force = force.copy()
+        step_force[0, 2] -= offset  # the force on sphere 1 (below the plane at 2) by sphere 2
+        contacts = ContactFrame(step=10, position_i=np.zeros((2, 3)), position_j=np.zeros((2, 3)), id_i=i + 1,
+                                id_j=j + 1, force=step_force)
+        steps.append(SettledFill(frame=frame, wall_force=step_wall, contacts=contacts,
+                                 wall_forces={"floor": [0, 0, 15.0 + offset], "wall": [0, 0, 0.0]},
+                                 floor_walls=("floor",)))
+    each = [settled_fill_balance(step, [2.0, 4.0], G) for step in steps]
+    assert [balance.support_ratio for balance in each] == [16.0 / 15.0, 14.0 / 15.0]
+    assert [balance.planes[0].contact_force for balance in each] == [11.0, 9.0]
+    balance = settled_fill_balance(steps, [2.0, 4.0], G)
+    assert balance.support_ratio == 1.0 and balance.floor_ratio == 1.0 and balance.walls_ratio == 0.0
+    assert [plane.contact_force for plane in balance.planes] == [10.0, 5.0]
+    assert [plane.closure for plane in balance.planes] == [1.0, 1.0]
+    assert balance_problems(balance) == []
+
+
+def test_balances_of_different_fills_are_not_averaged():
+    sphere_clump, mass, z, wall, i, j, force = stack()
+    one = fill_balance(sphere_clump, mass, z, wall, i, j, force, [2.0], G, {"floor": [0, 0, 15.0]}, ("floor",))
+    other_planes = fill_balance(sphere_clump, mass, z, wall, i, j, force, [4.0], G, {"floor": [0, 0, 15.0]},
+                                ("floor",))
+    other_walls = fill_balance(sphere_clump, mass, z, wall, i, j, force, [2.0], G, {"base": [0, 0, 15.0]}, ("base",))
+    assert mean_balance([one, one]) == one
+    for other in (other_planes, other_walls):
+        with pytest.raises(ValueError, match="not of one fill"):
+            mean_balance([one, other])
+    with pytest.raises(ValueError, match="no balance"):
+        mean_balance([])
+    with pytest.raises(ValueError, match="no step"):
+        settled_fill_balance([], [2.0], G)
 
 
 def test_bad_input_is_refused_with_its_name():

@@ -137,9 +137,7 @@ def recirculation_targets(wildcards=None):
         for run in recirculation_runs("verification")
         for name in ("verification.json", "paths.png", "residence_times.png")
     ]
-    # The thin verification silo's fill is not checked: its clumps are pinched between walls one clump apart (4.3x
-    # their weight across), and its snapshot's support (0.957 of the weight) disagrees with its wall force history
-    # (1.005): an open question about wall friction forces in the snapshot, not a verdict on that fill.
+    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in recirculation_runs("verification")]
     return targets
 
 
