@@ -11,6 +11,11 @@ to the frame interval of the record (:func:`residence_time_resolution`); :func:`
 and propagates them to ``t_s / t_d``. Tracers still inside at the end (NaN) are left out, which biases ``t_m`` and
 ``t_d`` low; that bias is not part of the errors. Cutting every tracer at one horizon it was followed for removes it
 from the mean (:func:`mean_residence_time_within`), which Little's law then reproduces on the same passes.
+
+Tracers that enter together are not independent: they share one realisation of the flow (a pulse of the outlet,
+the state of the pile when they land). Where a run holds many later cohorts of the same size, the error of one
+cohort's mean is the spread of the cohorts' means (:func:`cohort_means_within`; on the default semi-mass-flow silo
+0.0081 s, against 0.0029 s from ``s / sqrt(n)`` within the tracer cohort).
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ __all__ = [
     "AppearanceTimes",
     "mean_residence_time",
     "mean_residence_time_within",
+    "cohort_means_within",
     "residence_time_resolution",
     "appearance_times",
 ]
@@ -96,7 +102,7 @@ def mean_residence_time(residence_times) -> Estimate:
                     dof=spread.n - 1 if spread.n > 1 else math.inf)
 
 
-def mean_residence_time_within(residence_times, horizon: float) -> Estimate:
+def mean_residence_time_within(residence_times, horizon: float, cohort_means=None) -> Estimate:
     """Mean residence time of the tracers that left within ``horizon`` of their entry, with its standard error [s].
 
     :func:`mean_residence_time` of the residence times ``t <= horizon``: ``E[t | t <= h]``, the mean of the RTD
@@ -109,22 +115,87 @@ def mean_residence_time_within(residence_times, horizon: float) -> Estimate:
         Residence time of each tracer [s]; NaN for a tracer that did not leave.
     horizon : float
         Longest residence time counted ``h``, > 0 [s].
+    cohort_means : array_like, optional
+        The same mean for other cohorts of the tracer's size (:func:`cohort_means_within`) [s]. With at least two,
+        the error is their sample standard deviation (``method="cohort spread"``, ``n`` the cohorts): the error of
+        one cohort's mean, the tracers' correlation within a cohort included.
 
     Returns
     -------
     Estimate
-        As :func:`mean_residence_time` (``n`` the tracers counted, error ``s / sqrt(n)``, NaN for one).
+        As :func:`mean_residence_time` (``n`` the tracers counted, error ``s / sqrt(n)``, NaN for one), or with
+        the cohorts' spread as its error.
 
     Raises
     ------
     ValueError
-        On a bad ``horizon``, a non-1-D array, infinite values, or no tracer out within ``horizon``.
+        On a bad ``horizon``, a non-1-D array, infinite values, no tracer out within ``horizon``, or a cohort mean
+        that is not finite.
     """
     h = positive_number("horizon", horizon)
     times = _exited(residence_times)  # the checks, and NaN (still inside) out
     if not np.any(times <= h):
         raise ValueError(f"residence_times: no tracer left within the horizon {h!r} s")
-    return mean_residence_time(times[times <= h])
+    within = mean_residence_time(times[times <= h])
+    cohorts = np.asarray([] if cohort_means is None else cohort_means, dtype=float).ravel()
+    if not np.all(np.isfinite(cohorts)):
+        raise ValueError("cohort_means must be finite")
+    if cohorts.size < 2:
+        return within
+    spread = seed_spread(cohorts)
+    return Estimate(value=within.value, std_error=spread.std, n=spread.n,
+                    method="cohort spread", dof=spread.n - 1)
+
+
+def cohort_means_within(entry_time, residence_time, horizon: float, cohort_size: int) -> np.ndarray:
+    """``E[t | t <= h]`` of each cohort of ``cohort_size`` consecutive passes, in order of entry [s].
+
+    The passes, sorted by entry time (stable), are cut into whole cohorts of ``cohort_size`` (a last, partial one
+    is dropped); a cohort's mean is that of its residence times ``t <= horizon`` (NaN, still inside, and longer
+    ones left out), as :func:`mean_residence_time_within`. A cohort with none within ``horizon`` is dropped.
+    Give only passes that were followed for at least ``horizon`` (entered by ``t_end - horizon``), so that no
+    cohort is censored.
+
+    Parameters
+    ----------
+    entry_time : array_like, shape (n,)
+        Entry of each pass, finite [s].
+    residence_time : array_like, shape (n,)
+        Its residence time [s]; NaN for a pass still inside.
+    horizon : float
+        ``h`` [s], > 0.
+    cohort_size : int
+        Passes per cohort, >= 1.
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (n_cohorts,)
+
+    Raises
+    ------
+    ValueError
+        On arrays of different lengths, a non-finite entry, an infinite or negative residence time, a bad horizon
+        or cohort size.
+    """
+    h = positive_number("horizon", horizon)
+    if isinstance(cohort_size, bool) or not float(cohort_size).is_integer() or int(cohort_size) < 1:
+        raise ValueError(f"cohort_size must be an integer >= 1, got {cohort_size!r}")
+    size = int(cohort_size)
+    entry = np.asarray(entry_time, dtype=float).ravel()
+    residence = np.asarray(residence_time, dtype=float).ravel()
+    if entry.shape != residence.shape:
+        raise ValueError(f"residence_time must have the shape of entry_time {entry.shape}, got {residence.shape}")
+    if not np.all(np.isfinite(entry)):
+        raise ValueError("entry_time must be finite")
+    if np.any(np.isinf(residence)) or np.any(residence < 0.0):
+        raise ValueError("residence_time must be >= 0 or NaN (still inside)")
+    ordered = residence[np.argsort(entry, kind="stable")]
+    n_cohorts = ordered.size // size
+    cohorts = ordered[: n_cohorts * size].reshape(n_cohorts, size)
+    counted = np.isfinite(cohorts) & (cohorts <= h)
+    keep = counted.any(axis=1)
+    sums = np.where(counted, cohorts, 0.0).sum(axis=1)
+    return sums[keep] / counted.sum(axis=1)[keep]
 
 
 def residence_time_resolution(frame_interval: float) -> float:

@@ -18,6 +18,7 @@ from analysis.numerics.rtd import (
 )
 from analysis.numerics.residence_statistics import (
     appearance_times,
+    cohort_means_within,
     mean_residence_time,
     mean_residence_time_within,
     residence_time_resolution,
@@ -266,6 +267,38 @@ def test_mean_residence_time_within_a_horizon_leaves_the_slower_and_unexited_out
 def test_mean_residence_time_within_rejects_bad_input(sample, horizon, message):
     with pytest.raises(ValueError, match=message):
         mean_residence_time_within(sample, horizon)
+
+
+def test_cohort_means_cut_the_passes_in_entry_order_and_average_those_within_the_horizon():
+    # entries out of order; in entry order the residence times are 1, 3, | 2, 9 (over h = 5), | NaN, 4, | 6 (partial)
+    entry = [0.4, 0.1, 0.0, 0.3, 0.2, 0.5, 0.6]
+    residence = [np.nan, 3.0, 1.0, 9.0, 2.0, 4.0, 6.0]
+    np.testing.assert_array_equal(cohort_means_within(entry, residence, 5.0, 2), [2.0, 2.0, 4.0])
+    # a cohort with none within the horizon is dropped
+    np.testing.assert_array_equal(cohort_means_within([0.0, 1.0], [7.0, 8.0], 5.0, 1), [])
+
+
+@pytest.mark.parametrize("entry, residence, horizon, size, message", [
+    ([0.0, 1.0], [1.0], 5.0, 1, "shape"),
+    ([0.0, np.nan], [1.0, 2.0], 5.0, 1, "entry_time must be finite"),
+    ([0.0, 1.0], [1.0, -2.0], 5.0, 1, ">= 0"),
+    ([0.0, 1.0], [1.0, 2.0], 0.0, 1, "horizon"),
+    ([0.0, 1.0], [1.0, 2.0], 5.0, 0, "cohort_size"),
+    ([0.0, 1.0], [1.0, 2.0], 5.0, 1.5, "cohort_size"),
+])
+def test_cohort_means_reject_bad_input(entry, residence, horizon, size, message):
+    with pytest.raises(ValueError, match=message):
+        cohort_means_within(entry, residence, horizon, size)
+
+
+def test_one_cohorts_error_is_the_spread_of_the_other_cohorts_means():
+    # cohort means 3, 5, 7: sample standard deviation 2; the tracer's own mean is kept
+    within = mean_residence_time_within(KNOWN_SAMPLE, 5.0, [3.0, 5.0, 7.0])
+    assert (within.value, within.std_error, within.n, within.method, within.dof) == (4.0, 2.0, 3, "cohort spread", 2)
+    # fewer than two cohorts: the error within the tracer
+    assert mean_residence_time_within(KNOWN_SAMPLE, 5.0, [3.0]) == mean_residence_time_within(KNOWN_SAMPLE, 5.0)
+    with pytest.raises(ValueError, match="cohort_means must be finite"):
+        mean_residence_time_within(KNOWN_SAMPLE, 5.0, [3.0, np.nan])
 
 
 def test_residence_time_resolution_is_the_frame_interval_over_sqrt_6():

@@ -40,7 +40,7 @@ import numpy as np
 from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
 from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
-from analysis.numerics.residence_statistics import mean_residence_time, mean_residence_time_within
+from analysis.numerics.residence_statistics import cohort_means_within, mean_residence_time, mean_residence_time_within
 from analysis.numerics.uncertainty import Estimate
 from analysis.numerics.vrr_noise import window_duration_for_precision
 from analysis.studies.silo_recirculation.concentration import (
@@ -237,11 +237,19 @@ def transit_timing(tracks: ClumpTracks, events: RecirculationEvents, timing: Loo
     (from :attr:`LoopTiming.steady_start`, :func:`analysis.studies.silo_recirculation.transit.transit_littles_law`)
     and the tracer's residence times up to it
     (:func:`analysis.numerics.residence_statistics.mean_residence_time_within`) then refer to the same control
-    volume, entry and exit events and clumps, and agree within their errors in a steady run.
+    volume, entry and exit events and clumps, and agree within their errors in a steady run. The tracer's error is
+    that of one cohort: the spread of the means of the later cohorts of its size
+    (:func:`analysis.numerics.residence_statistics.cohort_means_within`), where the run holds two or more.
     """
     horizon = transit_horizon(timing.t_open, timing.t_end, tracer.entry_time, horizon_fraction)
     little = transit_littles_law(tracks, events, horizon, timing.steady_start, outlet_z, n_batches)
-    return little, mean_residence_time_within(tracer.residence_time, horizon)
+    # the error of one cohort's mean: the spread over the cohorts of the tracer's size entering from its start on
+    # and followed for the horizon
+    entry = np.asarray(events.entry_time, dtype=float)
+    followed = np.isfinite(entry) & (entry >= float(np.min(tracer.entry_time))) & (entry <= timing.t_end - horizon)
+    residence = np.asarray(events.exit_time, dtype=float)[followed] - entry[followed]
+    cohorts = cohort_means_within(entry[followed], residence, horizon, tracer.entry_time.size)
+    return little, mean_residence_time_within(tracer.residence_time, horizon, cohorts)
 
 
 def _johanson_parameters(rtd: RTD) -> tuple[float, float]:
