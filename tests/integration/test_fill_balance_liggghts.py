@@ -7,10 +7,10 @@ clear share of the weight at rest (Janssen with the perspex/aluminium wall frict
 settle to 1e-12 J per clump.
 
 - Gentle (the default pour): 0.5 m/s from a 10 mm zone, the stream's momentum flux at most 3 % of the weight. Measured
-  here: walls + floor 0.998 of the weight, floor 0.75, walls +0.23; contacts / weight above 0.77, 0.80, 0.90 at
-  0.1, 0.2 and 0.4 of the fill height, closure within 0.4 %. About 55 s on one core.
-- Fast (the pour before issue 14): 3 m/s, no limit on the stream. Measured here: floor 2.0 of the weight, walls
-  -0.95 (they hold the fill down), contacts / weight above 1.5-2.0 at every plane. About 10 s.
+  here (the two-step snapshot): walls + floor 1.0006 of the weight, floor 0.75, walls +0.25; contacts / weight above
+  0.77, 0.80, 0.90 at 0.1, 0.2 and 0.4 of the fill height (the one-step snapshot before). About 55 s on one core.
+- Fast (the pour before issue 14): 3 m/s, no limit on the stream. Measured here: walls + floor 1.0006, floor 2.02 of
+  the weight, walls -1.02 (they hold the fill down), contacts / weight above 1.5-2.0 at every plane. About 10 s.
 
 The planes stop at 0.4 of the fill height: above it fewer than 7 clump layers remain, and even the gentle pour
 leaves them held down a little (0.6 H: contacts 1.036 of the weight above, walls -0.04), which the default silo,
