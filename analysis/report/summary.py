@@ -461,8 +461,9 @@ FILL_LEGEND = ("Forces on the settled fill before its outlet opens, as shares of
                "it; at most 1 in a silo.")
 BLENDER_LEGEND = ("Mean vertical velocity: the mean v_z of each passage (negative: downwards). VRR, sine period "
                   "f t_m: variance reduction ratio of a sine input whose period is f times the mean residence time. "
-                  "n/a under recirculations to homogenise: not homogenised within the simulated passes; it has no "
-                  "error (one noisy excursion of the curve adds or removes a whole recirculation; compare seeds). "
+                  "Recirculations to homogenise: its error is the spread of the answer over first passes redrawn "
+                  "within their counting noise (one excursion of the curve more or less moves it by a whole "
+                  "recirculation), with the window's resolution; n/a: not homogenised within the simulated passes. "
                   "At the counting-noise ceiling: the VRR is within a factor 2 of the largest one the tracers can "
                   "resolve, so it is only a lower bound.")
 

@@ -521,7 +521,8 @@ def test_comparison_table_has_a_stable_column_order():
         "configuration", "mass_flow_rate_kg_s", "mass_flow_rate_kg_s_error", "exterior_v_z_m_s",
         "exterior_v_z_m_s_error", "interior_v_z_m_s", "interior_v_z_m_s_error", "tube_v_z_m_s", "tube_v_z_m_s_error",
         "rtd_mean_s", "rtd_mean_s_error", "rtd_spread", "rtd_spread_error", "ts_over_td", "ts_over_td_error",
-        "recirculations_to_homogenise", "vrr_at_0.5_tm", "vrr_at_0.5_tm_error", "vrr_at_2_tm", "vrr_at_2_tm_error",
+        "recirculations_to_homogenise", "recirculations_to_homogenise_error", "vrr_at_0.5_tm", "vrr_at_0.5_tm_error",
+        "vrr_at_2_tm", "vrr_at_2_tm_error",
     ]
     assert rows[1]["configuration"] == "straight" and rows[1]["vrr_at_2_tm"] == 12.0
     assert rows[0]["recirculations_to_homogenise"] == 2.0 and rows[0]["tube_v_z_m_s"] == -0.03

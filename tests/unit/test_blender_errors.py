@@ -12,12 +12,14 @@ from analysis.numerics.uncertainty import Significance
 from analysis.studies.blender.comparison import BlenderMetrics, comparison_table, figure_columns, significance_rows
 from analysis.studies.blender.errors import (
     effective_count,
+    homogenisation_error,
     passage_velocity_estimates,
     residence_time_error,
     sine_vrr_error,
     steady_flow_rate_estimate,
     tracer_errors,
 )
+from analysis.numerics.lti import recirculations_to_homogenise
 from analysis.studies.blender.steady_field import BlenderField
 
 NAN = math.nan
@@ -190,9 +192,9 @@ def test_comparison_table_carries_errors_the_ceiling_and_its_flags():
                              rtd_mean=10.0, rtd_spread=0.4, ts_over_td=0.1, recirculations_to_homogenise=NAN,
                              vrr_by_period={0.5: 20.0, 2.0: 3.0})
     first, second = comparison_table([known, unknown])
-    assert list(first)[-8:] == ["recirculations_to_homogenise", "vrr_at_0.5_tm", "vrr_at_0.5_tm_error", "vrr_at_2_tm",
-                                "vrr_at_2_tm_error", "vrr_ceiling", "vrr_at_0.5_tm_at_ceiling",
-                                "vrr_at_2_tm_at_ceiling"]
+    assert list(first)[-9:] == ["recirculations_to_homogenise", "recirculations_to_homogenise_error", "vrr_at_0.5_tm",
+                                "vrr_at_0.5_tm_error", "vrr_at_2_tm", "vrr_at_2_tm_error", "vrr_ceiling",
+                                "vrr_at_0.5_tm_at_ceiling", "vrr_at_2_tm_at_ceiling"]
     assert (first["mass_flow_rate_kg_s_error"], first["rtd_mean_s_error"], first["vrr_at_0.5_tm_error"]) == (
         0.01, 1.5, 250.0)
     assert math.isnan(first["vrr_at_2_tm_error"]) and math.isnan(first["tube_v_z_m_s_error"])
@@ -253,3 +255,50 @@ def test_significance_rows_take_the_coverage_factor_and_check_their_input():
         significance_rows([])
     with pytest.raises(ValueError, match=r"rows\[1\] has no column 'flow'"):
         significance_rows([ROWS[0], {"configuration": "b"}])
+
+
+def _crossing(concentration):
+    """Windows until c stays within 10 % of 1 (one window per recirculation)."""
+    return recirculations_to_homogenise(concentration, mean=1.0, tolerance=0.1, per_pass_length=1.0)
+
+
+def _identity(first_pass):
+    return first_pass
+
+
+def test_without_counting_noise_the_homogenisation_error_is_the_windows_resolution():
+    # no noise, or noise where it cannot move the crossing (window 0 is 4 above the band): one window, uniform
+    for variance in ([0.0, 0.0, 0.0, 0.0], [1e-4, 0.0, 0.0, 0.0]):
+        assert homogenisation_error([5.0, 1.0, 1.0, 1.0], variance, _identity, _crossing, 1.0) == pytest.approx(
+            1.0 / math.sqrt(12.0), rel=1e-12)
+    # four windows per recirculation: a quarter of that
+    assert homogenisation_error([5.0, 1.0, 1.0, 1.0], [0.0] * 4, _identity, _crossing, 4.0) == pytest.approx(
+        0.25 / math.sqrt(12.0), rel=1e-12)
+
+
+def test_noise_that_can_add_an_excursion_moves_the_crossing_by_it():
+    # window 2 has unit noise: it leaves the band (|z| > 0.1) with p = 2 (1 - Phi(0.1)) = 0.9203, and the crossing
+    # is then 3 instead of 1: a two-point spread of 2 sqrt(p (1 - p)), with the resolution added
+    p = math.erfc(0.1 / math.sqrt(2.0))
+    expected = math.hypot(2.0 * math.sqrt(p * (1.0 - p)), 1.0 / math.sqrt(12.0))
+    error = homogenisation_error([5.0, 1.0, 1.0, 1.0], [0.0, 0.0, 1.0, 0.0], _identity, _crossing, 1.0, draws=4000)
+    # 4000 draws: p is known to sqrt(p (1 - p) / 4000) = 0.0043, the spread to about 4 %
+    assert error == pytest.approx(expected, rel=0.04)
+
+
+def test_a_figure_most_draws_never_reach_has_no_error():
+    # the last window leaves the band in 92 % of the draws: not homogenised within the record
+    assert math.isnan(homogenisation_error([1.0, 1.0, 1.0], [0.0, 0.0, 1.0], _identity, _crossing, 1.0))
+
+
+@pytest.mark.parametrize("first, variance, windows, draws, message", [
+    ([1.0, 1.0], [0.0], 1.0, 10, "shape"),
+    ([1.0], [-1.0], 1.0, 10, ">= 0"),
+    ([1.0], [0.0], 0.0, 10, "per_pass_length"),
+    ([1.0], [0.0], 1.0, 1, "draws"),
+    ([1.0], [NAN], 1.0, 10, "first_pass_variance"),
+])
+def test_homogenisation_error_refuses_bad_input(first, variance, windows, draws, message):
+    with pytest.raises(ValueError, match=message):
+        homogenisation_error(first, variance, _identity, _crossing, windows, draws=draws)
+

@@ -64,7 +64,8 @@ STUDY = BlenderStudy(
         window=0.5, window_start=np.array([0.0, 0.5]), time_in_passes=np.array([0.0, 0.25]),
         first_pass=np.array([0.0, 1.0]), concentration=np.array([0.0, 1.0]), pass_mean=np.array([0.5, 0.25]),
         tracer_fraction=0.2, tracer_bottom=0.18, mean_residence_time=2.0, entry_time=np.array([0.0, 0.5]),
-        entry_E=np.array([0.0, 2.0]), homogenised_after=3.0, tolerance=0.1, n_not_exited=1, n_entry_not_exited=0,
+        entry_E=np.array([0.0, 2.0]), homogenised_after=3.0, homogenised_after_error=0.25, tolerance=0.1,
+        n_not_exited=1, n_entry_not_exited=0,
     ),
     continuous=CONTINUOUS,
 )

@@ -48,12 +48,11 @@ class BlenderMetrics:
     ts_over_td : float
         ``t_s / t_d`` [-].
     recirculations_to_homogenise : float
-        Passes until the outlet stays within the band; NaN if never [-]. It has no error (see
-        :mod:`analysis.studies.blender.errors`).
+        Passes until the outlet stays within the band; NaN if never [-].
     vrr_by_period : mapping
         ``period / t_m`` -> VRR of a sine input [-].
     mass_flow_rate_error, exterior_v_z_error, interior_v_z_error, tube_v_z_error, rtd_mean_error,
-    rtd_spread_error, ts_over_td_error : float, optional
+    rtd_spread_error, ts_over_td_error, recirculations_to_homogenise_error : float, optional
         Standard errors of the figures of the same name, in their units; NaN (the default) when not known.
     vrr_errors : mapping, optional
         ``period / t_m`` -> standard error of its VRR [-]; a missing period has an unknown error.
@@ -78,6 +77,7 @@ class BlenderMetrics:
     rtd_mean_error: float = math.nan
     rtd_spread_error: float = math.nan
     ts_over_td_error: float = math.nan
+    recirculations_to_homogenise_error: float = math.nan
     vrr_errors: Mapping = field(default_factory=dict)
     vrr_ceiling: float = math.nan
 
@@ -87,6 +87,7 @@ _FIGURES = (
     ("mass_flow_rate_kg_s", "mass_flow_rate"), ("exterior_v_z_m_s", "exterior_v_z"),
     ("interior_v_z_m_s", "interior_v_z"), ("tube_v_z_m_s", "tube_v_z"), ("rtd_mean_s", "rtd_mean"),
     ("rtd_spread", "rtd_spread"), ("ts_over_td", "ts_over_td"),
+    ("recirculations_to_homogenise", "recirculations_to_homogenise"),
 )
 
 
@@ -116,8 +117,8 @@ def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
     """One row per configuration with a stable column order (for :func:`analysis.io.tables.write_flow_table`).
 
     Columns: ``configuration``, then each of ``mass_flow_rate_kg_s, exterior_v_z_m_s, interior_v_z_m_s,
-    tube_v_z_m_s, rtd_mean_s, rtd_spread, ts_over_td`` followed by its standard error ``<column>_error`` (same
-    unit; NaN when unknown), ``recirculations_to_homogenise`` (no error), then ``vrr_at_<f>_tm`` and
+    tube_v_z_m_s, rtd_mean_s, rtd_spread, ts_over_td, recirculations_to_homogenise`` followed by its standard error
+    ``<column>_error`` (same unit; NaN when unknown), then ``vrr_at_<f>_tm`` and
     ``vrr_at_<f>_tm_error`` for each period fraction f in increasing order (all configurations must share them).
     When any configuration knows its VRR ceiling, ``vrr_ceiling`` [-] (NaN where unknown) and a flag
     ``vrr_at_<f>_tm_at_ceiling`` per period follow: True where the VRR lies within
@@ -133,7 +134,6 @@ def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
         for column, attribute in _FIGURES:
             row[column] = float(getattr(item, attribute))
             row[column + ERROR_SUFFIX] = float(getattr(item, attribute + "_error"))
-        row["recirculations_to_homogenise"] = float(item.recirculations_to_homogenise)
         periods = sorted(item.vrr_by_period)
         for period in periods:
             row[_vrr_column(period)] = float(item.vrr_by_period[period])

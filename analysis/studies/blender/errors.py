@@ -25,16 +25,20 @@ RTD mean, spread and ``t_s / t_d``; VRR of the sine inputs
     given as a fraction of ``t_m`` do not change under that scaling. Changes of the field's shape are not
     covered: that needs the spread over seeds.
 Recirculations to homogenise
-    No error: the figure is the last time an oscillating concentration leaves a band around its mean, and any
-    noise in the curve can add or remove a whole excursion beyond the band, moving the answer by an oscillation
-    period; a linearised error of that threshold crossing would pretend a precision it does not have. Its
-    uncertainty needs the spread over seeds.
+    The figure is the last time an oscillating concentration leaves a band around its mean: any noise in the curve
+    can add or remove a whole excursion beyond the band, moving the answer by an oscillation period, so a
+    linearised error of that threshold crossing would pretend a precision it does not have. Instead
+    (:func:`homogenisation_error`) the first-pass concentration is redrawn within its counting noise (each window's
+    tracer weight leaving, variance the sum of the squared weights), every draw goes through the same linear
+    recycle model and gives its own crossing, and the error is the spread of those crossings, with the window's
+    resolution (one window, uniform) added. The field's own uncertainty is not in it: that needs the spread over
+    seeds.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +59,7 @@ __all__ = [
     "tracer_errors",
     "residence_time_error",
     "sine_vrr_error",
+    "homogenisation_error",
 ]
 
 DEFAULT_BATCHES = 10
@@ -374,3 +379,63 @@ def sine_vrr_error(vrr, n_effective: float):
     with np.errstate(invalid="ignore"):
         error = np.where(np.isfinite(values), values * np.sqrt(2.0 * np.maximum(values - 1.0, 0.0) / n), np.nan)
     return float(error) if error.ndim == 0 else error
+
+
+def homogenisation_error(first_pass, first_pass_variance, recycle: Callable[[np.ndarray], np.ndarray],
+                         homogenised: Callable[[np.ndarray], float], per_pass_length: float, draws: int = 400,
+                         seed: int = 0) -> float:
+    """Standard error of the recirculations to homogenise from the counting noise of the first pass [-].
+
+    ``draws`` first passes ``first_pass + sqrt(first_pass_variance) z`` (``z`` standard normal, a fixed ``seed`` so
+    that a run's figure is reproducible) each go through ``recycle`` (the linear model from a first pass to the
+    outlet concentration) and ``homogenised`` (the recirculations after which it stays in its band; NaN: never).
+    The error is the sample standard deviation of the finite answers, combined with the resolution of one window,
+    ``1 / (per_pass_length sqrt(12))`` (the answer moves in whole windows).
+
+    Parameters
+    ----------
+    first_pass : array_like, shape (n,)
+        First-pass concentration per window [-].
+    first_pass_variance : array_like, shape (n,)
+        Its variance per window [-], >= 0.
+    recycle : callable
+        First pass -> outlet concentration.
+    homogenised : callable
+        Outlet concentration -> recirculations to homogenise [-], NaN if never.
+    per_pass_length : float
+        Windows per recirculation, > 0.
+    draws : int, optional
+        Redrawn first passes, >= 2.
+    seed : int, optional
+        Seed of the draws.
+
+    Returns
+    -------
+    float
+        Standard error [-]; NaN when fewer than half the draws homogenise.
+
+    Raises
+    ------
+    ValueError
+        On arrays of different shapes, a negative or non-finite variance, bad ``per_pass_length`` or ``draws``.
+    """
+    values = finite_array("first_pass", first_pass, ndim=1)
+    variance = finite_array("first_pass_variance", first_pass_variance, ndim=1)
+    if variance.shape != values.shape:
+        raise ValueError(f"first_pass_variance must have the shape of first_pass {values.shape}, got {variance.shape}")
+    if np.any(variance < 0.0):
+        raise ValueError("first_pass_variance must be >= 0")
+    windows = finite_number("per_pass_length", per_pass_length)
+    if not windows > 0.0:
+        raise ValueError(f"per_pass_length must be > 0, got {per_pass_length!r}")
+    if isinstance(draws, bool) or int(draws) != draws or draws < 2:
+        raise ValueError(f"draws must be an integer >= 2, got {draws!r}")
+    rng = np.random.default_rng(seed)
+    noise = rng.standard_normal((int(draws), values.size)) * np.sqrt(variance)
+    answers = np.array([homogenised(recycle(values + row)) for row in noise], dtype=float)
+    finite = answers[np.isfinite(answers)]
+    if finite.size < max(2, answers.size / 2):
+        return math.nan
+    resolution = 1.0 / (windows * math.sqrt(12.0))
+    return combine_independent([float(finite.std(ddof=1)), resolution])
+

@@ -20,6 +20,7 @@ import numpy as np
 from analysis.checks import finite_array, positive_number
 from analysis.numerics.lti import VRRTable, recirculations_to_homogenise, vrr_versus_period
 from analysis.numerics.tracer_seeds import lattice_seeds
+from analysis.studies.blender.errors import homogenisation_error
 from analysis.studies.blender.steady_field import BlenderField, at_height, checked_field
 from analysis.studies.blender.tracers import (
     bin_index,
@@ -64,6 +65,9 @@ class DiscontinuousMode:
     homogenised_after : float
         Passes after which ``c`` stays within ``+-tolerance`` of ``tracer_fraction``; NaN if not within
         the windows.
+    homogenised_after_error : float
+        Its standard error from the counting noise of the first pass and the window's resolution
+        (:func:`analysis.studies.blender.errors.homogenisation_error`) [-]; NaN when unknown.
     tolerance : float
         Relative band [-].
     n_not_exited : int
@@ -84,6 +88,7 @@ class DiscontinuousMode:
     entry_time: np.ndarray
     entry_E: np.ndarray
     homogenised_after: float
+    homogenised_after_error: float
     tolerance: float
     n_not_exited: int
     n_entry_not_exited: int
@@ -121,7 +126,9 @@ def discontinuous_mode(
       ``c_first[j] = (tracer weight leaving in window j) t_m / (fill weight * window)``.
 
     The number of recirculations to homogenise is :func:`analysis.numerics.lti.recirculations_to_homogenise`
-    of ``c`` around the tracer share, with ``t_m / window`` samples per pass.
+    of ``c`` around the tracer share, with ``t_m / window`` samples per pass; its error comes from the counting
+    noise of ``c_first`` (variance: the squared tracer weights leaving in each window, scaled alike) through the
+    same model (:func:`analysis.studies.blender.errors.homogenisation_error`).
 
     Parameters
     ----------
@@ -184,7 +191,11 @@ def discontinuous_mode(
     is_tracer = z >= tracer_bottom
     index = np.floor(fill_residence[fill_out & is_tracer] / step).astype(np.int64)
     leaving = np.bincount(index, weights=weights[fill_out & is_tracer], minlength=n_windows)[:n_windows]
-    c_first = leaving * t_m / (float(weights.sum()) * step)
+    scale = t_m / (float(weights.sum()) * step)
+    c_first = leaving * scale
+    # counting noise: each tracer's weight leaves in one window or another
+    c_first_variance = np.bincount(index, weights=weights[fill_out & is_tracer] ** 2,
+                                   minlength=n_windows)[:n_windows] * scale ** 2
     first_term = int(np.flatnonzero(entry_E > 0.0)[0])
     if first_term == 0:
         raise ValueError(f"window = {step!r} s: material entering at the fill surface leaves within half a window; "
@@ -197,11 +208,20 @@ def discontinuous_mode(
     pass_index = np.floor((starts + 0.5 * step) / t_m).astype(np.int64)
     pass_mean = np.array([float(np.mean(c[pass_index == p])) for p in range(int(pass_index.max()) + 1)
                           if np.any(pass_index == p)])
-    homogenised = recirculations_to_homogenise(c, mean=share, tolerance=tolerance, per_pass_length=t_m / step)
+    def recycle(first_pass: np.ndarray) -> np.ndarray:
+        return predicted_concentration_from_first_pass(first_pass, entry_E, step, terms)
+
+    def homogenised_in(concentration: np.ndarray) -> float:
+        return recirculations_to_homogenise(concentration, mean=share, tolerance=tolerance, per_pass_length=t_m / step)
+
+    homogenised = homogenised_in(c)
+    homogenised_error = (homogenisation_error(c_first, c_first_variance, recycle, homogenised_in, t_m / step)
+                         if math.isfinite(homogenised) else math.nan)
     return DiscontinuousMode(
         window=step, window_start=starts, time_in_passes=starts / t_m, first_pass=c_first, concentration=c,
         pass_mean=pass_mean, tracer_fraction=share, tracer_bottom=tracer_bottom, mean_residence_time=t_m,
-        entry_time=entry_time, entry_E=entry_E, homogenised_after=homogenised, tolerance=tolerance,
+        entry_time=entry_time, entry_E=entry_E, homogenised_after=homogenised,
+        homogenised_after_error=homogenised_error, tolerance=tolerance,
         n_not_exited=int(np.count_nonzero(~fill_out)), n_entry_not_exited=int(np.count_nonzero(~entry_out)),
     )
 

@@ -252,6 +252,7 @@ def study_metrics(name: str, study: BlenderStudy, mass_flow_rate: float, compari
         rtd_spread=float(math.sqrt(rtd.variance) / rtd.t_mean),
         ts_over_td=float(rtd.ts_over_td),
         recirculations_to_homogenise=float(study.discontinuous.homogenised_after),
+        recirculations_to_homogenise_error=float(study.discontinuous.homogenised_after_error),
         vrr_by_period=vrr,
         mass_flow_rate_error=float(mass_flow_rate_error),
         exterior_v_z_error=passage_error("exterior"),
