@@ -76,11 +76,13 @@ def test_clumps_discharge_through_the_outlet_past_the_insert(blender_pipeline):
     x_at_insert_outlet = np.array(x_at_insert_outlet)
     plate_x = geometry["outlet"][0]
     # through both passages: inside the plates (interior, fast) and between plate and hopper wall (exterior,
-    # slow: in 0.8 s of this one-layer hopper only about a tenth of the clumps from above come that way)
+    # slow: in 0.8 s of this one-layer hopper 4 to 13 of the ~130 clumps from above came that way in the runs so far,
+    # a count that moves with the fill; a Poisson count of mean 5 is 0 with probability 0.7 %, so the check asks
+    # for at least one)
     inside, outside = np.sum(x_at_insert_outlet < plate_x), np.sum(x_at_insert_outlet > plate_x)
     print(f"{crossed.size} clumps left; {from_above.size} came from above the insert: {inside} through the interior, "
           f"{outside} through the exterior annulus")
-    assert inside > 50 and outside >= 5
+    assert inside > 50 and outside >= 1
 
 
 def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipeline):
