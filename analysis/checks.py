@@ -118,3 +118,16 @@ def number_or_nan(value) -> float:
     """A number read back from JSON or a table, where null or an empty cell (a NaN when written, or a figure not
     known) is NaN."""
     return math.nan if value is None else float(value)
+
+
+def integer_at_least(name: str, value, minimum: int) -> int:
+    """``value`` as an int when it is a whole number (not a bool) >= ``minimum``."""
+    if (
+        isinstance(value, (bool, np.bool_))
+        or not isinstance(value, (int, np.integer, float, np.floating))
+        or not math.isfinite(float(value))
+        or int(value) != value
+        or int(value) < minimum
+    ):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)

@@ -43,7 +43,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import convolve
 
-from analysis.checks import finite_array, finite_number, non_negative_number, positive_number, uniform_step
+from analysis.checks import (
+    finite_array,
+    finite_number,
+    integer_at_least,
+    non_negative_number,
+    positive_number,
+    uniform_step,
+)
 from analysis.numerics.rtd import rtd_moments
 
 __all__ = [
@@ -140,14 +147,6 @@ class Recirculation:
 
 
 # --------------------------------------------------------------------------- validation
-
-
-def _count(name: str, value, minimum: int = 1) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer, float)) or int(value) != value:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    if int(value) < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
 
 
 def _unit_area(e: np.ndarray, dt: float) -> np.ndarray:
@@ -330,7 +329,7 @@ def variance_reduction_ratio(c_in, c_out, steady_from=0, time=None) -> float:
     if b.shape != a.shape:
         raise ValueError(f"c_out must have the shape of c_in {a.shape}, got {b.shape}")
     if time is None:
-        start = _count("steady_from", steady_from, minimum=0)
+        start = integer_at_least("steady_from", steady_from, 0)
         window = slice(start, None)
         n = max(a.size - start, 0)
     else:
@@ -417,7 +416,7 @@ def vrr_versus_period(
         raise ValueError("periods_over_tm must be a non-empty array of numbers > 0")
     if waveform not in ("sine", "square"):
         raise ValueError(f"waveform must be 'sine' or 'square', got {waveform!r}")
-    n_periods = _count("n_periods", n_periods)
+    n_periods = integer_at_least("n_periods", n_periods, 1)
     method = _method(method)
     if normalise:
         e = _unit_area(e, dt)
@@ -492,7 +491,7 @@ def recirculate(c_first_input, E, time, passes: int, normalise: bool = True, met
     e = finite_array("E", E, ndim=1)
     if e.size == 0:
         raise ValueError("E must have at least 1 sample")
-    passes = _count("passes", passes)
+    passes = integer_at_least("passes", passes, 1)
     method = _method(method)
     if normalise:
         e = _unit_area(e, dt)
@@ -593,7 +592,7 @@ def carson_royal_recycle(first_pass_E, time, passes: int) -> np.ndarray:
         ``rows.sum(axis=0)`` is the outlet concentration of the recycle loop after a unit pulse.
     """
     t, _, e1 = _series_on_axis(time, "first_pass_E", first_pass_E, from_zero=True)
-    passes = _count("passes", passes)
+    passes = integer_at_least("passes", passes, 1)
     rows = np.empty((passes, t.size))
     rows[0] = e1
     for n in range(1, passes):

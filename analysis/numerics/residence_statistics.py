@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import positive_number
+from analysis.checks import finite_array, integer_at_least, positive_number
 from analysis.numerics.uncertainty import Estimate, combine_independent, seed_spread
 
 __all__ = [
@@ -137,9 +137,7 @@ def mean_residence_time_within(residence_times, horizon: float, cohort_means=Non
     if not np.any(times <= h):
         raise ValueError(f"residence_times: no tracer left within the horizon {h!r} s")
     within = mean_residence_time(times[times <= h])
-    cohorts = np.asarray([] if cohort_means is None else cohort_means, dtype=float).ravel()
-    if not np.all(np.isfinite(cohorts)):
-        raise ValueError("cohort_means must be finite")
+    cohorts = finite_array("cohort_means", [] if cohort_means is None else cohort_means)
     if cohorts.size < 2:
         return within
     spread = seed_spread(cohorts)
@@ -178,9 +176,7 @@ def cohort_means_within(entry_time, residence_time, horizon: float, cohort_size:
         or cohort size.
     """
     h = positive_number("horizon", horizon)
-    if isinstance(cohort_size, bool) or not float(cohort_size).is_integer() or int(cohort_size) < 1:
-        raise ValueError(f"cohort_size must be an integer >= 1, got {cohort_size!r}")
-    size = int(cohort_size)
+    size = integer_at_least("cohort_size", cohort_size, 1)
     entry = np.asarray(entry_time, dtype=float).ravel()
     residence = np.asarray(residence_time, dtype=float).ravel()
     if entry.shape != residence.shape:

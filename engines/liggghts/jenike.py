@@ -42,12 +42,10 @@ from engines.liggghts.markers import parse_markers
 from engines.liggghts.run import (
     DUMP_PREFIX,
     RUN_OUTPUTS,
-    SETTLED_FILL_PREFIX,
-    SETTLED_SNAPSHOT_STEPS,
-    SETTLED_WALLS_PATH,
     output_bytes,
     run_engine,
     set_aside_previous_attempt,
+    settled_fill_context,
     write_run_record,
 )
 from engines.templating import render_deck
@@ -190,16 +188,8 @@ def jenike_deck_context(case: JenikeCase) -> dict:
                 "columns": len(CONTACT_COLUMNS),
             },
             "thermo_every": case.output_every * 10,
-            "settled_fill": {
-                "path": f"dumps/{SETTLED_FILL_PREFIX}_*.txt",
-                "contacts_path": f"dumps/{SETTLED_CONTACT_PREFIX}_*.txt",
-                "contact_compute": "pair_contacts",
-                "contact_columns": len(CONTACT_COLUMNS),
-                "walls": list(SETTLED_WALLS),
-                "walls_path": SETTLED_WALLS_PATH,
-                "steps": SETTLED_SNAPSHOT_STEPS,
-                "timestep": case.timestep,
-            },
+            "settled_fill": {**settled_fill_context(SETTLED_CONTACT_PREFIX, len(CONTACT_COLUMNS), case.timestep),
+                             "walls": list(SETTLED_WALLS)},
         }
     )
     assert context["particle"]["type"] == PARTICLE_TYPE

@@ -47,6 +47,22 @@ SETTLED_WALLS_PATH = "dumps/settled_walls.txt"
 SETTLED_SNAPSHOT_STEPS = 200
 
 
+def settled_fill_context(contacts_prefix: str, contact_columns: int, timestep: float) -> dict:
+    """The deck context of the settled fill's snapshot (``settled_fill_snapshot`` in ``templates/liggghts/macros.j2``):
+    the files of its spheres, pair contacts (``<contacts_prefix>_<step>.txt``, ``contact_columns`` columns of the
+    ``pair_contacts`` compute) and walls' forces, and the length of its run; ``timestep`` [s] goes into the walls'
+    file title."""
+    return {
+        "path": f"dumps/{SETTLED_FILL_PREFIX}_*.txt",
+        "contacts_path": f"dumps/{contacts_prefix}_*.txt",
+        "contact_compute": "pair_contacts",
+        "contact_columns": contact_columns,
+        "walls_path": SETTLED_WALLS_PATH,
+        "steps": SETTLED_SNAPSHOT_STEPS,
+        "timestep": timestep,
+    }
+
+
 
 #: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
 RESTART_DIR = "restart"

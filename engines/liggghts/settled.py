@@ -1,14 +1,15 @@
 """The settled fill's snapshot written by the silo-type and Jenike decks (``settled_fill_snapshot`` in
 ``templates/liggghts/macros.j2``), read into neutral :class:`SettledFill` objects, one per step.
 
-The deck writes, at each of the two steps after the settle stage (``run 2``), a text ``dump custom`` of the spheres
+The deck writes, at the last two steps of a short run after the settle stage, a text ``dump custom`` of the spheres
 (``dumps/settled_fill_<step>.txt``: ``id type id_multisphere x y z vx vy vz radius mass`` and the summed force of
 every wall fix on the sphere, ``v_settled_wall_fx/fy/fz``, from their ``store_force``), the pair contacts
 (``dumps/contacts_<step>.txt`` of the silos, read by :mod:`engines.liggghts.contacts`; the Jenike deck's
 ``dumps/settled_contacts_<step>.txt`` in its own column layout) with 12 significant digits, and every wall's force
 on the particles (``dumps/settled_walls.txt``, the format of the wall force history, :mod:`engines.liggghts.forces`:
-6 digits). Two steps, because a LIGGGHTS fill at rest alternates about equilibrium from step to step (the macro
-says by how much); :func:`analysis.numerics.force_balance.settled_fill_balance` averages them.
+6 digits). Two steps, because a LIGGGHTS fill at rest alternates about equilibrium from step to step, and the last
+of a run, because its set-up kicks the fill (the macro says by how much);
+:func:`analysis.numerics.force_balance.settled_fill_balance` averages them.
 
 Why not a library reader: the text dump is the header of a ``dump local`` plus a table; the contact reader's
 strict parser (which names the file and the fault of a truncated dump) reads both.

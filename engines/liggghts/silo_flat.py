@@ -18,14 +18,12 @@ from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.run import (
     CONTACT_PREFIX,
     DUMP_PREFIX,
-    SETTLED_FILL_PREFIX,
-    SETTLED_SNAPSHOT_STEPS,
-    SETTLED_WALLS_PATH,
     RESTART_DIR,
     RESTART_PREFIX,
     Resume,
     restart_every,
     run_checked,
+    settled_fill_context,
 )
 from engines.interface import EngineRunError
 from engines.liggghts.markers import Marker
@@ -105,15 +103,7 @@ def silo_deck_context(case: SiloCase) -> dict:
             },
             "dump": {"id": "particle_dump", "every": dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
                      "fields": list(SILO_DUMP_FIELDS)},
-            "settled_fill": {
-                "path": f"dumps/{SETTLED_FILL_PREFIX}_*.txt",
-                "contacts_path": f"dumps/{CONTACT_PREFIX}_*.txt",
-                "contact_compute": "pair_contacts",
-                "contact_columns": N_CONTACT_COLUMNS,
-                "walls_path": SETTLED_WALLS_PATH,
-                "steps": SETTLED_SNAPSHOT_STEPS,
-                "timestep": case.timestep,
-            },
+            "settled_fill": settled_fill_context(CONTACT_PREFIX, N_CONTACT_COLUMNS, case.timestep),
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
             "thermo_every": dump_every,

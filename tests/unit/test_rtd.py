@@ -297,7 +297,7 @@ def test_one_cohorts_error_is_the_spread_of_the_other_cohorts_means():
     assert (within.value, within.std_error, within.n, within.method, within.dof) == (4.0, 2.0, 3, "cohort spread", 2)
     # fewer than two cohorts: the error within the tracer
     assert mean_residence_time_within(KNOWN_SAMPLE, 5.0, [3.0]) == mean_residence_time_within(KNOWN_SAMPLE, 5.0)
-    with pytest.raises(ValueError, match="cohort_means must be finite"):
+    with pytest.raises(ValueError, match="cohort_means must"):
         mean_residence_time_within(KNOWN_SAMPLE, 5.0, [3.0, np.nan])
 
 

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number
+from analysis.checks import finite_array, finite_number, integer_at_least, positive_number
 from analysis.numerics.residence_statistics import appearance_times
 from analysis.numerics.uncertainty import Estimate, batch_count, batch_means, batch_rate, combine_independent
 from analysis.studies.blender.profiles import passage_mean_v_z
@@ -425,17 +425,13 @@ def homogenisation_error(first_pass, first_pass_variance, recycle: Callable[[np.
         raise ValueError(f"first_pass_variance must have the shape of first_pass {values.shape}, got {variance.shape}")
     if np.any(variance < 0.0):
         raise ValueError("first_pass_variance must be >= 0")
-    windows = finite_number("per_pass_length", per_pass_length)
-    if not windows > 0.0:
-        raise ValueError(f"per_pass_length must be > 0, got {per_pass_length!r}")
-    if isinstance(draws, bool) or int(draws) != draws or draws < 2:
-        raise ValueError(f"draws must be an integer >= 2, got {draws!r}")
+    windows = positive_number("per_pass_length", per_pass_length)
+    draws = integer_at_least("draws", draws, 2)
     rng = np.random.default_rng(seed)
-    noise = rng.standard_normal((int(draws), values.size)) * np.sqrt(variance)
+    noise = rng.standard_normal((draws, values.size)) * np.sqrt(variance)
     answers = np.array([homogenised(recycle(values + row)) for row in noise], dtype=float)
     finite = answers[np.isfinite(answers)]
     if finite.size < max(2, answers.size / 2):
         return math.nan
     resolution = 1.0 / (windows * math.sqrt(12.0))
     return combine_independent([float(finite.std(ddof=1)), resolution])
-

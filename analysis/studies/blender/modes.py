@@ -208,14 +208,17 @@ def discontinuous_mode(
     pass_index = np.floor((starts + 0.5 * step) / t_m).astype(np.int64)
     pass_mean = np.array([float(np.mean(c[pass_index == p])) for p in range(int(pass_index.max()) + 1)
                           if np.any(pass_index == p)])
+    windows_per_pass = t_m / step
+
     def recycle(first_pass: np.ndarray) -> np.ndarray:
         return predicted_concentration_from_first_pass(first_pass, entry_E, step, terms)
 
     def homogenised_in(concentration: np.ndarray) -> float:
-        return recirculations_to_homogenise(concentration, mean=share, tolerance=tolerance, per_pass_length=t_m / step)
+        return recirculations_to_homogenise(concentration, mean=share, tolerance=tolerance,
+                                            per_pass_length=windows_per_pass)
 
     homogenised = homogenised_in(c)
-    homogenised_error = (homogenisation_error(c_first, c_first_variance, recycle, homogenised_in, t_m / step)
+    homogenised_error = (homogenisation_error(c_first, c_first_variance, recycle, homogenised_in, windows_per_pass)
                          if math.isfinite(homogenised) else math.nan)
     return DiscontinuousMode(
         window=step, window_start=starts, time_in_passes=starts / t_m, first_pass=c_first, concentration=c,

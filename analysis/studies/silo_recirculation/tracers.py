@@ -11,9 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_number, positive_number
+from analysis.checks import finite_number, integer_at_least, positive_number
 from analysis.studies.silo_recirculation.tracks import RecirculationEvents
-from analysis.studies.silo_recirculation.validation import integer_at_least
 
 __all__ = ["TracerPasses", "tracer_passes", "tracer_count"]
 

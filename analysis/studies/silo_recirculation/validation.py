@@ -1,4 +1,4 @@
-"""Argument checks shared by the recirculation modules (tracks, concentration, VRR, tracers).
+"""Argument checks shared by the recirculation modules (tracks, concentration, VRR, transit).
 
 Each returns the checked value or raises a ValueError that names the argument.
 """
@@ -9,20 +9,7 @@ import math
 
 import numpy as np
 
-__all__ = ["integer_at_least", "open_fraction", "event_times"]
-
-
-def integer_at_least(name: str, value, minimum: int) -> int:
-    """``value`` as an int when it is a whole number (not a bool) >= ``minimum``."""
-    if (
-        isinstance(value, (bool, np.bool_))
-        or not isinstance(value, (int, np.integer, float, np.floating))
-        or not math.isfinite(float(value))
-        or int(value) != value
-        or int(value) < minimum
-    ):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
+__all__ = ["open_fraction", "event_times"]
 
 
 def open_fraction(name: str, value) -> float:
