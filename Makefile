@@ -7,7 +7,7 @@ CORES    ?= 2
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 
-.PHONY: install install-system install-python run test test-unit test-integration dry-run bench estimate
+.PHONY: install install-system install-python run validate test test-unit test-integration dry-run bench estimate
 
 install: install-system install-python
 
@@ -31,6 +31,20 @@ install-python:
 run: install
 	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete --rerun-triggers mtime params input
 	$(PYTHON) -m snakemake --report results/report.html --configfile $(CONFIG)
+
+# The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it, about
+# 2.5 hours on 2 cores. It works in results/validation/ (its own results/ and report there, so that it never
+# overwrites the default run's), prints the estimate of every run first and resumes where an interrupted run stopped.
+VALIDATION_CONFIG ?= config/validation.yaml
+VALIDATION_DIR    ?= results/validation
+
+validate: install
+	@mkdir -p $(VALIDATION_DIR)/results
+	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results
+	$(PYTHON) -m snakemake --cores $(CORES) --snakefile $(CURDIR)/Snakefile --directory $(VALIDATION_DIR) \
+		--configfile $(abspath $(VALIDATION_CONFIG)) --rerun-incomplete --rerun-triggers mtime params input --keep-going
+	$(PYTHON) -m snakemake --snakefile $(CURDIR)/Snakefile --directory $(VALIDATION_DIR) \
+		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report.html
 
 test: install
 	$(PYTHON) -m pytest tests

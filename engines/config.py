@@ -300,12 +300,21 @@ def _check_blender_references(config: dict, require) -> None:
             f"config key 'blender.pathlines.release_height': {blender['pathlines']['release_height']} m must be below "
             f"the fill height blender.fill_height ({blender['fill_height']} m)"
         )
+    _require_subset(blender["gravity_configurations"], blender["configurations"], "blender.gravity_configurations",
+                    "blender.configurations")
     start, end = blender["discharge"]["steady_window"]
     if not start < end <= blender["discharge"]["time"]:
         raise ConfigError(
             f"config key 'blender.discharge.steady_window': {[start, end]} must be an increasing window within "
             f"blender.discharge.time ({blender['discharge']['time']} s)"
         )
+
+
+def _require_subset(chosen, among, key: str, among_key: str) -> None:
+    """A list key that picks from another list (null picks all): every entry must be in ``among``."""
+    for index, name in enumerate(chosen or []):
+        if name not in among:
+            raise ConfigError(f"config key '{key}[{index}]': '{name}' is not among {among_key} {list(among)}")
 
 
 def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None:
@@ -319,6 +328,9 @@ def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None
         raise ConfigError(f"config key 'materials.{particle}.density': the particle material needs a density")
     for index, shape in enumerate(sweep["shapes"]):
         require(shape, config["particle_models"], f"jenike.sweep.shapes[{index}]", "particle model")
+    for key in ("wall_test_shapes", "sensitivity_shapes"):
+        _require_subset(sweep[key], sweep["shapes"], f"jenike.sweep.{key}", "jenike.sweep.shapes")
+    _require_subset(sweep["sensitivity_tests"], sweep["tests"], "jenike.sweep.sensitivity_tests", "jenike.sweep.tests")
     wall_tests = []
     for index, test in enumerate(sweep["tests"]):
         if test != "internal":

@@ -34,8 +34,8 @@ MODES = ("continuous", "batch")
 #: Keys of ``blender`` that only steer the analysis or say how many runs to make; they do not define (or rerun) a
 #: simulation (a replicate is defined by its seed).
 ANALYSIS_ONLY_KEYS = (
-    "enabled", "configurations", "gravity_factors", "bin_size", "profile_heights_above", "pathlines", "rtd",
-    "discontinuous", "continuous", "replicates",
+    "enabled", "configurations", "gravity_factors", "gravity_configurations", "bin_size", "profile_heights_above",
+    "pathlines", "rtd", "discontinuous", "continuous", "replicates",
 )
 
 
@@ -298,15 +298,17 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
 
 
 def blender_cases(config: dict) -> dict[str, BlenderCase]:
-    """The blender runs of a validated configuration (configurations x gravity factors), keyed by run id;
-    empty when ``blender.enabled`` is false."""
+    """The blender runs of a validated configuration, keyed by run id: every configuration at the lowest gravity
+    factor, those of ``gravity_configurations`` (null: all) at every factor; empty when ``blender.enabled`` is false."""
     blender = config["blender"]
     if not blender["enabled"]:
         return {}
+    scaled = blender["gravity_configurations"] or blender["configurations"]
+    lowest = [min(blender["gravity_factors"])]
     cases = [
         build_blender_case(config, configuration, factor)
         for configuration in blender["configurations"]
-        for factor in blender["gravity_factors"]
+        for factor in (blender["gravity_factors"] if configuration in scaled else lowest)
     ]
     return {case.run_id: case for case in cases}
 

@@ -19,12 +19,15 @@ def other_lid(lid: str) -> str:
 def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
     """Expand the ``jenike.sweep`` section into the list of distinct sweep points.
 
-    The grid is every shape x test x sliding friction x rolling friction at the base restitution. The
+    The grid is every shape x test x sliding friction x rolling friction at the base restitution (wall tests only
+    for the shapes of ``wall_test_shapes``, null: all). The
     restitution sensitivity adds, per shape and test, the middle sliding friction at the first rolling
     friction for each extra restitution; the rotation-blocked reference adds every sliding friction at the
     first rolling friction with particle rotation blocked. The lid comparison adds, per shape, the internal
     test at every sliding friction and the first rolling friction with the other lid (key ``"lid"``).
-    Duplicates are dropped, order is stable.
+    These three studies go to the shapes of ``sensitivity_shapes`` and (the first two) the tests of
+    ``sensitivity_tests`` (null: all). Duplicates are dropped, order is
+    stable.
 
     Parameters
     ----------
@@ -55,18 +58,24 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
         if point not in points:
             points.append(point)
 
+    wall_test_shapes = sweep.get("wall_test_shapes") or sweep["shapes"]
+    sensitivity_shapes = sweep.get("sensitivity_shapes") or sweep["shapes"]
+    sensitivity_tests = sweep.get("sensitivity_tests") or sweep["tests"]
     for shape in sweep["shapes"]:
-        for test in sweep["tests"]:
+        tests = [test for test in sweep["tests"] if test == INTERNAL or shape in wall_test_shapes]
+        for test in tests:
             for mu_r in rolling:
                 for mu in sliding:
                     add(shape, test, mu, mu_r, base_restitution)
+            if shape not in sensitivity_shapes or test not in sensitivity_tests:
+                continue
             middle = sorted(sliding)[len(sliding) // 2]
             for restitution in sweep["restitution_sensitivity"]:
                 add(shape, test, middle, rolling[0], restitution)
             if sweep["rotation_blocked"]:
                 for mu in sliding:
                     add(shape, test, mu, rolling[0], base_restitution, blocked=True)
-        if sweep["lid_comparison"] and INTERNAL in sweep["tests"]:
+        if sweep["lid_comparison"] and INTERNAL in sweep["tests"] and shape in sensitivity_shapes:
             for mu in sliding:
                 point = {
                     "shape": shape,

@@ -161,3 +161,15 @@ def test_runs_are_configurations_times_gravity_factors_and_analysis_keys_do_not_
         blender_case_for_run(golden_config, "straight-g1-0000000000")
     disabled = changed(golden_config, lambda b: b.update(enabled=False))
     assert blender_cases(disabled) == {}
+
+
+def test_gravity_configurations_run_every_factor_and_the_others_the_lowest_only(golden_config):
+    config = changed(golden_config, lambda b: b.update(configurations=["straight", "converging"], gravity_factors=[5.0, 1.0, 50.0],
+                                                       gravity_configurations=["converging"]))
+    cases = blender_cases(validate_config(config))
+    assert sorted((c.configuration, c.gravity_factor) for c in cases.values()) == [
+        ("converging", 1.0), ("converging", 5.0), ("converging", 50.0), ("straight", 1.0)]
+    # the choice says how many runs to make; it does not define one
+    assert build_blender_case(validate_config(config), "straight").run_id == build_blender_case(golden_config, "straight").run_id
+    with pytest.raises(ConfigError, match=r"blender.gravity_configurations\[0\]': 'diverging' is not among blender.configurations"):
+        validate_config(changed(config, lambda b: b.update(gravity_configurations=["diverging"])))

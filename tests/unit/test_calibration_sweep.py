@@ -1,8 +1,10 @@
 """Expansion of the calibration sweep grid."""
 
+import pytest
+
 from calibration.sweep import chart_rows, diagnostic_points, is_chart_point, lid_comparison
 from engines.cases.jenike_sweep import sweep_points
-from engines.config import validate_config
+from engines.config import ConfigError, validate_config
 
 
 def test_default_sweep_is_shape_x_test_x_sliding_x_rolling():
@@ -82,3 +84,39 @@ def test_diagnostic_points_are_the_middle_friction_of_each_curve():
     assert diagnostic_points(points, {**sweep, "diagnostics": "all"}, "rigid") == [
         p for p in points if "lid" not in p
     ]
+
+
+def test_wall_tests_and_sensitivity_studies_can_be_kept_to_some_shapes_and_tests():
+    sweep = {
+        "shapes": ["sphere", "sphere2", "sphere4"],
+        "tests": ["internal", "aluminium"],
+        "wall_test_shapes": ["sphere2"],
+        "sensitivity_shapes": ["sphere2"],
+        "sensitivity_tests": ["internal"],
+        "sliding_friction": [0.1, 0.3, 0.5, 0.8],
+        "rolling_friction": [0.0, 0.1],
+        "restitution": 0.1,
+        "restitution_sensitivity": [0.6],
+        "rotation_blocked": True,
+        "lid_comparison": True,
+        "wall_test_particle_friction": 0.35,
+    }
+    points = sweep_points(sweep)
+    chart = [p for p in points if is_chart_point(p, 0.1)]
+    # internal curves for every shape, the wall test for sphere2 only: 3 x 8 + 8
+    assert len(chart) == 3 * 2 * 4 + 2 * 4
+    assert {p["shape"] for p in chart if p["test"] == "aluminium"} == {"sphere2"}
+    others = [p for p in points if not is_chart_point(p, 0.1)]
+    # restitution (1) + rotation blocked (4) + other lid (4), all on sphere2's internal test
+    assert len(others) == 1 + 4 + 4
+    assert {(p["shape"], p["test"]) for p in others} == {("sphere2", "internal")}
+    assert len(points) == len(chart) + len(others)
+
+
+def test_sweep_subsets_must_name_shapes_and_tests_of_the_sweep():
+    config = {"jenike": {"sweep": {"shapes": ["sphere2"], "wall_test_shapes": ["sphere4"]}}}
+    with pytest.raises(ConfigError, match=r"jenike.sweep.wall_test_shapes\[0\]': 'sphere4' is not among jenike.sweep.shapes"):
+        validate_config(config)
+    config = {"jenike": {"sweep": {"tests": ["internal"], "sensitivity_tests": ["aluminium"]}}}
+    with pytest.raises(ConfigError, match=r"jenike.sweep.sensitivity_tests\[0\]': 'aluminium' is not among jenike.sweep.tests"):
+        validate_config(config)
