@@ -216,6 +216,24 @@ def test_profile_uncertainty_is_the_spread_of_batch_fits_over_the_batches_that_c
             assert errors[i, 0] == pytest.approx(math.hypot(spread, resolution), rel=1e-12)
 
 
+def test_flow_pattern_index_is_wall_over_centreline_velocity_with_its_batch_error():
+    # Gaussian v_z = -A exp(-x^2 / (4 B z)): the outermost nodes are x = -0.075 and x = +0.073 (75 nodes, 2 mm)
+    x = PROFILE_GRID.x
+    z = 0.015
+    series = [_gaussian_frame(b) for b in (0.002, 0.05, 0.1)]
+    expected = [0.5 * (math.exp(-x[0]**2 / (4 * b * z)) + math.exp(-x[-1]**2 / (4 * b * z))) for b in (0.002, 0.05, 0.1)]
+    for frame, index in zip(series, expected):
+        analysis = analyse_profiles(frame, (z,), (0.1,))
+        assert analysis.flow_pattern_index[0] == pytest.approx(index, rel=1e-12)
+    # plug flow: 1; no flow on the axis: unknown
+    assert analyse_profiles(_gaussian_frame(1e6), (z,), (0.1,)).flow_pattern_index[0] == pytest.approx(1.0, abs=1e-4)
+    assert np.isnan(analyse_profiles(_gaussian_frame(0.002, A=0.0), (z,), (0.1,)).flow_pattern_index[0])
+    # three batches of one frame each (window holds t = 1, 2, 3)
+    uncertainty = profile_uncertainty([_gaussian_frame(0.01)] + series, np.arange(4.0), (0.5, 3.5), (z,), (0.1,),
+                                      covered_density=0.5, n_batches=3)
+    assert uncertainty.flow_pattern_index_error[0] == pytest.approx(np.std(expected, ddof=1) / math.sqrt(3), rel=1e-10)
+
+
 def test_profile_uncertainty_of_a_window_with_one_frame_is_unknown():
     series = [_gaussian_frame(0.002), _gaussian_frame(0.003)]
     uncertainty = profile_uncertainty(series, np.array([0.0, 1.0]), (0.5, 1.5), (0.015,), (0.1,), 0.5)

@@ -472,7 +472,8 @@ def janssen_rows(comparison: JanssenComparison) -> list[dict]:
 
 def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
     """The contents of ``fields.json``: grid, kernel, window, heights, the profile flow rates against the
-    measured outflow ``outflow_rate`` (kg/s), B per height, surface height and number of contacts."""
+    measured outflow ``outflow_rate`` (kg/s), B and the flow-pattern index (wall over centreline v_z) per height with
+    their errors, surface height and number of contacts."""
     return {
         "grid_shape": list(study.grid.shape),
         "grid_spacing_m": list(study.grid.spacing),
@@ -488,8 +489,16 @@ def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
         "kinematic_B_m": {f"{z:g}": b for z, b in zip(study.profiles.heights, study.profiles.kinematic_B)},
         "kinematic_B_m_error": {f"{z:g}": e for z, e in
                                 zip(study.profiles.heights, study.uncertainty.kinematic_B_error)},
+        "flow_pattern_index": {f"{z:g}": i for z, i in zip(study.profiles.heights, study.profiles.flow_pattern_index)},
+        "flow_pattern_index_error": {f"{z:g}": float(e) for z, e in
+                                     zip(study.profiles.heights, _index_errors(study))},
         "error_batches": study.uncertainty.n_batches,
         "janssen_error_bin_pairs": study.janssen.bin_pairs,
         "surface_height_m": study.top,
         "contacts": study.n_contacts,
     }
+
+
+def _index_errors(study: SiloFieldStudy) -> np.ndarray:
+    errors = study.uncertainty.flow_pattern_index_error
+    return np.full(len(study.profiles.heights), np.nan) if errors is None else errors

@@ -149,6 +149,16 @@ class ProfileAnalysis:
     kinematic_B: np.ndarray
     kinematic_u: np.ndarray
 
+    @property
+    def flow_pattern_index(self) -> np.ndarray:
+        """(heights,) wall velocity over centreline velocity (-): the mean v_z of the two nodes nearest the side
+        walls over v_z on the axis. 1 in plug (mass) flow, 0 where the material at the walls stands still (funnel
+        flow); NaN where the axis does not move."""
+        centre = np.array([np.interp(0.0, self.x, row) for row in self.v_z])
+        wall = 0.5 * (self.v_z[:, 0] + self.v_z[:, -1])
+        moving = centre != 0.0
+        return np.divide(wall, centre, out=np.full(centre.shape, np.nan), where=moving)
+
 
 def analyse_profiles(
     depth_averaged: Fields,
@@ -200,6 +210,8 @@ class ProfileUncertainty:
         Time windows the averaging window was cut into (-); 0 when it holds fewer than two frames.
     boundary_resolution : float
         Standard deviation of the position of a boundary inside one grid cell, ``dx / sqrt(12)`` (m).
+    flow_pattern_index_error : numpy.ndarray or None
+        (heights,) standard error of :attr:`ProfileAnalysis.flow_pattern_index` (-); None when not estimated.
     """
 
     kinematic_B_error: np.ndarray
@@ -208,6 +220,7 @@ class ProfileUncertainty:
     batches: np.ndarray
     n_batches: int
     boundary_resolution: float
+    flow_pattern_index_error: np.ndarray | None = None
 
 
 def _axis_density(fields: Fields, height: float) -> float:
@@ -234,7 +247,7 @@ def profile_uncertainty(
     subtract_wall_velocity: bool = False,
     kernel_width: float = 0.0,
 ) -> ProfileUncertainty:
-    """Errors of B(z) and of the flow channel boundary from batch means over time windows.
+    """Errors of B(z), of the flow channel boundary and of the flow-pattern index from batch means over time windows.
 
     The frames inside ``window`` are cut into ``K = min(n_batches, frames)`` contiguous batches of
     ``b = frames // K`` frames (the oldest ``frames % K`` frames left out, as in
@@ -281,10 +294,12 @@ def profile_uncertainty(
     right_error = np.full_like(left_error, np.nan)
     chosen = _in_window(depth_series, times, window)
     count = min(n_batches, len(chosen))
+    index_error = np.full(heights.size, np.nan)
     if count < 2:
         return ProfileUncertainty(b_error, left_error, right_error, np.zeros(heights.size, dtype=int), 0,
-                                  resolution)
+                                  resolution, index_error)
     b_values = np.full((count, heights.size), np.nan)
+    index = np.full((count, heights.size), np.nan)
     left = np.full((count, heights.size, len(fractions)), np.nan)
     right = np.full_like(left, np.nan)
     covered = np.zeros((count, heights.size), dtype=bool)
@@ -294,15 +309,18 @@ def profile_uncertainty(
         batch = chosen[k * size:(k + 1) * size]
         analysis = analyse_profiles(average_fields(batch), heights, fractions, subtract_wall_velocity, kernel_width)
         b_values[k], left[k], right[k] = analysis.kinematic_B, analysis.fcb_left, analysis.fcb_right
+        index[k] = analysis.flow_pattern_index
         covered[k] = [all(_axis_density(f, float(z)) >= covered_density for f in batch) for z in heights]
     for i in range(heights.size):
         use = covered[:, i]
         b_error[i] = _standard_error(b_values[use & np.isfinite(b_values[:, i]), i])
+        index_error[i] = _standard_error(index[use & np.isfinite(index[:, i]), i])
         for j in range(len(fractions)):
             for values, errors in ((left, left_error), (right, right_error)):
                 spread = _standard_error(values[use & np.isfinite(values[:, i, j]), i, j])
                 errors[i, j] = combine_independent([spread, resolution])
-    return ProfileUncertainty(b_error, left_error, right_error, covered.sum(axis=0).astype(int), count, resolution)
+    return ProfileUncertainty(b_error, left_error, right_error, covered.sum(axis=0).astype(int), count, resolution,
+                              index_error)
 
 
 @dataclass(frozen=True)
