@@ -277,6 +277,10 @@ def _check_recirculation_references(config: dict, require) -> None:
             f"config key 'silo_recirculation.outlet_width': {blending['outlet_width']} m must be smaller than "
             f"silo_recirculation.width ({blending['width']} m)"
         )
+    low, high = blending["bulk_density_slab"]
+    if not low < high:
+        raise ConfigError(f"config key 'silo_recirculation.bulk_density_slab': {[low, high]} must be an increasing "
+                          "pair of fractions of fill_height")
 
 
 def _check_blender_references(config: dict, require) -> None:

@@ -71,7 +71,7 @@ rule silo_recirculation_analysis:
     params:
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
                                     ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
-                                     "eulerian", "snapshots")},
+                                     "eulerian", "snapshots", "bulk_density_slab")},
     log:
         f"{run_dir(RECIRCULATION)}/logs/analysis.log",
     script:

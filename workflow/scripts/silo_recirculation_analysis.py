@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.studies.silo_recirculation.bulk_density import flowing_bulk_density
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
@@ -71,7 +72,14 @@ with logged_to(snakemake.log[0]) as log:
     johanson = johanson_curve(result)
     write_flow_table(out.rtd, rtd_rows(result, eulerian_rtd, johanson))
     write_flow_table(out.vrr_period, vrr_period_rows(result))
-    write_json(out.summary, blending_summary(case, result, eulerian_rtd, eulerian["bin_size"]))
+    low, high = settings["bulk_density_slab"]
+    density = flowing_bulk_density(
+        tracks.times, tracks.position[:, :, 2], loaded.mass, case["width_m"], case["depth_m"],
+        (low * case["fill_height_m"], high * case["fill_height_m"]), tracks.times[0] + timing.residence_time,
+    )
+    log.info("bulk density in the slab %s m: settled %.1f, flowing %.1f +- %.2g kg/m3, drop %.4f +- %.2g",
+             density.slab, density.settled, density.flowing, density.flowing_error, density.drop, density.drop_error)
+    write_json(out.summary, {**blending_summary(case, result, eulerian_rtd, eulerian["bin_size"]), **density.summary()})
 
     # --- plots
     plot_outlet_concentration(
