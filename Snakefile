@@ -18,6 +18,7 @@ include: "workflow/rules/silo.smk"
 include: "workflow/rules/silo_recirculation.smk"
 include: "workflow/rules/blender.smk"
 include: "workflow/rules/fill_balance.smk"
+include: "workflow/rules/validation.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -29,6 +30,7 @@ rule all:
         recirculation_targets,
         blender_targets,
         f"{RESULTS}/summary/summary.html",
+        f"{RESULTS}/summary/validation.csv",
     default_target: True
 
 

@@ -123,6 +123,12 @@ COLUMNS: dict[str, Column] = {
     "walls_ratio": Column("Walls / weight"),
     "silo_like": Column("Walls carry part of the weight (silo-like)", kind=FLAG),
     "balance_passed": Column("Force balance passed", kind=FLAG),
+    # the validation table (summary/validation.csv)
+    "value": Column("Value", kind=ESTIMATE),
+    "unit": Column("Unit", kind=TEXT),
+    "study_value": Column("The study", kind=TEXT),
+    "scale_shows": Column("The scale shows it", kind=TEXT),
+    "evidence": Column("From the run", kind=TEXT),
 }
 
 #: The blender comparison's VRR columns, one per sine period (a fraction of the mean residence time).
@@ -258,7 +264,7 @@ PAGE_LEGEND = (f"Figures are given as value ± standard error, the error to 2 si
                "n/a: not available.")
 
 
-def summary_html(title: str, sections: Sequence[Section | tuple]) -> str:
+def summary_html(title: str, sections: Sequence[Section | tuple], intro: str = "") -> str:
     """A self-contained HTML page: a heading and the key to the figures, then per section its title, a sentence,
     a table of rows and an optional legend.
 
@@ -266,6 +272,8 @@ def summary_html(title: str, sections: Sequence[Section | tuple]) -> str:
     ----------
     title : str
         Page title.
+    intro : str, optional
+        A paragraph under the key to the figures ("" for none).
     sections : sequence of Section or of (str, str, sequence of mapping[, str])
         ``(section title, explanation, rows[, legend])``; the columns are the rows' keys in order of first
         appearance, each ``"<key>_error"`` merged into the cell of ``"<key>"``. A section without rows says so
@@ -279,6 +287,8 @@ def summary_html(title: str, sections: Sequence[Section | tuple]) -> str:
         If a cell value is not a scalar (a mapping or a list).
     """
     parts = [f"<h1>{html.escape(title)}</h1><p class=\"legend\">{html.escape(PAGE_LEGEND)}</p>"]
+    if intro:
+        parts.append(f"<p>{html.escape(intro)}</p>")
     for section in sections:
         section = Section(*section)
         parts.append(f"<h2>{html.escape(section.title)}</h2><p>{html.escape(section.explanation)}</p>")
@@ -475,9 +485,17 @@ DIFFERENCES_LEGEND = ("A − B: the difference of a figure between two configura
                       "(batch means, tracer counts); replicates: N >= 3 adds the spread over seeds.")
 
 
+SCALE_LIMITS = ("Rows of the validation table (the report's validation page) whose physics the scale of this "
+                "configuration does not show, with the run's figures that decided. The validation scale "
+                "(`make validate`, config/validation.yaml, about 2.5 hours on 2 cores) runs the study at the smallest "
+                "scale that shows them: the study's 40 mm deep silos, its 95 mm Jenike cell with four particle "
+                "frictions, a deeper blender and the gravity series.")
+
+
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
                      recirculation: Sequence[Mapping], blender: Sequence[Mapping],
-                     balances: Sequence[Mapping] = (), blender_differences: Sequence[Mapping] = ()) -> list[Section]:
+                     balances: Sequence[Mapping] = (), blender_differences: Sequence[Mapping] = (),
+                     scale_limits: Sequence[Mapping] = ()) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -492,6 +510,9 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         The force balance of each settled fill (``metrics/fill_balance.json``).
     blender_differences : sequence of mapping
         The blender comparison's differences (``comparison/significance.csv``).
+    scale_limits : sequence of mapping
+        The validation rows this scale does not show: figure, case, note
+        (:func:`analysis.studies.validation.table.scale_limits`).
     """
     return [
         Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
@@ -510,4 +531,5 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
                 DIFFERENCES_LEGEND),
         Section("Settled fills", "How each settled fill carries its weight before the outlet opens.",
                 fill_balance_rows(balances), FILL_LEGEND),
+        Section("What this scale cannot show", SCALE_LIMITS, list(scale_limits)),
     ]

@@ -1,0 +1,185 @@
+"""Validation rows of the calibration: the bulk-friction curves of the Jenike sweep and the checks around them.
+
+Rows (see :mod:`analysis.studies.validation.rows`):
+
+- one per calibration curve (shape, test, rolling friction): bulk friction at the largest particle friction;
+  the scale shows the curve's physics when the cell is wide in particle diameters and the curve is seen to stop
+  rising (its first step resolved, its last step not);
+- rotation blocked against free rotation, the other lid against the configured one and each extra restitution
+  against the base one, on the same sweep points;
+- the calibrated particle-scale friction coefficients.
+
+Inputs are the rows of ``calibration/bulk_friction.csv`` as read (strings are fine) and the calibration's
+``parameters.yaml`` as read.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+from analysis.checks import number_or_nan
+from analysis.numerics.uncertainty import combine_independent
+from analysis.studies.validation.rows import NO, Criteria, plus_minus, resolved, row, verdict
+
+__all__ = ["calibration_rows"]
+
+GROUP = "Calibration (Jenike cell)"
+#: The study's chosen particle-scale friction of the two-sphere clump (SEED_DIGEST section 1).
+STUDY_FRICTION = {"internal": "0.35", "aluminium": "0.17", "perspex": "0.2"}
+
+
+_RESOLVED = {True: "resolved", False: "not resolved", None: "unknown"}
+
+
+def _flag(value) -> bool:
+    return str(value) == "True"
+
+
+def _point(entry: Mapping) -> tuple[float, float, float]:
+    return (float(entry["particle_friction"]), float(entry["bulk_friction"]),
+            number_or_nan(entry.get("bulk_friction_error")))
+
+
+def _curves(rows: Sequence[Mapping], keep) -> dict[tuple, list[tuple[float, float, float]]]:
+    curves: dict[tuple, list] = {}
+    for entry in rows:
+        if keep(entry):
+            key = (entry["shape"], entry["test"], float(entry["rolling_friction"]))
+            curves.setdefault(key, []).append(_point(entry))
+    return {key: sorted(points) for key, points in sorted(curves.items())}
+
+
+def _not(condition):
+    return None if condition is None else not condition
+
+
+def _cell_text(cell_diameter: float, diameter: float, criteria: Criteria) -> tuple[bool, str]:
+    ratio = cell_diameter / diameter
+    return ratio >= criteria.min_cell_diameters, (
+        f"cell {cell_diameter * 1000:.0f} mm = {ratio:.1f} particle diameters (>= {criteria.min_cell_diameters:g})")
+
+
+def _curve_row(label: str, key: tuple, points: list, cell_ok: bool, cell_text: str, criteria: Criteria) -> dict:
+    shape, test, rolling = key
+    k = criteria.coverage_factor
+    text = "; ".join(f"{mu:g}: {plus_minus(b, e)}" for mu, b, e in points)
+    mu, bulk, error = points[-1]
+    if len(points) < 3:
+        return row(GROUP, f"Bulk friction at particle friction {mu:g} ({label})", f"{shape}, {test}, rolling {rolling:g}",
+                   bulk, error, "-", "", NO, f"{cell_text}; particle friction -> bulk friction {text}; fewer than "
+                   "three points cannot show where bulk friction stops rising")
+    first = (points[1][1] - points[0][1], combine_independent([points[1][2], points[0][2]]))
+    last = (points[-1][1] - points[-2][1], combine_independent([points[-1][2], points[-2][2]]))
+    first_rises, last_rises = resolved(*first, k), resolved(*last, k)
+    shows = verdict(cell_ok, first_rises, _not(last_rises))
+    stops = {True: "still rises", False: "stops rising", None: "unknown"}[last_rises]
+    return row(GROUP, f"Bulk friction at particle friction {mu:g} ({label})", f"{shape}, {test}, rolling {rolling:g}",
+               bulk, error, "-", "", shows,
+               f"{cell_text}; particle friction -> bulk friction {text}; first step {plus_minus(*first)}, last step "
+               f"{plus_minus(*last)}: bulk friction {stops} within the swept range")
+
+
+def _paired_rows(figure: str, reference: dict, other: dict, cell_ok: bool, cell_text: str, criteria: Criteria,
+                 study: str, expect_difference: bool) -> list[dict]:
+    """The mean difference other - reference over their common sweep points, per curve."""
+    rows = []
+    for key, points in other.items():
+        base = {mu: (b, e) for mu, b, e in reference.get(key, [])}
+        pairs = [(b - base[mu][0], combine_independent([e, base[mu][1]]), mu) for mu, b, e in points if mu in base]
+        if not pairs:
+            continue
+        difference = sum(d for d, _, _ in pairs) / len(pairs)
+        error = combine_independent([e for _, e, _ in pairs]) / len(pairs)
+        seen = resolved(difference, error, criteria.coverage_factor)
+        if expect_difference:
+            shows = verdict(cell_ok, seen)
+        else:
+            # "insensitive" is shown only by an error small enough to have seen a change
+            level = sum(base[mu][0] for _, _, mu in pairs) / len(pairs)
+            precise = None if not math.isfinite(error) else error <= criteria.max_relative_error * abs(level)
+            shows = verdict(cell_ok, _not(seen), precise)
+        shape, test, rolling = key
+        listing = "; ".join(f"{mu:g}: {plus_minus(d, e)}" for d, e, mu in pairs)
+        rows.append(row(GROUP, figure, f"{shape}, {test}, rolling {rolling:g}", difference, error, "-", study, shows,
+                        f"{cell_text}; differences at particle friction {listing}; mean {plus_minus(difference, error)}"
+                        f": {_RESOLVED[seen]} at {criteria.coverage_factor:g} standard errors"))
+    return rows
+
+
+def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_diameter: float,
+                     particle_diameters: Mapping[str, float], base_restitution: float, lid: str,
+                     criteria: Criteria) -> list[dict]:
+    """The calibration's validation rows.
+
+    Parameters
+    ----------
+    bulk_rows : sequence of mapping
+        Rows of ``calibration/bulk_friction.csv``: shape, test, lid, rolling_friction, restitution,
+        rotation_blocked, particle_friction, bulk_friction, bulk_friction_error (-).
+    parameters : mapping
+        The calibration's ``parameters.yaml`` (:func:`calibration.inversion` output) as read.
+    cell_diameter : float
+        Inner diameter of the Jenike cell (m).
+    particle_diameters : mapping
+        Volume-equivalent diameter of each shape (m).
+    base_restitution : float
+        The sweep's base restitution (-).
+    lid : str
+        The configured lid; rows with the other lid are the lid comparison.
+    criteria : Criteria
+    """
+    def chart(entry):
+        return (float(entry["restitution"]) == base_restitution and not _flag(entry["rotation_blocked"])
+                and entry["lid"] == lid)
+
+    curves = _curves(bulk_rows, chart)
+    blocked = _curves(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and e["lid"] == lid
+                      and float(e["restitution"]) == base_restitution)
+    other_lid = _curves(bulk_rows, lambda e: e["lid"] != lid and not _flag(e["rotation_blocked"])
+                        and float(e["restitution"]) == base_restitution)
+    restitutions = sorted({float(e["restitution"]) for e in bulk_rows} - {base_restitution})
+    rows = []
+    for key, points in curves.items():
+        cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
+        rows.append(_curve_row(f"{lid} lid", key, points, cell_ok, cell_text, criteria))
+    for figure, others, study, expect in (
+        ("Bulk friction, rotation blocked - free", blocked, "higher with rotation blocked", True),
+        (f"Bulk friction, {'servo' if lid == 'rigid' else 'rigid'} lid - {lid} lid", other_lid,
+         "a servo lid that cannot tilt overestimates", True),
+    ):
+        for key in others:
+            cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
+            rows += _paired_rows(figure, curves, {key: others[key]}, cell_ok, cell_text, criteria, study, expect)
+    for restitution in restitutions:
+        extra = _curves(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and e["lid"] == lid
+                        and not _flag(e["rotation_blocked"]))
+        for key in extra:
+            cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
+            rows += _paired_rows(f"Bulk friction, restitution {restitution:g} - {base_restitution:g}", curves,
+                                 {key: extra[key]}, cell_ok, cell_text, criteria,
+                                 "insensitive to restitution", False)
+    rows += _calibrated_rows(parameters, cell_diameter, particle_diameters, criteria)
+    return rows
+
+
+def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diameters: Mapping[str, float],
+                     criteria: Criteria) -> list[dict]:
+    shape = parameters["shape"]
+    cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[shape], criteria)
+    found = [("internal", parameters.get("particle_particle"))]
+    found += sorted((parameters.get("particle_wall") or {}).items())
+    rows = []
+    for test, result in found:
+        if not result:
+            continue
+        target = parameters["targets_deg"].get(test)
+        clipped = bool(result.get("band_clipped"))
+        rows.append(row(
+            GROUP, f"Calibrated particle sliding friction ({'particle-particle' if test == 'internal' else 'particle-' + test})",
+            f"{shape}, rolling {parameters['rolling_friction']:g}", result["sliding_friction"],
+            number_or_nan(result.get("sliding_friction_error")), "-", STUDY_FRICTION.get(test, ""),
+            verdict(cell_ok, not clipped),
+            f"{cell_text}; reproduces the measured {target:g} deg +- {parameters['tolerance_deg']:g} deg; band "
+            f"{result['lower']:.3g} to {result['upper']:.3g}{' (clipped at the swept range)' if clipped else ''}"))
+    return rows
