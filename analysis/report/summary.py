@@ -492,10 +492,16 @@ SCALE_LIMITS = ("Rows of the validation table (the report's validation page) who
                 "frictions, a deeper blender and the gravity series.")
 
 
+SCALE_LIMITS_LEGEND = ("A row is not shown when its run is too small in particle diameters (silo depth, cell, "
+                       "outlet), its settled fill fails the force balance, its VRR reaches the outlet windows' "
+                       "counting-noise ceiling, the blender's mass-flow insert is not in mass flow, or its error does "
+                       "not resolve the effect; the criteria are in the configuration's validation section.")
+
+
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
                      recirculation: Sequence[Mapping], blender: Sequence[Mapping],
                      balances: Sequence[Mapping] = (), blender_differences: Sequence[Mapping] = (),
-                     scale_limits: Sequence[Mapping] = ()) -> list[Section]:
+                     scale_limits: Sequence[Mapping] | None = None) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -510,10 +516,15 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         The force balance of each settled fill (``metrics/fill_balance.json``).
     blender_differences : sequence of mapping
         The blender comparison's differences (``comparison/significance.csv``).
-    scale_limits : sequence of mapping
+    scale_limits : sequence of mapping, optional
         The validation rows this scale does not show: figure, case, note
-        (:func:`analysis.studies.validation.table.scale_limits`).
+        (:func:`analysis.studies.validation.table.scale_limits`); None leaves the section out.
     """
+    limits = []
+    if scale_limits is not None:
+        limits = [Section("What this scale cannot show", SCALE_LIMITS,
+                          list(scale_limits) or [{"note": "Every row of the validation table is shown at this scale."}],
+                          SCALE_LIMITS_LEGEND)]
     return [
         Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
                 CALIBRATION_LEGEND),
@@ -531,5 +542,4 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
                 DIFFERENCES_LEGEND),
         Section("Settled fills", "How each settled fill carries its weight before the outlet opens.",
                 fill_balance_rows(balances), FILL_LEGEND),
-        Section("What this scale cannot show", SCALE_LIMITS, list(scale_limits)),
-    ]
+    ] + limits

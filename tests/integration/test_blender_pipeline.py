@@ -18,6 +18,8 @@ import yaml
 
 from analysis.data.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_events, recirculation_tracks
+from analysis.studies.validation.blending import blender_rows, gravity_rows
+from analysis.studies.validation.rows import Criteria
 from engines.cases.blender import blender_cases
 from engines.config import validate_config
 from engines.layout import case_root, run_dir
@@ -95,3 +97,22 @@ def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipelin
     with open(workdir / case_root("blender") / "gravity" / "scaling.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) >= 2
+
+
+def test_validation_rows_of_the_real_runs_normalise_passages_and_scale_with_gravity(blender_pipeline):
+    """The validation table's blender rows from the runs' own files (the tiny insert is the mass-flow one here)."""
+    _, runs = blender_pipeline
+    summaries = [json.loads((runs[g] / "metrics" / "blender.json").read_text()) for g in (1.0, 4.0)]
+    cases = [json.loads((runs[g] / "deck" / "case.json").read_text()) for g in (1.0, 4.0)]
+    criteria = Criteria(mass_flow_configuration="tiny")
+    rows = blender_rows(summaries, cases, criteria)
+    # no tube: the interior annulus spans both plates and is the innermost passage
+    assert [row["figure"] for row in rows][:3] == [
+        "Exterior annulus v_z / cross-section mean", "Interior annulus v_z / cross-section mean",
+        "Exterior annulus / interior annulus v_z (mass flow of the insert)"]
+    assert all(np.isfinite(row["value"]) for row in rows)
+    scaled = gravity_rows(summaries, criteria)
+    scaled = [row for row in scaled if np.isfinite(row["value"])]  # no tube velocity without a tube
+    assert len(scaled) == 2 and all(row["value_error"] > 0.0 for row in scaled)
+    (flow,) = [row for row in scaled if row["figure"].startswith("Mass flow rate")]
+    assert flow["value"] == pytest.approx(1.0, abs=0.1)  # the 4 g flow rate is 2x the 1 g one, as asserted above

@@ -15,6 +15,7 @@ import pyvista
 
 from analysis.data.frames import clumps_from_frame
 from analysis.data.record import read_run_record
+from analysis.io.tables import read_table
 from analysis.studies.silo_flat.metrics import silo_flow_metrics
 from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
@@ -63,6 +64,20 @@ def test_all_clumps_were_inserted_and_settled(tiny_pipeline):
     assert record.stage("fill")["clumps"] == case["n_clumps"] == record.n_clumps
     assert record.stage("settle")["ke_per_clump"] < case["settle_threshold_J"]
     assert record.stage("open")["step"] >= record.stage("settle")["step"]
+
+
+def test_the_validation_table_judges_the_tiny_silo_and_the_summary_points_to_make_validate(tiny_pipeline):
+    workdir, run_dir, _ = tiny_pipeline
+    rows = read_table(workdir / "results" / "summary" / "validation.csv")
+    density = next(row for row in rows if row["figure"] == "Filling bulk density")
+    assert density["case"] == run_dir.name and density["value"] > 0.0 and density["value_error"] > 0.0
+    assert density["scale_shows"] == "no" and "3.6 particle diameters (>= 10)" in density["evidence"]
+    groups = {row["group"] for row in rows}
+    assert groups == {"Calibration (Jenike cell)", "Flat-bottom silo", "Front-wall friction series"}
+    assert all(row["scale_shows"] in ("yes", "no", "unknown") for row in rows)
+    page = (workdir / "results" / "summary" / "summary.html").read_text()
+    assert "What this scale cannot show" in page and "make validate" in page
+    assert "validation table" in (workdir / "results" / "summary" / "validation.html").read_text()
 
 
 def test_clumps_leave_through_the_outlet(tiny_pipeline):

@@ -17,7 +17,10 @@ import numpy as np
 import pytest
 import yaml
 
+from analysis.io.tables import read_table
 from analysis.numerics.uncertainty import Significance, difference_significant
+from analysis.studies.validation.blending import recirculation_rows
+from analysis.studies.validation.rows import Criteria
 from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from engines.cases.silo_recirculation import recirculation_cases
@@ -162,3 +165,18 @@ def test_thin_silo_compares_tracks_with_three_bin_sizes(blending_pipeline):
         assert 0.3 * particle_mean < stats["mean_s"] < 3.0 * particle_mean
     for name in ("paths.png", "residence_times.png"):
         assert (verification / name).read_bytes()[:4] == b"\x89PNG"
+
+
+def test_validation_rows_of_the_real_run_carry_errors_and_a_verdict(blending_pipeline):
+    """The validation table's recirculation rows from the run's own files: a 12 mm deep silo (3.6 particle
+    diameters) does not show the study's physics; the fill dilates while it flows, and the drop has an error."""
+    _, runs, _ = blending_pipeline
+    run = runs["blending"]
+    summary = json.loads((run / "metrics" / "blending.json").read_text())
+    assert summary["settled_bulk_density_kg_m3"] > summary["flowing_bulk_density_kg_m3"] > 0.0
+    assert summary["bulk_density_drop_error"] > 0.0
+    rows = recirculation_rows(json.loads((run / "deck" / "case.json").read_text()), summary,
+                              read_table(run / "metrics" / "rtd.csv"), Criteria())
+    assert len(rows) == 5 + 3  # one VRR row per layout, RTD peak, t_s/t_d, bulk density drop
+    assert all(math.isfinite(row["value"]) and row["value_error"] > 0.0 for row in rows)
+    assert {row["scale_shows"] for row in rows} == {"no"} and "particle diameters (>= 10)" in rows[0]["evidence"]

@@ -347,3 +347,13 @@ def test_recirculation_rows_add_the_transit_times_and_seed_count_when_the_table_
     page = summary_html("siloflow", [("Blending", "x", [picked])])
     assert "Hold-up residence time (stagnant zones included) (s)" in page
     assert "0.436 ± 0.012" in page and "0.416 ± 0.011" in page
+
+
+def test_summary_lists_the_validation_rows_this_scale_cannot_show():
+    limits = [{"figure": "Filling bulk density", "case": "r", "note": "depth 12.0 mm = 3.6 particle diameters (>= 10)"}]
+    sections = summary_sections({"shape": "sphere2"}, [], [], [], [], scale_limits=limits)
+    assert sections[-1].title == "What this scale cannot show" and sections[-1].rows == limits
+    assert "make validate" in sections[-1].explanation and sections[-1].legend
+    every = summary_sections({"shape": "sphere2"}, [], [], [], [], scale_limits=[])[-1]
+    assert every.rows == [{"note": "Every row of the validation table is shown at this scale."}]
+    assert summary_sections({"shape": "sphere2"}, [], [], [], [])[-1].title == "Settled fills"

@@ -23,8 +23,8 @@ __all__ = ["rtd_peak", "recirculation_rows", "blender_rows", "gravity_rows"]
 RECIRCULATION_GROUP = "Recirculating silo (blending)"
 BLENDER_GROUP = "Multi-flow blender"
 GRAVITY_GROUP = "Blender gravity series"
-#: The passages of the blender and how many of each a planar cross-section crosses.
-PASSAGES = {"exterior": ("exterior annulus", 2), "interior": ("interior annulus", 2), "tube": ("tube", 1)}
+#: The passages of the blender (metric key: name in the geometry's clear widths), outermost first.
+PASSAGES = {"exterior": "exterior annulus", "interior": "interior annulus", "tube": "tube"}
 #: Figures whose scaling with sqrt(g) the gravity rows test.
 GRAVITY_FIGURES = {"mass_flow_rate_kg_s": "mass flow rate", "tube_v_z_m_s": "tube velocity",
                    "exterior_v_z_m_s": "exterior annulus velocity"}
@@ -113,10 +113,18 @@ def _metric(metrics: Mapping, key: str) -> tuple[float, float]:
     return number_or_nan(metrics.get(key)), number_or_nan(metrics.get(f"{key}_error"))
 
 
+def _passages(widths: Mapping) -> dict[str, tuple[str, int]]:
+    """The passages a planar cross-section crosses, ``{key: (name, count)}``: the annuli twice (left and right)
+    except the interior one of an insert without a tube, which spans both plates; the tube once."""
+    present = {key: name for key, name in PASSAGES.items() if name in widths}
+    return {key: (name, 1 if key == "tube" or (key == "interior" and "tube" not in present) else 2)
+            for key, name in present.items()}
+
+
 def _cross_section_mean(metrics: Mapping, widths: Mapping) -> tuple[float, float]:
     """Width-weighted mean v_z over the passages a planar cross-section crosses, and its error (m/s)."""
     total, weighted, errors = 0.0, 0.0, []
-    for key, (passage, count) in PASSAGES.items():
+    for key, (passage, count) in _passages(widths).items():
         value, error = _metric(metrics, f"{key}_v_z_m_s")
         weight = count * float(widths[passage])
         total += weight
@@ -125,9 +133,12 @@ def _cross_section_mean(metrics: Mapping, widths: Mapping) -> tuple[float, float
     return weighted / total, combine_independent(errors) / total
 
 
-def _in_mass_flow(metrics: Mapping, criteria: Criteria) -> tuple[tuple[float, float], bool]:
-    exterior_over_tube = ratio(*_metric(metrics, "exterior_v_z_m_s"), *_metric(metrics, "tube_v_z_m_s"))
-    return exterior_over_tube, exterior_over_tube[0] >= criteria.mass_flow_velocity_ratio
+def _in_mass_flow(metrics: Mapping, widths: Mapping, criteria: Criteria) -> tuple[tuple[float, float], bool]:
+    """Exterior annulus over innermost passage velocity (the tube, else the interior annulus), and whether it
+    reaches the mass-flow ratio."""
+    inner = "tube" if "tube" in widths else "interior"
+    exterior_over_inner = ratio(*_metric(metrics, "exterior_v_z_m_s"), *_metric(metrics, f"{inner}_v_z_m_s"))
+    return exterior_over_inner, exterior_over_inner[0] >= criteria.mass_flow_velocity_ratio
 
 
 def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteria: Criteria) -> list[dict]:
@@ -139,7 +150,8 @@ def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteri
     chosen = sorted(((s, c) for s, c in zip(summaries, cases) if float(s["gravity_factor"]) == lowest),
                     key=lambda pair: pair[0]["configuration"])
     reference = [s for s, _ in chosen if s["configuration"] == criteria.mass_flow_configuration]
-    scale_ok = _in_mass_flow(reference[0]["metrics"], criteria)[1] if reference else None
+    scale_ok = (_in_mass_flow(reference[0]["metrics"], reference[0]["geometry"]["clear_widths"], criteria)[1]
+                if reference else None)
     scale_text = (f"{criteria.mass_flow_configuration} insert "
                   f"{'in mass flow' if scale_ok else 'not in mass flow' if scale_ok is False else 'not run'}")
     rows = []
@@ -149,19 +161,20 @@ def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteri
                  f"{float(case['depth_m']) / float(case['equivalent_diameter_m']):.1f} particle diameters")
         widths = summary["geometry"]["clear_widths"]
         mean, mean_error = _cross_section_mean(metrics, widths)
-        for key, (passage, _) in PASSAGES.items():
+        for key, (passage, _) in _passages(widths).items():
             value = ratio(*_metric(metrics, f"{key}_v_z_m_s"), mean, mean_error)
             rows.append(row(BLENDER_GROUP, f"{passage.capitalize()} v_z / cross-section mean", name, *value, "-", "",
                             verdict(scale_ok, _precise(*value, criteria)),
                             f"{scale_text}; cross-section mean {plus_minus(mean, mean_error)} m/s (passages weighted by "
                             f"their clear widths); {depth}"))
-        exterior_over_tube, in_mass_flow = _in_mass_flow(metrics, criteria)
-        rows.append(row(BLENDER_GROUP, "Exterior annulus / tube v_z (mass flow of the insert)", name,
+        exterior_over_tube, in_mass_flow = _in_mass_flow(metrics, widths, criteria)
+        inner = "tube" if "tube" in widths else "interior annulus"
+        rows.append(row(BLENDER_GROUP, f"Exterior annulus / {inner} v_z (mass flow of the insert)", name,
                         *exterior_over_tube, "-",
                         "mass flow" if name == criteria.mass_flow_configuration else "",
                         verdict(scale_ok),
                         f"{'in' if in_mass_flow else 'not in'} mass flow: the exterior annulus moves at "
-                        f"{exterior_over_tube[0]:.2f} of the tube's velocity (mass flow from "
+                        f"{exterior_over_tube[0]:.2f} of the {inner}'s velocity (mass flow from "
                         f"{criteria.mass_flow_velocity_ratio:g}); {depth}, {summary['n_clumps']} clumps"))
         for key, label in (("rtd_mean_s", "Mean residence time"),
                            ("recirculations_to_homogenise", "Recirculations to homogenise")):

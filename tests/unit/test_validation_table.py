@@ -1,0 +1,221 @@
+"""The validation table's rows and verdicts, on hand-built stage results with exact answers."""
+
+import math
+
+import pytest
+
+from analysis.report.summary import summary_html
+from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows, rtd_peak
+from analysis.studies.validation.calibration import calibration_rows
+from analysis.studies.validation.rows import NO, UNKNOWN, YES, Criteria, ratio, resolved, row, verdict
+from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
+from analysis.studies.validation.table import page_sections, scale_limits
+from engines.config import validate_config
+
+CRITERIA = Criteria()
+
+
+def test_criteria_come_from_the_config_section_with_their_defaults():
+    assert Criteria.from_config(validate_config({})["validation"]) == CRITERIA
+
+
+def test_verdict_ratio_and_resolution():
+    assert verdict(True, True) == YES and verdict(True, False, None) == NO and verdict(True, None) == UNKNOWN
+    value, error = ratio(3.0, 0.3, 2.0, 0.4)
+    assert value == 1.5 and error == pytest.approx(1.5 * math.hypot(0.1, 0.2), rel=1e-14)
+    assert math.isnan(ratio(1.0, 0.1, 0.0, 0.1)[0])
+    assert resolved(0.5, 0.2, 2.0) is True and resolved(0.4, 0.2, 2.0) is False and resolved(1.0, math.nan, 2.0) is None
+    with pytest.raises(ValueError, match="shows must be"):
+        row("g", "f", "c", 1.0, 0.1, "-", "", "maybe", "")
+
+
+# --------------------------------------------------------------------------- calibration
+
+
+def _bulk(shape, mu, bulk, error, lid="rigid", restitution=0.1, blocked=False, test="internal", rolling=0.0):
+    return {"shape": shape, "test": test, "lid": lid, "rolling_friction": rolling, "restitution": restitution,
+            "rotation_blocked": blocked, "particle_friction": mu, "bulk_friction": bulk, "bulk_friction_error": error}
+
+
+PARAMETERS = {"shape": "sphere2", "rolling_friction": 0.0, "tolerance_deg": 1.0, "targets_deg": {"internal": 30.0},
+              "particle_particle": {"sliding_friction": 0.3, "sliding_friction_error": 0.01, "lower": 0.25,
+                                    "upper": 0.35, "band_clipped": False}}
+
+
+def test_a_curve_that_rises_then_levels_off_in_a_wide_cell_shows_where_bulk_friction_stops_rising():
+    rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01), _bulk("sphere2", 0.5, 0.56, 0.01),
+            # a shape that still rises, and a lid comparison: servo - rigid = +0.05 and +0.03 (mean 0.04)
+            _bulk("sphere", 0.1, 0.30, 0.01), _bulk("sphere", 0.3, 0.40, 0.01), _bulk("sphere", 0.5, 0.50, 0.01),
+            _bulk("sphere2", 0.1, 0.45, 0.01, lid="servo"), _bulk("sphere2", 0.3, 0.58, 0.01, lid="servo"),
+            # restitution 0.6 at 0.3: 0.55 -> 0.552 (not resolved, precise): insensitive
+            _bulk("sphere2", 0.3, 0.552, 0.01, restitution=0.6)]
+    diameters = {"sphere": 0.0038, "sphere2": 0.004}
+    table = calibration_rows(rows, PARAMETERS, 0.095, diameters, 0.1, "rigid", CRITERIA)
+    curves = {r["case"]: r for r in table if r["figure"].startswith("Bulk friction at")}
+    levelled = curves["sphere2, internal, rolling 0"]
+    assert levelled["value"] == 0.56 and levelled["value_error"] == 0.01 and levelled["scale_shows"] == YES
+    assert "23.8 particle diameters" in levelled["evidence"] and "stops rising" in levelled["evidence"]
+    assert curves["sphere, internal, rolling 0"]["scale_shows"] == NO
+    (lid,) = [r for r in table if "servo lid - rigid lid" in r["figure"]]
+    assert lid["value"] == pytest.approx(0.04, abs=1e-12)
+    assert lid["value_error"] == pytest.approx(math.sqrt(4 * 1e-4) / 2, rel=1e-12) and lid["scale_shows"] == YES
+    (restitution,) = [r for r in table if "restitution 0.6 - 0.1" in r["figure"]]
+    assert restitution["value"] == pytest.approx(0.002, abs=1e-12) and restitution["scale_shows"] == YES
+    (calibrated,) = [r for r in table if r["figure"].startswith("Calibrated")]
+    assert calibrated["value"] == 0.3 and calibrated["study_value"] == "0.35" and calibrated["scale_shows"] == YES
+    # the same curves in a 40 mm cell: 10 diameters, below 20
+    small = calibration_rows(rows, PARAMETERS, 0.04, diameters, 0.1, "rigid", CRITERIA)
+    assert all(r["scale_shows"] == NO for r in small if r["figure"].startswith("Bulk friction at"))
+
+
+def test_a_curve_of_two_points_cannot_show_where_it_stops_rising():
+    rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01)]
+    (curve, _) = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", CRITERIA)
+    assert curve["scale_shows"] == NO and "fewer than three points" in curve["evidence"]
+
+
+# --------------------------------------------------------------------------- flat-bottom silo
+
+
+def _silo(depth=0.04, problems=(), index=(0.5, 0.02), run_id="base"):
+    case = {"run_id": run_id, "depth_m": depth, "width_m": 0.15, "outlet_width_m": 0.04,
+            "equivalent_diameter_m": 0.004}
+    flow = {"filling_bulk_density_kg_m3": 650.0, "filling_bulk_density_kg_m3_error": 2.0,
+            "mass_flow_rate_kg_s": 0.3, "mass_flow_rate_kg_s_error": 0.006, "beverloo_mass_flow_rate_kg_s": 0.25,
+            "beverloo_ratio": 1.2, "beverloo_ratio_error": 0.03,
+            "beverloo": {"discharge_coefficient": 0.58, "shape_coefficient": 1.5}}
+    fields = {"flow_pattern_index": {"0.02": 0.1, "0.04": index[0]}, "flow_pattern_index_error": {"0.02": 0.01, "0.04": index[1]}}
+    balance = {"support_ratio": 0.999, "problems": list(problems)}
+    return SiloRun(case, flow, fields, balance,
+                   janssen=[{"depth_below_surface_m": 0.05, "sigma_v_dem_Pa": 300.0, "sigma_v_dem_Pa_error": 6.0,
+                             "sigma_v_janssen_Pa": 320.0, "hydrostatic_pa": 400.0, "hydrostatic_pa_error": 0.0},
+                            {"depth_below_surface_m": 0.01, "sigma_v_dem_Pa": 90.0, "sigma_v_dem_Pa_error": 6.0,
+                             "sigma_v_janssen_Pa": 90.0, "hydrostatic_pa": 90.0, "hydrostatic_pa_error": 0.0}],
+                   kinematic=[{"z_m": 0.02, "B_m": 0.008, "B_m_error": 0.0004, "batches": 8}],
+                   boundary=[{"z_m": 0.02, "fraction": 0.05, "x_left_m": -0.07, "x_right_m": 0.07,
+                              "x_left_m_error": 0.001, "x_right_m_error": 0.001},
+                             {"z_m": 0.02, "fraction": 0.1, "x_left_m": -0.03, "x_right_m": 0.05,
+                              "x_left_m_error": 0.003, "x_right_m_error": 0.004}])
+
+
+def test_silo_rows_give_the_figures_with_their_errors_and_judge_depth_and_balance():
+    table = {r["figure"]: r for r in silo_rows(_silo(), CRITERIA)}
+    assert table["Filling bulk density"]["value"] == 650.0 and table["Filling bulk density"]["scale_shows"] == YES
+    coefficient = table["Beverloo discharge coefficient C (k = 1.5)"]
+    assert coefficient["value"] == pytest.approx(0.58 * 1.2) and coefficient["value_error"] == pytest.approx(0.58 * 0.03)
+    stress = table["Vertical stress / hydrostatic, 50 mm below the surface"]
+    assert stress["value"] == 0.75 and stress["value_error"] == pytest.approx(0.015) and stress["scale_shows"] == YES
+    assert table["Vertical stress / Janssen, 50 mm below the surface"]["value"] == pytest.approx(300.0 / 320.0)
+    channel = table["Flow channel half-width (0.1 of centreline v_z) at z = 20 mm"]
+    assert channel["value"] == pytest.approx(0.04) and channel["value_error"] == pytest.approx(0.0025)
+    assert channel["scale_shows"] == YES
+    assert table["Kinematic constant B at z = 20 mm"]["scale_shows"] == YES
+    # 12 mm deep (3 diameters) and a fill that fails its balance: nothing shown
+    shallow = silo_rows(_silo(depth=0.012, problems=["planes"]), CRITERIA)
+    assert all(r["scale_shows"] == NO for r in shallow)
+    assert "3.0 particle diameters" in shallow[0]["evidence"] and "planes" in shallow[0]["evidence"]
+
+
+def test_front_wall_series_reports_the_index_and_its_change_across_the_walled_runs():
+    series = [("mu_fw=0.2", _silo(index=(0.5, 0.02))), ("mu_fw=0", _silo(index=(0.8, 0.03))),
+              ("mu_fw=1", _silo(index=(0.3, 0.04))), ("periodic", _silo(index=(0.9, 0.02)))]
+    rows = front_wall_series_rows(series, 0.045, CRITERIA)
+    assert [r["value"] for r in rows[:4]] == [0.5, 0.8, 0.3, 0.9]
+    assert rows[0]["figure"] == "Flow-pattern index (wall / centreline v_z) at z = 40 mm"
+    change = rows[-1]
+    assert change["figure"] == "Flow-pattern index, front-wall friction 1 - 0"
+    assert change["value"] == pytest.approx(-0.5) and change["value_error"] == pytest.approx(0.05)
+    assert change["scale_shows"] == YES
+
+
+# --------------------------------------------------------------------------- blending
+
+
+def test_rtd_peak_is_the_largest_bin_over_the_mean_with_bin_and_mean_errors():
+    theta, error = rtd_peak([0.5, 1.5, 2.5, 3.5], [0.1, 0.3, 0.2, 0.1], 2.0, 0.1)
+    assert theta == 0.75
+    assert error == pytest.approx(0.75 * math.hypot(1.0 / math.sqrt(12.0) / 1.5, 0.05), rel=1e-14)
+
+
+def test_recirculation_rows_judge_the_vrr_against_the_window_ceiling_and_resolve_the_density_drop():
+    case = {"depth_m": 0.04, "equivalent_diameter_m": 0.004}
+    summary = {
+        "flow_pattern": "internal_flow", "clumps_per_window": 100.0, "vrr_sampling_limit": 100.0,
+        "layouts": {"blue13": {"blue_fraction": 0.13, "sublayers": 1, "vrr_by_recirculation": [2.0, 20.0, 120.0],
+                               "vrr_by_recirculation_error": [0.5, 5.0, 30.0], "vrr_at_ceiling": [False, False, True]},
+                    "blue50_5layers": {"blue_fraction": 0.5, "sublayers": 5, "vrr_by_recirculation": [30.0, 150.0],
+                                       "vrr_by_recirculation_error": [8.0, 40.0], "vrr_at_ceiling": [False, True]}},
+        "rtd_particle_ids": {"t_mean_s": 2.0, "t_mean_s_error": 0.1, "n_tracer": 200, "t_s_over_t_d": 0.25,
+                             "t_s_over_t_d_error": 0.01},
+        "bulk_density_drop": 0.06, "bulk_density_drop_error": 0.002, "bulk_density_slab_m": [0.012, 0.036],
+        "settled_bulk_density_kg_m3": 600.0, "flowing_bulk_density_kg_m3": 564.0,
+        "flowing_bulk_density_kg_m3_error": 1.2,
+    }
+    rtd = [{"method": "particle_ids", "time_s": t, "E_per_s": e} for t, e in ((0.5, 0.1), (1.5, 0.3), (2.5, 0.2))]
+    table = recirculation_rows(case, summary, rtd, CRITERIA)
+    vrr13, vrr5 = table[0], table[1]
+    assert vrr13["value"] == 20.0 and vrr13["scale_shows"] == YES
+    assert vrr5["value"] == 150.0 and vrr5["scale_shows"] == NO and "(ceiling)" in vrr5["evidence"]
+    peak, ts_td, drop = table[2], table[3], table[4]
+    assert peak["value"] == 0.75 and ts_td["value"] == 0.25
+    assert drop["value"] == 0.06 and drop["value_error"] == 0.002 and drop["scale_shows"] == YES
+    assert len(table) == 5
+
+
+def _blender(configuration, exterior, tube, factor=1.0, flow=0.01):
+    metrics = {"exterior_v_z_m_s": exterior, "exterior_v_z_m_s_error": 0.0, "interior_v_z_m_s": -2.0,
+               "interior_v_z_m_s_error": 0.0, "tube_v_z_m_s": tube, "tube_v_z_m_s_error": 0.0,
+               "mass_flow_rate_kg_s": flow, "mass_flow_rate_kg_s_error": 0.0001, "rtd_mean_s": 5.0,
+               "rtd_mean_s_error": 0.2, "recirculations_to_homogenise": 3.0, "recirculations_to_homogenise_error": 0.5}
+    return {"configuration": configuration, "gravity_factor": factor, "metrics": metrics, "n_clumps": 1000,
+            "geometry": {"clear_widths": {"exterior annulus": 0.05, "interior annulus": 0.02, "tube": 0.02}}}
+
+
+def test_blender_rows_normalise_by_the_width_weighted_cross_section_and_judge_mass_flow_on_the_chosen_insert():
+    case = {"depth_m": 0.0125, "equivalent_diameter_m": 0.0033}
+    summaries = [_blender("converging", -1.0, -3.0), _blender("diverging", -0.5, -3.0)]
+    rows = blender_rows(summaries, [case, case], CRITERIA)
+    converging = {r["figure"]: r for r in rows if r["case"] == "converging"}
+    # mean = (2 * 0.05 * -1 + 2 * 0.02 * -2 + 0.02 * -3) / 0.16 = -1.5
+    assert converging["Exterior annulus v_z / cross-section mean"]["value"] == pytest.approx(2.0 / 3.0)
+    assert converging["Tube v_z / cross-section mean"]["value"] == pytest.approx(2.0)
+    mass_flow = converging["Exterior annulus / tube v_z (mass flow of the insert)"]
+    assert mass_flow["value"] == pytest.approx(1.0 / 3.0) and mass_flow["scale_shows"] == NO
+    assert all(r["scale_shows"] == NO for r in rows)  # the converging insert is not in mass flow
+    in_mass_flow = blender_rows([_blender("converging", -2.0, -3.0)], [case], CRITERIA)
+    assert {r["scale_shows"] for r in in_mass_flow} == {YES}
+
+
+def test_gravity_rows_divide_the_ratio_to_1_g_by_sqrt_g():
+    summaries = [_blender("converging", -1.0, -3.0), _blender("converging", -math.sqrt(5.0), -3.0 * math.sqrt(5.0),
+                                                               factor=5.0, flow=0.01 * math.sqrt(5.0) * 1.1)]
+    rows = {r["figure"].split(" at ")[0]: r for r in gravity_rows(summaries, CRITERIA)}
+    assert rows["Tube velocity"]["value"] == pytest.approx(1.0) and rows["Exterior annulus velocity"]["value"] == pytest.approx(1.0)
+    flow = rows["Mass flow rate"]
+    assert flow["value"] == pytest.approx(1.1)
+    assert flow["value_error"] == pytest.approx(1.1 * math.hypot(0.0001 / 0.01, 0.0001 / (0.011 * math.sqrt(5.0))))
+    assert "does not scale" in flow["evidence"] and "scales with" in rows["Tube velocity"]["evidence"]
+    assert gravity_rows([_blender("converging", -1.0, -3.0)], CRITERIA) == []
+
+
+def test_the_page_groups_rows_and_the_summary_lists_what_the_scale_cannot_show():
+    rows = [row("Silo", "A", "c1", 1.0, 0.1, "-", "", YES, "fine"), row("Silo", "B", "c1", 2.0, 0.1, "-", "", NO, "too shallow"),
+            row("Blender", "C", "c2", 3.0, math.nan, "-", "", UNKNOWN, "error unknown")]
+    sections = page_sections(rows)
+    assert [s[0] for s in sections] == ["Silo", "Blender"] and sections[0][1] == "1 of 2 rows shown at this scale."
+    assert scale_limits(rows) == [{"figure": "B", "case": "c1", "note": "too shallow"},
+                                  {"figure": "C", "case": "c2", "note": "error unknown"}]
+    page = summary_html("validation", sections, intro="How to read it.")
+    assert "<p>How to read it.</p>" in page and "<td>2.00 ± 0.10</td>" in page and "too shallow" in page
+
+
+def test_without_a_tube_the_interior_annulus_spans_both_plates_and_is_the_inner_passage():
+    summary = _blender("plates", -1.0, float("nan"))
+    summary["geometry"]["clear_widths"] = {"exterior annulus": 0.05, "interior annulus": 0.04}
+    rows = {r["figure"]: r for r in blender_rows([summary], [{"depth_m": 0.01, "equivalent_diameter_m": 0.003}],
+                                                   Criteria(mass_flow_configuration="plates"))}
+    # mean = (2 * 0.05 * -1 + 1 * 0.04 * -2) / 0.14
+    mean = (-0.1 - 0.08) / 0.14
+    assert rows["Interior annulus v_z / cross-section mean"]["value"] == pytest.approx(-2.0 / mean)
+    inner = rows["Exterior annulus / interior annulus v_z (mass flow of the insert)"]
+    assert inner["value"] == pytest.approx(0.5) and inner["scale_shows"] == YES
