@@ -487,7 +487,7 @@ DIFFERENCES_LEGEND = ("A − B: the difference of a figure between two configura
 
 SCALE_LIMITS = ("Rows of the validation table (the report's validation page) whose physics the scale of this "
                 "configuration does not show, with the run's figures that decided. The validation scale "
-                "(`make validate`, config/validation.yaml, about 2.5 hours on 2 cores) runs the study at the smallest "
+                "(`make validate`, config/validation.yaml, about 15 core-hours) runs the study at the smallest "
                 "scale that shows them: the study's 40 mm deep silos, its 95 mm Jenike cell with four particle "
                 "frictions, a deeper blender and the gravity series.")
 
