@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 
 from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
 from engines.cases.particles import particle_template
-from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
+from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from analysis.data.constants import GRAVITY
-from engines.cases.common import engine_kind, material_table, plan_fill, run_id, without_fill_checks
+from engines.cases.common import engine_kind, largest_impact_velocity, material_table, plan_fill, run_id, without_fill_checks
 from engines.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"
@@ -208,10 +208,6 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
             )
     walls = blender["wall_materials"]
     table = material_table(config, material_name, [walls["side"], walls["front_back"]])
-    t_rayleigh = rayleigh_time(
-        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
-    )
-    timestep = blender["timestep_fraction"] * t_rayleigh
     scale = 1.0 / math.sqrt(gravity_factor)
     gravity = GRAVITY * gravity_factor
 
@@ -222,10 +218,19 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
     # soft contacts of the reduced stiffness do not stand much more.
     fill_config.update(zone_width_fraction=blender["fill_zone_width_fraction"])
     n_clumps = int(round(fill_config["bulk_density_estimate"] * fill_area * blender["depth"] / particle.mass))
-    fill = plan_fill(particle, blender["width"], blender["depth"], fill_height, fill_config, timestep, gravity, n_clumps)
     # The walls end one clump size below the top of the domain: LIGGGHTS refuses mesh nodes on a periodic
     # boundary, and re-entering clumps appear above the pile anyway.
     domain_top = geometry.z_top + clump_size
+    # In continuous mode a discharged clump falls sink_depth below the outlet and re-enters at the top.
+    reentry_velocity = (free_fall_velocity(0.0, blender["sink_depth"], gravity)
+                        if blender["discharge"]["mode"] == "continuous" else 0.0)
+    timestep_choice = stable_timestep(
+        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
+        largest_impact_velocity(fill_config, fill_height, domain_top, gravity, reentry_velocity),
+        blender["timestep_fraction"], blender["timestep_hertz_fraction"],
+    )
+    timestep = timestep_choice.timestep
+    fill = plan_fill(particle, blender["width"], blender["depth"], fill_height, fill_config, timestep, gravity, n_clumps)
     if fill.zone[5] + clump_size > geometry.z_top:
         raise ValueError(
             f"blender configuration '{configuration}': the pouring zone above the heap reaches "
@@ -271,8 +276,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         outlet_width=blender["outlet_width"],
         wall_materials={"side": walls["side"], "bottom": walls["side"], "front_back": walls["front_back"]},
         front_back_walls=True,
-        timestep=timestep,
-        rayleigh_time=t_rayleigh,
+        timestep_choice=timestep_choice,
         fill=fill,
         settle_threshold=blender["settle_threshold"] * gravity_factor,
         settle_check_steps=settle_check_steps,

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 
 from engines.cases.particles import ParticleTemplate
-from engines.cases.physics import steps_for
+from engines.cases.physics import free_fall_velocity, steps_for
 
 
 @dataclass(frozen=True)
@@ -134,6 +134,36 @@ def run_id(prefix: str, parameters: dict) -> str:
     return f"{prefix}-{hashlib.sha256(canonical.encode()).hexdigest()[:10]}"
 
 
+def fill_zone(
+    particle: ParticleTemplate, width: float, depth: float, fill_height: float, fill_config: dict
+) -> tuple[float, float, float, float, float, float]:
+    """The central insertion zone (x_min, x_max, y_min, y_max, z_min, z_max) (m) of :func:`plan_fill`.
+
+    Centred, spanning the whole depth, its floor above the highest heap the pile can form,
+    H + (W/2) tan(heap angle), plus two clump diameters.
+    """
+    clearance = particle.bounding_radius
+    zone_half_width = 0.5 * fill_config["zone_width_fraction"] * width
+    x_min, x_max = -zone_half_width + clearance, zone_half_width - clearance
+    if x_max - x_min <= 2.0 * clearance or depth <= 2.0 * clearance:
+        raise ValueError("insertion zone thinner than one clump: increase silo depth or zone_width_fraction")
+    heap_rise = 0.5 * width * math.tan(math.radians(fill_config["heap_angle"]))
+    z_min = fill_height + heap_rise + 4.0 * particle.bounding_radius
+    return (x_min, x_max, 0.0, depth, z_min, z_min + fill_config["zone_height"])
+
+
+def largest_impact_velocity(fill_config: dict, fill_height: float, drop_top: float, gravity: float,
+                    reentry_velocity: float = 0.0) -> float:
+    """The largest impact velocity a silo-type case expects (m/s), for the Hertz time-step limit.
+
+    A clump that starts at ``drop_top`` (m; the top of the pouring zone or of the domain) moving down at the
+    insertion velocity, or at ``reentry_velocity`` when the case sends discharged clumps back in at the top,
+    falls freely to the fill height. Flow inside the silo is far slower than this fall.
+    """
+    start = max(fill_config["insertion_velocity"], reentry_velocity)
+    return free_fall_velocity(start, drop_top - fill_height, gravity)
+
+
 def plan_fill(
     particle: ParticleTemplate,
     width: float,
@@ -164,15 +194,7 @@ def plan_fill(
         n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
     if n_clumps < 1:
         raise ValueError("fill_height too small: less than one clump fits")
-    clearance = particle.bounding_radius
-    zone_half_width = 0.5 * fill_config["zone_width_fraction"] * width
-    x_min, x_max = -zone_half_width + clearance, zone_half_width - clearance
-    y_min, y_max = 0.0, depth
-    if x_max - x_min <= 2.0 * clearance or y_max - y_min <= 2.0 * clearance:
-        raise ValueError("insertion zone thinner than one clump: increase silo depth or zone_width_fraction")
-    heap_rise = 0.5 * width * math.tan(math.radians(fill_config["heap_angle"]))
-    z_min = fill_height + heap_rise + 4.0 * particle.bounding_radius
-    z_max = z_min + fill_config["zone_height"]
+    x_min, x_max, y_min, y_max, z_min, z_max = fill_zone(particle, width, depth, fill_height, fill_config)
     zone_volume = (x_max - x_min) * (y_max - y_min) * (z_max - z_min)
     clumps_per_insertion = max(1, int(fill_config["volume_fraction"] * zone_volume / particle.volume))
     velocity = fill_config["insertion_velocity"]

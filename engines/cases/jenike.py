@@ -35,7 +35,9 @@ from analysis.data.constants import GRAVITY
 from engines.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
 from engines.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
 from engines.cases.particles import ParticleTemplate, particle_template
-from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
+from engines.cases.physics import (
+    ChosenTimestep, TimestepChoice, engine_seeds, free_fall_velocity, stable_timestep, steps_for,
+)
 from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
 from engines.cases.jenike_sweep import sweep_points
 from engines.cases.stages import Stage
@@ -115,7 +117,7 @@ class JenikeFill:
 
 
 @dataclass(frozen=True)
-class JenikeCase:
+class JenikeCase(ChosenTimestep):
     """Everything that defines one Jenike shear run, derived from validated configuration and a sweep point."""
 
     particle: ParticleTemplate
@@ -126,8 +128,7 @@ class JenikeCase:
     fill_contacts: ContactSet
     test_contacts: ContactSet
     rotation_blocked: bool
-    timestep: float
-    rayleigh_time: float
+    timestep_choice: TimestepChoice
     fill: JenikeFill
     normal_force: float
     rigid_lid: RigidLid | None
@@ -203,6 +204,9 @@ class JenikeCase:
             "clump_mass_kg": self.particle.mass,
             "clump_volume_m3": self.particle.volume,
             "rayleigh_time_s": self.rayleigh_time,
+            "hertz_time_s": self.timestep_choice.hertz_time,
+            "impact_velocity_m_s": self.timestep_choice.impact_velocity,
+            "timestep_limited_by": self.timestep_choice.limited_by,
             "timestep_s": self.timestep,
             "geometry": geometry,
             "fill": asdict(self.fill),
@@ -313,10 +317,11 @@ def _material_table(config: dict, point: dict, test: ContactSet) -> MaterialTabl
     )
 
 
-def plan_fill(
-    geometry: CellGeometry, particle: ParticleTemplate, overfill: float, settle_time: float, timestep: float
-) -> JenikeFill:
-    """Size the pour: clump count for the overfilled sample, the loose column it is created in, steps.
+def fill_column(
+    geometry: CellGeometry, particle: ParticleTemplate, overfill: float
+) -> tuple[int, tuple[float, ...], float, float, float]:
+    """The loose column the sample is poured from: (clump count, region centres (m), region radius (m), its
+    bottom and top (m)).
 
     n = FILL_SOLID_FRACTION (1 + overfill) pi R^2 H / V_clump with H the sample height. The column is the
     intersection of vertical cylinders of radius R - r_b (r_b the clump's bounding radius) about the
@@ -344,7 +349,15 @@ def plan_fill(
         raise ValueError("jenike cell too small: less than one clump fits")
     column = n_clumps * particle.volume / (INSERT_SOLID_FRACTION * area)
     z_min = r_b
-    z_max = z_min + max(column, 2.0 * r_b)
+    return n_clumps, centres, radius, z_min, z_min + max(column, 2.0 * r_b)
+
+
+def plan_fill(
+    geometry: CellGeometry, particle: ParticleTemplate, overfill: float, settle_time: float, timestep: float
+) -> JenikeFill:
+    """Size the pour: clump count for the overfilled sample, the loose column it is created in
+    (:func:`fill_column`), steps."""
+    n_clumps, centres, radius, z_min, z_max = fill_column(geometry, particle, overfill)
     fall_time = math.sqrt(2.0 * z_max / GRAVITY)
     largest_sphere = float(particle.sphere_radii.max())
     return JenikeFill(
@@ -393,10 +406,6 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     fill_contacts, test_contacts = contact_sets(config, point, n_types)
     table = _material_table(config, point, test_contacts)
 
-    t_rayleigh = rayleigh_time(
-        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
-    )
-    timestep = jenike["timestep_fraction"] * t_rayleigh
     radius = 0.5 * cell["inner_diameter"]
     displacement = jenike["shear"]["displacement"]
     overfill = jenike["fill"]["overfill"]
@@ -421,6 +430,14 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
                 f"jenike.cell.plate_size ({cell['plate_size']} m) must be at least {2 * reach:.4g} m so the "
                 "shear ring stays on the plate over its whole travel"
             )
+    # The highest clump of the loose column falls onto the floor: the largest impact the test sees (the
+    # shear is a hundred times slower).
+    column_top = fill_column(geometry, particle, overfill)[4]
+    timestep_choice = stable_timestep(
+        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
+        free_fall_velocity(0.0, column_top, GRAVITY), jenike["timestep_fraction"], jenike["timestep_hertz_fraction"],
+    )
+    timestep = timestep_choice.timestep
     fill = plan_fill(geometry, particle, overfill, jenike["fill"]["settle_time"], timestep)
 
     normal_force = jenike["consolidation"]["normal_stress"] * geometry.area
@@ -473,8 +490,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         fill_contacts=fill_contacts,
         test_contacts=test_contacts,
         rotation_blocked=point["rotation_blocked"],
-        timestep=timestep,
-        rayleigh_time=t_rayleigh,
+        timestep_choice=timestep_choice,
         fill=fill,
         normal_force=normal_force,
         rigid_lid=rigid_lid,

@@ -6,6 +6,7 @@ All quantities in SI units.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 
 def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson_ratio: float) -> float:
@@ -36,6 +37,132 @@ def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson_
         raise ValueError(f"poisson_ratio must lie in (0, 0.5), got {poisson_ratio!r}")
     shear_modulus = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
     return math.pi * radius * math.sqrt(density / shear_modulus) / (0.1631 * poisson_ratio + 0.8766)
+
+
+def hertz_contact_time(
+    radius: float, density: float, youngs_modulus: float, poisson_ratio: float, impact_velocity: float
+) -> float:
+    """Duration of a head-on Hertz impact of two identical spheres.
+
+    t_H = 2.87 (m*^2 / (R* E*^2 v))^(1/5), with the effective mass m* = m/2, radius R* = R/2 and modulus
+    E* = E / (2 (1 - nu^2)) of two equal spheres (Johnson, Contact Mechanics, section 11.4; the form
+    LIGGGHTS' ``fix check/timestep/gran`` uses). A sphere of a clump is given its own mass, not the clump's:
+    the lighter body makes the shorter contact, so the bound holds for every contact the sphere takes part in.
+
+    Parameters
+    ----------
+    radius : float
+        Sphere radius R (m).
+    density : float
+        Solid density rho (kg/m^3).
+    youngs_modulus : float
+        Young's modulus E (Pa).
+    poisson_ratio : float
+        Poisson ratio nu (-).
+    impact_velocity : float
+        Relative normal velocity of the impact v (m/s); faster impacts are shorter.
+
+    Returns
+    -------
+    float
+        Contact duration (s).
+    """
+    rayleigh_time(radius, density, youngs_modulus, poisson_ratio)  # the same checks of the material
+    if not (math.isfinite(impact_velocity) and impact_velocity > 0):
+        raise ValueError(f"impact_velocity must be a positive finite number, got {impact_velocity!r}")
+    mass = density * 4.0 / 3.0 * math.pi * radius**3
+    effective_modulus = youngs_modulus / (2.0 * (1.0 - poisson_ratio**2))
+    return 2.87 * ((0.5 * mass) ** 2 / (0.5 * radius * effective_modulus**2 * impact_velocity)) ** 0.2
+
+
+@dataclass(frozen=True)
+class TimestepChoice:
+    """A time step and the two stability limits it was chosen from.
+
+    Attributes
+    ----------
+    timestep : float
+        The time step: the smaller of the two limits (s).
+    rayleigh_time : float
+        Rayleigh time of the smallest sphere (s).
+    hertz_time : float
+        Hertz contact duration of two smallest spheres at the largest expected impact velocity (s).
+    impact_velocity : float
+        The largest relative velocity the case expects at an impact (m/s).
+    limited_by : str
+        ``"rayleigh"`` or ``"hertz"``: the criterion that set the time step.
+    """
+
+    timestep: float
+    rayleigh_time: float
+    hertz_time: float
+    impact_velocity: float
+    limited_by: str
+
+
+class ChosenTimestep:
+    """Mixin for a case that holds a ``timestep_choice``: its time step and Rayleigh time as attributes."""
+
+    timestep_choice: TimestepChoice
+
+    @property
+    def timestep(self) -> float:
+        """Time step (s)."""
+        return self.timestep_choice.timestep
+
+    @property
+    def rayleigh_time(self) -> float:
+        """Rayleigh time of the smallest sphere (s)."""
+        return self.timestep_choice.rayleigh_time
+
+
+def stable_timestep(
+    radius: float,
+    density: float,
+    youngs_modulus: float,
+    poisson_ratio: float,
+    impact_velocity: float,
+    rayleigh_fraction: float,
+    hertz_fraction: float,
+) -> TimestepChoice:
+    """The time step of a run from two explicit stability criteria.
+
+    dt = min(f_R t_R, f_H t_H(v_max)): a fraction of the Rayleigh time (a surface wave must not cross a sphere
+    within one step) and a fraction of the Hertz contact duration at the largest impact velocity the case
+    expects (an impact must span enough steps to integrate its force). These are the two limits LIGGGHTS'
+    ``fix check/timestep/gran`` checks.
+
+    Parameters
+    ----------
+    radius, density, youngs_modulus, poisson_ratio : float
+        The smallest sphere's radius (m), solid density (kg/m^3), Young's modulus (Pa) and Poisson ratio (-).
+    impact_velocity : float
+        Largest expected relative impact velocity v_max (m/s).
+    rayleigh_fraction, hertz_fraction : float
+        f_R and f_H (-), each in (0, 1].
+
+    Returns
+    -------
+    TimestepChoice
+    """
+    for name, value in (("rayleigh_fraction", rayleigh_fraction), ("hertz_fraction", hertz_fraction)):
+        if not (math.isfinite(value) and 0 < value <= 1):
+            raise ValueError(f"{name} must lie in (0, 1], got {value!r}")
+    t_rayleigh = rayleigh_time(radius, density, youngs_modulus, poisson_ratio)
+    t_hertz = hertz_contact_time(radius, density, youngs_modulus, poisson_ratio, impact_velocity)
+    by_rayleigh, by_hertz = rayleigh_fraction * t_rayleigh, hertz_fraction * t_hertz
+    return TimestepChoice(
+        timestep=min(by_rayleigh, by_hertz),
+        rayleigh_time=t_rayleigh,
+        hertz_time=t_hertz,
+        impact_velocity=impact_velocity,
+        limited_by="rayleigh" if by_rayleigh <= by_hertz else "hertz",
+    )
+
+
+def free_fall_velocity(start_velocity: float, height: float, gravity: float) -> float:
+    """Speed after a free fall of ``height`` (m) that starts downwards at ``start_velocity`` (m/s)."""
+    return math.sqrt(start_velocity**2 + 2.0 * gravity * max(height, 0.0))
 
 
 def is_prime(number: int) -> bool:

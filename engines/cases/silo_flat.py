@@ -17,10 +17,11 @@ from dataclasses import asdict, dataclass, field
 
 from analysis.data.constants import GRAVITY
 from engines.cases.common import (
-    FillPlan, MaterialTable, engine_kind, material_table, plan_fill, run_id, without_fill_checks,
+    FillPlan, MaterialTable, engine_kind, fill_zone, largest_impact_velocity, material_table, plan_fill, run_id,
+    without_fill_checks,
 )
 from engines.cases.particles import ParticleTemplate, particle_template
-from engines.cases.physics import engine_seeds, rayleigh_time, steps_for
+from engines.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
 from engines.cases.stages import Stage
 
 CASE_NAME = "silo_flat"
@@ -32,7 +33,7 @@ ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "repl
 
 
 @dataclass(frozen=True)
-class SiloCase:
+class SiloCase(ChosenTimestep):
     """Everything that defines one flat-bottom silo run, derived from validated configuration."""
 
     particle: ParticleTemplate
@@ -43,8 +44,7 @@ class SiloCase:
     outlet_width: float
     wall_materials: dict
     front_back_walls: bool
-    timestep: float
-    rayleigh_time: float
+    timestep_choice: TimestepChoice
     fill: FillPlan
     settle_threshold: float
     settle_check_steps: int
@@ -95,6 +95,9 @@ class SiloCase:
             "clump_volume_m3": self.particle.volume,
             "equivalent_diameter_m": self.particle.equivalent_diameter,
             "rayleigh_time_s": self.rayleigh_time,
+            "hertz_time_s": self.timestep_choice.hertz_time,
+            "impact_velocity_m_s": self.timestep_choice.impact_velocity,
+            "timestep_limited_by": self.timestep_choice.limited_by,
             "timestep_s": self.timestep,
             "n_clumps": self.fill.n_clumps,
             "dump_interval_s": self.dump_every * self.timestep,
@@ -115,12 +118,14 @@ def build_silo_case(config: dict) -> SiloCase:
     return silo_case_from_section(config, config["silo_flat"], "silo_flat")
 
 
-def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
+def silo_case_from_section(config: dict, silo: dict, section: str, reentry_velocity: float = 0.0) -> SiloCase:
     """Derive a :class:`SiloCase` from a silo-type section ``silo`` (the keys of ``silo_flat``, shared keys
     inherited from ``defaults``) and the configuration's materials, particle models and contacts.
 
     ``section`` names the config section in error messages and decides the engine (``<section>.engine`` or
-    ``engine.kind``), which is part of the defining parameters and so of the run id.
+    ``engine.kind``), which is part of the defining parameters and so of the run id. ``reentry_velocity`` (m/s)
+    is the downward speed at which a case that sends discharged clumps back in at the top releases them there
+    (the recirculating silo's feeder velocity); it enters the Hertz limit of the time step.
     """
     material_name = silo["particle_material"]
     material = config["materials"][material_name]
@@ -138,10 +143,14 @@ def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
     walls = silo["wall_materials"]
     used_walls = [walls["side"], walls["bottom"]] + ([walls["front_back"]] if silo["front_back_walls"] else [])
     table = material_table(config, material_name, used_walls)
-    t_rayleigh = rayleigh_time(
-        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"]
+    zone = fill_zone(particle, silo["width"], silo["depth"], silo["fill_height"], silo["fill"])
+    domain_top = zone[5] + 2.0 * particle.bounding_radius
+    timestep_choice = stable_timestep(
+        particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
+        largest_impact_velocity(silo["fill"], silo["fill_height"], domain_top, GRAVITY, reentry_velocity),
+        silo["timestep_fraction"], silo["timestep_hertz_fraction"],
     )
-    timestep = silo["timestep_fraction"] * t_rayleigh
+    timestep = timestep_choice.timestep
     fill = plan_fill(particle, silo["width"], silo["depth"], silo["fill_height"], silo["fill"], timestep, GRAVITY)
     settle = silo["settle"]
     settle_check_steps = steps_for(settle["check_interval"], timestep)
@@ -175,8 +184,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
         outlet_width=silo["outlet_width"],
         wall_materials=dict(walls),
         front_back_walls=silo["front_back_walls"],
-        timestep=timestep,
-        rayleigh_time=t_rayleigh,
+        timestep_choice=timestep_choice,
         fill=fill,
         settle_threshold=settle["kinetic_energy_threshold"],
         settle_check_steps=settle_check_steps,
@@ -184,7 +192,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str) -> SiloCase:
         discharge_steps=steps_for(silo["discharge_time"], timestep),
         dump_every=steps_for(silo["dump_interval"], timestep),
         sink_depth=sink_depth,
-        domain_top=fill.zone[5] + 2.0 * particle.bounding_radius,
+        domain_top=domain_top,
         seeds=tuple(engine_seeds(silo["seed"], 3)),
         defining_parameters=defining,
     )

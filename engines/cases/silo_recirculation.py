@@ -30,7 +30,8 @@ SECTION = "silo_recirculation"
 #: The silo keys the recirculating silo takes from its own section (the shared ones inherited from ``defaults``);
 #: geometry, sink and discharge are set from the channel and the feeder. The settings of the batch silo's
 #: analysis (steady window, Beverloo) keep their schema defaults.
-SILO_KEYS = ("engine", "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction", "seed")
+SILO_KEYS = ("engine", "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction",
+             "timestep_hertz_fraction", "seed")
 
 #: Roles of a recirculation run: the blending study proper, or the one-particle-thick verification silo.
 ROLES = ("blending", "verification")
@@ -199,7 +200,7 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         discharge_time=recirculations * t_res,
         dump_interval=section["dump_interval"],
     )
-    silo_case = silo_case_from_section(changed, silo, SECTION)
+    silo_case = silo_case_from_section(changed, silo, SECTION, reentry_velocity=section["feeder_velocity"])
     half_outlet = 0.5 * section["outlet_width"]
     channel = section["channel_length"]
     feeder_zone = (-half_outlet, half_outlet, -channel, -0.5 * channel)

@@ -173,3 +173,16 @@ def test_gravity_configurations_run_every_factor_and_the_others_the_lowest_only(
     assert build_blender_case(validate_config(config), "straight").run_id == build_blender_case(golden_config, "straight").run_id
     with pytest.raises(ConfigError, match=r"blender.gravity_configurations\[0\]': 'diverging' is not among blender.configurations"):
         validate_config(changed(config, lambda b: b.update(gravity_configurations=["diverging"])))
+
+
+def test_continuous_blender_impact_adds_the_fall_through_the_sink_and_scales_with_gravity(golden_config):
+    config = copy.deepcopy(golden_config)
+    config["blender"]["discharge"]["mode"] = "continuous"
+    configuration = config["blender"]["configurations"][0]
+    for factor in (1.0, 50.0):
+        case = build_blender_case(config, configuration, factor)
+        silo, g = case.silo, 9.81 * factor
+        reentry_squared = 2 * g * config["blender"]["sink_depth"]
+        expected = math.sqrt(max(silo.fill.insertion_velocity**2, reentry_squared)
+                             + 2 * g * (silo.domain_top - silo.fill_height))
+        assert silo.timestep_choice.impact_velocity == pytest.approx(expected, rel=1e-12)

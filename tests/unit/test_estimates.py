@@ -222,7 +222,8 @@ def test_changing_a_silo_case_changes_its_estimate_exactly(config):
     case = build_silo_case(config)
     changed = dataclasses.replace(
         case, fill=dataclasses.replace(case.fill, n_clumps=500, fill_steps=7000), settle_check_steps=100,
-        settle_max_checks=3, discharge_steps=9000, dump_every=1000, timestep=2.0e-5,
+        settle_max_checks=3, discharge_steps=9000, dump_every=1000,
+        timestep_choice=dataclasses.replace(case.timestep_choice, timestep=2.0e-5),
     )
     estimate = estimate_silo_case(changed, model=WORST_CASE)
     assert estimate.steps == 7000 + 300 + 9000

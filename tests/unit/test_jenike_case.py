@@ -37,7 +37,7 @@ from engines.liggghts.jenike import (
     set_aside_previous_jenike_attempt,
     write_jenike_inputs,
 )
-from engines.cases.physics import rayleigh_time
+from engines.cases.physics import hertz_contact_time, rayleigh_time
 from engines.templating import UnsafeDeckValue, render_deck
 from tests.golden_files import assert_matches_golden
 
@@ -170,6 +170,14 @@ def test_time_step_is_the_fraction_of_the_rayleigh_time_of_the_smallest_sphere()
     case = _case()
     assert case.rayleigh_time == rayleigh_time(0.0015, 950.0, 5.0e6, 0.4)
     assert case.timestep == 0.1 * case.rayleigh_time
+
+
+def test_hertz_limit_takes_the_fall_from_the_top_of_the_loose_column():
+    case = _case(timestep_fraction=0.5, timestep_hertz_fraction=0.01)
+    choice = case.timestep_choice
+    assert choice.impact_velocity == pytest.approx(math.sqrt(2 * 9.81 * case.fill.region_z[1]), rel=1e-12)
+    assert choice.hertz_time == hertz_contact_time(0.0015, 950.0, 5.0e6, 0.4, choice.impact_velocity)
+    assert (choice.limited_by, case.timestep) == ("hertz", 0.01 * choice.hertz_time)
 
 
 def test_normal_force_steps_and_fill_follow_the_config():

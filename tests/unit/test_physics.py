@@ -4,7 +4,9 @@ import math
 
 import pytest
 
-from engines.cases.physics import engine_seeds, is_prime, rayleigh_time, steps_for
+from engines.cases.physics import (
+    engine_seeds, free_fall_velocity, hertz_contact_time, is_prime, rayleigh_time, stable_timestep, steps_for,
+)
 
 
 def test_rayleigh_time_of_a_3mm_hdpe_sphere_by_hand():
@@ -38,3 +40,45 @@ def test_steps_for_rounds_up_and_tolerates_float_noise():
     assert steps_for(0.005, 1e-5) == 500
     assert steps_for(0.0050001, 1e-5) == 501
     assert steps_for(1e-9, 1e-5) == 1
+
+
+def test_hertz_contact_time_of_two_3mm_hdpe_spheres_by_hand():
+    # m = 950 * 4/3 pi (1.5e-3)^3 = 1.343030e-5 kg; m* = m/2, R* = 0.75 mm, E* = 5e6 / (2 (1 - 0.16)) Pa
+    mass = 950.0 * 4.0 / 3.0 * math.pi * 1.5e-3**3
+    expected = 2.87 * ((mass / 2) ** 2 / (0.75e-3 * (5e6 / 1.68) ** 2 * 1.0)) ** 0.2
+    assert expected == pytest.approx(2.6560e-4, rel=1e-4)
+    assert hertz_contact_time(1.5e-3, 950.0, 5e6, 0.4, 1.0) == pytest.approx(expected, rel=1e-12)
+
+
+def test_hertz_contact_time_falls_as_the_fifth_root_of_the_impact_velocity():
+    slow = hertz_contact_time(1.5e-3, 950.0, 5e6, 0.4, 0.1)
+    assert hertz_contact_time(1.5e-3, 950.0, 5e6, 0.4, 3.2) == pytest.approx(slow / 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("velocity", [0.0, -1.0, math.nan, math.inf])
+def test_hertz_contact_time_rejects_a_velocity_that_is_not_positive_and_finite(velocity):
+    with pytest.raises(ValueError, match="impact_velocity"):
+        hertz_contact_time(1.5e-3, 950.0, 5e6, 0.4, velocity)
+
+
+def test_stable_timestep_takes_the_smaller_limit_and_names_it():
+    t_r = rayleigh_time(1.5e-3, 950.0, 5e6, 0.4)
+    t_h = hertz_contact_time(1.5e-3, 950.0, 5e6, 0.4, 1.0)
+    by_rayleigh = stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 1.0, 0.2, 0.2)
+    assert (by_rayleigh.timestep, by_rayleigh.limited_by) == (0.2 * t_r, "rayleigh")
+    assert (by_rayleigh.rayleigh_time, by_rayleigh.hertz_time, by_rayleigh.impact_velocity) == (t_r, t_h, 1.0)
+    # a tenfold faster impact shortens the contact by 10^(1/5) = 1.585: now the Hertz limit binds
+    fast = stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 10.0, 0.2, 0.1)
+    assert fast.limited_by == "hertz"
+    assert fast.timestep == pytest.approx(0.1 * t_h / 10.0**0.2, rel=1e-12)
+
+
+@pytest.mark.parametrize("fractions", [(0.0, 0.1), (0.1, -0.1), (1.5, 0.1), (0.1, math.nan)])
+def test_stable_timestep_rejects_fractions_outside_zero_to_one(fractions):
+    with pytest.raises(ValueError, match="fraction"):
+        stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 1.0, *fractions)
+
+
+def test_free_fall_velocity_adds_the_fall_to_the_start_speed():
+    assert free_fall_velocity(3.0, 1.0, 8.0) == 5.0  # sqrt(9 + 2 * 8 * 1)
+    assert free_fall_velocity(3.0, -1.0, 8.0) == 3.0  # a start below the landing point falls nowhere

@@ -54,6 +54,25 @@ def test_insertion_events_do_not_overlap(tiny_config):
     assert case.fill.fill_steps * case.timestep * case.fill.particle_rate >= case.fill.n_clumps
 
 
+def test_time_step_is_the_rayleigh_limit_when_impacts_are_slow(tiny_config):
+    case = build_silo_case(tiny_config)
+    choice = case.timestep_choice
+    # the fastest impact: a clump leaving the top of the domain at the insertion velocity falls onto the fill
+    fall = case.domain_top - case.fill_height
+    assert choice.impact_velocity == pytest.approx(math.sqrt(case.fill.insertion_velocity**2 + 2 * 9.81 * fall), rel=1e-12)
+    assert choice.limited_by == "rayleigh"
+    assert case.timestep == pytest.approx(0.1 * choice.rayleigh_time, rel=1e-12)
+    assert case.summary()["timestep_limited_by"] == "rayleigh"
+
+
+def test_time_step_is_the_hertz_limit_when_the_rayleigh_fraction_is_loose(tiny_config):
+    tiny_config["silo_flat"]["timestep_fraction"] = 0.5
+    tiny_config["silo_flat"]["timestep_hertz_fraction"] = 0.05
+    choice = build_silo_case(tiny_config).timestep_choice
+    assert choice.limited_by == "hertz"
+    assert choice.timestep == pytest.approx(0.05 * choice.hertz_time, rel=1e-12)
+
+
 def test_the_pour_is_gentle_its_momentum_flux_on_the_finished_fill_stays_below_the_set_share_of_the_weight(tiny_config):
     tiny_config["silo_flat"]["fill"]["momentum_flux_ratio"] = 0.05
     case = build_silo_case(tiny_config)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import math
 import re
 from pathlib import Path
 
@@ -137,3 +138,12 @@ def test_bad_recirculation_config_is_named(golden_config, edit, message):
     edit(raw["silo_recirculation"])
     with pytest.raises(ConfigError, match=message):
         validate_config(raw)
+
+
+def test_clumps_re_entering_at_the_feeder_velocity_set_the_largest_impact(golden_config):
+    config = copy.deepcopy(golden_config)
+    config["silo_recirculation"]["feeder_velocity"] = 5.0  # faster than the 0.5 m/s pour
+    case = build_recirculation_case(config, "internal_flow")
+    silo = case.silo
+    fall = silo.domain_top - silo.fill_height
+    assert silo.timestep_choice.impact_velocity == pytest.approx(math.sqrt(5.0**2 + 2 * 9.81 * fall), rel=1e-12)
