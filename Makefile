@@ -69,3 +69,4 @@ bench: install
 	$(PYTHON) -m tests.bench.bench_coarse_graining results/bench/coarse_graining.csv
 	$(PYTHON) -m tests.bench.bench_pathlines results/bench/pathlines.csv
 	$(PYTHON) -m tests.bench.bench_mpi results/bench/mpi.csv
+	$(PYTHON) -m tests.bench.bench_decks results/bench/decks.csv

@@ -34,7 +34,7 @@ from engines.estimates import (
     wall_time,
 )
 from engines.cases.jenike import build_jenike_case
-from engines.liggghts.cost import calibrate_cost_model
+from engines.liggghts.cost import StageCost, calibrate_cost_model, stage_costs
 from engines.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
@@ -388,3 +388,32 @@ def test_settling_is_counted_as_a_share_of_its_longest_time_in_whole_checks():
     assert estimate_silo_case(silo).steps == 1000 + 50 + 2000  # the default model: a quarter
     with pytest.raises(ValueError, match="settle_fraction"):
         CostModel(settle_fraction=0.0)
+
+
+STAGED_LOG = """\
+    Step    Atoms           Time       n_clumps            CPU
+       0        0              0              0              0
+     100      200          0.001            100            1.0
+Loop time of 2.0 on 1 procs for 100 steps with 200 atoms, finish time Thu Nov 26 16:28:43 2026
+print "SILOFLOW filled step=$(step)"
+SILOFLOW filled step=100
+    Step    Atoms           Time       n_clumps            CPU
+     100      200          0.001            100              0
+     300      200          0.003            100            2.0
+Loop time of 4.0 on 2 procs for 200 steps with 200 atoms
+SILOFLOW settle step=300
+    Step    Atoms           Time       n_clumps            CPU
+     300      200          0.003            100              0
+     400      100          0.004             50            1.0
+Loop time of 1.0 on 1 procs for 100 steps with 100 atoms
+SILOFLOW opened step=400
+"""
+
+
+def test_stage_costs_split_cpu_time_and_integrate_sphere_steps_by_stage():
+    costs = stage_costs(STAGED_LOG, {None: "fill", "filled": "settle", "opened": "discharge"})
+    # fill: one row pair, (0 + 200) / 2 * 100; settle: 200 * 200 + (200 + 100) / 2 * 100, the "settle" marker
+    # is not in the mapping and keeps the stage; the echoed print command is no marker
+    assert costs == {"fill": StageCost(2.0, 100, 10_000.0), "settle": StageCost(9.0, 300, 55_000.0)}
+    assert costs["settle"].sphere_steps_per_second == pytest.approx(55_000.0 / 9.0, rel=1e-12)
+    assert math.isnan(StageCost(0.0, 0, 0.0).sphere_steps_per_second)
