@@ -33,7 +33,7 @@ run: install
 	$(PYTHON) -m snakemake --report results/report.html --configfile $(CONFIG)
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it, about
-# 15 core-hours (make estimate CONFIG=config/validation.yaml). It works in results/validation/ (its own results/
+# 16 core-hours (make estimate CONFIG=config/validation.yaml). It works in results/validation/ (its own results/
 # and report there, so that it never overwrites the default run's), prints the estimate of every run first and
 # resumes where an interrupted run stopped.
 VALIDATION_CONFIG ?= config/validation.yaml
