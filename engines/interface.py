@@ -127,6 +127,11 @@ class Engine(ABC):
         """
 
     @abstractmethod
+    def measured_cost(self, run_dir: str | Path) -> float | None:
+        """CPU seconds per sphere and time step that a run took on this machine, from the engine's own timing of
+        every attempt (s), or None when the run left no timing (not run, or stopped before its first stage ended)."""
+
+    @abstractmethod
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         """The particle frames a run saved, oldest first (``on_damaged``: ``error`` or ``skip`` a damaged one)."""
 

@@ -7,12 +7,15 @@ unless ``estimates.disk_check`` is false.
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
+import statistics
 import sys
 from pathlib import Path
 
 from engines.cases import CASE_BUILDERS
 from engines.config import load_config
+from engines.interface import engine_for
 from engines.estimates import (
     CostModel,
     RunEstimate,
@@ -32,11 +35,31 @@ def cost_model(config: dict) -> CostModel:
                      settle_fraction=section["settle_fraction"])
 
 
-def config_estimates(config: dict) -> list[RunEstimate]:
+def config_estimates(config: dict, model: CostModel | None = None) -> list[RunEstimate]:
     """Estimates of every engine run a validated configuration defines (calibration sweep, silo runs with their
-    parametric variants, recirculation runs, blender runs), in that order."""
-    model, ranks = cost_model(config), config["engine"]["mpi_ranks"]
+    parametric variants, recirculation runs, blender runs), in that order; ``model`` defaults to the config's."""
+    model, ranks = model or cost_model(config), config["engine"]["mpi_ranks"]
     return [estimate_case(case, ranks, model) for build in CASE_BUILDERS.values() for case in build(config).values()]
+
+
+def measured_cost_model(config: dict, estimates: list[RunEstimate], results: str | Path) -> tuple[CostModel, int] | None:
+    """The config's cost model with the CPU time per sphere-step measured on this machine, and from how many runs.
+
+    The measure is the median over the runs of ``estimates`` that have finished under ``results`` (their run
+    record written), each timed by its own engine (:meth:`engines.interface.Engine.measured_cost`); None when
+    none has finished or none left timing.
+    """
+    measured = []
+    for estimate in estimates:
+        directory = run_directory(results, estimate)
+        if (directory / RUN_RECORD).exists():
+            value = engine_for(config, estimate.kind).measured_cost(directory)
+            if value is not None:
+                measured.append(value)
+    if not measured:
+        return None
+    model = dataclasses.replace(cost_model(config), seconds_per_sphere_step=statistics.median(measured))
+    return model, len(measured)
 
 
 def run_directory(results: str | Path, estimate: RunEstimate) -> Path:
@@ -102,9 +125,18 @@ def main(argv: list[str] | None = None) -> int:
     config = load_config(argv[0])
     results = argv[1] if len(argv) == 2 else "results"
     estimates = config_estimates(config)
-    print(f"Estimates for {argv[0]} (cost model: {cost_model(config).seconds_per_sphere_step:.3g} s per sphere and "
-          f"step on one core, {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
-          f"{cost_model(config).settle_fraction:.0%} of its longest time)")
+    model = cost_model(config)
+    measured = measured_cost_model(config, estimates, results)
+    if measured is None:
+        source = "estimates.seconds_per_sphere_step of the config: no run of it has finished here yet"
+    else:
+        model, count = measured
+        estimates = config_estimates(config, model)
+        source = (f"measured on this machine, the median of {count} finished run(s) under {results}/; the config "
+                  f"says {cost_model(config).seconds_per_sphere_step:.3g}")
+    print(f"Estimates for {argv[0]} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere and step on one "
+          f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
+          f"{model.settle_fraction:.0%} of its longest time)")
     print(estimate_table(estimates))
     waiting = pending(estimates, results)
     print(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "

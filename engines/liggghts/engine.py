@@ -37,7 +37,8 @@ from engines.liggghts.jenike import (
     run_jenike,
     write_jenike_inputs,
 )
-from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX
+from engines.liggghts.cost import calibrate_cost_model
+from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs
 from engines.liggghts.settled import read_settled_fill
 from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
@@ -136,6 +137,13 @@ class LiggghtsEngine(Engine):
         settings = dict(options.settings or {})
         return _adapter(case).run(case, Path(run_dir), executable=settings.get("executable", "liggghts"),
                                   mpi_ranks=options.mpi_ranks, mpirun=options.mpirun)
+
+    def measured_cost(self, run_dir: str | Path) -> float | None:
+        text = "\n".join(path.read_text(errors="replace") for path in attempt_logs(run_dir))
+        try:
+            return calibrate_cost_model(text).seconds_per_sphere_step
+        except ValueError:  # no timing line: the run has not finished a stage
+            return None
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return list(read_frames(Path(run_dir) / "dumps", DUMP_PREFIX, record.timestep_s, on_damaged=on_damaged))

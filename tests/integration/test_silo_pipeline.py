@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import statistics
 
 import pytest
 import yaml
@@ -21,6 +22,8 @@ from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
+from engines.liggghts.cost import calibrate_cost_model
+from engines.planning import config_estimates, measured_cost_model, run_directory
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
@@ -107,6 +110,25 @@ def test_outputs_and_logs_are_where_the_workflow_says(tiny_pipeline):
     assert f"siloflow result: {run_dir / 'metrics' / 'flow.csv'}" in result.stdout + result.stderr
     # no frame cache: it was as large as the dumps and not faster (make bench)
     assert not (run_dir / "frames").exists()
+
+
+def test_make_estimate_takes_its_cost_model_from_the_finished_runs(tiny_pipeline):
+    workdir, run_dir, _ = tiny_pipeline
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    for section, values in yaml.safe_load((workdir / "tiny.yaml").read_text()).items():
+        raw[section] = {**raw[section], **values}
+    config = validate_config(raw)
+    estimates = config_estimates(config)
+    results = workdir / "results"
+    finished = [run_directory(results, e) for e in estimates if (run_directory(results, e) / "run.json").exists()]
+    assert run_dir in finished and len(finished) >= 2  # the silo and its restitution variant at least
+    engine = engine_named("liggghts")
+    silo_cost = engine.measured_cost(run_dir)
+    assert silo_cost == calibrate_cost_model((run_dir / "log.liggghts").read_text()).seconds_per_sphere_step
+    assert 1e-8 < silo_cost < 1e-5  # s per sphere-step: between 100 thousand and 100 million per second
+    model, count = measured_cost_model(config, estimates, results)
+    assert count == len(finished)
+    assert model.seconds_per_sphere_step == statistics.median(engine.measured_cost(d) for d in finished)
 
 
 def test_a_second_call_has_nothing_to_do(tiny_pipeline):

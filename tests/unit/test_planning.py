@@ -12,6 +12,7 @@ from engines.planning import (
     ensure_disk_space,
     estimate_table,
     main,
+    measured_cost_model,
     pending,
     preflight,
     run_directory,
@@ -62,3 +63,11 @@ def test_the_estimate_table_and_command(estimates, capsys):
     assert main([str(DEFAULT_CONFIG)]) == 0
     assert "runs still to do" in capsys.readouterr().out
     assert main([]) == 2
+
+
+def test_a_finished_run_without_engine_timing_leaves_the_config_cost_model(estimates, tmp_path):
+    run_dir = run_directory(tmp_path, estimates[0])
+    run_dir.mkdir(parents=True)
+    (run_dir / "run.json").write_text(json.dumps({}))
+    assert measured_cost_model(load_config(DEFAULT_CONFIG), estimates, tmp_path) is None
+    assert measured_cost_model(load_config(DEFAULT_CONFIG), estimates, tmp_path / "nothing here") is None
