@@ -152,8 +152,9 @@ def fill_zone(
     return (x_min, x_max, 0.0, depth, z_min, z_min + fill_config["zone_height"])
 
 
-def largest_impact_velocity(fill_config: dict, fill_height: float, drop_top: float, gravity: float,
-                    reentry_velocity: float = 0.0) -> float:
+def largest_impact_velocity(
+    fill_config: dict, fill_height: float, drop_top: float, gravity: float, reentry_velocity: float = 0.0
+) -> float:
     """The largest impact velocity a silo-type case expects (m/s), for the Hertz time-step limit.
 
     A clump that starts at ``drop_top`` (m; the top of the pouring zone or of the domain) moving down at the
@@ -199,7 +200,7 @@ def plan_fill(
     clumps_per_insertion = max(1, int(fill_config["volume_fraction"] * zone_volume / particle.volume))
     velocity = fill_config["insertion_velocity"]
     insert_every = steps_for(fill_config["zone_height"] / velocity, timestep)
-    impact_velocity = math.sqrt(velocity**2 + 2.0 * gravity * (z_min - fill_height))
+    impact_velocity = free_fall_velocity(velocity, z_min - fill_height, gravity)
     weight = n_clumps * particle.mass * gravity
     gentle_rate = fill_config["momentum_flux_ratio"] * weight / (impact_velocity * particle.mass)  # clumps/s
     clumps_per_insertion = max(1, min(clumps_per_insertion, int(gentle_rate * insert_every * timestep)))

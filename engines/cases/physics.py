@@ -115,6 +115,13 @@ class ChosenTimestep:
         """Rayleigh time of the smallest sphere (s)."""
         return self.timestep_choice.rayleigh_time
 
+    def timestep_summary(self) -> dict:
+        """The time step and the limits it was chosen from, for ``case.json``."""
+        choice = self.timestep_choice
+        return {"rayleigh_time_s": choice.rayleigh_time, "hertz_time_s": choice.hertz_time,
+                "impact_velocity_m_s": choice.impact_velocity, "timestep_limited_by": choice.limited_by,
+                "timestep_s": choice.timestep}
+
 
 def stable_timestep(
     radius: float,

@@ -15,7 +15,6 @@ Run with ``python -m tests.bench.bench_decks results/bench/decks.csv`` (a few mi
 
 from __future__ import annotations
 
-import copy
 import csv
 import re
 import subprocess
@@ -23,11 +22,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-from engines.cases.silo_flat import build_silo_case
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.interface import EngineOptions, engine_for
+from engines.interface import EngineOptions
 from engines.liggghts.cost import stage_costs
 from engines.liggghts.markers import parse_markers
+from tests.bench.small_silo import small_silo
 
 HAND_DECK = Path(__file__).resolve().parent / "hand_silo.liggghts"
 SILO = {"width": 0.08, "depth": 0.012, "fill_height": 0.04, "outlet_width": 0.024, "discharge_time": 0.6,
@@ -83,11 +81,7 @@ def run_hand_deck(run_dir: Path, variables: dict[str, str], executable: str = "l
 
 def main(argv: list[str]) -> int:
     output = Path(argv[1] if len(argv) > 1 else "results/bench/decks.csv")
-    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
-    raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(SILO)}
-    config = validate_config(raw)
-    case = build_silo_case(config)
-    engine = engine_for(config, "silo_flat")
+    case, engine = small_silo(SILO)
     with tempfile.TemporaryDirectory() as scratch:
         generated_dir, hand_dir = Path(scratch) / "generated", Path(scratch) / "hand"
         engine.write_inputs(case, generated_dir)

@@ -11,7 +11,6 @@ Run with ``python -m tests.bench.bench_mpi results/bench/mpi.csv`` (a few minute
 
 from __future__ import annotations
 
-import copy
 import csv
 import math
 import sys
@@ -21,9 +20,8 @@ from pathlib import Path
 
 from analysis.data.frames import clumps_from_frame
 from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
-from engines.cases.silo_flat import build_silo_case
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.interface import EngineOptions, engine_for
+from engines.interface import EngineOptions
+from tests.bench.small_silo import small_silo
 from tests.conftest import TINY_SILO
 
 SILO = {**TINY_SILO, "width": 0.12, "fill_height": 0.06, "discharge_time": 0.5}
@@ -41,11 +39,7 @@ def flow_rate(engine, run_dir: Path, record, case) -> tuple[float, float]:
 
 def main(argv: list[str]) -> int:
     output = Path(argv[1] if len(argv) > 1 else "results/bench/mpi.csv")
-    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
-    raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(SILO)}
-    config = validate_config(raw)
-    case = build_silo_case(config)
-    engine = engine_for(config, "silo_flat")
+    case, engine = small_silo(SILO)
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
         for ranks in (1, 2):

@@ -1,0 +1,17 @@
+"""The small flat-bottom silo the engine benchmarks run: the default config with a few ``silo_flat`` keys changed."""
+
+from __future__ import annotations
+
+import copy
+
+from engines.cases.silo_flat import SiloCase, build_silo_case
+from engines.config import REPO_ROOT, load_config_file, validate_config
+from engines.interface import Engine, engine_for
+
+
+def small_silo(overrides: dict) -> tuple[SiloCase, Engine]:
+    """The silo case of the default config with ``overrides`` on ``silo_flat``, and the engine that runs it."""
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(overrides)}
+    config = validate_config(raw)
+    return build_silo_case(config), engine_for(config, "silo_flat")
