@@ -14,9 +14,10 @@ The engine's own files (dumps, logs, restart files) also live in the run directo
 
 from __future__ import annotations
 
-from pathlib import PurePosixPath
+import os
+from pathlib import Path, PurePosixPath
 
-__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_RECORD", "case_root", "run_dir", "run_path"]
+__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_RECORD", "case_root", "run_dir", "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
 RESULTS = "results"
@@ -55,3 +56,12 @@ def run_path(case: str, relative: str, run: str = RUN_WILDCARD, results: str = R
     if relative.startswith("/") or ".." in PurePosixPath(relative).parts:
         raise ValueError(f"run paths are relative and stay inside the run directory, got {relative!r}")
     return f"{run_dir(case, run, results)}/{relative}"
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a ``.partial`` file and a rename, so that a reader (or a killed run) never
+    sees half of it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)

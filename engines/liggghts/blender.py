@@ -16,8 +16,9 @@ from engines.cases.blender_meshes import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
-from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_run_record
-from engines.liggghts.inputs import write_case_inputs
+from engines.liggghts.silo_flat import silo_deck_context
+from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
+from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
 from engines.templating import render_deck
 
 GATE = "outlet_gate"
@@ -90,6 +91,7 @@ def run_blender(
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case.silo)},
         lambda checked: silo_run_record(
+            ENGINE_NAME,
             "blender", case.run_id, checked,
             {"configuration": case.configuration, "gravity_factor": case.gravity_factor, "mode": case.mode},
             [-case.silo.sink_depth, case.silo.domain_top]),

@@ -4,11 +4,11 @@ step) and the writing of a run's inputs (wall meshes, ``case.json``, the deck) i
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from analysis.data.constants import GRAVITY
 from engines.cases.geometry import write_stl
+from engines.layout import write_text_atomic
 
 #: The engine's registry name (engine.kind), written into every run record.
 ENGINE_NAME = "liggghts"
@@ -54,13 +54,6 @@ def common_context(case) -> dict:
             "ntry": 1000000,
         },
     }
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".partial")
-    partial.write_text(text, encoding="utf-8")
-    os.replace(partial, path)
 
 
 def write_case_inputs(meshes: dict, summary: dict, deck_text: str, deck_dir: str | Path) -> Path:

@@ -37,8 +37,9 @@ from engines.interface import EngineRunError
 from engines.layout import RUN_RECORD
 from engines.liggghts.contacts import parse_local_table
 from engines.liggghts.dumps import list_dumps
-from engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix, write_text_atomic
-from engines.liggghts.markers import parse_markers
+from engines.layout import write_text_atomic
+from engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix
+from engines.markers import parse_markers
 from engines.liggghts.run import (
     DUMP_PREFIX,
     RUN_OUTPUTS,

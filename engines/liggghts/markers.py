@@ -1,38 +1,8 @@
-"""What the LIGGGHTS log tells the orchestrator: stage markers the decks print, and fatal error lines."""
+"""What the LIGGGHTS log tells the orchestrator beyond the stage markers (:mod:`engines.markers`): fatal error lines."""
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass
-
-
-@dataclass(frozen=True)
-class Marker:
-    """A ``SILOFLOW <event> key=value ...`` line the deck prints at a stage boundary."""
-
-    event: str
-    values: dict
-
-
-_MARKER = re.compile(r"^SILOFLOW (\w+)((?: \w+=\S+)*)\s*$")
-
-
-def parse_markers(log_text: str) -> list[Marker]:
-    """Stage markers in the order the engine printed them (echoed ``print`` commands are skipped)."""
-    markers = []
-    for line in log_text.splitlines():
-        match = _MARKER.match(line.strip())
-        if not match:
-            continue
-        values = {}
-        for item in match.group(2).split():
-            key, _, raw = item.partition("=")
-            try:
-                values[key] = float(raw)
-            except ValueError:
-                values[key] = raw
-        markers.append(Marker(match.group(1), values))
-    return markers
+__all__ = ["error_lines", "log_excerpt"]
 
 
 def error_lines(log_text: str) -> list[str]:

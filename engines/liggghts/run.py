@@ -28,8 +28,10 @@ from engines.estimates import format_bytes
 from engines.interface import EngineNotFound, EngineRunError
 from engines.layout import RUN_RECORD
 from engines.liggghts.dumps import list_dumps
-from engines.liggghts.inputs import DECK_NAME, write_text_atomic
-from engines.liggghts.markers import Marker, error_lines, log_excerpt, parse_markers
+from engines.layout import write_text_atomic
+from engines.liggghts.inputs import DECK_NAME
+from engines.liggghts.markers import error_lines, log_excerpt
+from engines.markers import Marker, parse_markers
 from engines.liggghts.thermo import ThermoProgress
 from engines.progress import ProgressMonitor
 from engines.templating import render_deck

@@ -10,7 +10,6 @@ import numpy as np
 from analysis.data.record import RunRecord
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.silo_flat import SiloCase
-from engines.estimates import CostModel, silo_run_steps
 from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
 from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
@@ -25,8 +24,7 @@ from engines.liggghts.run import (
     run_checked,
     settled_fill_context,
 )
-from engines.interface import EngineRunError
-from engines.liggghts.markers import Marker
+from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck
 
 #: What the silo-type decks dump per sphere: what their analyses read (ids, clump ids, centres, velocities,
@@ -125,99 +123,6 @@ def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
     return write_case_inputs(silo_meshes(case), case.summary(), render_silo_deck(case), deck_dir)
 
 
-def check_silo_run(
-    case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged",
-    clumps_conserved: bool = False,
-) -> dict:
-    """Check that a finished silo run did what the case asked; returns the stage record.
-
-    ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
-    drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
-    ``clumps_conserved`` (periodic runs, where nothing may leave) the clump count must be unchanged at its end.
-
-    Raises
-    ------
-    EngineRunError
-        When clumps are missing after filling, the fill did not settle, a stage marker or the dumps
-        are missing.
-    """
-    by_event = {}
-    for marker in markers:
-        by_event.setdefault(marker.event, []).append(marker)
-    for event in ("filled", "settled", "opened", last_stage):
-        if event not in by_event:
-            raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
-    filled = by_event["filled"][-1].values
-    if int(round(filled["clumps"])) != case.fill.n_clumps:
-        raise EngineRunError(
-            f"{run_dir}: only {int(filled['clumps'])} of {case.fill.n_clumps} clumps were inserted; "
-            "widen silo_flat.fill.zone_width_fraction or lower silo_flat.fill.volume_fraction"
-        )
-    settled = by_event["settled"][-1].values
-    if not settled["ke_per_clump"] < case.settle_threshold:
-        raise EngineRunError(
-            f"{run_dir}: the fill did not settle: kinetic energy per clump {settled['ke_per_clump']:.3g} J is above "
-            f"the threshold {case.settle_threshold:.3g} J after the longest settling time; raise "
-            "silo_flat.settle.max_time or the threshold"
-        )
-    if len(dump_files) < 2:
-        raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
-    final = int(round(by_event[last_stage][-1].values["clumps"]))
-    if clumps_conserved and final != case.fill.n_clumps:
-        raise EngineRunError(
-            f"{run_dir}: {case.fill.n_clumps} clumps were inserted but {final} remain after the '{last_stage}' stage; "
-            "clumps were lost through a boundary"
-        )
-    opened = by_event["opened"][-1].values
-    return {
-        "filled": filled,
-        "settled": settled,
-        "opened": opened,
-        last_stage: by_event[last_stage][-1].values,
-        "settle_checks": [m.values for m in by_event.get("settle", [])],
-        "open_step": int(round(opened["step"])),
-        "open_time_s": opened["time"],
-        "timestep_s": case.timestep,
-        "n_clumps": case.fill.n_clumps,
-        "n_dumps": len(dump_files),
-    }
-
-
-def expected_simulated_time(silo: SiloCase) -> float:
-    """Simulated time a silo-type deck is expected to reach (s): fill, the expected share of the settling time
-    (:class:`engines.estimates.CostModel`), discharge; the target of its progress reports."""
-    return silo_run_steps(silo, CostModel().settle_fraction) * silo.timestep
-
-
-#: Stage kinds of the markers a silo-type deck prints at the end of its stages.
-SILO_STAGE_MARKERS = {"filled": "fill", "settled": "settle", "opened": "open", "discharged": "discharge",
-                      "recirculated": "recirculate"}
-
-
-def silo_run_record(case_kind: str, run_id: str, checked: dict, labels: dict | None = None,
-                    domain_z: list | None = None) -> RunRecord:
-    """The run record of a checked silo-type run (``checked``: :func:`check_silo_run` plus the run's ``mpi_ranks``,
-    ``resumed_attempts`` and ``output_bytes``)."""
-    return RunRecord(
-        engine=ENGINE_NAME,
-        case=case_kind,
-        run_id=run_id,
-        timestep_s=checked["timestep_s"],
-        n_clumps=checked["n_clumps"],
-        n_frames=checked["n_dumps"],
-        mpi_ranks=checked["mpi_ranks"],
-        stages={kind: checked[marker] for marker, kind in SILO_STAGE_MARKERS.items() if marker in checked},
-        resumed_attempts=checked["resumed_attempts"],
-        output_bytes=checked["output_bytes"],
-        settle_checks=checked["settle_checks"],
-        open_step=checked["open_step"],
-        open_time_s=checked["open_time_s"],
-        domain_z=domain_z,
-        outlet_z=0.0,
-        labels=dict(labels or {}),
-    )
-
-
 def run_silo(
     case: SiloCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun"
 ) -> RunRecord:
@@ -227,6 +132,6 @@ def run_silo(
         lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case)},
-        lambda checked: silo_run_record("silo_flat", case.run_id, checked),
+        lambda checked: silo_run_record(ENGINE_NAME, "silo_flat", case.run_id, checked),
         Resume("liggghts/silo_flat.lmp.j2", silo_deck_context(case), case.discharge_steps),
     )

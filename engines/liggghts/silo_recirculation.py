@@ -15,8 +15,9 @@ from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.geometry import vertical_rectangle_x
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
-from engines.liggghts.silo_flat import check_silo_run, expected_simulated_time, silo_deck_context, silo_run_record, silo_meshes
-from engines.liggghts.inputs import write_case_inputs
+from engines.liggghts.silo_flat import silo_deck_context, silo_meshes
+from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
+from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
 from engines.templating import render_deck
 
 CHANNEL_MESHES = ("channel_left", "channel_right")
@@ -83,6 +84,7 @@ def run_recirculation(
         {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
          "target_time": expected_simulated_time(case.silo)},
         lambda checked: silo_run_record(
+            ENGINE_NAME,
             "silo_recirculation", case.run_id, checked,
             {"flow_pattern": case.pattern, "role": case.role,
              "estimated_residence_time_s": case.estimated_residence_time},

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from engines.liggghts.markers import Marker, parse_markers
+from engines.markers import Marker, parse_markers
 
 #: Canonical thermo columns: the decks' thermo keywords without the ``v_`` prefix of variables.
 STEP, ATOMS, TIME, CLUMPS, KE_PER_CLUMP, CPU = "step", "atoms", "time", "n_clumps", "ke_per_clump", "cpu"

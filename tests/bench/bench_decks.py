@@ -24,7 +24,7 @@ from pathlib import Path
 
 from engines.interface import EngineOptions
 from engines.liggghts.cost import stage_costs
-from engines.liggghts.markers import parse_markers
+from engines.markers import parse_markers
 from tests.bench.small_silo import small_silo
 
 HAND_DECK = Path(__file__).resolve().parent / "hand_silo.liggghts"

@@ -25,7 +25,7 @@ from engines.cases.jenike import (
 )
 from engines.cases.jenike_cell import circle_intersection_area
 from engines.interface import EngineRunError
-from engines.liggghts.markers import Marker
+from engines.markers import Marker
 from engines.liggghts.jenike import (
     CONTACT_COLUMNS,
     FORCE_COLUMNS,

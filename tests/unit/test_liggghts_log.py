@@ -7,8 +7,9 @@ import pytest
 
 from engines.interface import EngineNotFound, EngineRunError
 from engines.liggghts.run import engine_command, set_aside_previous_attempt
-from engines.liggghts.markers import error_lines, parse_markers
-from engines.liggghts.silo_flat import check_silo_run
+from engines.liggghts.markers import error_lines
+from engines.markers import parse_markers
+from engines.silo_checks import check_silo_run
 from engines.cases.silo_flat import build_silo_case
 
 LOG = """\
