@@ -199,7 +199,37 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
         raise ConfigError(_describe(best))
     _check_finite(filled, ())
     _check_references(filled)
+    _check_engine_settings(config, filled)
     return filled
+
+
+#: The case sections, each run by its own ``engine`` or by ``engine.kind``.
+CASE_SECTIONS = ("jenike", "silo_flat", "silo_recirculation", "blender")
+#: Settings of one engine only: ``engine.<kind>.*``, and the MPI keys, which only LIGGGHTS uses.
+ENGINE_ONLY_KEYS = {"liggghts": (("engine", "mpi_ranks"), ("engine", "mpirun")), "yade": ()}
+
+
+def engines_in_use(filled: Mapping) -> set[str]:
+    """The engines that run at least one case section of a validated configuration."""
+    return {filled[section].get("engine") or filled["engine"]["kind"] for section in CASE_SECTIONS}
+
+
+def _check_engine_settings(raw: Mapping, filled: Mapping) -> None:
+    """Refuse a setting the user gave for an engine that runs no case: ``engine.<kind>.*`` or an MPI key of
+    LIGGGHTS' (it would be silently ignored)."""
+    used = engines_in_use(filled)
+    given = raw.get("engine") or {}
+    for kind, only in ENGINE_ONLY_KEYS.items():
+        if kind in used:
+            continue
+        keys = [f"engine.{kind}.{key}" for key in sorted(given.get(kind) or {})]
+        keys += [".".join(path) for path in only if path[1] in given]
+        if keys:
+            runs = ", ".join(sorted(used))
+            raise ConfigError(
+                f"config key '{keys[0]}' is a {kind} setting, but no case runs on {kind} (the cases run on {runs}: "
+                f"engine.kind and the sections' 'engine'); remove it, or run a case on {kind}"
+            )
 
 
 def _check_finite(node: Any, path: tuple) -> None:

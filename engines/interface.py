@@ -46,7 +46,7 @@ __all__ = [
 ]
 
 #: Engines siloflow can drive, by registry name (the package ``engines.<name>`` implements each).
-ENGINE_KINDS = ("liggghts",)
+ENGINE_KINDS = ("liggghts", "yade")
 
 
 class EngineError(RuntimeError):

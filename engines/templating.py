@@ -3,7 +3,9 @@
 Decks are engine syntax in ``templates/``; every number and name comes from a rendering context that is
 checked before rendering. LIGGGHTS executes whatever a line says (``shell``, ``include``, ``variable ...
 getenv``), expands ``$x`` even inside quotes, treats ``#`` as a comment and ``&`` as a line join, so a
-rendered value may only be a finite number, an identifier-like name, or a relative path made by siloflow.
+rendered value may only be a finite number, an identifier-like name, or a relative path made by siloflow. YADE
+scripts are Python: the same values, names and paths as quoted string literals (``pystr``), so no value from a
+configuration is ever evaluated as code.
 """
 
 from __future__ import annotations
@@ -71,6 +73,12 @@ def deck_path(value: Any) -> str:
     return text
 
 
+def deck_string(value: Any) -> str:
+    """Render a name or relative path as a Python string literal (YADE scripts): the checks of :func:`deck_path`,
+    then quotes; the characters it allows need no escaping."""
+    return repr(deck_path(value))
+
+
 def check_context(node: Any, where: str = "context") -> None:
     """Walk a rendering context and refuse anything that is not a number, a boolean or a safe string.
 
@@ -112,6 +120,7 @@ def deck_environment(root: Path = TEMPLATE_ROOT) -> jinja2.Environment:
     environment.filters["int"] = deck_integer
     environment.filters["name"] = deck_name
     environment.filters["path"] = deck_path
+    environment.filters["pystr"] = deck_string
     return environment
 
 

@@ -6,6 +6,7 @@ import copy
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -32,6 +33,21 @@ TINY_SILO = {
     "discharge_time": 0.6,
     # the fill is only 40 mm high: profiles low enough to stay inside it during the steady discharge
     "fields": {"profile_heights": [0.01, 0.02, 0.03]},
+}
+
+
+# A silo small enough for YADE's integration tests (about 350 clumps; YADE integrates them 5-8 times slower than
+# LIGGGHTS on this case): fill, settle, open, and 0.3 s of discharge.
+MICRO_SILO = {
+    "width": 0.04,
+    "depth": 0.012,
+    "fill_height": 0.02,
+    "outlet_width": 0.016,
+    "fill": FAST_POUR,
+    "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
+    "discharge_time": 0.3,
+    "fields": {"profile_heights": [0.005, 0.01]},
+    "engine": "yade",
 }
 
 
@@ -114,6 +130,13 @@ def liggghts():
     """The LIGGGHTS engine, through the registry (the integration tests run it only through the interface)."""
     require_liggghts()
     return engine_named("liggghts")
+
+
+def require_yade():
+    """Fail loudly when YADE is missing: its integration tests must run the real engine. `make test` installs it
+    (Debian package yade, without recommends)."""
+    if not Path("/usr/lib/x86_64-linux-gnu/yade-double/py/yade").is_dir():
+        pytest.fail("YADE is not installed: run `make test`, which installs the Debian package yade")
 
 
 def require_liggghts():

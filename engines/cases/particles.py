@@ -105,16 +105,13 @@ def _two_sphere_union_volume(r1: float, r2: float, distance: float) -> float:
     return separate - lens
 
 
-def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution: int) -> float:
-    """Volume of a union of spheres: exact chord lengths in z, midpoint rule in (x, y).
+def _union_column_moments(centres: np.ndarray, radii: np.ndarray, resolution: int, order: int):
+    """Moments of a union of spheres: exact integrals along z, midpoint rule in (x, y).
 
-    The bounding box in x and y is divided into ``resolution x resolution`` cells.
-    Along the vertical line through each cell centre the union of the spheres is
-    a union of intervals whose total length is computed exactly (sort by lower
-    end, sweep). Integrating that length over (x, y) with the midpoint rule
-    gives the volume. The integrand is continuous (it vanishes like a square
-    root at the silhouette), so the error falls like ``resolution**-2``; at the
-    default resolution of 400 it is ~1e-5 relative, well below 1e-3. Deterministic.
+    The bounding box in x and y is divided into ``resolution x resolution`` cells. Along the vertical line through
+    each cell centre the union of the spheres is a union of intervals (sort by lower end, sweep); the integrals of
+    ``1, z, ..., z**order`` over them are exact. Returns, per cell, ``(x, y, [int z**n dz for n <= order])`` chunk
+    by chunk, and the cell area. Deterministic (no random sampling).
     """
     lower = (centres[:, :2] - radii[:, None]).min(axis=0)
     upper = (centres[:, :2] + radii[:, None]).max(axis=0)
@@ -125,7 +122,7 @@ def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution:
     # Chunk over x rows so memory stays bounded (~ a few million values) for many spheres.
     n_spheres = radii.size
     rows_per_chunk = max(1, int(2_000_000 // (resolution * n_spheres)))
-    total_length = 0.0
+    chunks = []
     for row_start in range(0, resolution, rows_per_chunk):
         xs, ys = np.meshgrid(x_cells[row_start : row_start + rows_per_chunk], y_cells, indexing="ij")
         xs = xs.ravel()[:, None]
@@ -137,22 +134,88 @@ def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution:
         low = np.where(hits, centres[None, :, 2] - half_chord, np.inf)
         high = np.where(hits, centres[None, :, 2] + half_chord, np.inf)
 
-        order = np.argsort(low, axis=1)
-        low = np.take_along_axis(low, order, axis=1)
-        high = np.take_along_axis(high, order, axis=1)
-        hits = np.take_along_axis(hits, order, axis=1)
+        by_low = np.argsort(low, axis=1)
+        low = np.take_along_axis(low, by_low, axis=1)
+        high = np.take_along_axis(high, by_low, axis=1)
+        hits = np.take_along_axis(hits, by_low, axis=1)
 
         reach = np.full(xs.shape[0], -np.inf)  # highest z covered so far on each line
-        length = np.zeros(xs.shape[0])
+        moments = np.zeros((order + 1, xs.shape[0]))
         for k in range(n_spheres):
             valid = hits[:, k]
             # Misses carry infinite ends (sorted last); zero them so no inf - inf occurs.
             high_k = np.where(valid, high[:, k], 0.0)
             start = np.where(valid, np.maximum(low[:, k], reach), 0.0)
-            length += np.maximum(high_k - start, 0.0)
+            covered = high_k > start
+            for n in range(order + 1):
+                moments[n] += np.where(covered, (high_k ** (n + 1) - start ** (n + 1)) / (n + 1), 0.0)
             reach = np.where(valid, np.maximum(reach, high_k), reach)
-        total_length += float(length.sum())
-    return total_length * float(step[0] * step[1])
+        chunks.append((xs[:, 0], ys[:, 0], moments))
+    return chunks, float(step[0] * step[1])
+
+
+def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution: int) -> float:
+    """Volume of a union of spheres: exact chord lengths in z, midpoint rule in (x, y)
+    (:func:`_union_column_moments`).
+
+    The integrand is continuous (it vanishes like a square root at the silhouette), so the error falls like
+    ``resolution**-2``; at the default resolution of 400 it is ~1e-5 relative, well below 1e-3.
+    """
+    chunks, area = _union_column_moments(centres, radii, resolution, 0)
+    return sum(float(moments[0].sum()) for _, _, moments in chunks) * area
+
+
+def clump_inertia(sphere_positions, sphere_radii, density: float, resolution: int = 400) -> np.ndarray:
+    """Inertia tensor of a multisphere clump about its centre of mass, overlaps counted once [kg m2].
+
+    The union of the spheres is integrated as in :func:`clump_volume` (exact along z, midpoint rule on a
+    ``resolution x resolution`` grid in x and y), for the moments of order 0, 1 and 2; the tensor is
+    ``density * integral of (|r|^2 delta_ij - r_i r_j)`` about the centre of mass. An engine that builds clumps
+    from spheres (YADE adds the sphere masses) is given this, so that both engines simulate the same particle.
+
+    Parameters
+    ----------
+    sphere_positions : array_like, shape (k, 3)
+        Sphere centres [m].
+    sphere_radii : array_like, shape (k,)
+        Sphere radii [m], > 0.
+    density : float
+        Solid density [kg/m3], > 0.
+    resolution : int, optional
+        Grid cells per horizontal axis (>= 10).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        The inertia tensor [kg m2].
+    """
+    centres = finite_array("sphere_positions", sphere_positions, ndim=2)
+    radii = finite_array("sphere_radii", sphere_radii)
+    if centres.shape[1] != 3 or radii.shape != (centres.shape[0],) or np.any(radii <= 0.0):
+        raise ValueError(f"sphere_positions must have shape (k, 3) and sphere_radii (k,) with radii > 0, got "
+                         f"{centres.shape} and {radii.shape}")
+    if not (math.isfinite(density) and density > 0.0):
+        raise ValueError(f"density must be finite and > 0, got {density!r}")
+    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 10:
+        raise ValueError(f"resolution must be an integer >= 10, got {resolution!r}")
+    chunks, area = _union_column_moments(centres, radii, int(resolution), 2)
+    # raw moments about the origin: volume, first moments, second moments (x x, y y, z z, x y, x z, y z)
+    m0 = sum(float(m[0].sum()) for _, _, m in chunks)
+    first = np.array([sum(float((x * m[0]).sum()) for x, _, m in chunks),
+                      sum(float((y * m[0]).sum()) for _, y, m in chunks),
+                      sum(float(m[1].sum()) for _, _, m in chunks)])
+    second = np.empty((3, 3))
+    second[0, 0] = sum(float((x * x * m[0]).sum()) for x, _, m in chunks)
+    second[1, 1] = sum(float((y * y * m[0]).sum()) for _, y, m in chunks)
+    second[2, 2] = sum(float(m[2].sum()) for _, _, m in chunks)
+    second[0, 1] = second[1, 0] = sum(float((x * y * m[0]).sum()) for x, y, m in chunks)
+    second[0, 2] = second[2, 0] = sum(float((x * m[1]).sum()) for x, _, m in chunks)
+    second[1, 2] = second[2, 1] = sum(float((y * m[1]).sum()) for _, y, m in chunks)
+    volume, first, second = m0 * area, first * area, second * area
+    centre = first / volume
+    # shift the second moments to the centre of mass (parallel axis theorem)
+    central = second - volume * np.outer(centre, centre)
+    return density * (np.trace(central) * np.eye(3) - central)
 
 
 def clump_volume(

@@ -20,6 +20,7 @@ from engines.cases.common import (
     FillPlan, MaterialTable, engine_kind, fill_zone, largest_impact_velocity, material_table, plan_fill, run_id,
     without_fill_checks,
 )
+from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import ParticleTemplate, particle_template
 from engines.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
 from engines.cases.stages import Stage
@@ -107,6 +108,20 @@ class SiloCase(ChosenTimestep):
             "materials": list(self.materials.names),
             "parameters": self.defining_parameters,
         }
+
+#: The meshes of the silo's floor: the plates left and right of the outlet and its gate.
+FLOOR_MESHES = ("floor_left", "floor_right", "outlet_gate")
+
+
+def silo_meshes(case: SiloCase) -> dict:
+    """Floor plates left and right of the outlet and the gate that closes it (z = 0, normals up)."""
+    half_width, half_outlet, depth = 0.5 * case.width, 0.5 * case.outlet_width, case.depth
+    return {
+        "floor_left": horizontal_rectangle(-half_width, -half_outlet, 0.0, depth, 0.0),
+        "floor_right": horizontal_rectangle(half_outlet, half_width, 0.0, depth, 0.0),
+        "outlet_gate": horizontal_rectangle(-half_outlet, half_outlet, 0.0, depth, 0.0),
+    }
+
 
 def build_silo_case(config: dict) -> SiloCase:
     """Derive the :class:`SiloCase` of the ``silo_flat`` section of a validated configuration

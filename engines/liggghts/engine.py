@@ -40,7 +40,8 @@ from engines.liggghts.jenike import (
 from engines.liggghts.cost import calibrate_cost_model
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs
 from engines.liggghts.settled import read_settled_fill
-from engines.liggghts.silo_flat import FLOOR_MESHES, run_silo, write_silo_inputs
+from engines.cases.silo_flat import FLOOR_MESHES
+from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 
 __all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.data.record import RunRecord
-from engines.estimates import format_bytes
 from engines.interface import EngineNotFound, EngineRunError
-from engines.layout import RUN_RECORD
+from engines.run_files import output_bytes, write_run_record
+from engines.run_files import set_aside_previous_attempt as set_aside
 from engines.liggghts.dumps import list_dumps
 from engines.layout import write_text_atomic
 from engines.liggghts.inputs import DECK_NAME
@@ -115,26 +115,9 @@ RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart", WALL_FORCES_NAME)
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:
-    """Move the output of an unfinished earlier attempt into ``failed_attempts/<UTC time>/``.
-
-    Nothing is deleted: the user may want to inspect a failed run. ``outputs`` names the files and
-    folders a run writes. Returns the new location, if any.
-    """
-    run_dir = Path(run_dir)
-    leftovers = [run_dir / name for name in outputs if (run_dir / name).exists()]
-    leftovers += sorted(run_dir.glob(f"{RESUME_STEM}*"))
-    if not leftovers:
-        return None
-    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
-    target = run_dir / "failed_attempts" / stamp
-    attempt = 1
-    while target.exists():
-        attempt += 1
-        target = run_dir / "failed_attempts" / f"{stamp}-{attempt}"
-    target.mkdir(parents=True)
-    for path in leftovers:
-        shutil.move(str(path), str(target / path.name))
-    return target
+    """Move the output of an unfinished earlier attempt (``outputs``, and the resumptions' files) into
+    ``failed_attempts/<UTC time>/`` (:func:`engines.run_files.set_aside_previous_attempt`)."""
+    return set_aside(run_dir, outputs, (f"{RESUME_STEM}*",))
 
 
 #: Wall time between progress lines in a run's log (s) and between polls of the engine's output (s).
@@ -186,14 +169,6 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
             f"The run directory is left for inspection: {run_dir}"
         )
     return log_text
-
-
-def write_run_record(run_dir: Path, record: RunRecord) -> Path:
-    """Write ``run.json`` last and atomically: its presence means the run is complete and checked."""
-    path = Path(run_dir) / RUN_RECORD
-    write_text_atomic(path, record.to_json())
-    logging.getLogger("siloflow").info("run complete: %s; the run wrote %s", path, format_bytes(record.output_bytes))
-    return path
 
 
 @dataclass(frozen=True)
@@ -306,10 +281,3 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, to_recor
     record = to_record(checked)
     write_run_record(run_dir, record)
     return record
-
-
-def output_bytes(run_dir: str | Path) -> int:
-    """Size of everything a run wrote (dumps, logs, deck, meshes) in bytes; ``run.json`` reports it."""
-    return sum(path.stat().st_size for path in Path(run_dir).rglob("*") if path.is_file())
-
-

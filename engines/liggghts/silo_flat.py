@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.data.record import RunRecord
-from engines.cases.geometry import horizontal_rectangle
-from engines.cases.silo_flat import SiloCase
+from engines.cases.silo_flat import SiloCase, silo_meshes
 from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
 from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
@@ -31,20 +30,6 @@ from engines.templating import render_deck
 #: radii, masses), in binary. Forces and angular velocities are left out (a third of the volume); contact forces
 #: come from the separate contact dump.
 SILO_DUMP_FIELDS = ("id", "type", "id_multisphere", "x", "y", "z", "vx", "vy", "vz", "radius", "mass")
-
-#: The meshes of the silo's floor: the plates left and right of the outlet and its gate.
-FLOOR_MESHES = ("floor_left", "floor_right", "outlet_gate")
-
-
-def silo_meshes(case: SiloCase) -> dict:
-    """Floor plates left and right of the outlet and the gate that closes it (z = 0, normals up)."""
-    half_width, half_outlet, depth = 0.5 * case.width, 0.5 * case.outlet_width, case.depth
-    return {
-        "floor_left": horizontal_rectangle(-half_width, -half_outlet, 0.0, depth, 0.0),
-        "floor_right": horizontal_rectangle(half_outlet, half_width, 0.0, depth, 0.0),
-        "outlet_gate": horizontal_rectangle(-half_outlet, half_outlet, 0.0, depth, 0.0),
-    }
-
 
 def silo_deck_context(case: SiloCase) -> dict:
     """The rendering context of ``templates/liggghts/silo_flat.lmp.j2``."""

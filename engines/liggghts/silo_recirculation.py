@@ -15,7 +15,8 @@ from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.geometry import vertical_rectangle_x
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
-from engines.liggghts.silo_flat import silo_deck_context, silo_meshes
+from engines.cases.silo_flat import silo_meshes
+from engines.liggghts.silo_flat import silo_deck_context
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
 from engines.templating import render_deck

@@ -160,20 +160,31 @@ LIGGGHTS_NAMES = re.compile(
 )
 
 
+#: What names YADE's code, file names or formats; only engines/yade/ and templates/yade/ may say these.
+YADE_NAMES = re.compile(
+    r"engines\.yade|engines/yade|yade/\w+\.py\.j2|log\.yade|yade-double|wall_force_history|\bO\.(?:bodies|engines|save|load)\b|"
+    r"appendClumped|MindlinPhys|settled_fill_\w*\.npz|particles_\w*\.npz"
+)
+#: Per engine: the pattern of its names and the package that alone may say them.
+ENGINE_NAMES = {"liggghts": (LIGGGHTS_NAMES, ("engines", "liggghts")), "yade": (YADE_NAMES, ("engines", "yade"))}
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINE_NAMES))
 @pytest.mark.parametrize("folder", ["engines", "analysis", "calibration", "workflow", "Snakefile"])
-def test_only_the_liggghts_package_names_liggghts_files_and_formats(folder):
+def test_only_an_engines_package_names_its_files_and_formats(folder, engine):
+    pattern, package = ENGINE_NAMES[engine]
     root = REPO_ROOT / folder
     paths = [root] if root.is_file() else [p for p in root.rglob("*") if p.is_file() and p.suffix in (".py", ".smk", ".yaml", ".rst")]
     found = []
     for path in paths:
         relative = path.relative_to(REPO_ROOT)
-        if relative.parts[:2] == ("engines", "liggghts") or "__pycache__" in relative.parts:
+        if relative.parts[:2] == package or "__pycache__" in relative.parts:
             continue
         for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-            match = LIGGGHTS_NAMES.search(line)
+            match = pattern.search(line)
             if match:
                 found.append(f"{relative}:{number}: {match.group(0)!r} in {line.strip()[:100]}")
-    assert not found, "LIGGGHTS names outside engines/liggghts/:\n" + "\n".join(found)
+    assert not found, f"{engine} names outside {'/'.join(package)}/:\n" + "\n".join(found)
 
 
 def test_every_engine_kind_is_registered_and_names_its_base_template():
@@ -183,4 +194,4 @@ def test_every_engine_kind_is_registered_and_names_its_base_template():
         assert engine.name == name
         assert (REPO_ROOT / "templates" / engine.base_template).is_file()
         from_registry.append(name)
-    assert from_registry == ["liggghts"]
+    assert from_registry == ["liggghts", "yade"]

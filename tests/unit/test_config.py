@@ -34,7 +34,8 @@ def test_every_schema_key_has_description_and_default():
 def test_empty_config_gets_every_default():
     config = validate_config({})
     assert config["engine"] == {"kind": "liggghts", "mpi_ranks": 1, "mpirun": "mpirun",
-                                "liggghts": {"executable": "liggghts"}}
+                                "liggghts": {"executable": "liggghts"},
+                                "yade": {"python": "/usr/bin/python3", "threads": 1}}
     assert config["silo_flat"]["width"] == 0.15
     assert config["silo_flat"]["settle"]["kinetic_energy_threshold"] == 1e-12
     assert config["silo_flat"]["beverloo"] == {

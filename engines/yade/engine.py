@@ -1,0 +1,99 @@
+"""YADE (Debian ``yade`` 2023.02, imported from the system Python 3, headless) behind the engine interface.
+
+:class:`YadeEngine` renders each case it builds into a Python script from ``templates/yade/`` (every case template
+extends :attr:`YadeEngine.base_template`), runs it with :mod:`engines.yade.run` and reads its outputs back with
+:mod:`engines.yade.outputs` into the neutral objects of :mod:`analysis.data`. The rolling-resistance model differs
+from the LIGGGHTS decks' (:mod:`engines.yade.inputs` says how).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from analysis.data.forces import WallForceHistory
+from analysis.data.frames import ParticleFrame
+from analysis.data.record import RunRecord
+from analysis.data.settled import SettledFill
+from engines.cases.silo_flat import FLOOR_MESHES, SiloCase
+from engines.interface import CaseNotSupported, Engine, EngineOptions, register
+from engines.layout import CASE_SUMMARY
+from engines.yade.cost import measured_seconds_per_sphere_step
+from engines.yade.inputs import ENGINE_NAME, rolling_friction
+from engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
+from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs
+from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
+
+__all__ = ["YadeEngine"]
+
+#: What each case kind YADE builds is written and run with, and the walls that make its floor.
+_ADAPTERS = {SiloCase: ("silo_flat", write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES)}
+
+
+def _adapter(case):
+    try:
+        return _ADAPTERS[type(case)]
+    except KeyError:
+        raise CaseNotSupported(
+            f"YADE has no script for a {type(case).__name__} yet; it runs {', '.join(c.__name__ for c in _ADAPTERS)}: "
+            "set this case section's 'engine' (or engine.kind) to liggghts") from None
+
+
+def options_from(options: EngineOptions) -> YadeOptions:
+    """The YADE options of a validated ``engine`` section (``engine.yade``)."""
+    settings = dict(options.settings or {})
+    return YadeOptions(python=str(settings.get("python", YadeOptions.python)),
+                       threads=int(settings.get("threads", YadeOptions.threads)))
+
+
+@register
+class YadeEngine(Engine):
+    """YADE 2023.02: scripts from ``templates/yade/``, run headless with the system Python 3, read back."""
+
+    name = ENGINE_NAME
+    base_template = "yade/base.py.j2"
+
+    def check_case(self, case) -> None:
+        """Refuse a case YADE cannot run as configured: a case kind without a script, different rolling frictions
+        (YADE's rolling moment has one eta), a periodic silo depth.
+
+        Raises
+        ------
+        CaseNotSupported
+            Naming the config key and the limit.
+        """
+        kind, _, _, check, _ = _adapter(case)
+        rolling_friction(case.materials, f"{kind} run {case.run_id}")
+        check(case)
+
+    def write_inputs(self, case, run_dir: str | Path) -> Path:
+        self.check_case(case)
+        _adapter(case)[1](case, Path(run_dir) / "deck")
+        return Path(run_dir) / CASE_SUMMARY
+
+    def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:
+        # one process, engine.yade.threads OpenMP threads; engine.mpi_ranks is LIGGGHTS' (engines.config refuses it
+        # when no case runs on LIGGGHTS)
+        self.check_case(case)
+        return _adapter(case)[2](case, Path(run_dir), options_from(options))
+
+    def measured_cost(self, run_dir: str | Path) -> float | None:
+        return measured_seconds_per_sphere_step(attempt_logs(run_dir))
+
+    def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
+        return read_frames(run_dir, DUMP_PREFIX, on_damaged)
+
+    def wall_forces(self, run_dir: str | Path, record: RunRecord) -> WallForceHistory:
+        return read_wall_forces(run_dir, record.timestep_s)
+
+    def contacts(self, run_dir: str | Path, record: RunRecord, kind: str = "pair") -> list:
+        if kind not in ("pair", "wall"):
+            raise ValueError(f"contact kind must be 'pair' or 'wall', got {kind!r}")
+        if kind == "wall":
+            raise ValueError(f"{record.case} runs on YADE save no particle-wall contacts")
+        return [fill.contacts for fill in self.settled_fill(run_dir, record)]
+
+    def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
+        floors = {kind: floor for kind, _, _, _, floor in _ADAPTERS.values()}
+        if record.case not in floors:
+            raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on YADE")
+        return read_settled_fill(run_dir, SETTLED_FILL_PREFIX, floors[record.case])

@@ -1,0 +1,109 @@
+"""What every YADE script of siloflow shares: the rendering context of materials, contact law, clump and time step,
+and the writing of a run's inputs (``case.json``, the script) into its ``deck/`` folder.
+
+The contact law is Hertz-Mindlin (``Ip2_FrictMat_FrictMat_MindlinPhys`` with ``en = es`` = the configured
+restitution, per material pair, and the pair's sliding friction) with Mindlin's rolling moment (``includeMoment``):
+an elastic-plastic spring of stiffness ``krot`` capped at ``eta R |Fn|``, with ``eta`` the rolling friction. YADE
+2023.02 has no constant directional torque (CDT), the model of the LIGGGHTS decks; the two agree where rolling is
+fully mobilised (the moment sits at its cap, ``mu_r R |Fn|`` against the rolling direction, in both), and differ
+where it is not: CDT's moment is at its cap as soon as the sphere turns, EPSD's grows with the rolled angle and
+pushes back elastically. ``krot`` is a constant in YADE: it is set to the EPSD rule ``2.25 kn mu_r^2 R^2`` with
+``kn`` the Hertz stiffness of a particle-particle contact carrying one clump's weight. ``eta`` is one number for
+all contacts in YADE, so a case whose contacts have different rolling frictions is refused
+(:func:`rolling_friction`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from analysis.data.constants import GRAVITY
+from engines.cases.particles import clump_inertia
+from engines.interface import CaseNotSupported
+from engines.layout import write_text_atomic
+
+#: The engine's registry name (engine.kind), written into every run record.
+ENGINE_NAME = "yade"
+DECK_NAME = "run.py"
+
+
+def rolling_friction(table, where: str) -> float:
+    """The one rolling friction of every contact with a particle in it (YADE's ``eta`` is global).
+
+    Raises
+    ------
+    CaseNotSupported
+        Naming the config key ``contacts`` and the differing pairs.
+    """
+    values = {(table.names[0], table.names[j]): float(v) for j, v in enumerate(table.rolling_friction[0])}
+    distinct = sorted(set(values.values()))
+    if len(distinct) > 1:
+        raise CaseNotSupported(
+            f"config key 'contacts': rolling_friction differs between the pairs with a particle "
+            f"({', '.join(f'[{a}, {b}]: {v:g}' for (a, b), v in values.items())}) in {where}; YADE's Mindlin rolling "
+            "moment takes one eta for all contacts: give every pair with the particle material the same "
+            "rolling_friction, or run this case on LIGGGHTS"
+        )
+    return distinct[0]
+
+
+def hertz_stiffness_at_load(radius: float, youngs_modulus: float, poisson_ratio: float, load: float) -> float:
+    """Normal stiffness dF/d(delta) [N/m] of a Hertz contact of two equal spheres carrying ``load`` [N].
+
+    With ``E* = E / (2 (1 - nu^2))`` and ``R* = R / 2``, ``F = 4/3 E* sqrt(R*) delta^(3/2)``, so
+    ``kn = 2 E* sqrt(R* delta) = (6 E*^2 R* F)^(1/3)``."""
+    e_star = youngs_modulus / (2.0 * (1.0 - poisson_ratio**2))
+    return (6.0 * e_star**2 * 0.5 * radius * load) ** (1.0 / 3.0)
+
+
+def principal_clump(particle) -> tuple[np.ndarray, np.ndarray]:
+    """The clump's sphere centres in its principal frame [m] and its principal moments of inertia [kg m2] (exact
+    union, :func:`engines.cases.particles.clump_inertia`)."""
+    tensor = clump_inertia(particle.sphere_positions, particle.sphere_radii, particle.density)
+    moments, axes = np.linalg.eigh(tensor)
+    return particle.sphere_positions @ axes, moments
+
+
+def common_context(case, table, wall_density: float = 1000.0) -> dict:
+    """The context of ``templates/yade/base.py.j2``: materials, pair contacts, rolling law, clump, time step."""
+    particle = case.particle
+    rolling = rolling_friction(table, f"run {case.run_id}")
+    radius = float(particle.sphere_radii.min())
+    kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * GRAVITY)
+    centres, moments = principal_clump(particle)
+    n = len(table.names)
+    return {
+        "materials": {
+            "list": [{"youngs_modulus": float(table.youngs_modulus[i]), "poisson_ratio": float(table.poisson_ratio[i]),
+                      "density": float(particle.density if i == 0 else wall_density)} for i in range(n)],
+            "pairs": [{"i": i, "j": j, "sliding_friction": float(table.sliding_friction[i][j]),
+                       "restitution": float(table.restitution[i][j])} for i in range(n) for j in range(i, n)],
+            "rolling_friction": rolling,
+            "rolling_stiffness": 2.25 * kn * rolling**2 * radius**2,
+        },
+        "particle": {
+            "spheres": [[*map(float, c), float(r)] for c, r in zip(centres, particle.sphere_radii)],
+            "mass": float(particle.mass),
+            "inertia": [float(m) for m in moments],
+        },
+        "timestep": case.timestep,
+        "gravity": GRAVITY,
+    }
+
+
+def exploded_speed(height: float, insertion_velocity: float = 0.0) -> float:
+    """A clump speed no physical run of a case of ``height`` [m] reaches [m/s]: ten times free fall through it."""
+    return 10.0 * (math.sqrt(2.0 * GRAVITY * height) + insertion_velocity)
+
+
+def write_script_inputs(summary: dict, script_text: str, deck_dir: str | Path) -> Path:
+    """Write ``case.json`` and the script into ``deck_dir`` (each atomically, the summary last); returns the script."""
+    deck_dir = Path(deck_dir)
+    script = deck_dir / DECK_NAME
+    write_text_atomic(script, script_text)
+    write_text_atomic(deck_dir / "case.json", json.dumps(summary, indent=2, sort_keys=True, default=float))
+    return script

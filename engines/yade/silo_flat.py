@@ -1,0 +1,107 @@
+"""YADE scripts of the flat-bottom silo: the rendering context of ``templates/yade/silo_flat.py.j2``, the inputs
+written into a run's ``deck/`` folder, and the run, checked as every engine's silo runs are
+(:mod:`engines.silo_checks`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from analysis.data.record import RunRecord
+from engines.cases.silo_flat import SiloCase, silo_meshes
+from engines.interface import CaseNotSupported
+from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
+from engines.templating import render_deck
+from engines.yade.inputs import ENGINE_NAME, common_context, exploded_speed, write_script_inputs
+from engines.yade.run import (
+    DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
+)
+
+#: Restart snapshots per discharge: a killed run loses at most 1/20 of it.
+RESTARTS_PER_STAGE = 20
+
+
+def check_silo_case(case: SiloCase) -> None:
+    """Refuse what the YADE silo script does not build.
+
+    Raises
+    ------
+    CaseNotSupported
+        For a periodic depth (``silo_flat.front_back_walls: false``).
+    """
+    if not case.front_back_walls:
+        raise CaseNotSupported(
+            f"config key 'silo_flat.front_back_walls': false (a periodic depth) is not built on YADE (run "
+            f"{case.run_id}); YADE's periodic cell would also wrap the side walls' direction: give the silo front "
+            "and back walls or run it on LIGGGHTS"
+        )
+
+
+def _triangles(mesh) -> list[list[float]]:
+    return [[float(v) for v in mesh.vertices[face].ravel()] for face in mesh.faces]
+
+
+def silo_script_context(case: SiloCase) -> dict:
+    """The rendering context of ``templates/yade/silo_flat.py.j2``."""
+    table = case.materials
+    side, bottom, front_back = (table.type_of(case.wall_materials[key]) - 1 for key in ("side", "bottom", "front_back"))
+    half_width = 0.5 * case.width
+    context = common_context(case, table)
+    context.update({
+        "title": f"siloflow-silo_flat-{case.run_id}",
+        "exploded_speed": exploded_speed(case.domain_top + case.sink_depth, case.fill.insertion_velocity),
+        "half_width": half_width,
+        "depth": case.depth,
+        "sink_bottom": -case.sink_depth,
+        "domain_top": case.domain_top,
+        "primitive_walls": [
+            {"id": "wall_left", "axis": 0, "position": -half_width, "material": side},
+            {"id": "wall_right", "axis": 0, "position": half_width, "material": side},
+            {"id": "wall_front", "axis": 1, "position": 0.0, "material": front_back},
+            {"id": "wall_back", "axis": 1, "position": case.depth, "material": front_back},
+        ],
+        "meshes": [{"id": name, "material": bottom, "triangles": _triangles(mesh)}
+                   for name, mesh in silo_meshes(case).items()],
+        "gate_mesh": "outlet_gate",
+        "fill": {
+            "seed": case.seeds[2],
+            "zone": list(case.fill.zone),
+            "n_clumps": case.fill.n_clumps,
+            "clumps_per_insertion": case.fill.clumps_per_insertion,
+            "insert_every": case.fill.insert_every,
+            "insertion_velocity": case.fill.insertion_velocity,
+            "steps": case.fill.fill_steps,
+            "max_extra_insertions": int(np.ceil(case.fill.n_clumps / case.fill.clumps_per_insertion)) + 10,
+        },
+        "settle": {"threshold": case.settle_threshold, "check_steps": case.settle_check_steps,
+                   "max_checks": case.settle_max_checks},
+        "settled_fill": {"steps": 200},
+        "discharge": {"steps": case.discharge_steps},
+        "sample_every": case.dump_every,
+        "restart_every": max(1, -(-case.discharge_steps // RESTARTS_PER_STAGE)),
+        "wall_forces_path": WALL_FORCES_NAME,
+        "paths": {"dumps": DUMP_PREFIX, "settled": SETTLED_FILL_PREFIX, "restart": RESTART_DIR,
+                  "resume_stem": RESUME_STEM},
+    })
+    return context
+
+
+def render_silo_script(case: SiloCase) -> str:
+    """The YADE script of a flat-bottom silo run."""
+    check_silo_case(case)
+    return render_deck("yade/silo_flat.py.j2", silo_script_context(case))
+
+
+def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
+    """Write the script and ``case.json`` into ``deck_dir``; returns the script path."""
+    return write_script_inputs(case.summary(), render_silo_script(case), deck_dir)
+
+
+def run_silo(case: SiloCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
+    """Run a rendered flat-bottom silo script, check it and write ``run.json``; returns the record."""
+    return run_script_checked(
+        run_dir, options, expected_simulated_time(case),
+        lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
+        lambda checked: silo_run_record(ENGINE_NAME, "silo_flat", case.run_id, checked),
+    )
