@@ -6,12 +6,13 @@ CONFIG   ?= config/config.yaml
 CORES    ?= 2
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
+YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 
 .PHONY: install install-system install-python run validate test test-unit test-integration dry-run bench estimate
 
 install: install-system install-python
 
-# Debian packages: only when the engine or MPI launcher is missing.
+# Debian packages: only when an engine or the MPI launcher is missing.
 install-system:
 	@if ! command -v liggghts >/dev/null 2>&1 || ! command -v mpirun >/dev/null 2>&1; then \
 		echo "Installing $(APT_PACKAGES) with apt-get"; \
@@ -19,6 +20,15 @@ install-system:
 		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PACKAGES); \
 	else \
 		echo "LIGGGHTS: $$(command -v liggghts), MPI: $$(command -v mpirun)"; \
+	fi
+	@# YADE without its recommends (62 packages instead of a desktop); siloflow imports its Python modules from
+	@# /usr/bin/python3 and never starts its launcher, which opens ports.
+	@if [ ! -d $(YADE_MODULES) ]; then \
+		echo "Installing yade (no recommends) with apt-get"; \
+		$(SUDO) apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends yade; \
+	else \
+		echo "YADE: $(YADE_MODULES)"; \
 	fi
 
 # pip is a no-op when everything is already satisfied.

@@ -72,7 +72,7 @@ RUN_RECORD_SCHEMA = {
     "properties": {
         "schema_version": {"const": SCHEMA_VERSION},
         "engine": {"type": "string", "pattern": "^[a-z][a-z0-9_]*$"},
-        "case": {"enum": ["jenike", "silo_flat", "silo_recirculation", "blender"]},
+        "case": {"enum": ["jenike", "silo_flat", "silo_recirculation", "blender", "verification"]},
         "run_id": {"type": "string", "pattern": "^[A-Za-z0-9_.=,+-]+$"},
         "timestep_s": {"type": "number", "exclusiveMinimum": 0},
         "n_clumps": {"type": "integer", "minimum": 0},

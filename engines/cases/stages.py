@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 __all__ = ["OUTPUTS", "STAGE_KINDS", "Stage"]
 
 #: Every kind of stage a case may ask for.
-STAGE_KINDS = ("fill", "settle", "consolidate", "shear", "open", "discharge", "recirculate")
+STAGE_KINDS = ("fill", "settle", "consolidate", "shear", "open", "discharge", "recirculate", "release")
 #: What a stage may have to output: particle frames, contact forces, the force history of the walls, restart files.
 OUTPUTS = ("frames", "contacts", "wall_contacts", "wall_forces", "restart")
 

@@ -20,6 +20,7 @@ from engines.cases.blender import BlenderCase
 from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import SiloCase
 from engines.cases.silo_recirculation import RecirculationCase
+from engines.cases.verification import VerificationCase
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from engines.liggghts.blender import GATE, run_blender, write_blender_inputs
@@ -43,6 +44,7 @@ from engines.liggghts.settled import read_settled_fill
 from engines.cases.silo_flat import FLOOR_MESHES
 from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
+from engines.liggghts.verification import run_verification, write_verification_inputs
 
 __all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]
 
@@ -59,6 +61,7 @@ _STAGES = {
     "silo_recirculation": ("fill", "settle", "open", "recirculate"),
     "blender": ("fill", "settle", "open", "discharge"),
     "jenike": ("fill", "settle", "consolidate", "shear"),
+    "verification": ("release",),
 }
 
 
@@ -76,6 +79,7 @@ _ADAPTERS = {
     RecirculationCase: _Adapter("silo_recirculation", write_recirculation_inputs, run_recirculation),
     BlenderCase: _Adapter("blender", write_blender_inputs, run_blender),
     JenikeCase: _Adapter("jenike", write_jenike_inputs, run_jenike),
+    VerificationCase: _Adapter("verification", write_verification_inputs, run_verification),
 }
 
 
@@ -88,6 +92,8 @@ def _adapter(case) -> _Adapter:
 
 def _restitution_pairs(case) -> list[tuple[str, str, float, str]]:
     """(material a, material b, restitution, config key) of every pair with a particle in it."""
+    if isinstance(case, VerificationCase):
+        return [("sphere", "sphere", case.restitution, f"verification problem {case.name}")]
     if isinstance(case, JenikeCase):
         names = case.materials.names
         found = []

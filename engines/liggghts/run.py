@@ -28,7 +28,7 @@ from engines.interface import EngineNotFound, EngineRunError
 from engines.run_files import output_bytes, write_run_record
 from engines.run_files import set_aside_previous_attempt as set_aside
 from engines.liggghts.dumps import list_dumps
-from engines.layout import write_text_atomic
+from engines.layout import RUN_RECORD, write_text_atomic
 from engines.liggghts.inputs import DECK_NAME
 from engines.liggghts.markers import error_lines, log_excerpt
 from engines.markers import Marker, parse_markers

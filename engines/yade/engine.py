@@ -15,6 +15,7 @@ from analysis.data.frames import ParticleFrame
 from analysis.data.record import RunRecord
 from analysis.data.settled import SettledFill
 from engines.cases.silo_flat import FLOOR_MESHES, SiloCase
+from engines.cases.verification import VerificationCase
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from engines.yade.cost import measured_seconds_per_sphere_step
@@ -22,11 +23,15 @@ from engines.yade.inputs import ENGINE_NAME, rolling_friction
 from engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
 from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs
 from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
+from engines.yade.verification import run_verification, write_verification_inputs
 
 __all__ = ["YadeEngine"]
 
 #: What each case kind YADE builds is written and run with, and the walls that make its floor.
-_ADAPTERS = {SiloCase: ("silo_flat", write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES)}
+_ADAPTERS = {
+    SiloCase: ("silo_flat", write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES),
+    VerificationCase: ("verification", write_verification_inputs, run_verification, lambda case: None, None),
+}
 
 
 def _adapter(case):
@@ -62,7 +67,8 @@ class YadeEngine(Engine):
             Naming the config key and the limit.
         """
         kind, _, _, check, _ = _adapter(case)
-        rolling_friction(case.materials, f"{kind} run {case.run_id}")
+        if hasattr(case, "materials"):
+            rolling_friction(case.materials, f"{kind} run {case.run_id}")
         check(case)
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
@@ -93,7 +99,7 @@ class YadeEngine(Engine):
         return [fill.contacts for fill in self.settled_fill(run_dir, record)]
 
     def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
-        floors = {kind: floor for kind, _, _, _, floor in _ADAPTERS.values()}
+        floors = {kind: floor for kind, _, _, _, floor in _ADAPTERS.values() if floor is not None}
         if record.case not in floors:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on YADE")
         return read_settled_fill(run_dir, SETTLED_FILL_PREFIX, floors[record.case])

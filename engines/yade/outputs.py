@@ -41,7 +41,8 @@ def _frame(data: dict, path: Path) -> ParticleFrame:
             time=float(data["time"]), step=int(data["step"]), id=data["id"].astype(np.int64),
             type=data["type"].astype(np.int32), clump_id=data["clump_id"].astype(np.int64),
             position=data["position"].reshape(-1, 3), velocity=data["velocity"].reshape(-1, 3),
-            angular_velocity=None, radius=data["radius"], mass=data["mass"])
+            angular_velocity=data["angular_velocity"].reshape(-1, 3) if "angular_velocity" in data else None,
+            radius=data["radius"], mass=data["mass"])
     except KeyError as error:
         raise DamagedOutput(f"{path}: the archive has no {error.args[0]!r}") from None
 

@@ -1,0 +1,59 @@
+"""LIGGGHTS decks of the verification problems (``templates/liggghts/verification.lmp.j2``): free spheres of one
+material, the floor as a primitive wall of a second material of the same properties, every sphere's state dumped."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+from analysis.data.record import RunRecord
+from engines.cases.verification import VerificationCase
+from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
+from engines.liggghts.run import DUMP_PREFIX, run_checked
+from engines.templating import render_deck
+from engines.verification_checks import check_verification_run, verification_record
+
+#: What the verification decks dump per sphere: the state the closed forms need, spin included.
+VERIFICATION_DUMP_FIELDS = ("id", "type", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz", "radius",
+                            "mass")
+
+
+def verification_deck_context(case: VerificationCase) -> dict:
+    """The rendering context of ``templates/liggghts/verification.lmp.j2``."""
+    pair = lambda value: [float(value)] * 4  # noqa: E731  (particle-particle and particle-floor alike)
+    return {
+        "title": f"siloflow-verification-{case.run_id}",
+        "boundary": ["f", "f", "f"],
+        "domain": {"x": list(case.domain[0:2]), "y": list(case.domain[2:4]), "z": list(case.domain[4:6])},
+        "switches": {"soft_particles": case.youngs_modulus < 5e6, "hard_particles": case.youngs_modulus > 1e9},
+        "neighbor_skin": 0.4 * case.radius,
+        "materials": {"n_types": 2, "youngs_modulus": [case.youngs_modulus] * 2, "poisson_ratio": [case.poisson_ratio] * 2,
+                      "restitution": pair(case.restitution), "sliding_friction": pair(case.sliding_friction),
+                      "rolling_friction": pair(case.rolling_friction)},
+        "timestep": case.timestep,
+        "gravity": abs(case.gravity[2]),
+        "spheres": [asdict(sphere) for sphere in case.spheres],
+        "diameter": 2.0 * case.radius,
+        "density": case.density,
+        "floor": case.floor,
+        "steps": case.steps,
+        "dump": {"id": "particle_dump", "every": case.output_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
+                 "fields": list(VERIFICATION_DUMP_FIELDS)},
+    }
+
+
+def write_verification_inputs(case: VerificationCase, deck_dir: str | Path) -> Path:
+    """Write the deck and ``case.json`` into ``deck_dir``; returns the deck path."""
+    deck = render_deck("liggghts/verification.lmp.j2", verification_deck_context(case))
+    return write_case_inputs({}, case.summary(), deck, deck_dir)
+
+
+def run_verification(case: VerificationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
+                     mpirun: str = "mpirun") -> RunRecord:
+    """Run a rendered verification deck (serially: one or two spheres), check it and write ``run.json``."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_verification_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": 1, "mpirun": mpirun},
+        lambda checked: verification_record(ENGINE_NAME, case, checked),
+    )

@@ -1,0 +1,54 @@
+"""YADE scripts of the verification problems (``templates/yade/verification.py.j2``): free spheres of one material,
+the floor as an infinite wall of a second material of the same properties, every sphere's state saved."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+from analysis.data.constants import GRAVITY
+from analysis.data.record import RunRecord
+from engines.cases.verification import VerificationCase
+from engines.templating import render_deck
+from engines.verification_checks import check_verification_run, verification_record
+from engines.yade.inputs import ENGINE_NAME, hertz_stiffness_at_load, write_script_inputs
+from engines.yade.run import DUMP_PREFIX, YadeOptions, run_script_checked
+
+
+def verification_script_context(case: VerificationCase) -> dict:
+    """The rendering context of ``templates/yade/verification.py.j2``."""
+    material = {"youngs_modulus": case.youngs_modulus, "poisson_ratio": case.poisson_ratio, "density": case.density}
+    kn = hertz_stiffness_at_load(case.radius, case.youngs_modulus, case.poisson_ratio, case.mass * GRAVITY)
+    return {
+        "title": f"siloflow-verification-{case.run_id}",
+        "timestep": case.timestep,
+        "gravity": abs(case.gravity[2]),
+        "materials": {
+            "list": [material, material],
+            "pairs": [{"i": i, "j": j, "sliding_friction": case.sliding_friction, "restitution": case.restitution}
+                      for i, j in ((0, 0), (0, 1), (1, 1))],
+            "rolling_friction": case.rolling_friction,
+            "rolling_stiffness": 2.25 * kn * case.rolling_friction**2 * case.radius**2,
+        },
+        "radius": case.radius,
+        "spheres": [asdict(sphere) for sphere in case.spheres],
+        "floor": case.floor,
+        "steps": case.steps,
+        "output_every": case.output_every,
+        "frame_prefix": DUMP_PREFIX,
+    }
+
+
+def write_verification_inputs(case: VerificationCase, deck_dir: str | Path) -> Path:
+    """Write the script and ``case.json`` into ``deck_dir``; returns the script path."""
+    script = render_deck("yade/verification.py.j2", verification_script_context(case))
+    return write_script_inputs(case.summary(), script, deck_dir)
+
+
+def run_verification(case: VerificationCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
+    """Run a rendered verification script, check it and write ``run.json``; returns the record."""
+    return run_script_checked(
+        run_dir, options, case.steps * case.timestep,
+        lambda markers, frames: check_verification_run(case, markers, frames, Path(run_dir)),
+        lambda checked: verification_record(ENGINE_NAME, case, checked),
+    )
