@@ -19,6 +19,7 @@ include: "workflow/rules/silo_recirculation.smk"
 include: "workflow/rules/blender.smk"
 include: "workflow/rules/fill_balance.smk"
 include: "workflow/rules/validation.smk"
+include: "workflow/rules/verification.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -214,16 +214,27 @@ def engines_in_use(filled: Mapping) -> set[str]:
     return {filled[section].get("engine") or filled["engine"]["kind"] for section in CASE_SECTIONS}
 
 
+def _engine_defaults() -> dict:
+    """The schema's defaults of the ``engine`` section, each engine's settings one level down."""
+    section = load_schema()["properties"]["engine"]["properties"]
+    return {key: ({name: spec.get("default") for name, spec in value.get("properties", {}).items()}
+                  if value.get("type") == "object" else value.get("default"))
+            for key, value in section.items()}
+
+
 def _check_engine_settings(raw: Mapping, filled: Mapping) -> None:
     """Refuse a setting the user gave for an engine that runs no case: ``engine.<kind>.*`` or an MPI key of
     LIGGGHTS' (it would be silently ignored)."""
     used = engines_in_use(filled)
     given = raw.get("engine") or {}
+    defaults = _engine_defaults()
     for kind, only in ENGINE_ONLY_KEYS.items():
         if kind in used:
             continue
-        keys = [f"engine.{kind}.{key}" for key in sorted(given.get(kind) or {})]
-        keys += [".".join(path) for path in only if path[1] in given]
+        # a value equal to its default changes nothing (and a validated configuration carries every default)
+        own = given.get(kind) or {}
+        keys = [f"engine.{kind}.{key}" for key in sorted(own) if own[key] != defaults[kind].get(key)]
+        keys += [".".join(path) for path in only if path[1] in given and given[path[1]] != defaults[path[1]]]
         if keys:
             runs = ", ".join(sorted(used))
             raise ConfigError(

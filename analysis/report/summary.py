@@ -129,6 +129,14 @@ COLUMNS: dict[str, Column] = {
     "study_value": Column("The study", kind=TEXT),
     "scale_shows": Column("The scale shows it", kind=TEXT),
     "evidence": Column("From the run", kind=TEXT),
+    # the verification table (verification/verification.csv)
+    "quantity": Column("Quantity", kind=TEXT),
+    "engine": Column("Engine", kind=TEXT),
+    "closed_form": Column("Closed form"),
+    "measured": Column("Measured"),
+    "error": Column("Relative error"),
+    "tolerance": Column("Tolerance"),
+    "passes": Column("Within tolerance", kind=FLAG),
 }
 
 #: The blender comparison's VRR columns, one per sine period (a fraction of the mean residence time).

@@ -21,7 +21,8 @@ from analysis.numerics.verification import (
     zero_crossings,
 )
 
-__all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "verification_table"]
+__all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "trajectories_from_frames",
+           "verification_table"]
 
 #: Relative tolerance of each measured quantity (the time step resolves a contact in 100 steps; frames of the
 #: impacts are every step).
@@ -58,6 +59,30 @@ class VerificationRow:
     @property
     def passes(self) -> bool:
         return abs(self.error) <= self.tolerance
+
+
+def trajectories_from_frames(frames) -> Trajectories:
+    """The trajectories of a run's frames (:class:`analysis.data.frames.ParticleFrame`, oldest first), spheres in
+    the order of their ids.
+
+    Raises
+    ------
+    ValueError
+        When the frames hold different spheres or no angular velocity.
+    """
+    if not frames:
+        raise ValueError("no frames")
+    ids = np.sort(frames[0].id)
+    columns = {"position": [], "velocity": [], "angular_velocity": []}
+    for frame in frames:
+        order = np.argsort(frame.id)
+        if not np.array_equal(frame.id[order], ids):
+            raise ValueError(f"the frame of step {frame.step} holds spheres {frame.id.tolist()}, not {ids.tolist()}")
+        if frame.angular_velocity is None:
+            raise ValueError(f"the frame of step {frame.step} has no angular velocity")
+        for name in columns:
+            columns[name].append(getattr(frame, name)[order])
+    return Trajectories(np.array([frame.time for frame in frames]), *(np.array(columns[n]) for n in columns))
 
 
 def _row(problem: str, quantity: str, closed: float, measured: float) -> VerificationRow:
@@ -131,6 +156,8 @@ def verification_table(rows_by_engine: dict[str, list[VerificationRow]]) -> pd.D
         for row in rows:
             records.append({"engine": engine, **asdict(row), "error": row.error, "passes": row.passes})
     columns = ["problem", "quantity", "engine", "closed_form", "measured", "error", "tolerance", "passes"]
+    if not records:
+        raise ValueError("no verification rows")
     table = pd.DataFrame.from_records(records, columns=columns)
     return table.sort_values(["problem", "quantity", "engine"], kind="stable").reset_index(drop=True)
 

@@ -1,0 +1,158 @@
+"""The verification problems' closed forms and measurements, against exact answers on synthetic trajectories."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from analysis.data.frames import ParticleFrame
+from analysis.numerics.verification import (
+    HERTZ_TIME_CONSTANT,
+    contact_interval,
+    hertz_contact_time,
+    linear_slope,
+    rolling_deceleration_cdt,
+    sliding_to_rolling,
+    zero_crossings,
+)
+from analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
+from engines.cases.verification import PROBLEMS, verification_cases
+
+
+def test_hertz_time_constant_is_the_integral_it_names():
+    value, _ = integrate.quad(lambda x: (1.0 - x**2.5) ** -0.5, 0.0, 1.0)
+    assert HERTZ_TIME_CONSTANT == pytest.approx(2.0 * value, rel=1e-9)
+    assert HERTZ_TIME_CONSTANT == pytest.approx(2.9432, abs=1e-4)
+
+
+def test_hertz_time_follows_the_undamped_impact_ode():
+    """Integrate m x'' = -4/3 E sqrt(R) x^(3/2) from x = 0, x' = v until x returns to 0."""
+    mass, radius, modulus, speed = 1.7e-5, 1.5e-3, 2.98e6, 1.0
+
+    def motion(_, y):
+        return [y[1], -4.0 / 3.0 * modulus * math.sqrt(radius) * max(y[0], 0.0) ** 1.5 / mass]
+
+    leaves = lambda t, y: y[0] if t > 0 else 1.0  # noqa: E731
+    leaves.terminal, leaves.direction = True, -1
+    solution = integrate.solve_ivp(motion, (0.0, 1.0), [0.0, speed], events=leaves, rtol=1e-11, atol=1e-14)
+    assert hertz_contact_time(mass, radius, modulus, speed) == pytest.approx(solution.t_events[0][0], rel=1e-6)
+
+
+def test_sliding_to_rolling_and_rolling_deceleration_by_hand():
+    assert sliding_to_rolling(0.7, 0.5, 10.0) == pytest.approx((0.04, 0.5), rel=1e-15)
+    assert rolling_deceleration_cdt(0.14, 10.0) == pytest.approx(1.0, rel=1e-15)
+    with pytest.raises(ValueError, match="friction"):
+        sliding_to_rolling(1.0, 0.0, 9.81)
+
+
+def test_zero_crossings_interpolate_linearly():
+    t = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    assert zero_crossings(t, [1.0, -1.0, -3.0, 1.0, 1.0]).tolist() == [0.5, 2.75]
+    assert zero_crossings(t, [1.0, 0.0, -1.0, -1.0, -1.0]).tolist() == [1.0]
+
+
+def test_contact_interval_and_its_refusals():
+    t = np.linspace(0.0, 1.0, 11)
+    assert contact_interval(t, (t - 0.25) * (t - 0.75)) == pytest.approx((0.25, 0.75), abs=0.01)
+    with pytest.raises(ValueError, match="never touch"):
+        contact_interval(t, t + 1.0)
+    with pytest.raises(ValueError, match="not ended"):
+        contact_interval(t, 0.5 - t)
+
+
+def test_linear_slope_of_a_line_is_exact():
+    slope, error = linear_slope([0.0, 1.0, 2.0, 3.0], [1.0, -1.0, -3.0, -5.0])
+    assert slope == pytest.approx(-2.0, rel=1e-15) and error == pytest.approx(0.0, abs=1e-15)
+
+
+def _params(name):
+    case = verification_cases()[name]
+    return {**case.summary(), "gravity": case.gravity, "radius": case.radius}
+
+
+def test_a_synthetic_elastic_wall_impact_measures_its_own_rebound_and_contact():
+    p = _params("wall_impact")
+    r, closed = p["radius"], hertz_contact_time(p["mass_kg"], p["radius"], 5e6 / (2 * (1 - 0.16)), 1.0)
+    t = np.linspace(0.0, 3 * closed, 3001)
+    # a gap that dips below zero exactly for the Hertz time, the velocity reversed after it
+    start = closed / 2
+    gap = np.where((t > start) & (t < start + closed), -1e-6, 1e-6)
+    gap[np.argmax(t > start) - 1] = 0.0
+    z = r + gap
+    v = np.where(t < start + closed / 2, -1.0, 1.0)
+    position = np.zeros((t.size, 1, 3))
+    position[:, 0, 2] = z
+    velocity = np.zeros((t.size, 1, 3))
+    velocity[:, 0, 2] = v
+    rows = measure_problem("wall_impact", p, Trajectories(t, position, velocity, np.zeros_like(velocity)))
+    assert [(row.quantity, row.measured) for row in rows][0] == ("restitution", 1.0)
+    assert rows[1].measured == pytest.approx(closed, abs=2 * (t[1] - t[0]))
+    assert all(row.passes for row in rows)
+
+
+def test_a_sphere_that_slides_then_rolls_as_the_closed_form_says_passes():
+    p = _params("slide_to_roll")
+    r, mu, g = p["radius"], p["sliding_friction"], 9.81
+    v0 = PROBLEMS["slide_to_roll"]["speed"]
+    t_star, v_roll = sliding_to_rolling(v0, mu, g)
+    t = np.linspace(0.0, 2 * t_star, 801)
+    speed = np.where(t < t_star, v0 - mu * g * t, v_roll)
+    spin = np.where(t < t_star, 2.5 * mu * g * t / r, v_roll / r)
+    velocity, angular = np.zeros((t.size, 1, 3)), np.zeros((t.size, 1, 3))
+    velocity[:, 0, 0], angular[:, 0, 1] = speed, spin
+    rows = measure_problem("slide_to_roll", p, Trajectories(t, np.zeros_like(velocity), velocity, angular))
+    assert rows[0].measured == pytest.approx(t_star, rel=1e-9)
+    assert rows[1].measured == pytest.approx(v_roll, rel=1e-12)
+    assert rows[0].error == pytest.approx(0.0, abs=1e-9)
+
+
+def test_rolling_deceleration_is_measured_on_the_rolling_phase_only():
+    p = _params("rolling")
+    a = rolling_deceleration_cdt(p["rolling_friction"], 9.81)
+    t = np.linspace(0.0, 0.06, 601)
+    speed = np.maximum(0.05 - a * t, 0.0)
+    speed[:10] += 0.003  # the settling bounce at the start is left out
+    velocity = np.zeros((t.size, 1, 3))
+    velocity[:, 0, 0] = speed
+    (row,) = measure_problem("rolling", p, Trajectories(t, np.zeros_like(velocity), velocity, np.zeros_like(velocity)))
+    assert row.measured == pytest.approx(a, rel=1e-9)
+
+
+def test_the_table_reports_each_engines_rows_and_refuses_an_unknown_problem():
+    p = _params("rolling")
+    with pytest.raises(ValueError, match="unknown verification problem"):
+        measure_problem("spin", p, Trajectories(np.zeros(3), *(np.zeros((3, 1, 3)),) * 3))
+    rows = measure_problem("wall_impact_damped", _params("wall_impact_damped"), Trajectories(
+        np.array([0.0, 1.0, 2.0, 3.0]), np.array([[[0, 0, 2e-3]], [[0, 0, 1e-3]], [[0, 0, 1.4e-3]], [[0, 0, 2e-3]]]),
+        np.array([[[0, 0, -1.0]]] * 3 + [[[0, 0, 0.6]]]), np.zeros((4, 1, 3))))
+    table = verification_table({"a": rows, "b": rows})
+    assert table["engine"].tolist() == ["a", "b"]
+    assert table["measured"].tolist() == pytest.approx([0.6, 0.6])
+    assert table["error"].tolist() == pytest.approx([0.2, 0.2])
+    assert not table["passes"].any()
+
+
+def test_trajectories_order_spheres_by_id_and_refuse_missing_spin():
+    def frame(step, ids, spin=True):
+        n = len(ids)
+        return ParticleFrame(time=step * 0.1, step=step, id=np.array(ids), type=np.ones(n, dtype=np.int32),
+                             clump_id=np.array(ids), position=np.array(ids, dtype=float)[:, None] * np.ones((n, 3)),
+                             velocity=np.zeros((n, 3)), angular_velocity=np.zeros((n, 3)) if spin else None,
+                             radius=np.ones(n), mass=np.ones(n))
+    run = trajectories_from_frames([frame(0, [2, 1]), frame(1, [1, 2])])
+    assert run.position[:, :, 0].tolist() == [[1.0, 2.0], [1.0, 2.0]]
+    assert run.time.tolist() == [0.0, 0.1]
+    with pytest.raises(ValueError, match="no angular velocity"):
+        trajectories_from_frames([frame(0, [1, 2], spin=False)])
+
+
+def test_the_suite_resolves_each_contact_and_lasts_long_enough():
+    cases = verification_cases()
+    assert set(cases) == set(PROBLEMS)
+    for name, case in cases.items():
+        assert case.run_id.startswith(name)
+        if "impact" in name:
+            assert case.output_every == 1  # every step: the contact time is resolved to one time step
