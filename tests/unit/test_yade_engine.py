@@ -100,13 +100,18 @@ def test_a_case_without_a_yade_script_is_refused_naming_the_engine_key():
 
 @pytest.mark.parametrize("raw, key", [
     ({"engine": {"yade": {"threads": 2}}}, "engine.yade.threads"),
-    ({"engine": {"kind": "yade", "liggghts": {"executable": "liggghts"}}}, "engine.liggghts.executable"),
+    ({"engine": {"kind": "yade", "liggghts": {"executable": "/opt/liggghts/lmp"}}}, "engine.liggghts.executable"),
     ({"engine": {"kind": "yade", "mpi_ranks": 2}}, "engine.mpi_ranks"),
     ({"engine": {"kind": "yade", "mpirun": "mpiexec"}}, "engine.mpirun"),
 ])
 def test_a_setting_of_an_engine_that_runs_no_case_is_refused_naming_the_key(raw, key):
     with pytest.raises(ConfigError, match=rf"config key '{key}' is a \w+ setting, but no case runs on"):
         validate_config(raw)
+
+
+def test_a_setting_at_its_default_is_accepted_so_a_validated_config_validates_again():
+    config = validate_config({"engine": {"yade": {"threads": 1}}})
+    assert validate_config(config)["engine"] == config["engine"]
 
 
 def test_settings_of_both_engines_are_accepted_when_both_run_cases():
