@@ -80,3 +80,4 @@ bench: install
 	$(PYTHON) -m tests.bench.bench_pathlines results/bench/pathlines.csv
 	$(PYTHON) -m tests.bench.bench_mpi results/bench/mpi.csv
 	$(PYTHON) -m tests.bench.bench_decks results/bench/decks.csv
+	$(PYTHON) -m tests.bench.bench_engines results/bench/engines.csv

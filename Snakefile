@@ -20,6 +20,7 @@ include: "workflow/rules/blender.smk"
 include: "workflow/rules/fill_balance.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/verification.smk"
+include: "workflow/rules/cross_engine.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -137,6 +137,16 @@ COLUMNS: dict[str, Column] = {
     "error": Column("Relative error"),
     "tolerance": Column("Tolerance"),
     "passes": Column("Within tolerance", kind=FLAG),
+    # the cross-engine table (cross_engine/cross_engine.csv)
+    "liggghts_mean": Column("LIGGGHTS, mean over seeds"),
+    "liggghts_std": Column("LIGGGHTS, standard deviation"),
+    "liggghts_seeds": Column("LIGGGHTS seeds", kind=COUNT),
+    "yade_mean": Column("YADE, mean over seeds"),
+    "yade_std": Column("YADE, standard deviation"),
+    "yade_seeds": Column("YADE seeds", kind=COUNT),
+    "difference_error": Column("Standard error of the difference"),
+    "difference_in_errors": Column("Difference / its standard error"),
+    "larger_than_2_errors": Column("Larger than 2 standard errors", kind=FLAG),
 }
 
 #: The blender comparison's VRR columns, one per sine period (a fraction of the mean residence time).

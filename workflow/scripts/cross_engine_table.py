@@ -1,0 +1,26 @@
+"""Snakemake adapter: the cross-engine table (CSV and report page) from every run's metrics."""
+
+import json
+from pathlib import Path
+
+from analysis.io.tables import write_flow_table, write_text
+from analysis.report.summary import summary_html
+from analysis.studies.cross_engine import CROSS_ENGINE_QUANTITIES, compare_engines
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    runs = [json.loads(Path(path).read_text()) for path in snakemake.input.metrics]
+    engines = snakemake.params.engines
+    rows = []
+    for key, (label, unit) in CROSS_ENGINE_QUANTITIES.items():
+        values = {engine: [run[key] for run in runs if run["engine"] == engine] for engine in engines}
+        rows.append(compare_engines(values, label, unit))
+    write_flow_table(snakemake.output.table, rows)
+    explanation = snakemake.params.explanation
+    write_text(snakemake.output.page, summary_html("Cross-engine check: the same silo on two engines",
+                                                   [("The small flat-bottom silo", explanation, rows)]))
+    for row in rows:
+        log.info("%s: %s %.5g +- %.2g, %s %.5g +- %.2g (std over seeds); difference %.3g = %.2f standard errors%s",
+                 row["quantity"], engines[0], row[f"{engines[0]}_mean"], row[f"{engines[0]}_std"], engines[1],
+                 row[f"{engines[1]}_mean"], row[f"{engines[1]}_std"], row["difference"], row["difference_in_errors"],
+                 " (larger than 2)" if row["larger_than_2_errors"] else "")
