@@ -9,6 +9,8 @@ Closed forms (SI units):
   ``5/7 v0`` (solid sphere, I = 2/5 m r^2, no rolling resistance).
 - A sphere rolling without slip against a constant directional torque ``mu_r r |Fn|``: it decelerates at
   ``(5/7) mu_r g``.
+- A free symmetric top (principal moments ``I_axis, I_perp, I_perp``) spinning at ``omega`` (body axes = space axes
+  at t = 0): its symmetry axis precesses about the angular momentum ``L = I omega`` at ``|L| / I_perp``.
 
 Measurements take arrays (times, gaps, velocities), never files.
 """
@@ -26,7 +28,9 @@ __all__ = [
     "HERTZ_TIME_CONSTANT",
     "contact_interval",
     "hertz_contact_time",
+    "axis_precession_angle",
     "linear_slope",
+    "precession_rate",
     "rolling_deceleration_cdt",
     "sliding_to_rolling",
     "zero_crossings",
@@ -69,6 +73,37 @@ def sliding_to_rolling(speed: float, friction: float, gravity: float) -> tuple[f
 def rolling_deceleration_cdt(rolling_friction: float, gravity: float) -> float:
     """Deceleration [m/s^2] of a solid sphere rolling without slip against a constant directional torque."""
     return 5.0 / 7.0 * _positive("rolling_friction", rolling_friction) * _positive("gravity", gravity)
+
+
+def precession_rate(inertia, angular_velocity) -> float:
+    """Rate [rad/s] at which the symmetry axis (the first principal axis) of a free symmetric top precesses about
+    its angular momentum.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,)
+        Principal moments [kg m2]: the symmetry axis first, then the two equal ones (their mean is used).
+    angular_velocity : array_like, shape (3,)
+        Angular velocity [rad/s] in the principal frame.
+    """
+    moments = finite_array("inertia", inertia)
+    omega = finite_array("angular_velocity", angular_velocity)
+    if moments.shape != (3,) or omega.shape != (3,) or np.any(moments <= 0):
+        raise ValueError(f"inertia (3 moments > 0) and angular_velocity (3,) expected, got {moments} and {omega}")
+    return float(np.linalg.norm(moments * omega) / moments[1:].mean())
+
+
+def axis_precession_angle(axis, momentum) -> np.ndarray:
+    """Unwrapped angle [rad] of the unit vectors ``axis`` ``(n, 3)`` about the direction of ``momentum`` (3,):
+    the angle of each vector's part perpendicular to it, in a fixed basis of that plane."""
+    vectors = finite_array("axis", axis, ndim=2)
+    direction = finite_array("momentum", momentum)
+    direction = direction / np.linalg.norm(direction)
+    helper = np.eye(3)[int(np.argmin(np.abs(direction)))]
+    first = np.cross(direction, helper)
+    first /= np.linalg.norm(first)
+    second = np.cross(direction, first)
+    return np.unwrap(np.arctan2(vectors @ second, vectors @ first))
 
 
 def zero_crossings(times, values) -> np.ndarray:

@@ -13,9 +13,11 @@ import numpy as np
 import pandas as pd
 
 from analysis.numerics.verification import (
+    axis_precession_angle,
     contact_interval,
     hertz_contact_time,
     linear_slope,
+    precession_rate,
     rolling_deceleration_cdt,
     sliding_to_rolling,
     zero_crossings,
@@ -27,7 +29,7 @@ __all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "
 #: Relative tolerance of each measured quantity (the time step resolves a contact in 100 steps; frames of the
 #: impacts are every step).
 TOLERANCES = {"restitution": 0.02, "contact_time": 0.03, "rolling_time": 0.02, "rolling_speed": 0.01,
-              "rolling_deceleration": 0.03}
+              "rolling_deceleration": 0.03, "precession_rate": 0.01}
 
 
 @dataclass(frozen=True)
@@ -96,7 +98,7 @@ def _flat_modulus(p: dict) -> float:
 
 def measure_problem(problem: str, p: dict, run: Trajectories) -> list[VerificationRow]:
     """The rows of problem ``problem`` (``wall_impact``, ``pair_impact``, their ``_damped`` variants,
-    ``slide_to_roll``, ``rolling``) from its
+    ``slide_to_roll``, ``rolling``, ``clump_rotation``) from its
     parameters ``p`` (``radius``, ``mass_kg``, ``youngs_modulus``, ``poisson_ratio``, ``restitution``,
     ``sliding_friction``, ``rolling_friction``, ``gravity``) and the run's trajectories.
 
@@ -127,6 +129,12 @@ def measure_problem(problem: str, p: dict, run: Trajectories) -> list[Verificati
             rows.append(_row(problem, "contact_time",
                              hertz_contact_time(m / 2.0, r / 2.0, _flat_modulus(p), before), end - start))
         return rows
+    if problem == "clump_rotation":
+        axis = x[:, 1] - x[:, 0]
+        axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+        inertia, spin = np.asarray(p["clump_inertia"]), np.asarray(p["initial_angular_velocity"])
+        slope, _ = linear_slope(t, axis_precession_angle(axis, inertia * spin))
+        return [_row(problem, "precession_rate", precession_rate(inertia, spin), abs(slope))]
     gravity = abs(p["gravity"][2])
     if problem == "slide_to_roll":
         slip = v[:, 0, 0] - w[:, 0, 1] * r

@@ -13,6 +13,9 @@ two free spheres of the study's HDPE, a flat floor (or none) and gravity (or non
   rolls at 5/7 of its speed, at t = 2 v0 / (7 mu g) (no rolling resistance).
 - ``rolling``: a sphere rolls on the floor without slip: rolling resistance slows it; for a constant directional
   torque (CDT) at (5/7) mu_r g.
+- ``clump_rotation``: the study's two-sphere clump (3 mm spheres 0.75 mm apart) spins freely about an axis that is
+  not a principal one: its axis precesses about the angular momentum L at |L| / I_perp, which tests the clump's
+  inertia (the union of the spheres, overlap counted once).
 
 Every problem is a :class:`VerificationCase`: engine-neutral data, written and run by an engine like any other case;
 its frames (every sphere's position, velocity and spin) are what :mod:`analysis.numerics.verification` measures.
@@ -23,7 +26,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from engines.cases.common import run_id
+from engines.cases.particles import clump_inertia, clump_volume
 from engines.cases.stages import Stage
 
 __all__ = ["MATERIAL", "PROBLEMS", "VerificationCase", "VerificationSphere", "verification_cases"]
@@ -61,6 +67,16 @@ class VerificationCase:
     steps: int
     output_every: int
     domain: tuple[float, float, float, float, float, float]
+    #: a clump instead of free spheres: its sphere centres relative to its centre of mass [m] (principal axes along
+    #: x, y, z), its principal moments of inertia [kg m2] and mass [kg] (the exact union of the spheres)
+    clump_spheres: tuple[tuple[float, float, float], ...] = ()
+    clump_inertia: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    clump_mass: float = 0.0
+
+    @property
+    def n_spheres(self) -> int:
+        """Spheres in the problem (those of the clump, or the free ones)."""
+        return len(self.clump_spheres) or len(self.spheres)
 
     @property
     def run_id(self) -> str:
@@ -70,8 +86,8 @@ class VerificationCase:
 
     @property
     def mass(self) -> float:
-        """Mass of one sphere [kg]."""
-        return self.density * 4.0 / 3.0 * math.pi * self.radius**3
+        """Mass of one sphere [kg], or of the clump."""
+        return self.clump_mass if self.clump_spheres else self.density * 4.0 / 3.0 * math.pi * self.radius**3
 
     def stages(self) -> tuple[Stage, ...]:
         return (Stage("release", {"duration_s": self.steps * self.timestep,
@@ -81,8 +97,8 @@ class VerificationCase:
         """Plain-data summary (``case.json``)."""
         return {"case": "verification", "run_id": self.run_id, "problem": self.name, "timestep_s": self.timestep,
                 "steps": self.steps, "frame_interval_s": self.output_every * self.timestep,
-                "mass_kg": self.mass, **{key: value for key, value in self.__dict__.items()
-                                         if key not in ("spheres", "name")}}
+                "mass_kg": self.mass, "initial_angular_velocity": self.spheres[0].angular_velocity,
+                **{key: value for key, value in self.__dict__.items() if key not in ("spheres", "name")}}
 
 
 def _hertz_time(radius_eff: float, mass_eff: float, modulus_eff: float, speed: float) -> float:
@@ -100,7 +116,10 @@ PROBLEMS = {
     "pair_impact_damped": {"speed": 0.5, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "slide_to_roll": {"speed": 0.2, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "rolling": {"speed": 0.05, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.1},
+    "clump_rotation": {"speed": 100.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
 }
+#: The study's two-sphere clump: centres along x, 0.75 mm apart.
+CLUMP_HALF_SPACING = 0.375e-3
 
 
 def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCase]:
@@ -146,4 +165,20 @@ def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCa
     mu_r = PROBLEMS["rolling"]["rolling_friction"]
     case("rolling", [VerificationSphere((0.0, 0.0, r), (v, 0.0, 0.0), (0.0, v / r, 0.0))], True,
          (0.0, 0.0, -GRAVITY), resting, 0.8 * v / (5.0 / 7.0 * mu_r * GRAVITY))
+    # a free clump spinning at 100 rad/s about an axis 30 degrees off its long axis (no contacts: the time step only
+    # resolves the rotation, 2000 steps a turn)
+    centres = np.array([[-CLUMP_HALF_SPACING, 0.0, 0.0], [CLUMP_HALF_SPACING, 0.0, 0.0]])
+    tensor = clump_inertia(centres, [r, r], rho)
+    spin = PROBLEMS["clump_rotation"]["speed"]
+    omega = (spin * math.cos(math.radians(30.0)), spin * math.sin(math.radians(30.0)), 0.0)
+    turn = 2.0 * math.pi / spin
+    problem = PROBLEMS["clump_rotation"]
+    steps = 4000 * 3
+    cases["clump_rotation"] = VerificationCase(
+        name="clump_rotation", spheres=(VerificationSphere((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), omega),), floor=False,
+        gravity=(0.0, 0.0, 0.0), radius=r, density=rho, youngs_modulus=e_mod, poisson_ratio=nu,
+        sliding_friction=problem["sliding_friction"], rolling_friction=0.0, restitution=problem["restitution"],
+        timestep=turn / 2000.0, steps=steps, output_every=20, domain=(-box, box, -box, box, -box, box),
+        clump_spheres=tuple(tuple(map(float, c)) for c in centres),
+        clump_inertia=tuple(float(v) for v in np.diag(tensor)), clump_mass=rho * clump_volume(centres, [r, r]))
     return cases

@@ -36,9 +36,29 @@ def verification_deck_context(case: VerificationCase) -> dict:
         "diameter": 2.0 * case.radius,
         "density": case.density,
         "floor": case.floor,
+        "clump": _clump_context(case),
         "steps": case.steps,
         "dump": {"id": "particle_dump", "every": case.output_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk",
                  "fields": list(VERIFICATION_DUMP_FIELDS)},
+    }
+
+
+def _clump_context(case: VerificationCase) -> dict | None:
+    """The clump of a clump problem: its multisphere template (Monte Carlo inertia from 1e6 samples, as the silo
+    decks), a spot around its start position, and its spin; None for free spheres."""
+    if not case.clump_spheres:
+        return None
+    centre, spin = case.spheres[0].position, case.spheres[0].angular_velocity
+    half = 2.0 * case.radius  # LIGGGHTS places the clump at random in it; a smaller region has "no volume"
+    return {
+        # LIGGGHTS wants the seeds of the template, the distribution and the insertion all different
+        "insertion_seed": 49979687,
+        "particle": {"name": "clump", "seed": 15485863, "distribution_seed": 32452843, "type": 1,
+                     "density": case.density, "ntry": 1000000,
+                     "spheres": [[*map(float, c), float(case.radius)] for c in case.clump_spheres]},
+        "spot": [centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half, centre[2] - half,
+                 centre[2] + half],
+        "omega": list(spin),
     }
 
 

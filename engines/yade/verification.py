@@ -36,6 +36,9 @@ def verification_script_context(case: VerificationCase) -> dict:
         "steps": case.steps,
         "output_every": case.output_every,
         "frame_prefix": DUMP_PREFIX,
+        # a clump problem's clump: centres in its principal frame, the exact mass and principal inertia
+        "clump": ({"centres": [list(c) for c in case.clump_spheres], "mass": case.clump_mass,
+                   "inertia": list(case.clump_inertia)} if case.clump_spheres else None),
     }
 
 

@@ -11,6 +11,8 @@ from scipy import integrate
 from analysis.data.frames import ParticleFrame
 from analysis.numerics.verification import (
     HERTZ_TIME_CONSTANT,
+    axis_precession_angle,
+    precession_rate,
     contact_interval,
     hertz_contact_time,
     linear_slope,
@@ -46,6 +48,23 @@ def test_sliding_to_rolling_and_rolling_deceleration_by_hand():
     assert rolling_deceleration_cdt(0.14, 10.0) == pytest.approx(1.0, rel=1e-15)
     with pytest.raises(ValueError, match="friction"):
         sliding_to_rolling(1.0, 0.0, 9.81)
+
+
+def test_precession_of_a_symmetric_top_by_hand():
+    # I = (1, 2, 2), omega = (2, 1, 0): L = (2, 2, 0), |L| / I_perp = sqrt(8) / 2
+    assert precession_rate([1.0, 2.0, 2.0], [2.0, 1.0, 0.0]) == pytest.approx(math.sqrt(2.0), rel=1e-15)
+
+
+def test_axis_angle_about_the_momentum_unwraps_a_steady_precession():
+    t = np.linspace(0.0, 3.0, 301)
+    momentum = np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)
+    first = np.array([0.0, 0.0, 1.0])
+    second = np.cross(momentum, first)
+    rate, tilt = 5.0, 0.4
+    axis = (np.cos(tilt) * momentum + np.sin(tilt) * (np.cos(rate * t)[:, None] * first
+                                                      + np.sin(rate * t)[:, None] * second))
+    slope, _ = linear_slope(t, axis_precession_angle(axis, 3.0 * momentum))
+    assert abs(slope) == pytest.approx(rate, rel=1e-12)
 
 
 def test_zero_crossings_interpolate_linearly():

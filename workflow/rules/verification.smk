@@ -18,6 +18,8 @@ VERIFICATION_EXPLANATIONS = {
                      "at 5/7 v0.",
     "rolling": "A sphere rolls at 0.05 m/s without slip (rolling friction 0.1): a constant directional torque "
                "slows it at (5/7) mu_r g; YADE's elastic-plastic rolling moment does the same once it is at its cap.",
+    "clump_rotation": "The two-sphere clump spins freely at 100 rad/s, 30 degrees off its long axis: the axis precesses "
+                      "about the angular momentum L at |L| / I_perp, with the inertia of the union of the spheres.",
 }
 
 #: Rows that differ on an engine, and why ("<engine>/<problem>/<quantity>"): the report says it beside the row.

@@ -21,8 +21,10 @@ with logged_to(snakemake.log[0]) as log:
     metrics = silo_flow_metrics(discharge, width=case["width_m"], depth=case["depth_m"],
                                 outlet_width=case["outlet_width_m"], particle_diameter=diameter)
     height = snakemake.params.profile_height_fraction * case["fill_height_m"]
-    velocity = centreline_vertical_velocity(discharge, height, diameter, diameter, metrics.fit.t_start,
-                                            metrics.fit.t_end)
+    # the steady window is timed from the opening (the first discharge frame)
+    opened = discharge[0].time
+    velocity = centreline_vertical_velocity(discharge, height, diameter, diameter, opened + metrics.fit.t_start,
+                                            opened + metrics.fit.t_end)
     summary = {"engine": record.engine, "run_id": record.run_id, "seed": case["parameters"]["silo"]["seed"],
                "filling_bulk_density_kg_m3": metrics.bulk_density.density,
                "mass_flow_rate_kg_s": metrics.fit.mass_flow_rate, "centreline_v_z_m_s": velocity,
