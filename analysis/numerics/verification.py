@@ -9,6 +9,8 @@ Closed forms (SI units):
   ``5/7 v0`` (solid sphere, I = 2/5 m r^2, no rolling resistance).
 - A sphere rolling without slip against a constant directional torque ``mu_r r |Fn|``: it decelerates at
   ``(5/7) mu_r g``.
+- A block on a flat under gravity tilted by theta, friction mu: it slides at ``g (sin theta - mu cos theta)`` when
+  ``tan theta > mu`` and stays put otherwise.
 - A free symmetric top (principal moments ``I_axis, I_perp, I_perp``) spinning at ``omega`` (body axes = space axes
   at t = 0): its symmetry axis precesses about the angular momentum ``L = I omega`` at ``|L| / I_perp``.
 
@@ -29,6 +31,7 @@ __all__ = [
     "contact_interval",
     "hertz_contact_time",
     "axis_precession_angle",
+    "incline_acceleration",
     "linear_slope",
     "precession_rate",
     "rolling_deceleration_cdt",
@@ -73,6 +76,16 @@ def sliding_to_rolling(speed: float, friction: float, gravity: float) -> tuple[f
 def rolling_deceleration_cdt(rolling_friction: float, gravity: float) -> float:
     """Deceleration [m/s^2] of a solid sphere rolling without slip against a constant directional torque."""
     return 5.0 / 7.0 * _positive("rolling_friction", rolling_friction) * _positive("gravity", gravity)
+
+
+def incline_acceleration(angle_deg: float, friction: float, gravity: float) -> float:
+    """Acceleration [m/s^2] of a block on an incline of ``angle_deg`` with sliding friction ``friction``: zero when
+    friction holds it (``tan(angle) <= friction``)."""
+    angle = math.radians(_positive("angle_deg", angle_deg))
+    gravity = _positive("gravity", gravity)
+    if not (isinstance(friction, (int, float)) and math.isfinite(friction) and friction >= 0):
+        raise ValueError(f"friction must be a finite number >= 0, got {friction!r}")
+    return max(0.0, gravity * (math.sin(angle) - friction * math.cos(angle)))
 
 
 def precession_rate(inertia, angular_velocity) -> float:

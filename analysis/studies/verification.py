@@ -7,6 +7,7 @@ Input per run: the sphere trajectories as arrays (times ``(n,)``; positions, vel
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -16,6 +17,7 @@ from analysis.numerics.verification import (
     axis_precession_angle,
     contact_interval,
     hertz_contact_time,
+    incline_acceleration,
     linear_slope,
     precession_rate,
     rolling_deceleration_cdt,
@@ -29,7 +31,7 @@ __all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "
 #: Relative tolerance of each measured quantity (the time step resolves a contact in 100 steps; frames of the
 #: impacts are every step).
 TOLERANCES = {"restitution": 0.02, "contact_time": 0.03, "rolling_time": 0.02, "rolling_speed": 0.01,
-              "rolling_deceleration": 0.03, "precession_rate": 0.01}
+              "rolling_deceleration": 0.03, "precession_rate": 0.01, "incline_acceleration": 0.02}
 
 
 @dataclass(frozen=True)
@@ -52,11 +54,13 @@ class VerificationRow:
     closed_form: float
     measured: float
     tolerance: float
+    #: what the error is relative to: the closed form, or (where that is 0) the scale of the quantity
+    scale: float = 0.0
 
     @property
     def error(self) -> float:
-        """Relative error of the measurement."""
-        return (self.measured - self.closed_form) / abs(self.closed_form)
+        """Error of the measurement relative to the closed form (or to ``scale`` when given)."""
+        return (self.measured - self.closed_form) / (self.scale or abs(self.closed_form))
 
     @property
     def passes(self) -> bool:
@@ -87,8 +91,8 @@ def trajectories_from_frames(frames) -> Trajectories:
     return Trajectories(np.array([frame.time for frame in frames]), *(np.array(columns[n]) for n in columns))
 
 
-def _row(problem: str, quantity: str, closed: float, measured: float) -> VerificationRow:
-    return VerificationRow(problem, quantity, float(closed), float(measured), TOLERANCES[quantity])
+def _row(problem: str, quantity: str, closed: float, measured: float, scale: float = 0.0) -> VerificationRow:
+    return VerificationRow(problem, quantity, float(closed), float(measured), TOLERANCES[quantity], float(scale))
 
 
 def _flat_modulus(p: dict) -> float:
@@ -98,7 +102,7 @@ def _flat_modulus(p: dict) -> float:
 
 def measure_problem(problem: str, p: dict, run: Trajectories) -> list[VerificationRow]:
     """The rows of problem ``problem`` (``wall_impact``, ``pair_impact``, their ``_damped`` variants,
-    ``slide_to_roll``, ``rolling``, ``clump_rotation``) from its
+    ``slide_to_roll``, ``rolling``, ``incline_slide``, ``incline_stick``, ``clump_rotation``) from its
     parameters ``p`` (``radius``, ``mass_kg``, ``youngs_modulus``, ``poisson_ratio``, ``restitution``,
     ``sliding_friction``, ``rolling_friction``, ``gravity``) and the run's trajectories.
 
@@ -135,6 +139,17 @@ def measure_problem(problem: str, p: dict, run: Trajectories) -> list[Verificati
         inertia, spin = np.asarray(p["clump_inertia"]), np.asarray(p["initial_angular_velocity"])
         slope, _ = linear_slope(t, axis_precession_angle(axis, inertia * spin))
         return [_row(problem, "precession_rate", precession_rate(inertia, spin), abs(slope))]
+    if problem in ("incline_slide", "incline_stick"):
+        # the block's centre of mass along the slope, after it has settled on the floor (two fifths of the run)
+        along = v[:, :, 0].mean(axis=1)
+        settled = t > 0.4 * t[-1]
+        slope, _ = linear_slope(t[settled], along[settled])
+        g = float(np.linalg.norm(p["gravity"]))
+        angle = math.degrees(math.atan2(p["gravity"][0], -p["gravity"][2]))
+        closed = incline_acceleration(angle, p["sliding_friction"], g)
+        # a block that sticks has no acceleration to be relative to: its error is relative to g sin(theta)
+        return [_row(problem, "incline_acceleration", closed, slope,
+                     0.0 if closed > 0 else g * math.sin(math.radians(angle)))]
     gravity = abs(p["gravity"][2])
     if problem == "slide_to_roll":
         slip = v[:, 0, 0] - w[:, 0, 1] * r

@@ -13,6 +13,9 @@ two free spheres of the study's HDPE, a flat floor (or none) and gravity (or non
   rolls at 5/7 of its speed, at t = 2 v0 / (7 mu g) (no rolling resistance).
 - ``rolling``: a sphere rolls on the floor without slip: rolling resistance slows it; for a constant directional
   torque (CDT) at (5/7) mu_r g.
+- ``incline_slide``, ``incline_stick``: a block (four spheres in a square, 3 r apart) on the floor under gravity
+  tilted by 30 and 15 degrees: above the friction angle (tan 30 deg > mu) it slides at g (sin theta - mu cos theta),
+  below it stays put.
 - ``clump_rotation``: the study's two-sphere clump (3 mm spheres 0.75 mm apart) spins freely about an axis that is
   not a principal one: its axis precesses about the angular momentum L at |L| / I_perp, which tests the clump's
   inertia (the union of the spheres, overlap counted once).
@@ -116,6 +119,8 @@ PROBLEMS = {
     "pair_impact_damped": {"speed": 0.5, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "slide_to_roll": {"speed": 0.2, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "rolling": {"speed": 0.05, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.1},
+    "incline_slide": {"angle_deg": 30.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
+    "incline_stick": {"angle_deg": 15.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "clump_rotation": {"speed": 100.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
 }
 #: The study's two-sphere clump: centres along x, 0.75 mm apart.
@@ -181,4 +186,19 @@ def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCa
         timestep=turn / 2000.0, steps=steps, output_every=20, domain=(-box, box, -box, box, -box, box),
         clump_spheres=tuple(tuple(map(float, c)) for c in centres),
         clump_inertia=tuple(float(v) for v in np.diag(tensor)), clump_mass=rho * clump_volume(centres, [r, r]))
+    # a block of four spheres on the floor, gravity tilted about y: it slides along +x or sticks
+    block = np.array([[sx * 1.5 * r, sy * 1.5 * r, 0.0] for sx in (-1, 1) for sy in (-1, 1)])
+    block_tensor = clump_inertia(block, [r] * 4, rho)
+    for name in ("incline_slide", "incline_stick"):
+        problem = PROBLEMS[name]
+        angle = math.radians(problem["angle_deg"])
+        timestep = resting / steps_per_contact
+        steps = int(math.ceil(0.1 / timestep))
+        cases[name] = VerificationCase(
+            name=name, spheres=(VerificationSphere((0.0, 0.0, 1.05 * r), (0.0, 0.0, 0.0)),), floor=True,
+            gravity=(GRAVITY * math.sin(angle), 0.0, -GRAVITY * math.cos(angle)), radius=r, density=rho,
+            youngs_modulus=e_mod, poisson_ratio=nu, sliding_friction=problem["sliding_friction"], rolling_friction=0.0,
+            restitution=problem["restitution"], timestep=timestep, steps=steps, output_every=max(1, steps // 400),
+            domain=(-box, box + 0.05, -box, box, -box, box), clump_spheres=tuple(tuple(map(float, c)) for c in block),
+            clump_inertia=tuple(float(v) for v in np.diag(block_tensor)), clump_mass=4 * mass)
     return cases

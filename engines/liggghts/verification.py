@@ -3,6 +3,7 @@ material, the floor as a primitive wall of a second material of the same propert
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 from pathlib import Path
 
@@ -31,7 +32,8 @@ def verification_deck_context(case: VerificationCase) -> dict:
                       "restitution": pair(case.restitution), "sliding_friction": pair(case.sliding_friction),
                       "rolling_friction": pair(case.rolling_friction)},
         "timestep": case.timestep,
-        "gravity": abs(case.gravity[2]),
+        "gravity": _magnitude(case.gravity),
+        "gravity_direction": [g / _magnitude(case.gravity) for g in case.gravity] if any(case.gravity) else [0.0, 0.0, -1.0],
         "spheres": [asdict(sphere) for sphere in case.spheres],
         "diameter": 2.0 * case.radius,
         "density": case.density,
@@ -43,21 +45,27 @@ def verification_deck_context(case: VerificationCase) -> dict:
     }
 
 
+def _magnitude(vector) -> float:
+    return math.sqrt(sum(v * v for v in vector))
+
+
 def _clump_context(case: VerificationCase) -> dict | None:
     """The clump of a clump problem: its multisphere template (Monte Carlo inertia from 1e6 samples, as the silo
     decks), a spot around its start position, and its spin; None for free spheres."""
     if not case.clump_spheres:
         return None
     centre, spin = case.spheres[0].position, case.spheres[0].angular_velocity
-    half = 2.0 * case.radius  # LIGGGHTS places the clump at random in it; a smaller region has "no volume"
+    # LIGGGHTS places the clump at random in it (a smaller region has "no volume"): across 4 r, and from the start
+    # height up by a fiftieth of a radius, so that a clump on the floor starts just above it
+    half = 2.0 * case.radius
     return {
         # LIGGGHTS wants the seeds of the template, the distribution and the insertion all different
         "insertion_seed": 49979687,
         "particle": {"name": "clump", "seed": 15485863, "distribution_seed": 32452843, "type": 1,
                      "density": case.density, "ntry": 1000000,
                      "spheres": [[*map(float, c), float(case.radius)] for c in case.clump_spheres]},
-        "spot": [centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half, centre[2] - half,
-                 centre[2] + half],
+        "spot": [centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half, centre[2],
+                 centre[2] + 0.02 * case.radius],
         "omega": list(spin),
     }
 

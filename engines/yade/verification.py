@@ -23,6 +23,7 @@ def verification_script_context(case: VerificationCase) -> dict:
         "title": f"siloflow-verification-{case.run_id}",
         "timestep": case.timestep,
         "gravity": abs(case.gravity[2]),
+        "gravity_vector": list(case.gravity),
         "materials": {
             "list": [material, material],
             "pairs": [{"i": i, "j": j, "sliding_friction": case.sliding_friction, "restitution": case.restitution}

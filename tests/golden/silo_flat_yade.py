@@ -15,6 +15,7 @@ from yade import O, Matrix3, Quaternion, Vector3, utils  # noqa: E402
 
 TIMESTEP = 1.1540372226009369e-05
 GRAVITY = 9.81
+GRAVITY_VECTOR = (0.0, 0.0, -GRAVITY)
 #: per material: Young's modulus [Pa], Poisson ratio, density [kg/m3] (the particle material first)
 MATERIALS = [(5000000.0, 0.4, 950.0), (5000000.0, 0.4, 1000.0), (5000000.0, 0.4, 1000.0), ]
 #: per material pair (i, j): sliding friction, restitution
@@ -67,7 +68,7 @@ def set_engines(material_ids):
                                                krot=ROLLING_STIFFNESS, eta=ROLLING_FRICTION)],
             [Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=True)],
         ),
-        NewtonIntegrator(gravity=(0.0, 0.0, -GRAVITY), damping=0.0),
+        NewtonIntegrator(gravity=GRAVITY_VECTOR, damping=0.0),
     ]
     O.dt = TIMESTEP
 

@@ -35,7 +35,7 @@ def table(tmp_path_factory):
 
 def test_every_closed_form_holds_on_liggghts(table):
     liggghts = table[table["engine"] == "liggghts"]
-    assert len(liggghts) == 10
+    assert len(liggghts) == 12
     assert liggghts["passes"].all(), liggghts.to_string()
 
 

@@ -12,6 +12,7 @@ from analysis.data.frames import ParticleFrame
 from analysis.numerics.verification import (
     HERTZ_TIME_CONSTANT,
     axis_precession_angle,
+    incline_acceleration,
     precession_rate,
     contact_interval,
     hertz_contact_time,
@@ -65,6 +66,28 @@ def test_axis_angle_about_the_momentum_unwraps_a_steady_precession():
                                                       + np.sin(rate * t)[:, None] * second))
     slope, _ = linear_slope(t, axis_precession_angle(axis, 3.0 * momentum))
     assert abs(slope) == pytest.approx(rate, rel=1e-12)
+
+
+def test_incline_acceleration_by_hand_and_zero_below_the_friction_angle():
+    assert incline_acceleration(30.0, 0.0, 10.0) == pytest.approx(5.0, rel=1e-15)
+    assert incline_acceleration(45.0, 0.5, 10.0) == pytest.approx(10.0 * math.sqrt(0.5) * 0.5, rel=1e-12)
+    assert incline_acceleration(15.0, 0.35, 9.81) == 0.0
+
+
+@pytest.mark.parametrize("name", ["incline_slide", "incline_stick"])
+def test_a_synthetic_block_moving_as_the_closed_form_says_passes(name):
+    p = _params(name)
+    g = np.linalg.norm(p["gravity"])
+    angle = math.degrees(math.atan2(p["gravity"][0], -p["gravity"][2]))
+    a = incline_acceleration(angle, p["sliding_friction"], g)
+    t = np.linspace(0.0, 0.05, 401)
+    velocity = np.zeros((t.size, 4, 3))
+    velocity[:, :, 0] = (a * t)[:, None]
+    velocity[:20, :, 2] = 0.01  # the settling at the start is left out
+    (row,) = measure_problem(name, p, Trajectories(t, np.zeros_like(velocity), velocity, np.zeros_like(velocity)))
+    assert row.closed_form == pytest.approx(a, rel=1e-15)
+    assert row.measured == pytest.approx(a, rel=1e-9, abs=1e-12)
+    assert row.passes and abs(row.error) < 1e-9
 
 
 def test_zero_crossings_interpolate_linearly():

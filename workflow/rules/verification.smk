@@ -18,6 +18,10 @@ VERIFICATION_EXPLANATIONS = {
                      "at 5/7 v0.",
     "rolling": "A sphere rolls at 0.05 m/s without slip (rolling friction 0.1): a constant directional torque "
                "slows it at (5/7) mu_r g; YADE's elastic-plastic rolling moment does the same once it is at its cap.",
+    "incline_slide": "A block of four spheres on the floor, gravity tilted by 30 degrees (tan 30 > mu = 0.35): it "
+                     "slides at g (sin 30 - mu cos 30).",
+    "incline_stick": "The same block at 15 degrees (tan 15 < mu): friction holds it; the error is relative to "
+                     "g sin 15.",
     "clump_rotation": "The two-sphere clump spins freely at 100 rad/s, 30 degrees off its long axis: the axis precesses "
                       "about the angular momentum L at |L| / I_perp, with the inertia of the union of the spheres.",
 }
