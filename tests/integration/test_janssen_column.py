@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
@@ -55,8 +56,11 @@ def columns(tmp_path_factory):
     require_liggghts()
     require_yade()
     root = tmp_path_factory.mktemp("columns")
-    return {(engine, frictionless): _settled(engine, frictionless, root) for engine in ENGINES
-            for frictionless in (True, False)}
+    keys = [(engine, frictionless) for engine in ENGINES for frictionless in (True, False)]
+    # one run per core: each engine runs serially
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {key: pool.submit(_settled, *key, root) for key in keys}
+        return {key: future.result() for key, future in futures.items()}
 
 
 @pytest.mark.parametrize("engine", ENGINES)
