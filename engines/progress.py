@@ -17,8 +17,11 @@ driver serialises writers per call. So lines of parallel jobs may alternate but 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 import os
+import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from typing import Callable, Protocol, TextIO
@@ -291,3 +294,29 @@ class ProgressMonitor:
         self._report(report)
         self._last_report = self._clock()
         return report
+
+
+def run_with_progress(command: list[str], run_dir: str | os.PathLike, output_path: str | os.PathLike,
+                      environment: dict, parser: ScreenParser, target_time: float | None, report_every: float,
+                      poll_every: float = 1.0) -> int:
+    """Run ``command`` in ``run_dir`` with its output (stdout and stderr) written to ``output_path``, and return its
+    exit code. With ``target_time`` [s of simulated time] a :class:`ProgressMonitor` reads the output with
+    ``parser`` every ``poll_every`` s and reports every ``report_every`` s, in the log and, when the job's stderr is
+    a terminal, as one line naming the run there. No shell is involved and stdin is closed."""
+    terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
+    monitor = (ProgressMonitor(output_path, parser, target_time, os.path.basename(os.fspath(run_dir)), report_every,
+                               logging.getLogger("siloflow"), terminal) if target_time else None)
+    with open(output_path, "w", encoding="utf-8") as output:
+        process = subprocess.Popen(command, cwd=run_dir, stdout=output, stderr=subprocess.STDOUT, env=environment,
+                                   stdin=subprocess.DEVNULL)
+        while True:
+            try:
+                returncode = process.wait(timeout=poll_every)
+                break
+            except subprocess.TimeoutExpired:
+                if monitor is not None:
+                    output.flush()
+                    monitor.poll()
+    if monitor is not None:
+        monitor.finish()
+    return returncode

@@ -17,8 +17,6 @@ import logging
 import os
 import re
 import shutil
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,7 +30,7 @@ from engines.liggghts.inputs import DECK_NAME
 from engines.liggghts.markers import error_lines, log_excerpt
 from engines.markers import Marker, parse_markers
 from engines.liggghts.thermo import ThermoProgress
-from engines.progress import ProgressMonitor
+from engines.progress import run_with_progress
 from engines.templating import render_deck
 
 LOG_NAME = "log.liggghts"
@@ -142,21 +140,8 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     command = engine_command(f"deck/{deck_name}", executable, mpi_ranks, mpirun, log_name)
     (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
     (run_dir / RESTART_DIR).mkdir(exist_ok=True)
-    terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
-    monitor = (ProgressMonitor(run_dir / screen_name, ThermoProgress(), target_time, run_dir.name, PROGRESS_LOG_EVERY,
-                               logging.getLogger("siloflow"), terminal) if target_time else None)
-    with open(run_dir / screen_name, "w", encoding="utf-8") as screen:
-        process = subprocess.Popen(command, cwd=run_dir, stdout=screen, stderr=subprocess.STDOUT, env=_mpi_environment())
-        while True:
-            try:
-                returncode = process.wait(timeout=PROGRESS_POLL_EVERY)
-                break
-            except subprocess.TimeoutExpired:
-                if monitor is not None:
-                    screen.flush()
-                    monitor.poll()
-    if monitor is not None:
-        monitor.finish()
+    returncode = run_with_progress(command, run_dir, run_dir / screen_name, _mpi_environment(), ThermoProgress(),
+                                   target_time, PROGRESS_LOG_EVERY, PROGRESS_POLL_EVERY)
     log_path = run_dir / log_name
     log_text = log_path.read_text(encoding="utf-8", errors="replace") if log_path.exists() else ""
     screen_text = (run_dir / screen_name).read_text(encoding="utf-8", errors="replace")

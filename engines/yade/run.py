@@ -28,8 +28,6 @@ import logging
 import os
 import re
 import shutil
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -37,7 +35,7 @@ from typing import Callable
 from analysis.data.record import RunRecord
 from engines.interface import EngineNotFound, EngineRunError
 from engines.markers import Marker, parse_markers
-from engines.progress import ProgressMonitor
+from engines.progress import run_with_progress
 from engines.run_files import output_bytes, set_aside_previous_attempt, write_run_record
 from engines.yade.inputs import DECK_NAME
 from engines.yade.progress import ScriptProgress
@@ -117,22 +115,8 @@ def run_script(run_dir: str | Path, options: YadeOptions, target_time: float | N
     command = script_command(options, arguments)
     environment = {**os.environ, "OMP_NUM_THREADS": str(options.threads), "PYTHONUNBUFFERED": "1"}
     environment.pop("PYTHONPATH", None)  # the project's environment must not shadow the system Python's modules
-    terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
-    monitor = (ProgressMonitor(run_dir / log_name, ScriptProgress(), target_time, run_dir.name, PROGRESS_LOG_EVERY,
-                               logging.getLogger("siloflow"), terminal) if target_time else None)
-    with open(run_dir / log_name, "w", encoding="utf-8") as log:
-        process = subprocess.Popen(command, cwd=run_dir, stdout=log, stderr=subprocess.STDOUT, env=environment,
-                                   stdin=subprocess.DEVNULL)
-        while True:
-            try:
-                returncode = process.wait(timeout=PROGRESS_POLL_EVERY)
-                break
-            except subprocess.TimeoutExpired:
-                if monitor is not None:
-                    log.flush()
-                    monitor.poll()
-    if monitor is not None:
-        monitor.finish()
+    returncode = run_with_progress(command, run_dir, run_dir / log_name, environment, ScriptProgress(), target_time,
+                                   PROGRESS_LOG_EVERY, PROGRESS_POLL_EVERY)
     text = (run_dir / log_name).read_text(encoding="utf-8", errors="replace")
     problems = _error_lines(text)
     if returncode != 0 or problems:
