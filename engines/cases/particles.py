@@ -165,6 +165,23 @@ def _union_volume_by_columns(centres: np.ndarray, radii: np.ndarray, resolution:
     return sum(float(moments[0].sum()) for _, _, moments in chunks) * area
 
 
+def _checked_spheres(sphere_positions, sphere_radii, resolution: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sphere centres (k, 3) and radii (k,) > 0 as arrays, and a grid resolution >= 10; the error names the fault."""
+    centres = finite_array("sphere_positions", sphere_positions, ndim=2)
+    if centres.shape[1] != 3 or centres.shape[0] == 0:
+        raise ValueError(f"sphere_positions must have shape (k, 3) with k >= 1, got {centres.shape}")
+    radii = finite_array("sphere_radii", sphere_radii)
+    if radii.shape != (centres.shape[0],):
+        raise ValueError(
+            f"sphere_radii must have shape ({centres.shape[0]},), got {radii.shape}"
+        )
+    if np.any(radii <= 0.0):
+        raise ValueError("sphere_radii must be > 0")
+    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 10:
+        raise ValueError(f"resolution must be an integer >= 10, got {resolution!r}")
+    return centres, radii
+
+
 def clump_inertia(sphere_positions, sphere_radii, density: float, resolution: int = 400) -> np.ndarray:
     """Inertia tensor of a multisphere clump about its centre of mass, overlaps counted once [kg m2].
 
@@ -189,15 +206,9 @@ def clump_inertia(sphere_positions, sphere_radii, density: float, resolution: in
     numpy.ndarray, shape (3, 3)
         The inertia tensor [kg m2].
     """
-    centres = finite_array("sphere_positions", sphere_positions, ndim=2)
-    radii = finite_array("sphere_radii", sphere_radii)
-    if centres.shape[1] != 3 or radii.shape != (centres.shape[0],) or np.any(radii <= 0.0):
-        raise ValueError(f"sphere_positions must have shape (k, 3) and sphere_radii (k,) with radii > 0, got "
-                         f"{centres.shape} and {radii.shape}")
+    centres, radii = _checked_spheres(sphere_positions, sphere_radii, resolution)
     if not (math.isfinite(density) and density > 0.0):
         raise ValueError(f"density must be finite and > 0, got {density!r}")
-    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 10:
-        raise ValueError(f"resolution must be an integer >= 10, got {resolution!r}")
     chunks, area = _union_column_moments(centres, radii, int(resolution), 2)
     # raw moments about the origin: volume, first moments, second moments (x x, y y, z z, x y, x z, y z)
     m0 = sum(float(m[0].sum()) for _, _, m in chunks)
@@ -257,18 +268,7 @@ def clump_volume(
       relative error is ~2e-4 at a resolution of 100 and ~1e-5 at the
       default 400. Deterministic (no random sampling).
     """
-    centres = finite_array("sphere_positions", sphere_positions, ndim=2)
-    if centres.shape[1] != 3 or centres.shape[0] == 0:
-        raise ValueError(f"sphere_positions must have shape (k, 3) with k >= 1, got {centres.shape}")
-    radii = finite_array("sphere_radii", sphere_radii)
-    if radii.shape != (centres.shape[0],):
-        raise ValueError(
-            f"sphere_radii must have shape ({centres.shape[0]},), got {radii.shape}"
-        )
-    if np.any(radii <= 0.0):
-        raise ValueError("sphere_radii must be > 0")
-    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 10:
-        raise ValueError(f"resolution must be an integer >= 10, got {resolution!r}")
+    centres, radii = _checked_spheres(sphere_positions, sphere_radii, resolution)
     if method not in ("auto", "grid"):
         raise ValueError(f"method must be 'auto' or 'grid', got {method!r}")
 
