@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.interface import engine_named
+from engines.cases import cases_of
+from engines.interface import EngineOptions, engine_for, engine_named
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
@@ -144,3 +145,14 @@ def require_liggghts():
     without it. `make test` installs it (Debian package liggghts)."""
     if shutil.which("liggghts") is None:
         pytest.fail("LIGGGHTS is not installed: run `make test`, which installs the Debian package liggghts")
+
+
+def run_first_case(config: dict, kind: str, root: Path):
+    """Render and run the first case of kind ``kind`` of a validated configuration on its engine, in
+    ``root/<run id>``; returns (case, engine, run directory, run record)."""
+    case = next(iter(cases_of(config, kind).values()))
+    engine = engine_for(config, kind)
+    run_dir = root / case.run_id
+    engine.write_inputs(case, run_dir)
+    record = engine.run(case, run_dir, EngineOptions.from_config(config, engine.name))
+    return case, engine, run_dir, record

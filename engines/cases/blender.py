@@ -22,6 +22,8 @@ import math
 from dataclasses import dataclass, field
 
 from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
+from engines.cases.blender_meshes import blender_meshes
+from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import particle_template
 from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from analysis.data.constants import GRAVITY
@@ -323,3 +325,17 @@ def blender_case_for_run(config: dict, run: str) -> BlenderCase:
     if run not in cases:
         raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
     return cases[run]
+
+
+#: The gate over the outlet, removed when the outlet opens.
+GATE = "outlet_gate"
+#: Longest outline edge of a wall mesh (m): keeps triangles from being extremely elongated.
+MAX_MESH_EDGE = 0.05
+
+
+def blender_mesh_set(case: BlenderCase) -> dict:
+    """The wall meshes of a run: the geometry's closed walls plus the gate over the outlet (z = 0, normal up)."""
+    meshes = dict(blender_meshes(case.geometry, max_edge=MAX_MESH_EDGE))
+    half_outlet = 0.5 * case.geometry.outlet_width
+    meshes[GATE] = horizontal_rectangle(-half_outlet, half_outlet, 0.0, case.geometry.depth, 0.0)
+    return meshes

@@ -22,7 +22,8 @@ import copy
 from dataclasses import dataclass, field
 
 from engines.cases.common import run_id
-from engines.cases.silo_flat import SiloCase, silo_case_from_section
+from engines.cases.geometry import vertical_rectangle_x
+from engines.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
 
 CASE_NAME = "silo_recirculation"
 #: The config section of the case.
@@ -32,6 +33,9 @@ SECTION = "silo_recirculation"
 #: analysis (steady window, Beverloo) keep their schema defaults.
 SILO_KEYS = ("engine", "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction",
              "timestep_hertz_fraction", "seed")
+
+#: The walls of the channel below the outlet (meshes; part of the floor, which holds the fill up).
+CHANNEL_MESHES = ("channel_left", "channel_right")
 
 #: Roles of a recirculation run: the blending study proper, or the one-particle-thick verification silo.
 ROLES = ("blending", "verification")
@@ -111,6 +115,15 @@ class RecirculationCase:
             }
         )
         return summary
+
+
+def recirculation_meshes(case: RecirculationCase) -> dict:
+    """The batch silo's floor and gate plus the two channel walls below the outlet (normals into the channel)."""
+    half_outlet, depth, length = 0.5 * case.silo.outlet_width, case.silo.depth, case.channel_length
+    meshes = silo_meshes(case.silo)
+    meshes["channel_left"] = vertical_rectangle_x(-half_outlet, 0.0, depth, -length, 0.0, normal=1)
+    meshes["channel_right"] = vertical_rectangle_x(half_outlet, 0.0, depth, -length, 0.0, normal=-1)
+    return meshes
 
 
 def estimated_residence_time(

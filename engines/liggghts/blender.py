@@ -11,28 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from engines.cases.blender import BlenderCase
-from engines.cases.blender_meshes import blender_meshes
-from engines.cases.geometry import horizontal_rectangle
+from engines.cases.blender import GATE, BlenderCase, blender_mesh_set
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
 from engines.liggghts.silo_flat import silo_deck_context
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
 from engines.templating import render_deck
-
-GATE = "outlet_gate"
-#: Longest outline edge of a wall mesh (m): keeps triangles from being extremely elongated.
-MAX_MESH_EDGE = 0.05
-
-
-def blender_mesh_set(case: BlenderCase) -> dict:
-    """The wall meshes of a run: the geometry's closed walls plus the gate over the outlet (z = 0, normal up)."""
-    meshes = dict(blender_meshes(case.geometry, max_edge=MAX_MESH_EDGE))
-    half_outlet = 0.5 * case.geometry.outlet_width
-    meshes[GATE] = horizontal_rectangle(-half_outlet, half_outlet, 0.0, case.geometry.depth, 0.0)
-    return meshes
-
 
 def blender_deck_context(case: BlenderCase) -> dict:
     """The rendering context of ``templates/liggghts/blender.lmp.j2``."""

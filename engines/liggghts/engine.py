@@ -23,13 +23,14 @@ from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.verification import VerificationCase
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
-from engines.liggghts.blender import GATE, run_blender, write_blender_inputs
+from engines.cases.blender import GATE
+from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
 from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
+from engines.jenike_checks import JENIKE_FLOOR_WALLS
 from engines.liggghts.jenike import (
-    JENIKE_FLOOR_WALLS,
     PAIR_CONTACT_PREFIX,
     SETTLED_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,

@@ -20,10 +20,8 @@ Silo-type runs (flat-bottom silo, recirculating silo, blender)
     that is not well formed is an error naming the file and line.
 
 Jenike shear cell
-    The deck writes ``<run>/forces.txt`` (:func:`engines.liggghts.jenike.read_force_history`): forces of the
-    particles on the lid, the shear ring and the base, the lid's height and the mass above the shear plane.
-    :func:`jenike_wall_forces` turns them into walls ``lid``, ``shear_ring``, ``base`` (forces negated: on the
-    particles), signals ``lid_z`` [m] and ``mass_above`` [kg]. The deck writes no torques: they are NaN.
+    The deck writes ``<run>/forces.txt`` in the engines' one Jenike format (:mod:`engines.jenike_checks`, read
+    and turned into walls ``lid``, ``shear_ring``, ``base`` there).
 
 The parser is hand-written (a few lines around ``str.split``; the files hold one row per dump interval, a few
 hundred rows, so speed is no concern): ``numpy.loadtxt`` does not read the title's time step or the header's
@@ -40,15 +38,14 @@ from pathlib import Path
 import numpy as np
 
 from analysis.data.forces import WallForceHistory
-from engines.liggghts.jenike import FORCES_NAME, read_force_history
+from engines.jenike_checks import jenike_wall_forces, read_jenike_force_history
+from engines.liggghts.jenike import FORCES_NAME
 from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.run import RESUME_STEM
 
 __all__ = [
-    "JENIKE_WALLS",
     "RESUMED_WALL_FORCES_PREFIX",
     "WALL_FORCES_NAME",
-    "jenike_wall_forces",
     "read_jenike_forces",
     "read_silo_wall_forces",
     "read_wall_forces",
@@ -60,7 +57,6 @@ __all__ = [
 RESUMED_WALL_FORCES_PREFIX = f"{RESUME_STEM}_wall_forces"
 _TITLE = re.compile(r"^siloflow wall forces, time step (\S+) s$")
 QUANTITIES = ("fx", "fy", "fz", "tx", "ty", "tz")
-JENIKE_WALLS = ("lid", "shear_ring", "base")
 
 _RESUMED = re.compile(rf"^{RESUMED_WALL_FORCES_PREFIX}_(\d+)\.txt$")
 _WALL_COLUMN = re.compile(r"^v_([A-Za-z0-9_.-]+)_(fx|fy|fz|tx|ty|tz)$")
@@ -229,39 +225,15 @@ def read_silo_wall_forces(run_dir: str | Path) -> WallForceHistory:
         raise ValueError(f"{run_dir}: wall forces of {', '.join(p.name for _, p in files)}: {error}") from None
 
 
-def jenike_wall_forces(history: dict[str, np.ndarray]) -> WallForceHistory:
-    """The Jenike force history (:func:`engines.liggghts.jenike.read_force_history`) as a wall force history.
-
-    Returns
-    -------
-    analysis.data.forces.WallForceHistory
-        Walls ``lid``, ``shear_ring``, ``base`` (the bottom ring or plate) with the forces they exert on the
-        particles [N] (the file holds those of the particles on them: negated); torques NaN (the deck writes
-        none); signals ``lid_z`` (the lid's height) [m] and ``mass_above`` (clump mass above the shear plane) [kg].
-        Each sample averages the output interval before it; its time is the mean time of that interval [s].
-    """
-    columns = {"lid": "lid", "shear_ring": "ring", "base": "bottom"}
-    force = {wall: -np.column_stack([history[f"{prefix}_f{axis}"] for axis in "xyz"])
-             for wall, prefix in columns.items()}
-    n = len(history["time"])
-    return WallForceHistory(
-        time=history["time"],
-        walls=JENIKE_WALLS,
-        force=force,
-        torque={wall: np.full((n, 3), np.nan) for wall in JENIKE_WALLS},
-        signals={"lid_z": history["lid_z"], "mass_above": history["mass_above"]},
-    )
-
-
 def read_jenike_forces(run_dir: str | Path) -> WallForceHistory:
     """The wall forces of a Jenike run: ``<run_dir>/forces.txt`` read strictly, as :func:`jenike_wall_forces`.
 
     Raises
     ------
     FileNotFoundError, ValueError
-        As :func:`engines.liggghts.jenike.read_force_history`, naming the file.
+        As :func:`engines.jenike_checks.read_jenike_force_history`, naming the file.
     """
-    return jenike_wall_forces(read_force_history(Path(run_dir) / FORCES_NAME))
+    return jenike_wall_forces(read_jenike_force_history(Path(run_dir) / FORCES_NAME))
 
 
 def read_wall_forces(run_dir: str | Path) -> WallForceHistory:

@@ -15,7 +15,7 @@ Run directory layout (the engine runs inside the run directory; relative paths a
     <run>/deck/case.json       derived case quantities
     <run>/dumps/               particle dumps during consolidation and shear (binary legacy VTK), and
                                contact dumps pair_contacts_<step>.txt, wall_contacts_<step>.txt (rigid lid)
-    <run>/forces.txt           force history during consolidation and shear (see read_force_history;
+    <run>/forces.txt           force history during consolidation and shear (see engines.jenike_checks;
                                engines.liggghts.forces reads it as a WallForceHistory)
     <run>/log.liggghts         the engine log
     <run>/engine.out           the engine's screen output
@@ -33,7 +33,7 @@ from analysis.data.contacts import ContactFrame, WallContactFrame
 from engines.cases.geometry import write_stl
 from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
 from analysis.data.record import RunRecord
-from engines.interface import EngineRunError
+from engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from engines.layout import RUN_RECORD
 from engines.liggghts.contacts import parse_local_table
 from engines.liggghts.dumps import list_dumps
@@ -51,36 +51,14 @@ from engines.liggghts.run import (
 )
 from engines.templating import render_deck
 
+#: The force history the deck writes (``fix ave/time``; the format of :mod:`engines.jenike_checks`).
 FORCES_NAME = "forces.txt"
 
-#: Columns of the force history, in file order after the time step (SI units: s, N, m, kg).
-FORCE_COLUMNS = (
-    "time",
-    "lid_fx",
-    "lid_fy",
-    "lid_fz",
-    "ring_fx",
-    "ring_fy",
-    "ring_fz",
-    "bottom_fx",
-    "bottom_fy",
-    "bottom_fz",
-    "lid_z",
-    "mass_above",
-)
-
-STAGES = ("filled", "levelled", "lid_placed", "consolidated", "sheared")
-#: Stage kinds of the markers that end the stages of the Jenike case (lid_placed starts the consolidation).
-JENIKE_STAGE_MARKERS = {"filled": "fill", "levelled": "settle", "consolidated": "consolidate", "sheared": "shear"}
-
+#: The one name the LIGGGHTS deck gives the Jenike force history (format: :mod:`engines.jenike_checks`).
 PAIR_CONTACT_PREFIX = "pair_contacts"
 #: The pair contacts of the levelled, settled fill (before the lid), beside ``settled_fill_<step>.txt``; their own
 #: prefix keeps them out of the consolidation and shear contact frames.
 SETTLED_CONTACT_PREFIX = "settled_contacts"
-#: The meshes whose force on the settled fill the snapshot records (``dumps/settled_walls.txt``, exerted ON the
-#: particles); the base is the floor.
-SETTLED_WALLS = ("base", "shear_ring", "mould")
-JENIKE_FLOOR_WALLS = ("base",)
 #: The meshes of the cell's one mesh wall, by their index in the wall contact dumps.
 WALL_MESHES = ("base", "shear_ring", "mould", "lid")
 WALL_CONTACT_PREFIX = "wall_contacts"
@@ -216,56 +194,6 @@ def write_jenike_inputs(case: JenikeCase, deck_dir: str | Path) -> Path:
 # ---------------------------------------------------------------------------------------------- reading
 
 
-def read_force_history(path: str | Path) -> dict[str, np.ndarray]:
-    """Read the force history a Jenike deck writes (``fix ave/time ... file forces.txt``).
-
-    Each row averages the preceding output interval; ``time`` is the mean time of that interval.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        ``step`` and the :data:`FORCE_COLUMNS`: time (s); forces of the particles on the lid, the shear
-        ring and the bottom ring or plate (N); the lid's height (m); the clump mass above the shear plane
-        (kg).
-
-    Raises
-    ------
-    ValueError
-        Naming the file, if it is empty, a row has the wrong number of columns or is not numeric (e.g. a
-        run cut off while writing), or times do not increase.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"no force history at {path}")
-    rows = []
-    expected = len(FORCE_COLUMNS) + 1
-    for number, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), start=1):
-        text = line.strip()
-        if not text or text.startswith("#"):
-            continue
-        fields = text.split()
-        if len(fields) != expected:
-            raise ValueError(
-                f"{path}: line {number} has {len(fields)} columns, expected {expected} "
-                f"(step {' '.join(FORCE_COLUMNS)}); the file is malformed or truncated"
-            )
-        try:
-            values = [float(field) for field in fields]
-        except ValueError:
-            raise ValueError(f"{path}: line {number} is not numeric: {text[:80]!r}") from None
-        if not all(np.isfinite(values)):
-            raise ValueError(f"{path}: line {number} holds a non-finite value: {text[:80]!r}")
-        rows.append(values)
-    if not rows:
-        raise ValueError(f"{path}: the force history holds no data rows")
-    table = np.array(rows, dtype=float)
-    history = {"step": table[:, 0]}
-    history.update({name: table[:, i + 1] for i, name in enumerate(FORCE_COLUMNS)})
-    if np.any(np.diff(history["time"]) <= 0):
-        raise ValueError(f"{path}: times do not increase from row to row")
-    return history
-
-
 def read_contact_dump(path: str | Path) -> dict[str, np.ndarray]:
     """Read one contact dump (``dump local``) into named columns (:data:`CONTACT_COLUMNS`) plus ``step``.
 
@@ -334,52 +262,6 @@ def _wall_frame(table: dict) -> WallContactFrame:
 # ---------------------------------------------------------------------------------------------- running
 
 
-def check_jenike_run(case: JenikeCase, markers: list, run_dir: Path) -> dict:
-    """Check that a finished Jenike run did what the case asked; returns the stage record.
-
-    Raises
-    ------
-    EngineRunError
-        When a stage marker is missing, too few clumps were created, levelling removed nothing (the cell
-        was not filled above the ring top), or clumps were lost after levelling.
-    """
-    by_event: dict[str, list] = {}
-    for marker in markers:
-        by_event.setdefault(marker.event, []).append(marker)
-    for event in STAGES:
-        if event not in by_event:
-            raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
-    stages = {event: by_event[event][-1].values for event in STAGES}
-    created = int(round(stages["filled"]["clumps"]))
-    if created < 0.98 * case.fill.n_clumps:
-        raise EngineRunError(
-            f"{run_dir}: only {created} of {case.fill.n_clumps} clumps were created or stayed in the cell"
-        )
-    levelled = int(round(stages["levelled"]["clumps"]))
-    if levelled >= created:
-        raise EngineRunError(
-            f"{run_dir}: levelling removed no clump: the fill (top sphere centre at "
-            f"{stages['filled']['top']:.4g} m) did not reach the top of the shear ring "
-            f"({case.geometry.ring_top:.4g} m); raise jenike.fill.overfill"
-        )
-    final = int(round(stages["sheared"]["clumps"]))
-    if final != levelled:
-        raise EngineRunError(f"{run_dir}: {levelled - final} clumps were lost between levelling and the end of shear")
-    forces = run_dir / FORCES_NAME
-    history = read_force_history(forces)
-    return {
-        "stages": stages,
-        "n_clumps_created": created,
-        "n_clumps": levelled,
-        "timestep_s": case.timestep,
-        "consolidation_start_s": stages["lid_placed"]["time"],
-        "shear_start_s": stages["consolidated"]["time"],
-        "shear_end_s": stages["sheared"]["time"],
-        "force_samples": int(history["time"].size),
-        "forces": FORCES_NAME,
-    }
-
-
 def set_aside_previous_jenike_attempt(run_dir: str | Path) -> Path | None:
     """Move an earlier attempt's dumps, log, screen output and force history to ``failed_attempts/<UTC time>/``.
 
@@ -403,20 +285,8 @@ def run_jenike(
     (run_dir / RUN_RECORD).unlink(missing_ok=True)
     set_aside_previous_jenike_attempt(run_dir)
     log_text = run_engine(run_dir, executable, mpi_ranks, mpirun)
-    checked = check_jenike_run(case, parse_markers(log_text), run_dir)
-    stages = checked["stages"]
-    record = RunRecord(
-        engine=ENGINE_NAME,
-        case="jenike",
-        run_id=case.run_id,
-        timestep_s=case.timestep,
-        n_clumps=checked["n_clumps"],
-        n_frames=len(list_dumps(run_dir / "dumps", DUMP_PREFIX)),
-        mpi_ranks=mpi_ranks,
-        stages={kind: stages[marker] for marker, kind in JENIKE_STAGE_MARKERS.items()},
-        output_bytes=output_bytes(run_dir),
-        labels={key: checked[key] for key in ("consolidation_start_s", "shear_start_s", "shear_end_s",
-                                              "n_clumps_created", "force_samples")},
-    )
+    checked = check_jenike_run(case, parse_markers(log_text), run_dir, run_dir / FORCES_NAME)
+    record = jenike_run_record(ENGINE_NAME, case, checked, len(list_dumps(run_dir / "dumps", DUMP_PREFIX)),
+                               mpi_ranks, output_bytes(run_dir))
     write_run_record(run_dir, record)
     return record

@@ -11,27 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from engines.cases.silo_recirculation import RecirculationCase
-from engines.cases.geometry import vertical_rectangle_x
+from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
 from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
-from engines.cases.silo_flat import silo_meshes
 from engines.liggghts.silo_flat import silo_deck_context
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
 from engines.templating import render_deck
-
-CHANNEL_MESHES = ("channel_left", "channel_right")
-
-
-def recirculation_meshes(case: RecirculationCase) -> dict:
-    """The batch silo's floor and gate plus the two channel walls below the outlet (normals into the channel)."""
-    half_outlet, depth, length = 0.5 * case.silo.outlet_width, case.silo.depth, case.channel_length
-    meshes = silo_meshes(case.silo)
-    meshes["channel_left"] = vertical_rectangle_x(-half_outlet, 0.0, depth, -length, 0.0, normal=1)
-    meshes["channel_right"] = vertical_rectangle_x(half_outlet, 0.0, depth, -length, 0.0, normal=-1)
-    return meshes
-
 
 def recirculation_deck_context(case: RecirculationCase) -> dict:
     """The rendering context of ``templates/liggghts/silo_recirculation.lmp.j2``."""

@@ -14,15 +14,22 @@ from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.record import RunRecord
 from analysis.data.settled import SettledFill
+from engines.cases.blender import GATE, BlenderCase
+from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import FLOOR_MESHES, SiloCase
+from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase
 from engines.cases.verification import VerificationCase
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
+from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.layout import CASE_SUMMARY
 from engines.yade.cost import measured_seconds_per_sphere_step
+from engines.yade.blender import run_blender, write_blender_inputs
 from engines.yade.inputs import ENGINE_NAME, rolling_friction
+from engines.yade.jenike import FORCES_NAME, jenike_contacts, run_jenike, write_jenike_inputs
 from engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
 from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs
 from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
+from engines.yade.silo_recirculation import run_recirculation, write_recirculation_inputs
 from engines.yade.verification import run_verification, write_verification_inputs
 
 __all__ = ["YadeEngine"]
@@ -30,6 +37,10 @@ __all__ = ["YadeEngine"]
 #: What each case kind YADE builds is written and run with, and the walls that make its floor.
 _ADAPTERS = {
     SiloCase: ("silo_flat", write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES),
+    RecirculationCase: ("silo_recirculation", write_recirculation_inputs, run_recirculation,
+                        lambda case: check_silo_case(case.silo), FLOOR_MESHES + CHANNEL_MESHES),
+    BlenderCase: ("blender", write_blender_inputs, run_blender, lambda case: check_silo_case(case.silo), (GATE,)),
+    JenikeCase: ("jenike", write_jenike_inputs, run_jenike, lambda case: None, JENIKE_FLOOR_WALLS),
     VerificationCase: ("verification", write_verification_inputs, run_verification, lambda case: None, None),
 }
 
@@ -67,8 +78,9 @@ class YadeEngine(Engine):
             Naming the config key and the limit.
         """
         kind, _, _, check, _ = _adapter(case)
-        if hasattr(case, "materials"):
-            rolling_friction(case.materials, f"{kind} run {case.run_id}")
+        table = case.silo.materials if isinstance(case, (RecirculationCase, BlenderCase)) else getattr(case, "materials", None)
+        if table is not None:
+            rolling_friction(table, f"{kind} run {case.run_id}")
         check(case)
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
@@ -89,11 +101,15 @@ class YadeEngine(Engine):
         return read_frames(run_dir, DUMP_PREFIX, on_damaged)
 
     def wall_forces(self, run_dir: str | Path, record: RunRecord) -> WallForceHistory:
+        if record.case == "jenike":
+            return jenike_wall_forces(read_jenike_force_history(Path(run_dir) / FORCES_NAME))
         return read_wall_forces(run_dir, record.timestep_s)
 
     def contacts(self, run_dir: str | Path, record: RunRecord, kind: str = "pair") -> list:
         if kind not in ("pair", "wall"):
             raise ValueError(f"contact kind must be 'pair' or 'wall', got {kind!r}")
+        if record.case == "jenike":
+            return jenike_contacts(run_dir, kind)
         if kind == "wall":
             raise ValueError(f"{record.case} runs on YADE save no particle-wall contacts")
         return [fill.contacts for fill in self.settled_fill(run_dir, record)]

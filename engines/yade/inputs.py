@@ -1,8 +1,12 @@
 """What every YADE script of siloflow shares: the rendering context of materials, contact law, clump and time step,
 and the writing of a run's inputs (``case.json``, the script) into its ``deck/`` folder.
 
-The contact law is Hertz-Mindlin (``Ip2_FrictMat_FrictMat_MindlinPhys`` with ``en = es`` = the configured
-restitution, per material pair, and the pair's sliding friction) with Mindlin's rolling moment (``includeMoment``):
+The contact law is Hertz-Mindlin (``Ip2_FrictMat_FrictMat_MindlinPhys`` with ``en`` = the configured restitution,
+per material pair, and the pair's sliding friction) with Mindlin's rolling moment (``includeMoment``). It has no
+tangential dashpot (``es = 1``), unlike the LIGGGHTS decks: YADE sizes the dashpot with the masses of the two contacting
+spheres, while the mass a tangential force moves at the contact point of a clump is smaller (the clump turns), and at
+the study's restitution 0.1 the dashpot went unstable under the Jenike lid's load (a consolidated sample exploded;
+without it, or at e = 0.5, it did not). A sliding contact has no tangential dashpot in either engine. Rolling:
 an elastic-plastic spring of stiffness ``krot`` capped at ``eta R |Fn|``, with ``eta`` the rolling friction. YADE
 2023.02 has no constant directional torque (CDT), the model of the LIGGGHTS decks; the two agree where rolling is
 fully mobilised (the moment sits at its cap, ``mu_r R |Fn|`` against the rolling direction, in both), and differ
@@ -10,13 +14,16 @@ where it is not: CDT's moment is at its cap as soon as the sphere turns, EPSD's 
 pushes back elastically. ``krot`` is a constant in YADE: it is set to the EPSD rule ``2.25 kn mu_r^2 R^2`` with
 ``kn`` the Hertz stiffness of a particle-particle contact carrying one clump's weight. ``eta`` is one number for
 all contacts in YADE, so a case whose contacts have different rolling frictions is refused
-(:func:`rolling_friction`).
+(:func:`rolling_friction`). YADE caps the moment at ``eta`` times the mean of the two reference radii: for a sphere on a
+facet (a mesh wall) the facet's is twice the sphere's, so the cap there is ``1.5 eta r |Fn|`` where CDT's is
+``mu_r r |Fn|``.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +36,8 @@ from engines.layout import write_text_atomic
 #: The engine's registry name (engine.kind), written into every run record.
 ENGINE_NAME = "yade"
 DECK_NAME = "run.py"
+#: The case's meshes and long arrays, as the script sees them (it runs in the run directory).
+GEOMETRY_PATH = "deck/geometry.npz"
 
 
 def rolling_friction(table, where: str) -> float:
@@ -100,9 +109,23 @@ def exploded_speed(height: float, insertion_velocity: float = 0.0) -> float:
     return 10.0 * (math.sqrt(2.0 * GRAVITY * height) + insertion_velocity)
 
 
-def write_script_inputs(summary: dict, script_text: str, deck_dir: str | Path) -> Path:
-    """Write ``case.json`` and the script into ``deck_dir`` (each atomically, the summary last); returns the script."""
+def write_script_inputs(summary: dict, script_text: str, deck_dir: str | Path, meshes: dict | None = None,
+                        arrays: dict | None = None) -> Path:
+    """Write ``case.json``, the script, and the case's ``meshes`` (name -> triangle mesh) and other ``arrays`` (name ->
+    array) into ``deck_dir`` (each atomically, the summary last); returns the script.
+
+    Meshes and arrays go to ``geometry.npz`` (:data:`GEOMETRY_PATH` from the run directory), a mesh as one (n, 3, 3)
+    array of triangle corners [m], which the script's ``add_meshes`` turns into facets: numbers too many to render
+    into the script stay out of it (and out of its golden files).
+    """
     deck_dir = Path(deck_dir)
+    deck_dir.mkdir(parents=True, exist_ok=True)
+    stored = {name: mesh.vertices[mesh.faces] for name, mesh in (meshes or {}).items()}
+    stored.update(arrays or {})
+    if stored:
+        partial = deck_dir / f".{Path(GEOMETRY_PATH).name}.partial.npz"
+        np.savez(partial, **stored)
+        os.replace(partial, deck_dir / Path(GEOMETRY_PATH).name)
     script = deck_dir / DECK_NAME
     write_text_atomic(script, script_text)
     write_text_atomic(deck_dir / "case.json", json.dumps(summary, indent=2, sort_keys=True, default=float))

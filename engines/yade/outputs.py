@@ -18,7 +18,7 @@ from analysis.data.frames import ParticleFrame
 from analysis.data.settled import SettledFill
 from engines.yade.run import RESUME_STEM, WALL_FORCES_NAME, frame_files
 
-__all__ = ["read_frame", "read_frames", "read_settled_fill", "read_wall_forces"]
+__all__ = ["DamagedOutput", "read_archive", "read_frame", "read_frames", "read_settled_fill", "read_wall_forces"]
 
 _QUANTITIES = ("fx", "fy", "fz", "tx", "ty", "tz")
 
@@ -33,6 +33,22 @@ def _archive(path: Path) -> dict:
             return {key: archive[key] for key in archive.files}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise DamagedOutput(f"{path}: not a readable numpy archive ({error})") from error
+
+
+def read_archive(path: str | Path, required: tuple[str, ...]) -> dict:
+    """Every array of a numpy archive a script wrote, by name.
+
+    Raises
+    ------
+    DamagedOutput
+        Naming the file, when it is truncated or lacks one of ``required``.
+    """
+    path = Path(path)
+    data = _archive(path)
+    missing = [key for key in required if key not in data]
+    if missing:
+        raise DamagedOutput(f"{path}: the archive has no {', '.join(map(repr, missing))}")
+    return data
 
 
 def _frame(data: dict, path: Path) -> ParticleFrame:

@@ -147,11 +147,13 @@ def _resume(run_dir: Path, options: YadeOptions, target_time: float, final_step:
 
 def run_script_checked(run_dir: str | Path, options: YadeOptions, target_time: float,
                        check: Callable[[list[Marker], list[Path]], dict],
-                       to_record: Callable[[dict], RunRecord]) -> RunRecord:
+                       to_record: Callable[[dict], RunRecord], extra_outputs: tuple[str, ...] = ()) -> RunRecord:
     """Run (or resume) the rendered script of ``run_dir``, check the run and write ``run.json``; returns the record.
 
     ``check(markers, frame_files)`` raises :class:`EngineRunError` or returns what it checked; ``to_record`` turns
     that, with ``mpi_ranks``, ``resumed_attempts`` and ``output_bytes`` added, into the :class:`RunRecord`.
+    ``extra_outputs`` names the case's own outputs besides :data:`RUN_OUTPUTS`, set aside with them before a new
+    attempt.
     """
     run_dir = Path(run_dir)
     if not (run_dir / "deck" / DECK_NAME).exists():
@@ -162,7 +164,7 @@ def run_script_checked(run_dir: str | Path, options: YadeOptions, target_time: f
         final_step = int(round(opened[-1].values["final_step"]))
         _resume(run_dir, options, target_time, final_step)
     else:
-        set_aside_previous_attempt(run_dir, RUN_OUTPUTS, (f"{RESUME_STEM}*",))
+        set_aside_previous_attempt(run_dir, RUN_OUTPUTS + tuple(extra_outputs), (f"{RESUME_STEM}*",))
         (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
         run_script(run_dir, options, target_time)
     checked = check(parse_markers(_logs_text(run_dir)), frame_files(run_dir, DUMP_PREFIX))

@@ -13,7 +13,7 @@ from engines.cases.silo_flat import SiloCase, silo_meshes
 from engines.interface import CaseNotSupported
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck
-from engines.yade.inputs import ENGINE_NAME, common_context, exploded_speed, write_script_inputs
+from engines.yade.inputs import ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, write_script_inputs
 from engines.yade.run import (
     DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
 )
@@ -38,10 +38,6 @@ def check_silo_case(case: SiloCase) -> None:
         )
 
 
-def _triangles(mesh) -> list[list[float]]:
-    return [[float(v) for v in mesh.vertices[face].ravel()] for face in mesh.faces]
-
-
 def silo_script_context(case: SiloCase) -> dict:
     """The rendering context of ``templates/yade/silo_flat.py.j2``."""
     table = case.materials
@@ -61,8 +57,8 @@ def silo_script_context(case: SiloCase) -> dict:
             {"id": "wall_front", "axis": 1, "position": 0.0, "material": front_back},
             {"id": "wall_back", "axis": 1, "position": case.depth, "material": front_back},
         ],
-        "meshes": [{"id": name, "material": bottom, "triangles": _triangles(mesh)}
-                   for name, mesh in silo_meshes(case).items()],
+        "meshes": [{"id": name, "material": bottom} for name in silo_meshes(case)],
+        "geometry_path": GEOMETRY_PATH,
         "gate_mesh": "outlet_gate",
         "fill": {
             "seed": case.seeds[2],
@@ -77,7 +73,7 @@ def silo_script_context(case: SiloCase) -> dict:
         "settle": {"threshold": case.settle_threshold, "check_steps": case.settle_check_steps,
                    "max_checks": case.settle_max_checks},
         "settled_fill": {"steps": 200},
-        "discharge": {"steps": case.discharge_steps},
+        "discharge": {"steps": case.discharge_steps, "stage": "discharge", "marker": "discharged"},
         "sample_every": case.dump_every,
         "restart_every": max(1, -(-case.discharge_steps // RESTARTS_PER_STAGE)),
         "wall_forces_path": WALL_FORCES_NAME,
@@ -95,7 +91,7 @@ def render_silo_script(case: SiloCase) -> str:
 
 def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
     """Write the script and ``case.json`` into ``deck_dir``; returns the script path."""
-    return write_script_inputs(case.summary(), render_silo_script(case), deck_dir)
+    return write_script_inputs(case.summary(), render_silo_script(case), deck_dir, silo_meshes(case))
 
 
 def run_silo(case: SiloCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:

@@ -55,22 +55,62 @@ def materials():
     return ids
 
 
-def set_engines(material_ids):
-    friction = [(material_ids[i], material_ids[j], math.atan(mu)) for i, j, mu, _ in PAIRS]
-    restitution = [(material_ids[i], material_ids[j], e) for i, j, _, e in PAIRS]
+def set_engines(material_ids, pairs=None, rolling_friction=None, rolling_stiffness=None):
+    """The engine loop, with the contact parameters ``pairs`` (as PAIRS) and the rolling law (those of the run when
+    not given)."""
+    pairs = PAIRS if pairs is None else pairs
+    rolling_friction = ROLLING_FRICTION if rolling_friction is None else rolling_friction
+    rolling_stiffness = ROLLING_STIFFNESS if rolling_stiffness is None else rolling_stiffness
+    friction = [(material_ids[i], material_ids[j], math.atan(mu)) for i, j, mu, _ in pairs]
+    restitution = [(material_ids[i], material_ids[j], e) for i, j, _, e in pairs]
     O.engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb(), Bo1_Wall_Aabb()]),
         InteractionLoop(
             [Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+            # es = 1: no tangential dashpot (engines.yade.inputs: with clumps it went unstable at e = 0.1)
             [Ip2_FrictMat_FrictMat_MindlinPhys(frictAngle=MatchMaker(matches=friction),
-                                               en=MatchMaker(matches=restitution), es=MatchMaker(matches=restitution),
-                                               krot=ROLLING_STIFFNESS, eta=ROLLING_FRICTION)],
+                                               en=MatchMaker(matches=restitution),
+                                               es=MatchMaker(matches=[(a, b, 1.0) for a, b, _ in restitution]),
+                                               krot=rolling_stiffness, eta=rolling_friction)],
             [Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=True)],
         ),
         NewtonIntegrator(gravity=GRAVITY_VECTOR, damping=0.0),
     ]
     O.dt = TIMESTEP
+
+
+def use_contacts(material_ids, pairs, rolling_friction, rolling_stiffness):
+    """Switch every contact, present and future, to the sliding friction of ``pairs`` (as PAIRS) and the rolling law
+    (eta, krot). Restitution must stay as it is: the damping of present contacts was fixed when they formed."""
+    functor = O.engines[2].physDispatcher.functors[0]
+    friction = {}
+    for i, j, mu, e in pairs:
+        a, b = material_ids[i], material_ids[j]
+        friction[(a, b)] = friction[(b, a)] = mu
+        if abs(functor.en(a, b) - e) > 1e-12 * max(1.0, e):
+            fail(f"a contact switch may not change the restitution of materials {i} and {j}")
+    functor.frictAngle = MatchMaker(matches=[(material_ids[i], material_ids[j], math.atan(mu)) for i, j, mu, _ in pairs])
+    functor.eta, functor.krot = rolling_friction, rolling_stiffness
+    for contact in O.interactions:
+        if not contact.isReal:
+            continue
+        pair = (O.bodies[contact.id1].material.id, O.bodies[contact.id2].material.id)
+        contact.phys.tangensOfFrictionAngle = friction[pair]
+        # Mindlin's cap on the rolling moment is eta times the mean of the two reference radii, times |Fn|
+        contact.phys.maxBendPl = rolling_friction * 0.5 * (contact.geom.refR1 + contact.geom.refR2)
+        contact.phys.kr = rolling_stiffness
+
+
+def add_meshes(path, mesh_materials):
+    """Facets of the meshes in the numpy archive ``path`` (per mesh name, an (n, 3, 3) array of triangle corners [m]),
+    each mesh of the material id ``mesh_materials[name]``; returns each mesh's body ids by name."""
+    walls = {}
+    with np.load(path, allow_pickle=False) as meshes:
+        for name, material in mesh_materials.items():
+            walls[name] = O.bodies.append([utils.facet([tuple(map(float, corner)) for corner in triangle], material=material)
+                                           for triangle in meshes[name]])
+    return walls
 
 
 def add_clump(centre, rotation, velocity, material_id):
@@ -103,13 +143,17 @@ def random_rotation(rng):
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
+#: ids of clumps that are not particles (a rigid lid made of spheres): no particle count, energy or frame has them
+NOT_PARTICLES = set()
+
+
 def clumps():
-    return [b for b in O.bodies if b is not None and b.isClump]
+    return [b for b in O.bodies if b is not None and b.isClump and b.id not in NOT_PARTICLES]
 
 
 def sphere_arrays():
     """Clump member spheres: ids, clump ids, centres, velocities, radii, clump masses."""
-    rows = [b for b in O.bodies if b is not None and b.isClumpMember]
+    rows = [b for b in O.bodies if b is not None and b.isClumpMember and b.clumpId not in NOT_PARTICLES]
     ids = np.array([b.id for b in rows], dtype=np.int64)
     clump_ids = np.array([b.clumpId for b in rows], dtype=np.int64)
     position = np.array([tuple(b.state.pos) for b in rows], dtype=float).reshape(-1, 3)
@@ -174,9 +218,11 @@ class WallForceFile:
 
 def write_frame(path):
     ids, clump_ids, position, velocity, radius, mass = sphere_arrays()
+    # a member sphere turns with its clump
+    spin = np.array([tuple(O.bodies[int(c)].state.angVel) for c in clump_ids], dtype=float).reshape(-1, 3)
     save_atomic(path, lambda target: np.savez(target, step=O.iter, time=O.time, id=ids, type=np.ones_like(ids),
                                               clump_id=clump_ids, position=position, velocity=velocity,
-                                              radius=radius, mass=mass))
+                                              angular_velocity=spin, radius=radius, mass=mass))
 
 
 def wall_force_on_spheres(wall_ids):
@@ -202,7 +248,7 @@ def pair_contacts():
         if not i.isReal:
             continue
         b1, b2 = O.bodies[i.id1], O.bodies[i.id2]
-        if not (b1.isClumpMember and b2.isClumpMember):
+        if not (b1.isClumpMember and b2.isClumpMember) or {b1.clumpId, b2.clumpId} & NOT_PARTICLES:
             continue
         f = -(i.phys.normalForce + i.phys.shearForce)  # the force on id1
         rows.append((*b1.state.pos, *b2.state.pos, i.id1, i.id2, *f))
@@ -235,7 +281,7 @@ def run_steps(steps):
     end = O.iter + int(steps)
     while O.iter < end:
         stop = min([end] + [(O.iter // every + 1) * every for every, _ in SCHEDULE])
-        spheres = sum(1 for b in O.bodies if b is not None and b.isClumpMember)
+        spheres = sum(1 for b in O.bodies if b is not None and b.isClumpMember and b.clumpId not in NOT_PARTICLES)
         chunk = stop - O.iter
         # O.step() in a loop: O.run(n, True) starts and joins a thread, 40 ms a call, O.step() 3 us
         for _ in range(chunk):
@@ -282,18 +328,7 @@ WALLS['wall_left'] = [O.bodies.append(utils.wall(-0.04, axis=0, material=MATERIA
 WALLS['wall_right'] = [O.bodies.append(utils.wall(0.04, axis=0, material=MATERIAL_IDS[1]))]
 WALLS['wall_front'] = [O.bodies.append(utils.wall(0.0, axis=1, material=MATERIAL_IDS[2]))]
 WALLS['wall_back'] = [O.bodies.append(utils.wall(0.012, axis=1, material=MATERIAL_IDS[2]))]
-WALLS['floor_left'] = O.bodies.append([
-    utils.facet([(-0.04, 0.0, 0.0), (-0.012, 0.0, 0.0), (-0.012, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-    utils.facet([(-0.04, 0.0, 0.0), (-0.012, 0.012, 0.0), (-0.04, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-])
-WALLS['floor_right'] = O.bodies.append([
-    utils.facet([(0.012, 0.0, 0.0), (0.04, 0.0, 0.0), (0.04, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-    utils.facet([(0.012, 0.0, 0.0), (0.04, 0.012, 0.0), (0.012, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-])
-WALLS['outlet_gate'] = O.bodies.append([
-    utils.facet([(-0.012, 0.0, 0.0), (0.012, 0.0, 0.0), (0.012, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-    utils.facet([(-0.012, 0.0, 0.0), (0.012, 0.012, 0.0), (-0.012, 0.012, 0.0)], material=MATERIAL_IDS[1]),
-])
+WALLS.update(add_meshes('deck/geometry.npz', {'floor_left': MATERIAL_IDS[1], 'floor_right': MATERIAL_IDS[1], 'outlet_gate': MATERIAL_IDS[1], }))
 
 
 def inside(position):
@@ -330,11 +365,15 @@ def insert_clumps(rng, wanted):
     return placed
 
 
-def remove_discharged():
+def outflow():
     """Clumps that fell ``sink_depth`` below the outlet leave (LIGGGHTS' bottom boundary)."""
     for b in clumps():
         if b.state.pos[2] < SINK_BOTTOM:
             O.bodies.erase(b.id, True)
+
+
+#: (interval in steps, action) pairs the discharge runs besides frames and checkpoints
+DISCHARGE_ACTIONS = []
 
 
 def checkpoint():
@@ -342,7 +381,7 @@ def checkpoint():
 
 
 def frame():
-    remove_discharged()
+    outflow()
     write_frame(f"dumps/particles_{O.iter}.npz")
 
 
@@ -399,10 +438,11 @@ else:
     WALLS['outlet_gate'] = []
     say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))
 
-# --- discharge: clumps leave sink_depth below the outlet ---
-SCHEDULE[:] = [(SAMPLE_EVERY, lambda: (check_sane(inside), frame(), forces.sample(), progress("discharge"))),
-               (RESTART_EVERY, checkpoint)]
+# --- discharge: clumps leave through the outlet (outflow() says where they go) ---
+SCHEDULE[:] = DISCHARGE_ACTIONS + [
+    (SAMPLE_EVERY, lambda: (check_sane(inside), frame(), forces.sample(), progress('discharge'))),
+    (RESTART_EVERY, checkpoint)]
 if RESTART is None:
     frame()
 run_steps(FINAL_STEP - O.iter)
-say_stage("discharged")
+say_stage('discharged')

@@ -28,8 +28,8 @@ from engines.liggghts.jenike import (
     PAIR_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,
     read_contact_dump,
-    read_force_history,
 )
+from engines.jenike_checks import read_jenike_force_history
 from engines.interface import EngineOptions
 from tests.conftest import liggghts, require_liggghts
 
@@ -67,7 +67,7 @@ def _run(case: JenikeCase, run_dir: Path) -> Run:
     engine.write_inputs(case, run_dir)
     record = engine.run(case, run_dir, EngineOptions())
     # the engine's own columns (with the step) for the contact dump check; the neutral history for the friction
-    history = read_force_history(run_dir / FORCES_NAME)
+    history = read_jenike_force_history(run_dir / FORCES_NAME)
     signals = shear_signals(engine.wall_forces(run_dir, record), record.labels["shear_start_s"], record.labels["shear_end_s"])
     # A 4 mm shear of a 40 mm cell is too short for a plateau: average over its second half.
     half = signals.time[0] + 0.5 * (signals.time[-1] - signals.time[0])

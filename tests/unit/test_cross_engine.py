@@ -10,7 +10,7 @@ import pytest
 
 from analysis.data.frames import ClumpFrame
 from analysis.studies.cross_engine import centreline_vertical_velocity, compare_engines
-from engines.cases.cross_engine import cross_engine_cases
+from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases, jenike_point_label
 from engines.config import ConfigError, validate_config
 
 
@@ -69,3 +69,33 @@ def test_one_engine_or_one_seed_is_refused_naming_the_key():
         validate_config({"cross_engine": {"engines": ["liggghts"]}})
     with pytest.raises(ConfigError, match="cross_engine.seeds"):
         validate_config({"cross_engine": {"seeds": 1}})
+
+
+def test_the_jenike_runs_are_the_points_in_the_small_cell_differing_in_engine_and_seed_only():
+    config = validate_config({"cross_engine": {"seeds": 2}})
+    cases = cross_engine_jenike_cases(config)
+    assert list(cases) == ["liggghts", "yade"]
+    ligg, yade = (list(runs.values()) for runs in cases.values())
+    assert len(ligg) == len(yade) == 4  # two points, two seeds
+    labels = [label for label, _ in ligg]
+    assert labels == ["bulk friction, internal, mu = 0.3, mu_r = 0.1"] * 2 + \
+        ["bulk friction, wall (aluminium), mu = 0.3, mu_r = 0.1"] * 2
+    first, second = ligg[0][1], ligg[1][1]
+    assert first.geometry.inner_radius == 0.5 * config["cross_engine"]["jenike"]["inner_diameter"]
+    assert first.geometry.shear_displacement == config["cross_engine"]["jenike"]["shear_displacement"]
+    assert first.point["restitution"] == config["jenike"]["sweep"]["restitution"]
+    assert first.seeds != second.seeds and first.seeds == yade[0][1].seeds
+    assert first.fill.n_clumps == yade[0][1].fill.n_clumps
+    assert len({case.run_id for _, case in ligg + yade}) == 8
+
+
+def test_a_jenike_point_of_an_undefined_wall_material_is_refused_naming_the_point():
+    config = validate_config({"cross_engine": {"jenike": {"points": [
+        {"test": "glass", "sliding_friction": 0.3, "rolling_friction": 0.1}]}}})
+    with pytest.raises(ValueError, match=r"cross_engine.jenike.points .*glass.*material 'glass' is not defined"):
+        cross_engine_jenike_cases(config)
+
+
+def test_a_point_label_names_test_and_frictions():
+    assert jenike_point_label({"test": "perspex", "sliding_friction": 0.25, "rolling_friction": 0.0}) == \
+        "bulk friction, wall (perspex), mu = 0.25, mu_r = 0"

@@ -26,13 +26,11 @@ from engines.cases.jenike import (
 from engines.cases.jenike_cell import circle_intersection_area
 from engines.interface import EngineRunError
 from engines.markers import Marker
+from engines.jenike_checks import FORCE_COLUMNS, check_jenike_run, read_jenike_force_history
 from engines.liggghts.jenike import (
     CONTACT_COLUMNS,
-    FORCE_COLUMNS,
-    check_jenike_run,
     read_contact_dump,
     jenike_deck_context,
-    read_force_history,
     render_jenike_deck,
     set_aside_previous_jenike_attempt,
     write_jenike_inputs,
@@ -381,7 +379,7 @@ def _row(step: int, time: float, value: float = 1.0) -> str:
 def test_force_history_reader_returns_named_columns(tmp_path):
     path = tmp_path / "forces.txt"
     path.write_text(HEADER + _row(100, 0.001, 2.0) + "\n" + _row(200, 0.002, 3.0) + "\n")
-    history = read_force_history(path)
+    history = read_jenike_force_history(path)
     assert set(history) == {"step", *FORCE_COLUMNS}
     np.testing.assert_array_equal(history["time"], [0.001, 0.002])
     np.testing.assert_array_equal(history["mass_above"], [2.0, 3.0])
@@ -402,7 +400,7 @@ def test_force_history_reader_names_the_file_on_bad_content(tmp_path, content, m
     path = tmp_path / "forces.txt"
     path.write_text(content)
     with pytest.raises(ValueError, match=re.escape(str(path)) + ".*" + message):
-        read_force_history(path)
+        read_jenike_force_history(path)
 
 
 def _markers(created=815, levelled=655, final=655):
@@ -419,16 +417,16 @@ def _markers(created=815, levelled=655, final=655):
 def test_run_check_accepts_a_complete_run_and_names_each_failure(tmp_path):
     case = _case()
     (tmp_path / "forces.txt").write_text(HEADER + _row(1, 0.23) + "\n" + _row(2, 0.24) + "\n")
-    record = check_jenike_run(case, _markers(created=case.fill.n_clumps), tmp_path)
+    record = check_jenike_run(case, _markers(created=case.fill.n_clumps), tmp_path, tmp_path / 'forces.txt')
     assert record["shear_start_s"] == 0.27 and record["force_samples"] == 2
     with pytest.raises(EngineRunError, match="no 'sheared' stage marker"):
-        check_jenike_run(case, _markers(created=case.fill.n_clumps)[:-1], tmp_path)
+        check_jenike_run(case, _markers(created=case.fill.n_clumps)[:-1], tmp_path, tmp_path / 'forces.txt')
     with pytest.raises(EngineRunError, match="levelling removed no clump"):
-        check_jenike_run(case, _markers(created=case.fill.n_clumps, levelled=case.fill.n_clumps), tmp_path)
+        check_jenike_run(case, _markers(created=case.fill.n_clumps, levelled=case.fill.n_clumps), tmp_path, tmp_path / 'forces.txt')
     with pytest.raises(EngineRunError, match="3 clumps were lost"):
-        check_jenike_run(case, _markers(created=case.fill.n_clumps, final=652), tmp_path)
+        check_jenike_run(case, _markers(created=case.fill.n_clumps, final=652), tmp_path, tmp_path / 'forces.txt')
     with pytest.raises(EngineRunError, match="only 700 of"):
-        check_jenike_run(case, _markers(created=700), tmp_path)
+        check_jenike_run(case, _markers(created=700), tmp_path, tmp_path / 'forces.txt')
 
 
 CONTACT_DUMP = """ITEM: TIMESTEP

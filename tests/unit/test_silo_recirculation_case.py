@@ -18,7 +18,8 @@ from engines.cases.silo_recirculation import (
     recirculation_cases,
 )
 from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts.silo_recirculation import recirculation_meshes, render_recirculation_deck, write_recirculation_inputs
+from engines.cases.silo_recirculation import recirculation_meshes
+from engines.liggghts.silo_recirculation import render_recirculation_deck, write_recirculation_inputs
 from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"

@@ -13,7 +13,6 @@ from analysis.data.forces import WallForceHistory
 from engines.config import load_config
 from engines.cases.silo_flat import build_silo_case
 from engines.liggghts.forces import (
-    JENIKE_WALLS,
     RESUMED_WALL_FORCES_PREFIX,
     read_jenike_forces,
     read_silo_wall_forces,
@@ -21,7 +20,8 @@ from engines.liggghts.forces import (
     read_wall_forces,
 )
 from engines.liggghts.run import WALL_FORCES_NAME
-from engines.liggghts.jenike import FORCE_COLUMNS, FORCES_NAME
+from engines.liggghts.jenike import FORCES_NAME
+from engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS
 from engines.liggghts.run import RESUME_STEM, Resume
 from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
 

@@ -15,7 +15,9 @@ import pytest
 from engines.cases import cases_of
 from engines.cases.common import material_table
 from engines.cases.particles import clump_inertia, clump_volume
+from engines.cases.blender import build_blender_case
 from engines.cases.silo_flat import build_silo_case
+from engines.cases.silo_recirculation import build_recirculation_case
 from engines.config import ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_named
 from engines.templating import UnsafeDeckValue, deck_string, render_deck
@@ -23,7 +25,9 @@ from engines.yade.cost import measured_seconds_per_sphere_step
 from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
 from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
 from engines.yade.progress import ScriptProgress
+from engines.yade.blender import render_blender_script
 from engines.yade.silo_flat import render_silo_script, silo_script_context
+from engines.yade.silo_recirculation import render_recirculation_script
 from tests.golden_files import assert_matches_golden
 from tests.unit.test_templating import INJECTIONS
 
@@ -46,6 +50,32 @@ def test_silo_script_matches_golden_file_and_is_python():
     rendered = render_silo_script(_golden_case())
     assert_matches_golden(rendered, "silo_flat_yade.py")
     ast.parse(rendered)
+
+
+def _with_engine(name, section):
+    raw = load_config(GOLDEN / name)
+    raw[section]["engine"] = "yade"
+    for contact in raw["contacts"]:  # YADE takes one rolling friction
+        contact["rolling_friction"] = 0.1
+    return raw
+
+
+def test_recirculation_script_matches_golden_file_and_is_python():
+    case = build_recirculation_case(_with_engine("silo_recirculation_config.yaml", "silo_recirculation"),
+                                    "internal_flow")
+    rendered = render_recirculation_script(case)
+    assert_matches_golden(rendered, "silo_recirculation_yade.py")
+    ast.parse(rendered)
+    assert "FEEDER_VELOCITY = " in rendered and "say_stage('recirculated')" in rendered
+
+
+def test_blender_script_matches_golden_file_and_is_python():
+    raw = _with_engine("blender_config.yaml", "blender")
+    case = build_blender_case(validate_config(raw), "straight")
+    rendered = render_blender_script(case)
+    assert_matches_golden(rendered, "blender_yade.py")
+    ast.parse(rendered)
+    assert ("DOMAIN_TOP - SINK_BOTTOM" in rendered) == (case.mode == "continuous")
 
 
 def test_the_script_never_starts_yades_launcher_and_imports_from_the_system_modules():
@@ -89,13 +119,14 @@ def test_a_periodic_depth_is_refused_naming_the_key():
         engine_named("yade").write_inputs(case, "/nonexistent/never/written")
 
 
-def test_a_case_without_a_yade_script_is_refused_naming_the_engine_key():
-    raw = _raw_golden()
-    raw["silo_flat"]["engine"] = "liggghts"
-    config = validate_config({**raw, "jenike": {"engine": "yade"}})
-    case = next(iter(cases_of(config, "jenike").values()))
-    with pytest.raises(CaseNotSupported, match="YADE has no script for a JenikeCase yet"):
-        engine_named("yade").check_case(case)
+@pytest.mark.parametrize("kind", ["silo_flat", "silo_recirculation", "blender", "jenike"])
+def test_every_case_kind_of_the_default_config_has_a_yade_script(kind, tmp_path):
+    config = validate_config({"engine": {"kind": "yade"}})
+    engine = engine_named("yade")
+    case = next(iter(cases_of(config, kind).values()))
+    engine.check_case(case)
+    engine.write_inputs(case, tmp_path)
+    ast.parse((tmp_path / "deck" / "run.py").read_text())
 
 
 @pytest.mark.parametrize("raw, key", [

@@ -12,9 +12,9 @@ from engines.cases.silo_flat import build_silo_case, parametric_variants
 from engines.cases.silo_recirculation import SECTION as RECIRCULATION
 from engines.config import ConfigError, validate_config
 from engines.estimates import InsufficientDiskSpace, format_bytes
-from engines.cases.cross_engine import cross_engine_cases
+from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from engines.cases.verification import verification_cases
-from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for
+from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from engines.layout import CASE_SUMMARY, RESULTS, RUN_RECORD, case_root, run_dir, run_path
 from engines.planning import config_estimates, ensure_disk_space
 
