@@ -1,0 +1,86 @@
+"""The neutral planar velocity field of PIV and of DEM front-wall fields: nodes on a regular x-z grid, the two
+in-plane velocity components and a validity mask.
+
+Conventions (those of :mod:`analysis.numerics.grid`): SI units, x across the silo (x = 0 on the axis), z up (z = 0
+at the outlet plane); ``u`` is the x velocity, ``w`` the z velocity (negative downwards). Arrays are indexed
+``[k, i]``: row k along z, column i along x.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["PlanarField", "field_from_rows"]
+
+
+@dataclass(frozen=True)
+class PlanarField:
+    """A velocity field on a regular x-z grid.
+
+    Attributes
+    ----------
+    x : numpy.ndarray, shape (nx,)
+        Node x coordinates, increasing [m].
+    z : numpy.ndarray, shape (nz,)
+        Node z coordinates, increasing [m].
+    u, w : numpy.ndarray, shape (nz, nx)
+        Horizontal and vertical velocity [m/s]; NaN where not valid.
+    valid : numpy.ndarray of bool, shape (nz, nx)
+        Where the velocity is a measurement (not masked, not an outlier, not interpolated).
+    time : float
+        Time of the field [s].
+    """
+
+    x: np.ndarray
+    z: np.ndarray
+    u: np.ndarray
+    w: np.ndarray
+    valid: np.ndarray
+    time: float = 0.0
+
+    def __post_init__(self) -> None:
+        x, z = np.asarray(self.x, dtype=float), np.asarray(self.z, dtype=float)
+        for name, axis in (("x", x), ("z", z)):
+            if axis.ndim != 1 or axis.size < 1 or not np.all(np.isfinite(axis)):
+                raise ValueError(f"{name} must be a finite 1-D array of node coordinates")
+            if np.any(np.diff(axis) <= 0):
+                raise ValueError(f"{name} must increase from node to node")
+        shape = (z.size, x.size)
+        u, w = np.asarray(self.u, dtype=float), np.asarray(self.w, dtype=float)
+        valid = np.asarray(self.valid, dtype=bool)
+        for name, array in (("u", u), ("w", w), ("valid", valid)):
+            if array.shape != shape:
+                raise ValueError(f"{name} has shape {array.shape}, expected (nz, nx) = {shape}")
+        if np.any(valid & ~(np.isfinite(u) & np.isfinite(w))):
+            raise ValueError("a valid node has a non-finite velocity")
+        object.__setattr__(self, "x", x)
+        object.__setattr__(self, "z", z)
+        object.__setattr__(self, "u", np.where(valid, u, np.nan))
+        object.__setattr__(self, "w", np.where(valid, w, np.nan))
+        object.__setattr__(self, "valid", valid)
+
+
+def field_from_rows(x, z, u, w, valid, time: float = 0.0, decimals: int = 9) -> PlanarField:
+    """A :class:`PlanarField` from one row per node (any order), as PIV programs write them.
+
+    Coordinates are rounded to ``decimals`` before they are matched to grid lines (text files carry a few digits).
+
+    Raises
+    ------
+    ValueError
+        When the nodes do not fill a regular grid (a node missing or given twice).
+    """
+    x, z = np.round(np.asarray(x, dtype=float), decimals), np.round(np.asarray(z, dtype=float), decimals)
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(z))):
+        raise ValueError("node coordinates must be finite")
+    xs, i = np.unique(x, return_inverse=True)
+    zs, k = np.unique(z, return_inverse=True)
+    if xs.size * zs.size != x.size or np.unique(k * xs.size + i).size != x.size:
+        raise ValueError(f"{x.size} nodes do not fill a regular grid of {xs.size} x {zs.size} nodes")
+    shape = (zs.size, xs.size)
+    grids = [np.full(shape, np.nan), np.full(shape, np.nan), np.zeros(shape, dtype=bool)]
+    for grid, values in zip(grids, (u, w, valid)):
+        grid[k, i] = values
+    return PlanarField(xs, zs, grids[0], grids[1], grids[2], time)

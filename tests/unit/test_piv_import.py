@@ -1,0 +1,159 @@
+"""Measured PIV fields in: the readers of OpenPIV, PIVlab and siloflow CSV files, the image scale from wall markers,
+the neutral field and the Hampel filter, each against exact answers on hand-made fields and files."""
+
+from __future__ import annotations
+
+import numpy as np
+import openpiv.tools
+import pytest
+
+from analysis.io.piv import PivFormatError, read_openpiv, read_piv_csv, read_pivlab_txt, write_piv_csv
+from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
+from analysis.piv.field import PlanarField, field_from_rows
+from analysis.piv.hampel import hampel_filter, hampel_outliers
+
+# ---------------------------------------------------------------------------------------------- the scale
+
+
+def test_two_markers_fix_scale_and_origin_exactly_with_image_rows_down():
+    # 0.25 mm per pixel, pixel (0, 0) at x = -0.05 m, z = 0.3 m
+    truth = ImageScale(2.5e-4, -0.05, 0.3)
+    image = np.array([[40.0, 1000.0], [360.0, 200.0]])
+    silo = np.column_stack(truth.to_silo(image[:, 0], image[:, 1]))
+    fitted = scale_from_markers(image, silo)
+    assert fitted.scale == pytest.approx(2.5e-4, rel=1e-12)
+    assert (fitted.x0, fitted.z0) == pytest.approx((-0.05, 0.3), abs=1e-12)
+    assert fitted.residual < 1e-12
+
+
+def test_markers_off_a_square_camera_show_in_the_residual():
+    image = np.array([[0.0, 0.0], [100.0, 0.0], [0.0, 100.0]])
+    silo = np.array([[0.0, 0.0], [0.01, 0.0], [0.0, -0.0101]])  # 1 % taller than wide
+    assert scale_from_markers(image, silo).residual > 1e-5
+
+
+@pytest.mark.parametrize("image, silo, message", [
+    ([[10.0, 10.0]], [[0.0, 0.0]], "1 marker"),
+    ([[10.0, 10.0], [10.0, 10.0]], [[0.0, 0.0], [0.01, 0.0]], "one image position"),
+    ([[0.0, 0.0], [100.0, 0.0]], [[0.01, 0.0], [0.0, 0.0]], "scale of -0.0001"),
+    ([[0.0, np.nan], [100.0, 0.0]], [[0.0, 0.0], [0.01, 0.0]], "finite"),
+])
+def test_markers_that_fix_no_scale_are_refused_naming_them(image, silo, message):
+    with pytest.raises(ValueError, match=f"piv.markers: .*{message}"):
+        scale_from_markers(image, silo, "piv.markers")
+
+
+def test_pixel_vectors_become_silo_velocities_with_v_down_turned_up():
+    scale = ImageScale(1e-4, 0.0, 0.1)
+    # a 2 x 2 grid of window centres (px); 3 px right and 5 px down per frame at 100 frames/s
+    x = np.array([16.0, 48.0, 16.0, 48.0])
+    y = np.array([16.0, 16.0, 48.0, 48.0])
+    field = piv_field(x, y, np.full(4, 3.0), np.full(4, 5.0), np.ones(4, bool), True, scale, 100.0)
+    assert field.x.tolist() == pytest.approx([0.0016, 0.0048])
+    assert field.z.tolist() == pytest.approx([0.1 - 0.0048, 0.1 - 0.0016])
+    assert np.allclose(field.u, 0.03) and np.allclose(field.w, -0.05)
+
+
+# ---------------------------------------------------------------------------------------------- the readers
+
+
+def test_the_openpiv_reader_reads_what_openpiv_wrote_with_flags_and_mask(tmp_path):
+    y, x = np.mgrid[16:80:32, 16:112:32].astype(float)  # 2 rows x 3 columns of window centres
+    u = np.array([[1.5, 2.0, 2.5], [3.0, 3.5, 4.0]])
+    v = -u / 2
+    flags = np.array([[0, 1, 0], [2, 0, 0]])
+    mask = np.array([[0, 0, 0], [0, 0, 1]])
+    path = tmp_path / "field_0001.txt"
+    openpiv.tools.save(path, x, y, u, v, flags, mask)
+    rows = read_openpiv(path, y_down=True)
+    assert rows.x.tolist() == x.ravel().tolist() and rows.y.tolist() == y.ravel().tolist()
+    assert rows.u.tolist() == u.ravel().tolist() and rows.v.tolist() == v.ravel().tolist()
+    assert rows.valid.tolist() == [True, False, True, False, True, False]  # flags 1 and 2, and mask 1, are out
+
+
+def test_the_pivlab_reader_takes_its_information_lines_delimiters_and_types(tmp_path):
+    text = ("PIVlab by W.Th. & E.J.S., ASCII chart output - 26-Nov-2026\r\n"
+            "FRAME: 1, filenames: a.tif & b.tif, conversion factor xy (px -> m): 1, conversion factor uv: 1\r\n"
+            "x [px],y [px],u [px/frame],v [px/frame],Vector type [-]\r\n"
+            "16,16,1.25,-0.5,1\r\n48,16,NaN,NaN,0\r\n16,48,2,0.25,2\r\n48,48,3,1,1\r\n")
+    path = tmp_path / "PIVlab_0001.txt"
+    path.write_bytes(text.encode())
+    rows = read_pivlab_txt(path)
+    assert rows.y_down and rows.x.tolist() == [16, 48, 16, 48]
+    assert rows.u[0] == 1.25 and rows.v[3] == 1.0
+    assert rows.valid.tolist() == [True, False, False, True]
+
+
+def test_a_csv_field_round_trips_bit_for_bit(tmp_path):
+    field = PlanarField(np.array([-0.01, 0.0, 0.01]), np.array([0.02, 0.026]),
+                        np.array([[0.1, 0.2, 0.3], [0.4, np.nan, 1 / 3]]),
+                        np.array([[-1.0, -2.0, -3.0], [-4.0, np.nan, -2 / 3]]),
+                        np.array([[True, True, True], [True, False, True]]), time=1.5)
+    path = write_piv_csv(tmp_path / "piv.csv", field)
+    back = read_piv_csv(path, time=1.5)
+    assert back.x.tolist() == field.x.tolist() and back.z.tolist() == field.z.tolist()
+    assert np.array_equal(back.u, field.u, equal_nan=True) and np.array_equal(back.w, field.w, equal_nan=True)
+    assert back.valid.tolist() == field.valid.tolist()
+
+
+@pytest.mark.parametrize("content, message", [
+    ("x_m,z_m,u_m_s,w_m_s,valid\n0,0,1,1\n", "4 columns, expected 5"),
+    ("x_m,z_m,u_m_s,w_m_s,valid\nnan,0,1,1,1\n", "without a finite position"),
+    ("x,z,u,w,valid\n0,0,1,1,1\n", "the header is"),
+    ("x_m,z_m,u_m_s,w_m_s,valid\n0,0,1,1,1\n0.1,0.1,1,1,1\n", "do not fill a regular grid"),
+])
+def test_a_bad_csv_is_refused_naming_the_file_and_the_problem(tmp_path, content, message):
+    path = tmp_path / "measured.csv"
+    path.write_text(content)
+    with pytest.raises(PivFormatError, match=f"measured.csv: .*{message}"):
+        read_piv_csv(path)
+
+
+def test_a_bad_openpiv_or_pivlab_file_is_refused_naming_it(tmp_path):
+    path = tmp_path / "short.txt"
+    path.write_text("# x y u v flags mask\n1 2 3 4 0\n")
+    with pytest.raises(PivFormatError, match="short.txt: 5 columns, expected 6"):
+        read_openpiv(path, y_down=True)
+    path.write_text("x,y,u,v\n1,2,3,4\n")
+    with pytest.raises(PivFormatError, match="short.txt: line 2 has 4 columns"):
+        read_pivlab_txt(path)
+
+
+# ---------------------------------------------------------------------------------------------- field, Hampel
+
+
+def test_rows_in_any_order_fill_the_grid():
+    field = field_from_rows([0.0, 1.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1, 2, 3, 4], [5, 6, 7, 8], [1, 1, 1, 0])
+    assert field.u.tolist()[0] == [3, 2] and field.w[1, 0] == 5 and not field.valid[1, 1] and np.isnan(field.u[1, 1])
+
+
+def test_hampel_removes_planted_outliers_and_keeps_every_other_node_bit_for_bit():
+    z, x = np.mgrid[0:12, 0:15].astype(float)
+    rng = np.random.default_rng(3)
+    u = 0.01 * x + 0.003 * z + 1e-4 * rng.standard_normal(x.shape)  # a smooth shear with measurement noise
+    w = -0.2 + 0.004 * x**2 / 15 + 1e-4 * rng.standard_normal(x.shape)
+    planted = [(2, 3), (7, 11), (10, 0), (0, 14)]
+    for k, i in planted:
+        w[k, i] += 0.1  # a wrong correlation peak, 1000 noise levels off
+    u[5, 5] -= 0.3
+    field = PlanarField(np.arange(15.0), np.arange(12.0), u, w, np.ones(x.shape, bool))
+    # the floor (0.01 m/s) lies above the field's change from node to node (up to 0.0075 m/s at its edge)
+    filtered = hampel_filter(field, half_window=1, threshold=5.0, noise_floor=0.01)
+    removed = set(zip(*np.nonzero(~filtered.valid)))
+    assert removed == set(planted) | {(5, 5)}
+    keep = filtered.valid
+    assert np.array_equal(filtered.u[keep], field.u[keep]) and np.array_equal(filtered.w[keep], field.w[keep])
+
+
+def test_hampel_never_flags_an_invalid_node_or_one_without_enough_neighbours():
+    values = np.array([[0.0, 0.0, 9.0], [0.0, 0.0, 0.0]])
+    valid = np.array([[True, True, True], [False, False, False]])
+    # the corner 9 has one valid neighbour (fewer than 3): kept
+    assert not hampel_outliers(values, valid).any()
+
+
+def test_without_a_noise_floor_an_edge_with_a_gradient_looks_like_outliers():
+    x = np.tile(np.arange(6.0), (5, 1))
+    values = 0.01 * x**2  # every neighbour of the right edge lies to its left and they nearly agree
+    assert hampel_outliers(values, np.ones(values.shape, bool), threshold=3.0)[:, -1].any()
+    assert not hampel_outliers(values, np.ones(values.shape, bool), threshold=3.0, noise_floor=0.1).any()
