@@ -81,3 +81,4 @@ bench: install
 	$(PYTHON) -m tests.bench.bench_mpi results/bench/mpi.csv
 	$(PYTHON) -m tests.bench.bench_decks results/bench/decks.csv
 	$(PYTHON) -m tests.bench.bench_engines results/bench/engines.csv
+	$(PYTHON) -m tests.bench.bench_piv results/bench/piv.csv

@@ -68,20 +68,29 @@ def piv_displacements(frame_a: np.ndarray, frame_b: np.ndarray, window_px: int =
     Raises
     ------
     ValueError
-        For frames of different shapes, a window or overlap that does not fit, or fewer than one pass.
+        For frames of different shapes, a window or overlap that does not fit, fewer than one pass, or when OpenPIV
+        finds no valid vector.
     """
     if frame_a.shape != frame_b.shape or frame_a.ndim != 2:
         raise ValueError(f"frames must be two 2-D images of one shape, got {frame_a.shape} and {frame_b.shape}")
-    if passes < 1 or not 0 <= overlap_px < window_px or window_px * 2 ** (passes - 1) > min(frame_a.shape):
+    first_window, first_overlap = window_px * 2 ** max(passes - 1, 0), overlap_px * 2 ** max(passes - 1, 0)
+    # window deformation interpolates the first pass's vectors with cubic splines: at least 4 vectors per axis
+    vectors = min((size - first_window) // max(first_window - first_overlap, 1) + 1 for size in frame_a.shape)
+    if passes < 1 or not 0 <= overlap_px < window_px or vectors < (4 if passes > 1 else 1):
         raise ValueError(f"window {window_px} px, overlap {overlap_px} px and {passes} passes do not fit images of "
-                         f"{frame_a.shape[1]} x {frame_a.shape[0]} px")
+                         f"{frame_a.shape[1]} x {frame_a.shape[0]} px (the first pass needs 4 windows per axis)")
     settings = windef.PIVSettings()
     settings.windowsizes = tuple(window_px * 2 ** k for k in range(passes - 1, -1, -1))
     settings.overlap = tuple(overlap_px * 2 ** k for k in range(passes - 1, -1, -1))
     settings.num_iterations = passes  # OpenPIV runs 3 passes unless told, whatever windowsizes says
     settings.show_plot = settings.save_plot = False
-    x, y, u, v, flags = windef.simple_multipass(np.asarray(frame_a, dtype=float), np.asarray(frame_b, dtype=float),
-                                                settings)
+    try:
+        x, y, u, v, flags = windef.simple_multipass(np.asarray(frame_a, dtype=float),
+                                                    np.asarray(frame_b, dtype=float), settings)
+    except ValueError as error:
+        # OpenPIV raises "Something happened in the validation" when every vector of a pass failed it
+        raise ValueError(f"OpenPIV found no valid vector ({error}): the {window_px} px windows hold too little "
+                         "texture (too few particle edges) or the displacement exceeds them") from None
     # simple_multipass turned rows up and negated v (transform_coordinates); turn them back to image axes
     x, y, u, v = windef.transform_coordinates(x, y, u, v)
     valid = np.asarray(flags, dtype=int) == 0

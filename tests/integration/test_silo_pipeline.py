@@ -9,6 +9,7 @@ import csv
 import json
 import statistics
 
+import numpy as np
 import pytest
 import yaml
 
@@ -17,6 +18,7 @@ import pyvista
 from analysis.data.frames import clumps_from_frame
 from analysis.data.record import read_run_record
 from analysis.io.tables import read_table
+from analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
 from analysis.studies.silo_flat.metrics import silo_flow_metrics
 from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
@@ -223,6 +225,33 @@ def test_silo_flow_metrics_and_plots_are_written(tiny_pipeline):
     for name in ("profiles", "vz_contour", "kinematic_B", "kinematic_u", "centreline_velocity", "janssen",
                  "force_chains"):
         assert (run_dir / "plots" / f"{name}.png").read_bytes()[:4] == b"\x89PNG", name
+
+
+def test_synthetic_piv_of_the_front_wall_recovers_the_dem_profile_at_one_height(tiny_pipeline):
+    """Stated tolerance: at z = 20 mm, the PIV v_z profile averaged over three frame pairs (250 x 350 px over the
+    80 mm width, 100 frames/s, 40 px windows: about four particle diameters) lies within 20 % of the DEM profile's
+    peak speed of the DEM's own window means, RMS over the nodes, and its peak within 20 % of the DEM's."""
+    _, run_dir, _ = tiny_pipeline
+    rows = list(csv.DictReader((run_dir / "metrics" / "piv_accuracy.csv").open()))
+    assert len(rows) == 4  # two resolutions times two frame rates
+    coarse = [row for row in rows if row["width_px"] == "250"]
+    assert all(row["note"] == "" and int(row["nodes"]) > 100 and float(row["rms_w_m_s"]) < 0.05 for row in coarse)
+    # at 500 px over 80 mm a 40 px window is 2 particle diameters: where OpenPIV finds no valid vector, the row says so
+    assert all(row["note"] == "" or "no valid vector" in row["note"] for row in rows)
+    assert (run_dir / "plots" / "piv_accuracy.png").read_bytes()[:4] == b"\x89PNG"
+    record = read_run_record(run_dir / "run.json")
+    frames = [f for f in liggghts().read_frames(run_dir, record) if f.step > record.open_step]
+    width, resolution = TINY_SILO["width"], (250, 350)
+    pairs = [synthetic_piv(f.position, f.velocity, f.radius, silo_image_scale(width, resolution), resolution, 100.0,
+                           PivSettings(band=0.0033)) for f in frames[len(frames) // 4: 3 * len(frames) // 4: 10][:3]]
+    k = int(np.argmin(np.abs(pairs[0][0].z - 0.02)))
+    both = np.logical_and.reduce([m.valid[k] & t.valid[k] for m, t in pairs])
+    measured = np.mean([m.w[k, both] for m, _ in pairs], axis=0)
+    truth = np.mean([t.w[k, both] for _, t in pairs], axis=0)
+    peak = np.abs(truth).max()
+    assert both.sum() >= 6 and peak > 0.05
+    assert np.sqrt(np.mean((measured - truth) ** 2)) < 0.2 * peak
+    assert np.abs(measured).max() == pytest.approx(peak, rel=0.2)
 
 
 def test_parametric_study_compares_its_runs(tiny_pipeline):

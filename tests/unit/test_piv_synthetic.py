@@ -6,10 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from analysis.piv.accuracy import PivSettings, accuracy_row, accuracy_table, silo_image_scale
 from analysis.piv.calibration import ImageScale
 from analysis.piv.field import PlanarField
 from analysis.piv.front_wall import field_errors, front_wall_image, front_wall_spheres, window_mean_velocity
 from analysis.piv.synthetic import piv_displacements, render_particle_image
+from analysis.studies.silo_flat.piv_plots import plot_piv_accuracy
 
 HEIGHT, WIDTH = 400, 320
 
@@ -61,6 +63,7 @@ def test_multipass_recovers_a_linear_shear_within_two_tenths_of_a_pixel():
     ((40, 40), 16, 1, "one shape"),
     ((64, 64), 48, 2, "do not fit"),
     ((64, 64), 16, 0, "do not fit"),
+    ((64, 64), 16, 2, "4 windows per axis"),
 ])
 def test_frames_or_windows_that_do_not_fit_are_refused(shape_b, window, passes, message):
     with pytest.raises(ValueError, match=message):
@@ -107,3 +110,40 @@ def test_field_errors_are_bias_and_rms_over_the_nodes_valid_in_both():
     assert errors.nodes == 3
     assert errors.bias_u == pytest.approx(0.1) and errors.rms_u == pytest.approx(np.sqrt(0.11 / 3))
     assert errors.bias_w == pytest.approx(-0.2 / 3) and errors.rms_w == pytest.approx(np.sqrt(0.04 / 3))
+
+
+# ---------------------------------------------------------------------------------------------- the accuracy study
+
+
+def test_the_silo_image_spans_the_width_from_the_outlet_plane_up():
+    scale = silo_image_scale(0.1, (250, 350))
+    assert scale.scale == pytest.approx(4e-4)
+    x, z = scale.to_silo([0, 249], [349, 0])
+    assert x == pytest.approx([-0.05 + 2e-4, 0.05 - 2e-4]) and z == pytest.approx([2e-4, 0.14 - 2e-4])
+
+
+def test_an_accuracy_row_is_bias_and_rms_over_every_pair_and_the_centreline_error():
+    x, z = np.array([-0.01, 0.0, 0.01]), np.array([0.0, 0.01])
+    ones = np.ones((2, 3), bool)
+    truth = PlanarField(x, z, np.zeros((2, 3)), np.full((2, 3), -0.1), ones)
+    first = PlanarField(x, z, np.full((2, 3), 0.01), np.full((2, 3), -0.12), ones)
+    second = PlanarField(x, z, np.full((2, 3), -0.01), np.full((2, 3), -0.1), ones)
+    row = accuracy_row([(first, truth), (second, truth)])
+    assert row["nodes"] == 12 and row["pairs"] == 2
+    assert row["bias_u_m_s"] == pytest.approx(0.0) and row["rms_u_m_s"] == pytest.approx(0.01)
+    assert row["bias_w_m_s"] == pytest.approx(-0.01) and row["rms_w_m_s"] == pytest.approx(np.sqrt(0.0002))
+    assert row["rms_w_spread_m_s"] == pytest.approx(np.std([0.02, 0.0], ddof=1))
+    assert row["centreline_w_error_m_s"] == pytest.approx(-0.01)
+
+
+def test_a_resolution_without_a_valid_vector_is_a_row_that_says_why(tmp_path):
+    class Frame:  # no sphere near the front wall: both images are blank
+        position = np.array([[0.0, 0.05, 0.01]])
+        velocity = np.array([[0.0, 0.0, -0.1]])
+        radius = np.array([0.0015])
+
+    rows = accuracy_table([Frame()], 0.05, [(256, 256)], [100.0], PivSettings(window_px=32, overlap_px=16, passes=2))
+    assert rows[0]["nodes"] == 0 and np.isnan(rows[0]["rms_w_m_s"]) and "no valid vector" in rows[0]["note"]
+    good = dict(rows[0], width_px=256, mm_per_px=0.2, rms_w_m_s=0.01, bias_w_m_s=-0.002, rms_w_spread_m_s=0.001)
+    path = plot_piv_accuracy([rows[0], good], tmp_path / "piv.png")
+    assert path.read_bytes()[:4] == b"\x89PNG"

@@ -92,8 +92,15 @@ def silo_flat_targets(wildcards=None):
         run_path("silo_flat", name, run)
         for run in run_ids("silo_flat")
         for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
-                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names())
+                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names(),
+                     *piv_names())
     ]
+
+
+def piv_names():
+    if not config["silo_flat"]["piv"]["enabled"]:
+        return []
+    return ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
 
 
 def measured_comparison_names():

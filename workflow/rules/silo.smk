@@ -90,6 +90,22 @@ rule silo_fields:
         "../scripts/silo_fields.py"
 
 
+rule silo_piv_synthetic:
+    input:
+        record=rules.silo_run.output.record,
+        case=rules.silo_deck.output.case,
+    output:
+        table=f"{run_dir('silo_flat')}/metrics/piv_accuracy.csv",
+        plot=report(f"{run_dir('silo_flat')}/plots/piv_accuracy.png", caption="../report/silo_piv_accuracy.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV accuracy"}),
+    params:
+        piv=config["silo_flat"]["piv"],
+        on_damaged=config["dumps"]["on_damaged"],
+    log:
+        f"{run_dir('silo_flat')}/logs/piv_synthetic.log",
+    script:
+        "../scripts/silo_piv_synthetic.py"
+
+
 rule silo_measured_comparison:
     input:
         fields=rules.silo_fields.output.arrays,
