@@ -19,8 +19,11 @@ with logged_to(snakemake.log[0]) as log:
     piv = snakemake.params.piv
     frames = [f for f in engine_named(record.engine).read_frames(run_dir, record, snakemake.params.on_damaged)
               if f.step > record.open_step]
+    if not frames:
+        raise ValueError(f"{run_dir}: no particle frame after the outlet opened; synthetic PIV needs the discharge")
     # frame pairs spread over the middle half of the discharge
-    chosen = [frames[i] for i in np.linspace(len(frames) // 4, 3 * len(frames) // 4, piv["frame_pairs"]).astype(int)]
+    spread = np.linspace(len(frames) // 4, 3 * len(frames) // 4, piv["frame_pairs"]).astype(int)
+    chosen = [frames[i] for i in sorted(set(spread.tolist()))]
     settings = PivSettings(window_px=piv["window_px"], overlap_px=piv["overlap_px"], passes=piv["passes"],
                            band=piv["band_diameters"] * case["equivalent_diameter_m"], blur_px=piv["blur_px"],
                            noise=piv["noise"])
