@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PlanarField", "field_from_rows"]
+__all__ = ["PlanarField", "field_from_rows", "time_average"]
 
 
 @dataclass(frozen=True)
@@ -84,3 +84,28 @@ def field_from_rows(x, z, u, w, valid, time: float = 0.0, decimals: int = 9) -> 
     for grid, values in zip(grids, (u, w, valid)):
         grid[k, i] = values
     return PlanarField(xs, zs, grids[0], grids[1], grids[2], time)
+
+
+def time_average(fields, start: float, end: float, min_fraction: float = 0.5) -> PlanarField:
+    """The mean of the fields with ``start <= time <= end`` [s], node by node over the fields where the node is valid;
+    a node valid in fewer than ``min_fraction`` of them is not valid. Its time is the mean time of the fields.
+
+    Raises
+    ------
+    ValueError
+        When no field lies in the window, or the fields are not on one grid.
+    """
+    chosen = [f for f in fields if start <= f.time <= end]
+    if not chosen:
+        raise ValueError(f"no PIV field between {start} and {end} s")
+    first = chosen[0]
+    if any(f.u.shape != first.u.shape or not (np.array_equal(f.x, first.x) and np.array_equal(f.z, first.z))
+           for f in chosen):
+        raise ValueError("the PIV fields to average are not on one grid")
+    valid = np.array([f.valid for f in chosen])
+    count = valid.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u, w = (np.where(valid, component, 0.0).sum(axis=0) / count
+                for component in (np.array([f.u for f in chosen]), np.array([f.w for f in chosen])))
+    keep = count >= max(1.0, min_fraction * len(chosen))
+    return PlanarField(first.x, first.z, u, w, keep, float(np.mean([f.time for f in chosen])))

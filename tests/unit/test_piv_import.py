@@ -9,7 +9,7 @@ import pytest
 
 from analysis.io.piv import PivFormatError, read_openpiv, read_piv_csv, read_pivlab_txt, write_piv_csv
 from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
-from analysis.piv.field import PlanarField, field_from_rows
+from analysis.piv.field import PlanarField, field_from_rows, time_average
 from analysis.piv.hampel import hampel_filter, hampel_outliers
 
 # ---------------------------------------------------------------------------------------------- the scale
@@ -157,3 +157,16 @@ def test_without_a_noise_floor_an_edge_with_a_gradient_looks_like_outliers():
     values = 0.01 * x**2  # every neighbour of the right edge lies to its left and they nearly agree
     assert hampel_outliers(values, np.ones(values.shape, bool), threshold=3.0)[:, -1].any()
     assert not hampel_outliers(values, np.ones(values.shape, bool), threshold=3.0, noise_floor=0.1).any()
+
+
+def test_time_average_is_the_mean_over_the_window_of_the_valid_values():
+    x, z = np.array([0.0, 1.0]), np.array([0.0])
+    fields = [PlanarField(x, z, [[1.0, 2.0]], [[-1.0, -2.0]], [[True, True]], time=0.1),
+              PlanarField(x, z, [[3.0, 9.0]], [[-3.0, -9.0]], [[True, False]], time=0.2),
+              PlanarField(x, z, [[5.0, 4.0]], [[-5.0, -4.0]], [[True, True]], time=0.3),
+              PlanarField(x, z, [[99.0, 99.0]], [[0.0, 0.0]], [[True, True]], time=0.9)]  # outside the window
+    mean = time_average(fields, 0.1, 0.3)
+    assert mean.u.tolist() == [[3.0, 3.0]] and mean.w.tolist() == [[-3.0, -3.0]] and mean.time == pytest.approx(0.2)
+    assert time_average(fields, 0.1, 0.3, min_fraction=0.9).valid.tolist() == [[True, False]]
+    with pytest.raises(ValueError, match="no PIV field between 1.0 and 2.0 s"):
+        time_average(fields, 1.0, 2.0)
