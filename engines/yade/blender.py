@@ -11,11 +11,10 @@ from pathlib import Path
 
 from analysis.data.record import RunRecord
 from engines.cases.blender import GATE, BlenderCase, blender_mesh_set
-from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck
-from engines.yade.inputs import ENGINE_NAME, exploded_speed, write_script_inputs
-from engines.yade.run import YadeOptions, run_script_checked
-from engines.yade.silo_flat import check_silo_case, silo_script_context
+from engines.yade.inputs import exploded_speed, write_script_inputs
+from engines.yade.run import YadeOptions
+from engines.yade.silo_flat import check_silo_case, run_silo_type, silo_script_context
 
 __all__ = ["REENTRY_EVERY", "blender_script_context", "render_blender_script", "run_blender", "write_blender_inputs"]
 
@@ -59,12 +58,8 @@ def write_blender_inputs(case: BlenderCase, deck_dir: str | Path) -> Path:
 def run_blender(case: BlenderCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
     """Run a rendered blender script, check it (the silo's stage checks; in continuous mode no clump lost) and write
     ``run.json``; returns the record."""
-    return run_script_checked(
-        run_dir, options, expected_simulated_time(case.silo),
-        lambda markers, dumps: check_silo_run(case.silo, markers, dumps, Path(run_dir), last_stage="discharged",
-                                              clumps_conserved=case.mode == "continuous"),
-        lambda checked: silo_run_record(
-            ENGINE_NAME, "blender", case.run_id, checked,
-            {"configuration": case.configuration, "gravity_factor": case.gravity_factor, "mode": case.mode},
-            [-case.silo.sink_depth, case.silo.domain_top]),
-    )
+    return run_silo_type(case.silo, "blender", case.run_id, run_dir, options,
+                         clumps_conserved=case.mode == "continuous",
+                         labels={"configuration": case.configuration, "gravity_factor": case.gravity_factor,
+                                 "mode": case.mode},
+                         domain_z=[-case.silo.sink_depth, case.silo.domain_top])

@@ -24,8 +24,8 @@ from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_j
 from engines.layout import CASE_SUMMARY
 from engines.yade.cost import measured_seconds_per_sphere_step
 from engines.yade.blender import run_blender, write_blender_inputs
-from engines.yade.inputs import ENGINE_NAME, rolling_friction
-from engines.yade.jenike import FORCES_NAME, jenike_contacts, run_jenike, write_jenike_inputs
+from engines.yade.inputs import ENGINE_NAME
+from engines.yade.jenike import FORCES_NAME, check_jenike_case, jenike_contacts, run_jenike, write_jenike_inputs
 from engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
 from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs
 from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
@@ -40,7 +40,7 @@ _ADAPTERS = {
     RecirculationCase: ("silo_recirculation", write_recirculation_inputs, run_recirculation,
                         lambda case: check_silo_case(case.silo), FLOOR_MESHES + CHANNEL_MESHES),
     BlenderCase: ("blender", write_blender_inputs, run_blender, lambda case: check_silo_case(case.silo), (GATE,)),
-    JenikeCase: ("jenike", write_jenike_inputs, run_jenike, lambda case: None, JENIKE_FLOOR_WALLS),
+    JenikeCase: ("jenike", write_jenike_inputs, run_jenike, check_jenike_case, JENIKE_FLOOR_WALLS),
     VerificationCase: ("verification", write_verification_inputs, run_verification, lambda case: None, None),
 }
 
@@ -77,11 +77,7 @@ class YadeEngine(Engine):
         CaseNotSupported
             Naming the config key and the limit.
         """
-        kind, _, _, check, _ = _adapter(case)
-        table = case.silo.materials if isinstance(case, (RecirculationCase, BlenderCase)) else getattr(case, "materials", None)
-        if table is not None:
-            rolling_friction(table, f"{kind} run {case.run_id}")
-        check(case)
+        _adapter(case)[3](case)
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
         self.check_case(case)

@@ -77,23 +77,30 @@ def principal_clump(particle) -> tuple[np.ndarray, np.ndarray]:
     return particle.sphere_positions @ axes, moments
 
 
-def common_context(case, table, wall_density: float = 1000.0) -> dict:
-    """The context of ``templates/yade/base.py.j2``: materials, pair contacts, rolling law, clump, time step."""
+def materials_context(case, table, wall_density: float = 1000.0) -> dict:
+    """The materials of ``table``: each material's elastic constants and density, each pair's sliding friction and
+    restitution, and the one rolling law (eta, krot) of its particle contacts."""
     particle = case.particle
     rolling = rolling_friction(table, f"run {case.run_id}")
     radius = float(particle.sphere_radii.min())
     kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * GRAVITY)
-    centres, moments = principal_clump(particle)
     n = len(table.names)
     return {
-        "materials": {
-            "list": [{"youngs_modulus": float(table.youngs_modulus[i]), "poisson_ratio": float(table.poisson_ratio[i]),
-                      "density": float(particle.density if i == 0 else wall_density)} for i in range(n)],
-            "pairs": [{"i": i, "j": j, "sliding_friction": float(table.sliding_friction[i][j]),
-                       "restitution": float(table.restitution[i][j])} for i in range(n) for j in range(i, n)],
-            "rolling_friction": rolling,
-            "rolling_stiffness": 2.25 * kn * rolling**2 * radius**2,
-        },
+        "list": [{"youngs_modulus": float(table.youngs_modulus[i]), "poisson_ratio": float(table.poisson_ratio[i]),
+                  "density": float(particle.density if i == 0 else wall_density)} for i in range(n)],
+        "pairs": [{"i": i, "j": j, "sliding_friction": float(table.sliding_friction[i][j]),
+                   "restitution": float(table.restitution[i][j])} for i in range(n) for j in range(i, n)],
+        "rolling_friction": rolling,
+        "rolling_stiffness": 2.25 * kn * rolling**2 * radius**2,
+    }
+
+
+def common_context(case, table, wall_density: float = 1000.0) -> dict:
+    """The context of ``templates/yade/base.py.j2``: materials, pair contacts, rolling law, clump, time step."""
+    particle = case.particle
+    centres, moments = principal_clump(particle)
+    return {
+        "materials": materials_context(case, table, wall_density),
         "particle": {
             "spheres": [[*map(float, c), float(r)] for c, r in zip(centres, particle.sphere_radii)],
             "mass": float(particle.mass),

@@ -37,11 +37,13 @@ from analysis.data.record import RunRecord
 from engines.cases.jenike import LID_TYPE, PLATE_TYPE, RING_TYPE, JenikeCase
 from engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from engines.templating import render_deck
-from engines.yade.inputs import ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, write_script_inputs
+from engines.yade.inputs import (
+    ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, materials_context, rolling_friction, write_script_inputs,
+)
 from engines.yade.outputs import DamagedOutput, read_archive
 from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, frame_files, run_script_checked
 
-__all__ = ["FORCES_NAME", "read_pair_contacts", "read_wall_contacts", "render_jenike_script", "run_jenike",
+__all__ = ["FORCES_NAME", "check_jenike_case", "read_pair_contacts", "read_wall_contacts", "render_jenike_script", "run_jenike",
            "write_jenike_inputs"]
 
 FORCES_NAME = "jenike_force_history.txt"
@@ -63,6 +65,20 @@ def _sample_every(output_every: int) -> int:
     return max(divisors, default=1)
 
 
+def check_jenike_case(case: JenikeCase) -> None:
+    """Refuse a Jenike point whose test or fill contacts have different rolling frictions (YADE takes one eta).
+
+    Raises
+    ------
+    CaseNotSupported
+        Naming the config key.
+    """
+    rolling_friction(case.materials, f"jenike run {case.run_id}")
+    fill = case.fill_contacts
+    rolling_friction(dataclasses.replace(case.materials, rolling_friction=fill.rolling_friction),
+                     f"the fill of jenike run {case.run_id}")
+
+
 def _meshes(case: JenikeCase) -> dict:
     # the servo lid is a plane in the script, not the case's lid mesh
     return case.geometry.meshes("rigid")
@@ -74,7 +90,7 @@ def jenike_script_context(case: JenikeCase) -> dict:
     fill = case.fill_contacts
     fill_table = dataclasses.replace(case.materials, sliding_friction=fill.sliding_friction,
                                      rolling_friction=fill.rolling_friction, restitution=fill.restitution)
-    fill_materials = common_context(case, fill_table)["materials"]
+    fill_materials = materials_context(case, fill_table)
     geometry = case.geometry
     base_type = PLATE_TYPE if geometry.wall_test else RING_TYPE
     materials = {"base": base_type - 1, "shear_ring": RING_TYPE - 1, "mould": RING_TYPE - 1}

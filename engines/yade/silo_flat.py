@@ -13,7 +13,9 @@ from engines.cases.silo_flat import SiloCase, silo_meshes
 from engines.interface import CaseNotSupported
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck
-from engines.yade.inputs import ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, write_script_inputs
+from engines.yade.inputs import (
+    ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, rolling_friction, write_script_inputs,
+)
 from engines.yade.run import (
     DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
 )
@@ -23,13 +25,15 @@ RESTARTS_PER_STAGE = 20
 
 
 def check_silo_case(case: SiloCase) -> None:
-    """Refuse what the YADE silo script does not build.
+    """Refuse what the YADE silo scripts (flat-bottom, recirculating, blender) do not build.
 
     Raises
     ------
     CaseNotSupported
-        For a periodic depth (``silo_flat.front_back_walls: false``).
+        For contacts with different rolling frictions (YADE takes one eta), or a periodic depth
+        (``silo_flat.front_back_walls: false``).
     """
+    rolling_friction(case.materials, f"run {case.run_id}")
     if not case.front_back_walls:
         raise CaseNotSupported(
             f"config key 'silo_flat.front_back_walls': false (a periodic depth) is not built on YADE (run "
@@ -94,10 +98,19 @@ def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
     return write_script_inputs(case.summary(), render_silo_script(case), deck_dir, silo_meshes(case))
 
 
+def run_silo_type(silo: SiloCase, case_kind: str, run_id: str, run_dir: str | Path, options: YadeOptions,
+                  last_stage: str = "discharged", clumps_conserved: bool = False, labels: dict | None = None,
+                  domain_z: list | None = None) -> RunRecord:
+    """Run a rendered silo-type script (flat-bottom, recirculating, blender), check it as every engine's silo-type
+    runs are (:func:`engines.silo_checks.check_silo_run`) and write ``run.json``; returns the record."""
+    return run_script_checked(
+        run_dir, options, expected_simulated_time(silo),
+        lambda markers, dumps: check_silo_run(silo, markers, dumps, Path(run_dir), last_stage=last_stage,
+                                              clumps_conserved=clumps_conserved),
+        lambda checked: silo_run_record(ENGINE_NAME, case_kind, run_id, checked, labels, domain_z),
+    )
+
+
 def run_silo(case: SiloCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
     """Run a rendered flat-bottom silo script, check it and write ``run.json``; returns the record."""
-    return run_script_checked(
-        run_dir, options, expected_simulated_time(case),
-        lambda markers, dumps: check_silo_run(case, markers, dumps, Path(run_dir)),
-        lambda checked: silo_run_record(ENGINE_NAME, "silo_flat", case.run_id, checked),
-    )
+    return run_silo_type(case, "silo_flat", case.run_id, run_dir, options)

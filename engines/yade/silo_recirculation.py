@@ -14,11 +14,10 @@ from pathlib import Path
 
 from analysis.data.record import RunRecord
 from engines.cases.silo_recirculation import RecirculationCase, recirculation_meshes
-from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck
-from engines.yade.inputs import ENGINE_NAME, write_script_inputs
-from engines.yade.run import YadeOptions, run_script_checked
-from engines.yade.silo_flat import check_silo_case, silo_script_context
+from engines.yade.inputs import write_script_inputs
+from engines.yade.run import YadeOptions
+from engines.yade.silo_flat import check_silo_case, run_silo_type, silo_script_context
 
 __all__ = ["FEEDER_EVERY", "recirculation_script_context", "render_recirculation_script", "run_recirculation",
            "write_recirculation_inputs"]
@@ -55,13 +54,8 @@ def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) ->
 def run_recirculation(case: RecirculationCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
     """Run a rendered recirculation script, check it (the batch silo's checks, and no clump lost while
     recirculating) and write ``run.json``; returns the record."""
-    return run_script_checked(
-        run_dir, options, expected_simulated_time(case.silo),
-        lambda markers, dumps: check_silo_run(case.silo, markers, dumps, Path(run_dir), last_stage="recirculated",
-                                              clumps_conserved=True),
-        lambda checked: silo_run_record(
-            ENGINE_NAME, "silo_recirculation", case.run_id, checked,
-            {"flow_pattern": case.pattern, "role": case.role,
-             "estimated_residence_time_s": case.estimated_residence_time},
-            [-case.channel_length, case.silo.domain_top]),
-    )
+    return run_silo_type(case.silo, "silo_recirculation", case.run_id, run_dir, options, last_stage="recirculated",
+                         clumps_conserved=True,
+                         labels={"flow_pattern": case.pattern, "role": case.role,
+                                 "estimated_residence_time_s": case.estimated_residence_time},
+                         domain_z=[-case.channel_length, case.silo.domain_top])
