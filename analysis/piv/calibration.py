@@ -89,15 +89,16 @@ def piv_field(x, y, u, v, valid, y_down: bool, scale: ImageScale | None, frame_r
               time: float = 0.0) -> PlanarField:
     """The neutral field of PIV vectors (one per row; positions x, y and displacements u, v).
 
-    With ``scale``, positions are pixels and (u, v) pixels per frame at ``frame_rate`` [1/s]: both go through the
-    scale (image rows point down; ``y_down=False`` rows, already turned up by the PIV program, are turned back first,
-    which needs the image height: give such files with their pixel rows, or scaled). Without ``scale``, positions are
-    metres with y up (``y_down`` must be False) and (u, v) m/s.
+    With ``scale``, positions are image pixels with rows pointing down (``y_down`` must be True: rows a PIV program
+    already turned up cannot be placed without the image height) and (u, v) pixels per frame at ``frame_rate``
+    [1/s]; both go through the scale. Without ``scale``, positions are metres with y up (``y_down`` must be False)
+    and (u, v) m/s.
 
     Raises
     ------
     ValueError
-        For pixels without a frame rate, metres with y down, or nodes that do not fill a regular grid.
+        For pixels without a frame rate, pixel rows pointing up, metres with y down, or nodes that do not fill a
+        regular grid.
     """
     x, y, u, v = (np.asarray(a, dtype=float) for a in (x, y, u, v))
     if scale is None:

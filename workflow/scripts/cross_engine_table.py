@@ -17,12 +17,10 @@ with logged_to(snakemake.log[0]) as log:
         values = {engine: [run[key] for run in runs if run["engine"] == engine] for engine in engines}
         rows.append(compare_engines(values, label, unit))
     jenike = [json.loads(Path(path).read_text()) for path in snakemake.input.jenike]
-    jenike_rows = []
-    for point in dict.fromkeys(run["point"] for run in jenike):
+    for point in dict.fromkeys(run["point"] for run in jenike):  # each point once, in the order of the runs
         values = {engine: [run["bulk_friction"] for run in jenike if run["engine"] == engine and run["point"] == point]
                   for engine in engines}
-        jenike_rows.append(compare_engines(values, point, "-"))
-    rows += jenike_rows
+        rows.append(compare_engines(values, point, "-"))
     write_flow_table(snakemake.output.table, rows)
     explanation = snakemake.params.explanation
     write_text(snakemake.output.page, summary_html(
