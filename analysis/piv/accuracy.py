@@ -15,11 +15,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.piv.calibration import ImageScale, piv_field
-from analysis.piv.field import PlanarField
+from analysis.piv.derived import field_quantities
+from analysis.piv.field import PlanarField, time_average
 from analysis.piv.front_wall import field_errors, front_wall_image, front_wall_spheres, window_mean_velocity
 from analysis.piv.synthetic import piv_displacements
 
-__all__ = ["PivSettings", "accuracy_row", "accuracy_table", "silo_image_scale", "synthetic_piv"]
+__all__ = ["COMBINATION", "ERROR_COLUMNS", "PivSettings", "accuracy_row", "accuracy_table", "derived_errors",
+           "profile_error_rows", "silo_image_scale", "synthetic_piv"]
+
+#: The columns that name a combination of image resolution and frame rate.
+COMBINATION = ("width_px", "height_px", "frame_rate_hz", "mm_per_px")
+#: The error columns of an accuracy row (m/s unless the name says otherwise).
+ERROR_COLUMNS = ("bias_u_m_s", "rms_u_m_s", "bias_w_m_s", "rms_w_m_s", "rms_w_spread_m_s", "centreline_w_error_m_s",
+                 "fcb_error_m", "kinematic_b_error_percent")
 
 
 @dataclass(frozen=True)
@@ -63,10 +71,32 @@ def synthetic_piv(position: np.ndarray, velocity: np.ndarray, radius: np.ndarray
     return measured, truth
 
 
-def accuracy_row(pairs: list[tuple[PlanarField, PlanarField]]) -> dict:
+def derived_errors(pairs: list[tuple[PlanarField, PlanarField]], heights, fraction: float = 0.05) -> dict:
+    """PIV's error of the derived quantities (:func:`analysis.piv.derived.field_quantities`) of the mean field over
+    the pairs, against the truth's, averaged over ``heights`` [m]: the centreline v_z [m/s], the flow channel boundary
+    at ``fraction`` of it (mean absolute error over both sides) [m] and the kinematic constant B [% of the truth's].
+    A quantity that one of the two fields does not give is left out of its mean (NaN when none is left)."""
+    measured = field_quantities(time_average([m for m, _ in pairs], -np.inf, np.inf), heights, fraction)
+    truth = field_quantities(time_average([t for _, t in pairs], -np.inf, np.inf), heights, fraction)
+
+    def mean(values) -> float:
+        values = np.asarray(values, dtype=float)
+        return float(np.mean(values[np.isfinite(values)])) if np.isfinite(values).any() else float("nan")
+
+    return {
+        "centreline_w_error_m_s": mean([m.centreline_w - t.centreline_w for m, t in zip(measured, truth)]),
+        "fcb_error_m": mean([abs(getattr(m, side) - getattr(t, side)) for m, t in zip(measured, truth)
+                             for side in ("fcb_left", "fcb_right")]),
+        "kinematic_b_error_percent": mean([100.0 * (m.kinematic_b - t.kinematic_b) / t.kinematic_b
+                                           for m, t in zip(measured, truth)]),
+    }
+
+
+def accuracy_row(pairs: list[tuple[PlanarField, PlanarField]], heights=(), fraction: float = 0.05) -> dict:
     """Bias and RMS error of u and w [m/s] over every node of every pair (valid in both), with the spread of the
-    per-pair RMS of w over the pairs [m/s], and the error of the centreline w (the node column nearest x = 0, mean
-    over its nodes) [m/s]."""
+    per-pair RMS of w over the pairs [m/s], and the error of the derived quantities at ``heights`` [m]
+    (:func:`derived_errors`; without heights, only the centreline w: the node column nearest x = 0, mean over its
+    nodes) [m/s]."""
     measured = np.concatenate([(m.u - t.u)[m.valid & t.valid] for m, t in pairs])
     vertical = np.concatenate([(m.w - t.w)[m.valid & t.valid] for m, t in pairs])
     per_pair = [field_errors(m, t).rms_w for m, t in pairs]
@@ -75,20 +105,41 @@ def accuracy_row(pairs: list[tuple[PlanarField, PlanarField]]) -> dict:
         column = int(np.argmin(np.abs(m.x)))
         both = m.valid[:, column] & t.valid[:, column]
         centre.extend((m.w[both, column] - t.w[both, column]).tolist())
-    return {
+    row = {
         "nodes": int(measured.size), "pairs": len(pairs),
         "bias_u_m_s": float(measured.mean()), "rms_u_m_s": float(np.sqrt(np.mean(measured**2))),
         "bias_w_m_s": float(vertical.mean()), "rms_w_m_s": float(np.sqrt(np.mean(vertical**2))),
         "rms_w_spread_m_s": float(np.std(per_pair, ddof=1)) if len(per_pair) > 1 else float("nan"),
         "centreline_w_error_m_s": float(np.mean(centre)) if centre else float("nan"),
+        "fcb_error_m": float("nan"), "kinematic_b_error_percent": float("nan"),
     }
+    if len(heights):
+        row.update(derived_errors(pairs, heights, fraction))
+    return row
 
 
-def accuracy_table(frames: list, width: float, resolutions, frame_rates, settings: PivSettings) -> list[dict]:
-    """One row per image resolution and frame rate (:func:`accuracy_row` over ``frames``, each with ``position``,
-    ``velocity`` and ``radius`` of its spheres), with ``width_px``, ``height_px``, ``frame_rate_hz`` and the scale
-    [mm/px]. A combination where OpenPIV finds no valid vector gets NaN errors and its reason in ``note``."""
+def profile_error_rows(pairs: list[tuple[PlanarField, PlanarField]], heights) -> list[dict]:
+    """PIV's error of v_z along the profile at each height: bias and RMS [m/s] over the nodes of the node row nearest
+    the height (``z_m``, m) valid in both, over every pair. PIV's error is not uniform over a silo: it is largest in
+    the narrow, sheared flow channel, so a profile is judged against its own row's error."""
     rows = []
+    for height in heights:
+        k = int(np.argmin(np.abs(pairs[0][0].z - height)))
+        errors = np.concatenate([(m.w[k] - t.w[k])[m.valid[k] & t.valid[k]] for m, t in pairs])
+        rows.append({"z_m": float(pairs[0][0].z[k]), "nodes": int(errors.size),
+                     "bias_w_m_s": float(errors.mean()) if errors.size else float("nan"),
+                     "rms_w_m_s": float(np.sqrt(np.mean(errors**2))) if errors.size else float("nan")})
+    return rows
+
+
+def accuracy_table(frames: list, width: float, resolutions, frame_rates, settings: PivSettings, heights=(),
+                   fraction: float = 0.05) -> tuple[list[dict], list[dict]]:
+    """One row per image resolution and frame rate (:func:`accuracy_row` over ``frames``, each with ``position``,
+    ``velocity`` and ``radius`` of its spheres, derived quantities at ``heights`` [m]), with ``width_px``,
+    ``height_px``, ``frame_rate_hz`` and the scale [mm/px]. A combination where OpenPIV finds no valid vector, or
+    whose fields give no profile at a height, gets NaN errors and its reason in ``note``. Second, the same
+    combinations' rows of :func:`profile_error_rows` per height."""
+    rows, profiles = [], []
     for resolution in resolutions:
         scale = silo_image_scale(width, resolution)
         for frame_rate in frame_rates:
@@ -97,10 +148,11 @@ def accuracy_table(frames: list, width: float, resolutions, frame_rates, setting
             try:
                 pairs = [synthetic_piv(f.position, f.velocity, f.radius, scale, resolution, frame_rate, settings)
                          for f in frames]
-                row.update(accuracy_row(pairs), note="")
+                row.update(accuracy_row(pairs, heights, fraction), note="")
+                profiles.extend({key: row[key] for key in COMBINATION} | r for r in profile_error_rows(pairs, heights))
             except ValueError as error:
-                row.update({key: float("nan") for key in ("bias_u_m_s", "rms_u_m_s", "bias_w_m_s", "rms_w_m_s",
-                                                          "rms_w_spread_m_s", "centreline_w_error_m_s")},
-                           nodes=0, pairs=0, note=str(error))
+                row.update({key: float("nan") for key in ERROR_COLUMNS}, nodes=0, pairs=0, note=str(error))
+                profiles.extend({key: row[key] for key in COMBINATION} | {"z_m": float(height), "nodes": 0,
+                                "bias_w_m_s": float("nan"), "rms_w_m_s": float("nan")} for height in heights)
             rows.append(row)
-    return rows
+    return rows, profiles

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PlanarField", "field_from_rows", "time_average"]
+__all__ = ["PivRows", "PlanarField", "field_from_rows", "time_average"]
 
 
 @dataclass(frozen=True)
@@ -109,3 +109,18 @@ def time_average(fields, start: float, end: float, min_fraction: float = 0.5) ->
                 for component in (np.array([f.u for f in chosen]), np.array([f.w for f in chosen])))
     keep = count >= max(1.0, min_fraction * len(chosen))
     return PlanarField(first.x, first.z, u, w, keep, float(np.mean([f.time for f in chosen])))
+
+
+@dataclass(frozen=True)
+class PivRows:
+    """One row per vector as a PIV program wrote it: positions (x, y) and displacements or velocities (u, v) in the
+    file's units, ``y_down`` when y and v point down the image, and which vectors are measurements. ``pixels`` is
+    True for pixels and displacements per frame, False for metres and m/s, None when the file does not say."""
+
+    x: np.ndarray
+    y: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    valid: np.ndarray
+    y_down: bool
+    pixels: bool | None = None

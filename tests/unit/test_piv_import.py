@@ -3,11 +3,21 @@ the neutral field and the Hampel filter, each against exact answers on hand-made
 
 from __future__ import annotations
 
+import h5py
 import numpy as np
 import openpiv.tools
 import pytest
+import scipy.io
 
-from analysis.io.piv import PivFormatError, read_openpiv, read_piv_csv, read_pivlab_txt, write_piv_csv
+from analysis.io.piv import (
+    PivFormatError,
+    read_openpiv,
+    read_piv_csv,
+    read_piv_file,
+    read_pivlab_mat,
+    read_pivlab_txt,
+    write_piv_csv,
+)
 from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
 from analysis.piv.field import PlanarField, field_from_rows, time_average
 from analysis.piv.hampel import hampel_filter, hampel_outliers
@@ -170,3 +180,96 @@ def test_time_average_is_the_mean_over_the_window_of_the_valid_values():
     assert time_average(fields, 0.1, 0.3, min_fraction=0.9).valid.tolist() == [[True, False]]
     with pytest.raises(ValueError, match="no PIV field between 1.0 and 2.0 s"):
         time_average(fields, 1.0, 2.0)
+
+
+# ---------------------------------------------------------------------------------------------- PIVlab .mat, DaVis
+
+
+def _pivlab_frames():
+    """Two frames of 2 x 3 vectors in PIVlab's layout: image axes, types 1 measured, 0 masked, 2 interpolated."""
+    x, y = np.meshgrid([16.0, 48.0, 80.0], [16.0, 48.0])
+    frames = {}
+    for n, shift in ((1, 0.0), (2, 1.0)):
+        u = np.array([[1.0, 2.0, np.nan], [3.0, 4.0, 5.0]]) + shift
+        frames.update({f"x_{n}": x, f"y_{n}": y, f"u_{n}": u, f"v_{n}": -u, f"typevector_{n}": np.array([[1, 1, 0], [2, 1, 1]])})
+    return frames
+
+
+def _check_pivlab_frames(frames):
+    assert len(frames) == 2
+    for frame, shift in zip(frames, (0.0, 1.0)):
+        assert frame.y_down and frame.pixels is None
+        assert sorted(zip(frame.x.tolist(), frame.y.tolist())) == sorted(
+            (a, b) for a in (16.0, 48.0, 80.0) for b in (16.0, 48.0))
+        lookup = {(a, b): (c, d, e) for a, b, c, d, e in zip(frame.x, frame.y, frame.u, frame.v, frame.valid)}
+        assert lookup[(48.0, 48.0)] == (4.0 + shift, -4.0 - shift, True)
+        assert not lookup[(80.0, 16.0)][2] and not lookup[(16.0, 48.0)][2]  # masked, and interpolated
+
+
+def test_a_pivlab_mat_file_of_matlab_5_is_read_frame_by_frame(tmp_path):
+    path = tmp_path / "PIVlab.mat"
+    scipy.io.savemat(path, _pivlab_frames())
+    _check_pivlab_frames(read_pivlab_mat(path))
+
+
+def test_a_pivlab_mat_file_of_matlab_7_3_hdf5_is_read_frame_by_frame(tmp_path):
+    path = tmp_path / "PIVlab_v73.mat"
+    with h5py.File(path, "w", userblock_size=512) as handle:
+        for key, array in _pivlab_frames().items():
+            handle[key] = np.asarray(array, dtype=float).T  # MATLAB stores column-major: h5py sees the transpose
+    with open(path, "r+b") as handle:  # MATLAB's text header in the user block
+        handle.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Fri Nov 27 2026 HDF5 schema 1.00 .")
+    _check_pivlab_frames(read_pivlab_mat(path))
+
+
+def test_a_pivlab_mat_file_without_its_arrays_is_refused_naming_it(tmp_path):
+    path = tmp_path / "partial.mat"
+    frames = _pivlab_frames()
+    del frames["typevector_2"]
+    scipy.io.savemat(path, frames)
+    with pytest.raises(PivFormatError, match="partial.mat: frame 2 has no typevector_2"):
+        read_pivlab_mat(path)
+    path.write_text("not matlab")
+    with pytest.raises(PivFormatError, match="partial.mat: not a MATLAB file"):
+        read_pivlab_mat(path)
+
+
+def _davis_buffer(lvpyio):
+    """A 2 x 3 vector buffer, one vector masked, with DaVis scales."""
+    vectors = np.ma.zeros((2, 3), dtype=lvpyio.vec2c)
+    vectors["u"] = np.arange(6.0).reshape(2, 3)
+    vectors["v"] = -1.0
+    vectors[1, 2] = np.ma.masked
+    buffer = lvpyio.arrays_to_buffer(vectors)
+    # calibrated: 0.1 mm per px, y up (negative slope), 16 px vector grid, velocities 2 m/s per unit
+    buffer[0].scales = lvpyio.Scales(lvpyio.Scale(0.1, -5.0, "mm", "x"), lvpyio.Scale(-0.1, 20.0, "mm", "y"),
+                                     lvpyio.Scale(1.0, 0.0, "mm", ""), lvpyio.Scale(2.0, 0.0, "m/s", "V"))
+    buffer[0].grid = lvpyio.Grid(16, 16, 1)
+    return buffer
+
+
+def test_davis_vectors_come_in_metres_with_y_up_and_davis_masks(tmp_path):
+    lvpyio = pytest.importorskip("lvpyio", reason="DaVis files need the optional extra siloflow[davis]")
+    path = tmp_path / "B00001.vc7"
+    lvpyio.write_buffer(_davis_buffer(lvpyio), str(path))
+    (frame,) = read_piv_file(path, "davis")
+    assert frame.pixels is False and frame.y_down is False
+    assert frame.x[:3] == pytest.approx(1e-3 * (np.array([0.5, 1.5, 2.5]) * 16 * 0.1 - 5.0))
+    assert frame.y[[0, 3]] == pytest.approx(1e-3 * (np.array([0.5, 1.5]) * 16 * -0.1 + 20.0))
+    assert frame.u.tolist()[:5] == [0.0, 2.0, 4.0, 6.0, 8.0] and frame.v[0] == 2.0  # -1 along a y that points up
+    assert frame.valid.tolist() == [True] * 5 + [False]
+
+
+def test_read_piv_file_names_an_unknown_format_or_a_missing_file(tmp_path):
+    with pytest.raises(PivFormatError, match="piv.txt: unknown PIV format 'insight'"):
+        read_piv_file(tmp_path / "piv.txt", "insight")
+    with pytest.raises(PivFormatError, match="piv.txt: no such file"):
+        read_piv_file(tmp_path / "piv.txt", "openpiv")
+
+
+def test_a_csv_through_read_piv_file_is_one_frame_in_metres(tmp_path):
+    field = PlanarField(np.array([-0.01, 0.01]), np.array([0.02]), np.array([[0.1, 0.2]]), np.array([[-1.0, -2.0]]),
+                        np.array([[True, False]]))
+    (frame,) = read_piv_file(write_piv_csv(tmp_path / "f.csv", field), "csv")
+    assert (frame.pixels, frame.y_down) == (False, False)
+    assert frame.x.tolist() == [-0.01, 0.01] and frame.y.tolist() == [0.02, 0.02] and frame.valid.tolist() == [True, False]

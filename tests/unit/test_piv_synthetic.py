@@ -142,8 +142,11 @@ def test_a_resolution_without_a_valid_vector_is_a_row_that_says_why(tmp_path):
         velocity = np.array([[0.0, 0.0, -0.1]])
         radius = np.array([0.0015])
 
-    rows = accuracy_table([Frame()], 0.05, [(256, 256)], [100.0], PivSettings(window_px=32, overlap_px=16, passes=2))
+    rows, profiles = accuracy_table([Frame()], 0.05, [(256, 256)], [100.0],
+                                    PivSettings(window_px=32, overlap_px=16, passes=2), heights=[0.01, 0.02])
     assert rows[0]["nodes"] == 0 and np.isnan(rows[0]["rms_w_m_s"]) and "no valid vector" in rows[0]["note"]
+    assert [(p["width_px"], p["z_m"], p["nodes"]) for p in profiles] == [(256, 0.01, 0), (256, 0.02, 0)]
+    assert all(np.isnan(p["rms_w_m_s"]) for p in profiles)
     good = dict(rows[0], width_px=256, mm_per_px=0.2, rms_w_m_s=0.01, bias_w_m_s=-0.002, rms_w_spread_m_s=0.001)
     path = plot_piv_accuracy([rows[0], good], tmp_path / "piv.png")
     assert path.read_bytes()[:4] == b"\x89PNG"

@@ -6,6 +6,8 @@ from pathlib import Path
 
 sys.path.insert(0, workflow.basedir)
 
+from analysis.io.measured_piv import load_measured_piv, measured_piv_paths
+from analysis.piv.measured import check_windows
 from calibration.parameters import calibrated_config
 from engines.cases import CASE_BUILDERS, cases_of
 from engines.cases.silo_flat import build_silo_case, parametric_variants
@@ -44,6 +46,22 @@ def check_cases(configuration):
 
 #: Every case the validated configuration defines (the flat-bottom silo's as configured, before calibration).
 CASES = check_cases(config)
+
+
+def check_measured_piv(measured):
+    """The measured PIV files, read, scaled and filtered once before anything runs, so that a bad file or marker set
+    stops the workflow first, naming it."""
+    if not measured["files"]:
+        return []
+    try:
+        paths = measured_piv_paths(measured["files"])
+        check_windows(load_measured_piv(measured, paths), measured["windows"])
+    except ValueError as error:
+        raise WorkflowError(f"Invalid measured PIV (silo_flat.piv.measured): {error}") from None
+    return paths
+
+
+MEASURED_PIV_FILES = check_measured_piv(config["silo_flat"]["piv"]["measured"])
 
 
 def cases(kind):
@@ -98,9 +116,12 @@ def silo_flat_targets(wildcards=None):
 
 
 def piv_names():
-    if not config["silo_flat"]["piv"]["enabled"]:
-        return []
-    return ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
+    names = []
+    if config["silo_flat"]["piv"]["enabled"]:
+        names += ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
+    if MEASURED_PIV_FILES:
+        names += ["metrics/piv_comparison.csv", "plots/piv_comparison.png"]
+    return names
 
 
 def measured_comparison_names():

@@ -96,14 +96,35 @@ rule silo_piv_synthetic:
         case=rules.silo_deck.output.case,
     output:
         table=f"{run_dir('silo_flat')}/metrics/piv_accuracy.csv",
+        profiles=f"{run_dir('silo_flat')}/metrics/piv_accuracy_profiles.csv",
         plot=report(f"{run_dir('silo_flat')}/plots/piv_accuracy.png", caption="../report/silo_piv_accuracy.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV accuracy"}),
     params:
         piv=config["silo_flat"]["piv"],
+        heights=config["silo_flat"]["fields"]["profile_heights"],
         on_damaged=config["dumps"]["on_damaged"],
     log:
         f"{run_dir('silo_flat')}/logs/piv_synthetic.log",
     script:
         "../scripts/silo_piv_synthetic.py"
+
+
+rule silo_piv_compare:
+    input:
+        record=rules.silo_run.output.record,
+        case=rules.silo_deck.output.case,
+        profiles=rules.silo_piv_synthetic.output.profiles,
+        measured=lambda wildcards: [str(p) for p in MEASURED_PIV_FILES],
+    output:
+        table=f"{run_dir('silo_flat')}/metrics/piv_comparison.csv",
+        plot=report(f"{run_dir('silo_flat')}/plots/piv_comparison.png", caption="../report/silo_piv_comparison.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV comparison"}),
+    params:
+        piv=config["silo_flat"]["piv"],
+        heights=config["silo_flat"]["fields"]["profile_heights"],
+        on_damaged=config["dumps"]["on_damaged"],
+    log:
+        f"{run_dir('silo_flat')}/logs/piv_compare.log",
+    script:
+        "../scripts/silo_piv_compare.py"
 
 
 rule silo_measured_comparison:

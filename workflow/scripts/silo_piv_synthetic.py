@@ -27,10 +27,13 @@ with logged_to(snakemake.log[0]) as log:
     settings = PivSettings(window_px=piv["window_px"], overlap_px=piv["overlap_px"], passes=piv["passes"],
                            band=piv["band_diameters"] * case["equivalent_diameter_m"], blur_px=piv["blur_px"],
                            noise=piv["noise"])
-    rows = accuracy_table(chosen, case["width_m"], piv["resolutions"], piv["frame_rates"], settings)
+    rows, profiles = accuracy_table(chosen, case["width_m"], piv["resolutions"], piv["frame_rates"], settings,
+                                    snakemake.params.heights, piv["fcb_fraction"])
     write_flow_table(snakemake.output.table, rows)
+    write_flow_table(snakemake.output.profiles, profiles)
     plot_piv_accuracy(rows, snakemake.output.plot)
     for row in rows:
-        log.info("%d x %d px (%.3g mm/px), %g frames/s: v_z bias %.3g m/s, RMS %.3g +- %.2g m/s over %d nodes %s",
-                 row["width_px"], row["height_px"], row["mm_per_px"], row["frame_rate_hz"], row["bias_w_m_s"],
-                 row["rms_w_m_s"], row["rms_w_spread_m_s"], row["nodes"], row["note"])
+        log.info("%d x %d px (%.3g mm/px), %g frames/s: v_z bias %.3g m/s, RMS %.3g +- %.2g m/s over %d nodes; "
+                 "centreline %.3g m/s, FCB %.3g m, B %.3g %% %s", row["width_px"], row["height_px"], row["mm_per_px"],
+                 row["frame_rate_hz"], row["bias_w_m_s"], row["rms_w_m_s"], row["rms_w_spread_m_s"], row["nodes"],
+                 row["centreline_w_error_m_s"], row["fcb_error_m"], row["kinematic_b_error_percent"], row["note"])

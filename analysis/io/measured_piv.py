@@ -1,0 +1,51 @@
+"""The edge where a measured PIV sequence comes in: the configured files (glob patterns expanded in sorted order) read
+frame by frame with their format's reader, then made into timed, filtered silo fields
+(:func:`analysis.piv.measured.measured_fields`). Used before any simulation starts, to stop on a bad file, and by
+the comparison rule."""
+
+from __future__ import annotations
+
+import glob
+from pathlib import Path
+
+from analysis.io.piv import read_piv_file
+from analysis.piv.field import PlanarField
+from analysis.piv.measured import measured_fields, measured_piv_settings
+
+__all__ = ["load_measured_piv", "measured_piv_paths"]
+
+
+def measured_piv_paths(patterns, base: str | Path = ".", where: str = "silo_flat.piv.measured.files") -> list[Path]:
+    """The files of ``patterns`` (paths or glob patterns, relative to ``base``): each pattern's matches in sorted
+    order, patterns in the given order.
+
+    Raises
+    ------
+    ValueError
+        Naming ``where`` and the pattern that matches no file.
+    """
+    paths = []
+    for pattern in patterns:
+        full = Path(base) / pattern
+        matches = sorted(glob.glob(str(full))) if glob.has_magic(pattern) else ([str(full)] if full.exists() else [])
+        if not matches:
+            raise ValueError(f"{where}: {pattern!r} matches no file (looked in {Path(base).resolve()})")
+        paths.extend(Path(m) for m in matches)
+    return paths
+
+
+def load_measured_piv(measured: dict, paths) -> list[PlanarField]:
+    """The fields of the files ``paths`` read as the validated ``silo_flat.piv.measured`` section says.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the problem (:class:`analysis.io.piv.PivFormatError` is one), or the configuration key.
+    """
+    settings = measured_piv_settings(measured)
+    frames, sources = [], []
+    for path in paths:
+        for rows in read_piv_file(path, measured["format"], measured["y_down"]):
+            frames.append(rows)
+            sources.append(str(path))
+    return measured_fields(frames, settings, sources)

@@ -1,0 +1,139 @@
+"""Measured PIV frames made into silo velocity fields: each frame through the image scale and frame rate, stamped with
+its time and cleaned by the Hampel filter.
+
+A PIV sequence gives one field per image pair; field n (from 0) is at ``start_time + n field_interval`` after the
+outlet opened, where ``field_interval`` defaults to one camera frame (pairs of consecutive images). Pixel files need
+the scale from wall markers and the camera frame rate (a displacement per frame times the frame rate is a velocity);
+files in metres and m/s need neither.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
+from analysis.piv.field import PivRows, PlanarField
+from analysis.piv.hampel import hampel_filter
+
+__all__ = ["MeasuredPiv", "check_windows", "measured_fields", "measured_piv_settings"]
+
+
+@dataclass(frozen=True)
+class MeasuredPiv:
+    """How to read a measured sequence (``silo_flat.piv.measured``).
+
+    Attributes
+    ----------
+    pixels : bool
+        True when positions are pixels and vectors displacements per frame; False for metres and m/s.
+    scale : ImageScale or None
+        The image scale (from the wall markers); needed for pixels.
+    frame_rate : float or None
+        Camera frame rate [1/s]; needed for pixels and for the default field interval.
+    start_time : float
+        Time of the first field after the outlet opened [s].
+    field_interval : float or None
+        Time between successive fields [s]; None: one camera frame.
+    hampel_half_window, hampel_threshold, hampel_noise_floor : int, float, float
+        The Hampel filter (:func:`analysis.piv.hampel.hampel_filter`; noise floor in m/s).
+    """
+
+    pixels: bool
+    scale: ImageScale | None
+    frame_rate: float | None
+    start_time: float = 0.0
+    field_interval: float | None = None
+    hampel_half_window: int = 1
+    hampel_threshold: float = 3.0
+    hampel_noise_floor: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.pixels and (self.scale is None or self.frame_rate is None):
+            raise ValueError("PIV in pixels needs the image scale (two or more wall markers) and the frame rate")
+        if self.field_interval is None and self.frame_rate is None:
+            raise ValueError("give the frame rate or the interval between fields, to time the fields")
+        for name in ("frame_rate", "field_interval"):
+            value = getattr(self, name)
+            if value is not None and not value > 0:
+                raise ValueError(f"{name} must be > 0, got {value!r}")
+
+    @property
+    def interval(self) -> float:
+        """Time between successive fields [s]."""
+        return self.field_interval if self.field_interval is not None else 1.0 / self.frame_rate
+
+
+def measured_fields(frames: Sequence[PivRows], settings: MeasuredPiv,
+                    sources: str | Sequence[str] = "measured PIV") -> list[PlanarField]:
+    """The fields of ``frames`` (in time order) in silo coordinates, timed and Hampel-filtered; ``sources`` names
+    where the frames come from (one name for all, or one per frame).
+
+    Raises
+    ------
+    ValueError
+        Naming the frame's source and number: a frame whose file says other units than ``settings``, or that does
+        not fit the scale (:func:`analysis.piv.calibration.piv_field`).
+    """
+    fields = []
+    for number, rows in enumerate(frames):
+        source = sources if isinstance(sources, str) else sources[number]
+        if rows.pixels is not None and rows.pixels != settings.pixels:
+            raise ValueError(f"{source}, frame {number}: the file is in {'pixels' if rows.pixels else 'metres'}, the "
+                             f"configuration says {'pixels' if settings.pixels else 'metres'}")
+        try:
+            field = piv_field(rows.x, rows.y, rows.u, rows.v, rows.valid, rows.y_down,
+                              settings.scale if settings.pixels else None, settings.frame_rate,
+                              settings.start_time + number * settings.interval)
+        except ValueError as error:
+            raise ValueError(f"{source}, frame {number}: {error}") from None
+        fields.append(hampel_filter(field, settings.hampel_half_window, settings.hampel_threshold,
+                                    settings.hampel_noise_floor))
+    if not fields:
+        raise ValueError(f"{sources if isinstance(sources, str) else 'measured PIV'}: no PIV frame")
+    return fields
+
+
+def measured_piv_settings(measured: dict, where: str = "silo_flat.piv.measured") -> MeasuredPiv:
+    """The :class:`MeasuredPiv` of a validated ``silo_flat.piv.measured`` section: the scale from its markers for
+    pixel files.
+
+    Raises
+    ------
+    ValueError
+        Naming ``where``: pixel files without two or more markers that fix a scale, or without a frame rate; fields
+        that cannot be timed.
+    """
+    pixels = measured["units"] == "pixels"
+    scale = None
+    if pixels:
+        markers = measured["markers"]
+        if len(markers) < 2:
+            raise ValueError(f"{where}.markers: {len(markers)} marker(s) do not fix the image scale of pixel files; "
+                             "give two or more, each its image [column, row] (px) and silo [x, z] (m) position")
+        scale = scale_from_markers([m["image"] for m in markers], [m["silo"] for m in markers], f"{where}.markers")
+        if measured["frame_rate"] is None:
+            raise ValueError(f"{where}.frame_rate: pixel files need the camera frame rate")
+    hampel = measured["hampel"]
+    try:
+        return MeasuredPiv(pixels, scale, measured["frame_rate"], measured["start_time"], measured["field_interval"],
+                           hampel["half_window"], hampel["threshold"], hampel["noise_floor"])
+    except ValueError as error:
+        raise ValueError(f"{where}: {error}") from None
+
+
+def check_windows(fields: Sequence[PlanarField], windows, where: str = "silo_flat.piv.measured.windows") -> None:
+    """Refuse time windows [s] that are empty or hold none of the measured fields.
+
+    Raises
+    ------
+    ValueError
+        Naming ``where``, the window and the fields' time span.
+    """
+    times = [f.time for f in fields]
+    for index, (start, end) in enumerate(windows):
+        if not start < end:
+            raise ValueError(f"{where}[{index}]: the window [{start:g}, {end:g}] s does not end after it starts")
+        if not any(start <= t <= end for t in times):
+            raise ValueError(f"{where}[{index}]: no measured field between {start:g} and {end:g} s; the fields span "
+                             f"{min(times):g} to {max(times):g} s after the outlet opened")
