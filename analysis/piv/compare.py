@@ -1,6 +1,7 @@
 """DEM against measured PIV, the way the study compared them: the DEM's front-wall velocity on the PIV grid, averaged
 over the same time window, profiles at the same heights, and the difference set against what PIV itself gets wrong
-(the synthetic study's RMS error at the nearest pixel size and frame rate) and the DEM's own noise over its frames.
+(the synthetic study's RMS error along the profile at the nearest pixel size, frame rate and height) and the DEM's
+own noise over its frames.
 
 The DEM's answer on the PIV grid is the mean velocity of the spheres within the band of the front wall in each
 interrogation window (:func:`analysis.piv.front_wall.window_mean_velocity`), the same truth the synthetic study
