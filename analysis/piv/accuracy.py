@@ -54,22 +54,11 @@ def silo_image_scale(width: float, resolution: tuple[int, int]) -> ImageScale:
 def synthetic_piv(position: np.ndarray, velocity: np.ndarray, radius: np.ndarray, scale: ImageScale,
                   resolution: tuple[int, int], frame_rate: float, settings: PivSettings,
                   rng: np.random.Generator | None = None) -> tuple[PlanarField, PlanarField]:
-    """PIV of one frame's front wall and the truth on the same grid (module docstring): (PIV field, truth).
-
-    The image is cut off one first-pass window above the highest visible sphere: a camera aims at the fill, and a
-    head space of blank image above it (windows without texture, most of a tall image over a low fill) makes
-    OpenPIV's multipass fail everywhere, because its window deformation cannot interpolate across the hole."""
+    """PIV of one frame's front wall and the truth on the same grid (module docstring): (PIV field, truth)."""
     position = np.asarray(position, dtype=float).reshape(-1, 3)
     velocity = np.asarray(velocity, dtype=float).reshape(-1, 3)
     seen = front_wall_spheres(position, settings.band)
-    rows = int(resolution[1])
-    if seen.any():
-        top = float(np.max(position[seen, 2] + radius[seen]))
-        first_window = settings.window_px * 2 ** max(settings.passes - 1, 0)
-        bottom = scale.z0 - (rows - 1) * scale.scale  # the bottom row's z stays where it is
-        rows = min(rows, int(np.ceil((top - bottom) / scale.scale)) + 1 + first_window)
-        scale = ImageScale(scale.scale, scale.x0, bottom + (rows - 1) * scale.scale)
-    shape = (rows, int(resolution[0]))
+    shape = (int(resolution[1]), int(resolution[0]))
     # one generator for both images: their noise must be independent, or it correlates to zero displacement
     rendering = {"void_level": 0.5, "particle_level": 1.0, "blur_px": settings.blur_px, "noise": 0.5 * settings.noise,
                  "rng": rng if rng is not None else np.random.default_rng(0)}
