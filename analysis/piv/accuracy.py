@@ -21,7 +21,7 @@ from analysis.piv.front_wall import field_errors, front_wall_image, front_wall_s
 from analysis.piv.synthetic import piv_displacements
 
 __all__ = ["COMBINATION", "ERROR_COLUMNS", "PivSettings", "accuracy_row", "accuracy_table", "derived_errors",
-           "profile_error_rows", "silo_image_scale", "synthetic_piv"]
+           "profile_error_rows", "silo_image_scale", "synthetic_piv", "visible_top"]
 
 #: The columns that name a combination of image resolution and frame rate.
 COMBINATION = ("width_px", "height_px", "frame_rate_hz", "mm_per_px")
@@ -51,14 +51,40 @@ def silo_image_scale(width: float, resolution: tuple[int, int]) -> ImageScale:
     return ImageScale(scale, -0.5 * width + 0.5 * scale, (rows - 0.5) * scale)
 
 
+def visible_top(frames, band: float) -> float | None:
+    """The highest point [m] of the spheres within ``band`` [m] of the front wall over ``frames`` (each with
+    ``position`` and ``radius``), or None when none is visible."""
+    tops = []
+    for frame in frames:
+        position = np.asarray(frame.position, dtype=float).reshape(-1, 3)
+        seen = front_wall_spheres(position, band)
+        if seen.any():
+            tops.append(float(np.max(position[seen, 2] + np.asarray(frame.radius, dtype=float)[seen])))
+    return max(tops) if tops else None
+
+
 def synthetic_piv(position: np.ndarray, velocity: np.ndarray, radius: np.ndarray, scale: ImageScale,
                   resolution: tuple[int, int], frame_rate: float, settings: PivSettings,
-                  rng: np.random.Generator | None = None) -> tuple[PlanarField, PlanarField]:
-    """PIV of one frame's front wall and the truth on the same grid (module docstring): (PIV field, truth)."""
+                  rng: np.random.Generator | None = None, image_top: float | None = None) -> tuple[PlanarField, PlanarField]:
+    """PIV of one frame's front wall and the truth on the same grid (module docstring): (PIV field, truth).
+
+    With ``image_top`` [m] the image ends one first-pass window above it (but keeps at least the four first-pass
+    windows multipass needs): a camera aims at the fill, and a head space of blank image above it (windows without
+    texture, most of a tall image over a low fill) makes OpenPIV's multipass fail everywhere, because its window
+    deformation cannot interpolate across the hole. Pairs to be averaged need one ``image_top``, so that they share
+    a grid (:func:`visible_top` of all their frames)."""
     position = np.asarray(position, dtype=float).reshape(-1, 3)
     velocity = np.asarray(velocity, dtype=float).reshape(-1, 3)
     seen = front_wall_spheres(position, settings.band)
-    shape = (int(resolution[1]), int(resolution[0]))
+    rows = int(resolution[1])
+    if image_top is not None:
+        first_window = settings.window_px * 2 ** max(settings.passes - 1, 0)
+        first_step = first_window - settings.overlap_px * 2 ** max(settings.passes - 1, 0)
+        bottom = scale.z0 - (rows - 1) * scale.scale  # the bottom row's z stays where it is
+        needed = int(np.ceil((image_top - bottom) / scale.scale)) + 1 + first_window
+        rows = min(rows, max(needed, first_window + 3 * first_step))
+        scale = ImageScale(scale.scale, scale.x0, bottom + (rows - 1) * scale.scale)
+    shape = (rows, int(resolution[0]))
     # one generator for both images: their noise must be independent, or it correlates to zero displacement
     rendering = {"void_level": 0.5, "particle_level": 1.0, "blur_px": settings.blur_px, "noise": 0.5 * settings.noise,
                  "rng": rng if rng is not None else np.random.default_rng(0)}
@@ -140,14 +166,15 @@ def accuracy_table(frames: list, width: float, resolutions, frame_rates, setting
     whose fields give no profile at a height, gets NaN errors and its reason in ``note``. Second, the same
     combinations' rows of :func:`profile_error_rows` per height."""
     rows, profiles = [], []
+    top = visible_top(frames, settings.band)
     for resolution in resolutions:
         scale = silo_image_scale(width, resolution)
         for frame_rate in frame_rates:
             row = {"width_px": int(resolution[0]), "height_px": int(resolution[1]), "frame_rate_hz": float(frame_rate),
                    "mm_per_px": 1e3 * scale.scale}
             try:
-                pairs = [synthetic_piv(f.position, f.velocity, f.radius, scale, resolution, frame_rate, settings)
-                         for f in frames]
+                pairs = [synthetic_piv(f.position, f.velocity, f.radius, scale, resolution, frame_rate, settings,
+                                       image_top=top) for f in frames]
                 row.update(accuracy_row(pairs, heights, fraction), note="")
                 profiles.extend({key: row[key] for key in COMBINATION} | r for r in profile_error_rows(pairs, heights))
             except ValueError as error:

@@ -84,6 +84,9 @@ def piv_displacements(frame_a: np.ndarray, frame_b: np.ndarray, window_px: int =
     settings.overlap = tuple(overlap_px * 2 ** k for k in range(passes - 1, -1, -1))
     settings.num_iterations = passes  # OpenPIV runs 3 passes unless told, whatever windowsizes says
     settings.show_plot = settings.save_plot = False
+    # OpenPIV 0.26's vectorised correlation raises "too many values to unpack" on some frames of a silo's front wall
+    # (pyprocess.vectorized_correlation_to_displacements, first pass); the loop over windows does not
+    settings.use_vectorized = False
     try:
         x, y, u, v, flags = windef.simple_multipass(np.asarray(frame_a, dtype=float),
                                                     np.asarray(frame_b, dtype=float), settings)

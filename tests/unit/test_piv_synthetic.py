@@ -6,7 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.piv.accuracy import PivSettings, accuracy_row, accuracy_table, silo_image_scale
+from analysis.piv.accuracy import (
+    PivSettings,
+    accuracy_row,
+    accuracy_table,
+    silo_image_scale,
+    synthetic_piv,
+    visible_top,
+)
 from analysis.piv.calibration import ImageScale
 from analysis.piv.field import PlanarField
 from analysis.piv.front_wall import field_errors, front_wall_image, front_wall_spheres, window_mean_velocity
@@ -150,3 +157,23 @@ def test_a_resolution_without_a_valid_vector_is_a_row_that_says_why(tmp_path):
     good = dict(rows[0], width_px=256, mm_per_px=0.2, rms_w_m_s=0.01, bias_w_m_s=-0.002, rms_w_spread_m_s=0.001)
     path = plot_piv_accuracy([rows[0], good], tmp_path / "piv.png")
     assert path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_tall_image_over_a_low_fill_is_cut_off_above_the_fill():
+    """A camera image mostly of blank head space made OpenPIV's multipass fail everywhere; the image now ends one
+    first-pass window above the highest sphere, with its bottom row still at the outlet plane."""
+    rng = np.random.default_rng(3)
+    n = 700
+    position = np.column_stack([rng.uniform(-0.025, 0.025, n), np.full(n, 0.001), rng.uniform(0.0, 0.03, n)])
+    velocity = np.tile([0.0, 0.0, -0.05], (n, 1))
+    radius = np.full(n, 0.0008)
+    resolution = (256, 1024)  # 0.195 mm/px: 200 mm tall over a fill 30 mm high
+    scale = silo_image_scale(0.05, resolution)
+    top = visible_top([type("Frame", (), {"position": position, "radius": radius})], 0.002)
+    assert top == pytest.approx(position[:, 2].max() + 0.0008)
+    measured, truth = synthetic_piv(position, velocity, radius, scale, resolution, 100.0, PivSettings(band=0.002),
+                                    image_top=top)
+    assert 0.0 < measured.z[0] < 40 * scale.scale  # the grid still starts at the outlet plane
+    assert measured.z[-1] < 0.0308 + 80 * scale.scale
+    errors = field_errors(measured, truth)
+    assert errors.nodes > 30 and abs(errors.bias_w) < 0.005 and errors.rms_w < 0.01
