@@ -10,7 +10,7 @@ from pathlib import Path
 
 from analysis.io.piv import read_piv_file
 from analysis.piv.field import PlanarField
-from analysis.piv.measured import measured_fields, measured_piv_settings
+from analysis.piv.measured import MeasuredPiv, measured_fields
 
 __all__ = ["load_measured_piv", "measured_piv_paths"]
 
@@ -34,15 +34,15 @@ def measured_piv_paths(patterns, base: str | Path = ".", where: str = "silo_flat
     return paths
 
 
-def load_measured_piv(measured: dict, paths) -> list[PlanarField]:
-    """The fields of the files ``paths`` read as the validated ``silo_flat.piv.measured`` section says.
+def load_measured_piv(measured: dict, settings: MeasuredPiv, paths) -> list[PlanarField]:
+    """The fields of the files ``paths`` in the format of the validated ``silo_flat.piv.measured`` section, placed and
+    timed by its ``settings`` (:func:`analysis.piv.measured.measured_piv_settings`).
 
     Raises
     ------
     ValueError
-        Naming the file and the problem (:class:`analysis.io.piv.PivFormatError` is one), or the configuration key.
+        Naming the file and the problem (:class:`analysis.io.piv.PivFormatError` is one).
     """
-    settings = measured_piv_settings(measured)
     frames, sources = [], []
     for path in paths:
         for rows in read_piv_file(path, measured["format"], measured["y_down"]):

@@ -221,7 +221,7 @@ def test_a_configured_sequence_is_read_in_order_from_its_patterns(tmp_path):
         _write_openpiv(tmp_path / f"field_{n:04d}.txt", shift=n)
     paths = measured_piv_paths(["field_*.txt"], tmp_path)
     assert [p.name for p in paths] == ["field_0001.txt", "field_0002.txt", "field_0003.txt"]
-    fields = load_measured_piv(_measured_config(), paths)
+    fields = load_measured_piv(_measured_config(), measured_piv_settings(_measured_config()), paths)
     # 1e-4 m/px from the markers at 100 frames/s: (2 + n) px/frame is (2 + n) cm/s
     assert [f.time for f in fields] == pytest.approx([0.2, 0.21, 0.22])
     assert [float(np.nanmean(f.u)) for f in fields] == pytest.approx([0.03, 0.04, 0.05])
@@ -239,7 +239,7 @@ def test_a_configured_sequence_is_read_in_order_from_its_patterns(tmp_path):
 def test_a_bad_measured_file_is_named_with_its_problem(tmp_path, content, message):
     (tmp_path / "bad.txt").write_text(content)
     with pytest.raises(ValueError, match=message):
-        load_measured_piv(_measured_config(), [tmp_path / "bad.txt"])
+        load_measured_piv(_measured_config(), measured_piv_settings(_measured_config()), [tmp_path / "bad.txt"])
 
 
 @pytest.mark.parametrize("changes, message", [

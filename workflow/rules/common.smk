@@ -7,7 +7,7 @@ from pathlib import Path
 sys.path.insert(0, workflow.basedir)
 
 from analysis.io.measured_piv import load_measured_piv, measured_piv_paths
-from analysis.piv.measured import check_windows
+from analysis.piv.measured import check_windows, measured_piv_settings
 from calibration.parameters import calibrated_config
 from engines.cases import CASE_BUILDERS, cases_of
 from engines.cases.silo_flat import build_silo_case, parametric_variants
@@ -55,7 +55,7 @@ def check_measured_piv(measured):
         return []
     try:
         paths = measured_piv_paths(measured["files"])
-        check_windows(load_measured_piv(measured, paths), measured["windows"])
+        check_windows(load_measured_piv(measured, measured_piv_settings(measured), paths), measured["windows"])
     except ValueError as error:
         raise WorkflowError(f"Invalid measured PIV (silo_flat.piv.measured): {error}") from None
     return paths

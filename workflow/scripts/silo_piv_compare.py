@@ -18,7 +18,7 @@ with logged_to(snakemake.log[0]) as log:
     case = json.loads(Path(snakemake.input.case).read_text())
     piv, measured = snakemake.params.piv, snakemake.params.piv["measured"]
     settings = measured_piv_settings(measured)
-    fields = load_measured_piv(measured, [Path(p) for p in snakemake.input.measured])
+    fields = load_measured_piv(measured, settings, [Path(p) for p in snakemake.input.measured])
     frames = engine_named(record.engine).read_frames(run_dir, record, snakemake.params.on_damaged)
     rows, pairs = piv_comparison(
         frames, fields, read_table(snakemake.input.profiles), snakemake.params.heights, measured["windows"],
