@@ -432,7 +432,8 @@ def format_duration(seconds: float, digits: int = 2) -> str:
 
 #: Columns of :func:`estimate_rows`, in order.
 ESTIMATE_COLUMNS = (
-    "run", "kind", "mpi_ranks", "clumps", "spheres", "steps", "simulated_s", "wall_time", "dump_frames", "disk",
+    "run", "kind", "mpi_ranks", "clumps", "spheres", "steps", "simulated_s", "wall_time", "core_time", "dump_frames",
+    "disk",
 )
 
 
@@ -440,8 +441,9 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
     """Rows of the table ``make estimate`` prints: one per run, then a totals row.
 
     Columns (:data:`ESTIMATE_COLUMNS`): run, kind, mpi_ranks, clumps, spheres, steps, simulated_s (s),
-    wall_time (formatted), dump_frames, disk (formatted dumps). The totals row sums wall time
-    (the runs one after another), dump frames and disk; its other cells are empty.
+    wall_time (formatted), core_time (wall time times MPI ranks, formatted: what a cluster account is charged),
+    dump_frames, disk (formatted dumps). The totals row sums wall time (the runs one after another), core time,
+    dump frames and disk; its other cells are empty.
     """
     estimates = list(estimates)
     rows = [
@@ -454,6 +456,7 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
             "steps": estimate.steps,
             "simulated_s": estimate.simulated_time_s,
             "wall_time": format_duration(estimate.wall_time_s),
+            "core_time": format_duration(estimate.wall_time_s * estimate.mpi_ranks),
             "dump_frames": estimate.dump_frames,
             "disk": format_bytes(estimate.dump_bytes),
         }
@@ -463,6 +466,7 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
     totals.update(
         run=f"total ({len(estimates)} run{'s' if len(estimates) != 1 else ''})",
         wall_time=format_duration(sum(e.wall_time_s for e in estimates)),
+        core_time=format_duration(sum(e.wall_time_s * e.mpi_ranks for e in estimates)),
         dump_frames=sum(e.dump_frames for e in estimates),
         disk=format_bytes(sum(e.dump_bytes for e in estimates)),
     )

@@ -172,6 +172,15 @@ def free_fall_velocity(start_velocity: float, height: float, gravity: float) -> 
     return math.sqrt(start_velocity**2 + 2.0 * gravity * max(height, 0.0))
 
 
+def free_fall_time(start_velocity: float, height: float, gravity: float) -> float:
+    """Time (s) of a free fall of ``height`` (m) that starts downwards at ``start_velocity`` (m/s):
+    the root of v t + g t^2 / 2 = h."""
+    if not (height >= 0 and gravity > 0 and start_velocity >= 0):
+        raise ValueError(f"need height >= 0, gravity > 0 and start_velocity >= 0, got {height!r}, {gravity!r}, "
+                         f"{start_velocity!r}")
+    return (-start_velocity + math.sqrt(start_velocity**2 + 2.0 * gravity * height)) / gravity
+
+
 def is_prime(number: int) -> bool:
     """Whether an integer is prime (trial division; seeds are small)."""
     if number < 2:

@@ -16,7 +16,7 @@ from engines.liggghts.run import Resume, run_checked
 from analysis.data.record import RunRecord
 from engines.liggghts.silo_flat import silo_deck_context
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
-from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
+from engines.liggghts.inputs import ENGINE_NAME, processor_grid, write_case_inputs
 from engines.templating import render_deck
 
 def blender_deck_context(case: BlenderCase) -> dict:
@@ -41,6 +41,7 @@ def blender_deck_context(case: BlenderCase) -> dict:
             "continuous": case.mode == "continuous",
         }
     )
+    context["processors"] = processor_grid(context["domain"])
     return context
 
 

@@ -19,6 +19,37 @@ SOFT_LIMIT = 5e6
 HARD_LIMIT = 1e9
 
 
+#: A horizontal axis at least this fraction of the widest horizontal extent of the domain is split among MPI ranks.
+SPLIT_EXTENT_FRACTION = 0.5
+
+
+def processor_grid(domain: dict) -> list[int]:
+    """The MPI processor grid of a deck from its domain: ranks along the wide horizontal axes only (0: LIGGGHTS
+    chooses the count along that axis, 1: not split).
+
+    Every case of siloflow fills from the bottom up and empties from the top down, so slabs stacked along gravity
+    (z) would leave the upper ranks idle through most of the fill and the discharge; slabs side by side across the
+    width stay equally loaded at every fill level (a planar silo or blender is symmetric about its axis). A thin
+    axis (a planar silo's depth) is not split either: its slabs would be mostly ghost atoms. LIGGGHTS' own choice
+    (``processors * * *``) splits the longest axis, which for a silo is z.
+
+    Parameters
+    ----------
+    domain : dict
+        The deck's simulation box, ``{"x": [lo, hi], "y": [lo, hi], "z": [lo, hi]}`` (m).
+
+    Returns
+    -------
+    list of int
+        ``[px, py, pz]`` for the ``processors`` command, 0 for ``*``.
+    """
+    extents = [domain[axis][1] - domain[axis][0] for axis in ("x", "y")]
+    if not all(extent > 0 for extent in extents):
+        raise ValueError(f"the domain must have a positive extent along x and y, got {domain!r}")
+    widest = max(extents)
+    return [0 if extent >= SPLIT_EXTENT_FRACTION * widest else 1 for extent in extents] + [1]
+
+
 def flat_matrix(matrix) -> list[float]:
     return [float(value) for row in matrix for value in row]
 

@@ -38,7 +38,7 @@ from engines.layout import RUN_RECORD
 from engines.liggghts.contacts import parse_local_table
 from engines.liggghts.dumps import list_dumps
 from engines.layout import write_text_atomic
-from engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix
+from engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix, processor_grid
 from engines.markers import parse_markers
 from engines.liggghts.run import (
     DUMP_PREFIX,
@@ -172,6 +172,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
         }
     )
     assert context["particle"]["type"] == PARTICLE_TYPE
+    context["processors"] = processor_grid(context["domain"])
     return context
 
 

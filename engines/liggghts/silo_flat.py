@@ -10,7 +10,7 @@ import numpy as np
 from analysis.data.record import RunRecord
 from engines.cases.silo_flat import SiloCase, silo_meshes
 from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
-from engines.liggghts.inputs import ENGINE_NAME, common_context, write_case_inputs
+from engines.liggghts.inputs import ENGINE_NAME, common_context, processor_grid, write_case_inputs
 from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
 from engines.liggghts.run import WALL_FORCES_NAME
 from engines.liggghts.run import (
@@ -95,6 +95,7 @@ def silo_deck_context(case: SiloCase) -> dict:
                             "resume_prefix": RESUMED_WALL_FORCES_PREFIX},
         }
     )
+    context["processors"] = processor_grid(context["domain"])
     return context
 
 

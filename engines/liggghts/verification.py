@@ -9,7 +9,7 @@ from pathlib import Path
 
 from analysis.data.record import RunRecord
 from engines.cases.verification import VerificationCase
-from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
+from engines.liggghts.inputs import ENGINE_NAME, processor_grid, write_case_inputs
 from engines.liggghts.run import DUMP_PREFIX, run_checked
 from engines.templating import render_deck
 from engines.verification_checks import check_verification_run, verification_record
@@ -22,10 +22,12 @@ VERIFICATION_DUMP_FIELDS = ("id", "type", "x", "y", "z", "vx", "vy", "vz", "omeg
 def verification_deck_context(case: VerificationCase) -> dict:
     """The rendering context of ``templates/liggghts/verification.lmp.j2``."""
     pair = lambda value: [float(value)] * 4  # noqa: E731  (particle-particle and particle-floor alike)
+    domain = {"x": list(case.domain[0:2]), "y": list(case.domain[2:4]), "z": list(case.domain[4:6])}
     return {
         "title": f"siloflow-verification-{case.run_id}",
         "boundary": ["f", "f", "f"],
-        "domain": {"x": list(case.domain[0:2]), "y": list(case.domain[2:4]), "z": list(case.domain[4:6])},
+        "domain": domain,
+        "processors": processor_grid(domain),
         "switches": {"soft_particles": case.youngs_modulus < 5e6, "hard_particles": case.youngs_modulus > 1e9},
         "neighbor_skin": 0.4 * case.radius,
         "materials": {"n_types": 2, "youngs_modulus": [case.youngs_modulus] * 2, "poisson_ratio": [case.poisson_ratio] * 2,

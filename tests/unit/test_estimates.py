@@ -369,15 +369,17 @@ def test_estimate_rows_have_stable_columns_and_a_totals_row():
     rows = estimate_rows([first, second])
     assert [list(row) for row in rows] == [list(ESTIMATE_COLUMNS)] * 3
     assert rows[1] == {"run": "b", "kind": "blender", "mpi_ranks": 2, "clumps": 10, "spheres": 20, "steps": 100,
-                       "simulated_s": 0.5, "wall_time": "1 h", "dump_frames": 7, "disk": "2 GB"}
-    assert rows[0]["disk"] == "254 kB" and rows[0]["wall_time"] == "0.32 s"
+                       "simulated_s": 0.5, "wall_time": "1 h", "core_time": "2 h", "dump_frames": 7,
+                       "disk": "2 GB"}
+    assert rows[0]["disk"] == "254 kB" and rows[0]["wall_time"] == "0.32 s" and rows[0]["core_time"] == "0.32 s"
     assert rows[2] == {"run": "total (2 runs)", "kind": "", "mpi_ranks": "", "clumps": "", "spheres": "",
-                       "steps": "", "simulated_s": "", "wall_time": "1 h", "dump_frames": 15, "disk": "2 GB"}
+                       "steps": "", "simulated_s": "", "wall_time": "1 h", "core_time": "2 h", "dump_frames": 15,
+                       "disk": "2 GB"}
 
 
 def test_estimate_rows_of_no_runs_is_a_zero_totals_row():
     assert estimate_rows([]) == [{**dict.fromkeys(ESTIMATE_COLUMNS, ""), "run": "total (0 runs)",
-                                  "wall_time": "0 s", "dump_frames": 0, "disk": "0 B"}]
+                                  "wall_time": "0 s", "core_time": "0 s", "dump_frames": 0, "disk": "0 B"}]
 
 
 def test_settling_is_counted_as_a_share_of_its_longest_time_in_whole_checks():

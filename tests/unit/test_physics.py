@@ -5,7 +5,7 @@ import math
 import pytest
 
 from engines.cases.physics import (
-    engine_seeds, free_fall_velocity, hertz_contact_time, is_prime, rayleigh_time, stable_timestep, steps_for,
+    engine_seeds, free_fall_time, free_fall_velocity, hertz_contact_time, is_prime, rayleigh_time, stable_timestep, steps_for,
 )
 
 
@@ -82,3 +82,15 @@ def test_stable_timestep_rejects_fractions_outside_zero_to_one(fractions):
 def test_free_fall_velocity_adds_the_fall_to_the_start_speed():
     assert free_fall_velocity(3.0, 1.0, 8.0) == 5.0  # sqrt(9 + 2 * 8 * 1)
     assert free_fall_velocity(3.0, -1.0, 8.0) == 3.0  # a start below the landing point falls nowhere
+
+
+def test_free_fall_time_is_the_root_of_the_fall():
+    assert free_fall_time(3.0, 2.5, 8.0) == 0.5  # 3 * 0.5 + 8 * 0.25 / 2 = 2.5
+    assert free_fall_time(0.0, 4.9, 9.8) == 1.0
+    assert free_fall_time(2.0, 0.0, 9.8) == 0.0
+
+
+@pytest.mark.parametrize("args", [(1.0, -0.1, 9.8), (1.0, 1.0, 0.0), (-1.0, 1.0, 9.8)])
+def test_free_fall_time_refuses_a_negative_height_or_start_or_no_gravity(args):
+    with pytest.raises(ValueError, match="need height >= 0"):
+        free_fall_time(*args)

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from engines.config import ConfigError, load_config, validate_config
+from engines.liggghts.inputs import processor_grid
 from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
 from engines.cases.silo_flat import build_silo_case
 from engines.templating import (
@@ -135,3 +136,20 @@ def test_environment_is_strict_about_undefined_values():
     assert environment.undefined.__name__ == "StrictUndefined"
     with pytest.raises(Exception, match="undefined"):
         environment.from_string("{{ missing|num }}").render()
+
+
+def test_ranks_split_the_wide_horizontal_axes_and_never_gravity():
+    planar = {"x": [-0.075, 0.075], "y": [0.0, 0.012], "z": [-0.02, 0.3]}
+    cell = {"x": [-0.03, 0.03], "y": [-0.03, 0.03], "z": [0.0, 0.1]}
+    assert processor_grid(planar) == [0, 1, 1]
+    assert processor_grid(cell) == [0, 0, 1]
+    # an axis of exactly half the widest is split; a thinner one is not
+    assert processor_grid({"x": [0.0, 2.0], "y": [0.0, 1.0], "z": [0.0, 9.0]}) == [0, 0, 1]
+    assert processor_grid({"x": [0.0, 2.0], "y": [0.0, 0.99], "z": [0.0, 9.0]}) == [0, 1, 1]
+    with pytest.raises(ValueError, match="positive extent"):
+        processor_grid({"x": [0.0, 0.0], "y": [0.0, 1.0], "z": [0.0, 1.0]})
+
+
+def test_the_silo_deck_names_its_processor_grid_before_the_box(tiny_config):
+    deck = render_silo_deck(build_silo_case(tiny_config))
+    assert deck.index("\nprocessors * 1 1\n") < deck.index("\ncreate_box ")
