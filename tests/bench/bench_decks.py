@@ -44,7 +44,6 @@ Run with ``python -m tests.bench.bench_decks results/bench/decks.csv`` (about 8 
 
 from __future__ import annotations
 
-import copy
 import csv
 import math
 import re
@@ -61,15 +60,13 @@ from engines.cases.blender import BlenderCase, build_blender_case
 from engines.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
 from engines.cases.jenike_sweep import sweep_points
 from engines.cases.silo_flat import SiloCase
-from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import Engine, EngineOptions, engine_for
 from engines.liggghts.cost import StageCost, stage_costs
 from engines.markers import parse_markers
-from tests.bench.small_silo import small_silo
+from tests.bench.small_silo import default_config_with, small_silo
 from tests.conftest import FAST_POUR
 
 BENCH_DIR = Path(__file__).resolve().parent
-DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
 #: ``silo_flat`` keys of the small silo (m, s, J per clump).
 SILO = {"width": 0.08, "depth": 0.012, "fill_height": 0.04, "outlet_width": 0.024, "discharge_time": 0.6,
@@ -239,7 +236,7 @@ def jenike_variables(case: JenikeCase, generated: GeneratedRun, hand_dir: Path) 
 
 def jenike_case() -> tuple[JenikeCase, Engine]:
     """The Jenike run of :data:`JENIKE_POINT` on the default configuration, rigid lid, and its engine."""
-    config = validate_config(load_config_file(DEFAULT_CONFIG))
+    config = default_config_with("jenike", {})
     points = sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"])
     point = {**JENIKE_POINT, "lid": "rigid"}
     if JENIKE_POINT not in points and point not in points:
@@ -249,9 +246,7 @@ def jenike_case() -> tuple[JenikeCase, Engine]:
 
 def blender_case() -> tuple[BlenderCase, Engine]:
     """The small blender (:data:`BLENDER` on the default configuration) and its engine."""
-    raw = load_config_file(DEFAULT_CONFIG)
-    raw["blender"] = {**raw["blender"], **copy.deepcopy(BLENDER)}
-    config = validate_config(raw)
+    config = default_config_with("blender", BLENDER)
     return build_blender_case(config, BLENDER_CONFIGURATION), engine_for(config, "blender")
 
 

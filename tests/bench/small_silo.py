@@ -9,9 +9,14 @@ from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import Engine, engine_for
 
 
+def default_config_with(section: str, overrides: dict) -> dict:
+    """The default config, validated, with ``overrides`` on its ``section``."""
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    raw[section] = {**raw[section], **copy.deepcopy(overrides)}
+    return validate_config(raw)
+
+
 def small_silo(overrides: dict) -> tuple[SiloCase, Engine]:
     """The silo case of the default config with ``overrides`` on ``silo_flat``, and the engine that runs it."""
-    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
-    raw["silo_flat"] = {**raw["silo_flat"], **copy.deepcopy(overrides)}
-    config = validate_config(raw)
+    config = default_config_with("silo_flat", overrides)
     return build_silo_case(config), engine_for(config, "silo_flat")
