@@ -116,6 +116,26 @@ class JenikeFill:
     relax_steps: int
 
 
+#: Force samples per output interval: each row of the force history averages them. The forces change on the scale
+#: of a contact's duration (tens of steps here), so every step is not needed, and sampling every step was the shear
+#: stage's largest cost next to the contacts (make bench).
+FORCE_SAMPLES_PER_OUTPUT = 10
+
+
+def force_sample_every(output_every: int) -> int:
+    """Steps between the force samples of one output interval of ``output_every`` steps.
+
+    The largest divisor of ``output_every`` that still gives at least :data:`FORCE_SAMPLES_PER_OUTPUT` samples per
+    interval: both engines average equally spaced samples that end on the interval's last step (LIGGGHTS' ``fix
+    ave/time`` needs the divisor).
+    """
+    if output_every < 1:
+        raise ValueError(f"output_every must be >= 1 step, got {output_every!r}")
+    divisors = [d for d in range(1, output_every + 1)
+                if output_every % d == 0 and output_every // d >= FORCE_SAMPLES_PER_OUTPUT]
+    return max(divisors, default=1)
+
+
 @dataclass(frozen=True)
 class JenikeCase(ChosenTimestep):
     """Everything that defines one Jenike shear run, derived from validated configuration and a sweep point."""
@@ -157,6 +177,11 @@ class JenikeCase(ChosenTimestep):
     def test(self) -> str:
         """``internal`` or the wall material of a wall-friction test."""
         return self.point["test"]
+
+    @property
+    def force_sample_every(self) -> int:
+        """Steps between the force samples that each row of the force history averages (:func:`force_sample_every`)."""
+        return force_sample_every(self.output_every)
 
     @property
     def run_id(self) -> str:

@@ -157,6 +157,8 @@ def jenike_deck_context(case: JenikeCase) -> dict:
             "consolidation": {"ramp_steps": case.ramp_steps, "hold_steps": case.hold_steps},
             "shear": {"velocity": case.shear_velocity, "steps": case.shear_steps},
             "output_every": case.output_every,
+            "force_sample_every": case.force_sample_every,
+            "force_samples": case.output_every // case.force_sample_every,
             "forces_path": FORCES_NAME,
             "dump": {"id": "particle_dump", "every": case.dump_every, "path": f"dumps/{DUMP_PREFIX}_*.vtk"},
             "contact_dumps": {

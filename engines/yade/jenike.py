@@ -53,16 +53,8 @@ WALL_CONTACTS_STEM = "wall_contacts"
 WALL_NAMES = ("base", "shear_ring", "mould", "lid")
 #: The rigid lid's sphere centres (x, y) [m] in the deck's geometry archive.
 LID_POSITIONS = "lid_sphere_positions"
-#: Force samples per output interval (each row of the history averages them).
-SAMPLES_PER_OUTPUT = 10
 #: Steps of the settled fill's snapshot at the end of the relaxation.
 SNAPSHOT_STEPS = 2
-
-
-def _sample_every(output_every: int) -> int:
-    """The largest divisor of ``output_every`` that gives at least :data:`SAMPLES_PER_OUTPUT` samples per row."""
-    divisors = [d for d in range(1, output_every + 1) if output_every % d == 0 and output_every // d >= SAMPLES_PER_OUTPUT]
-    return max(divisors, default=1)
 
 
 def check_jenike_case(case: JenikeCase) -> None:
@@ -124,7 +116,7 @@ def jenike_script_context(case: JenikeCase) -> dict:
         "consolidation": {"ramp_steps": case.ramp_steps, "hold_steps": case.hold_steps},
         "shear": {"velocity": case.shear_velocity, "steps": case.shear_steps},
         "output_every": case.output_every,
-        "force_sample_every": _sample_every(case.output_every),
+        "force_sample_every": case.force_sample_every,
         "dump_every": case.dump_every,
         "settled_fill": {"steps": SNAPSHOT_STEPS, "walls": list(SETTLED_WALLS)},
         "forces_path": FORCES_NAME,

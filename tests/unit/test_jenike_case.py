@@ -22,6 +22,7 @@ from engines.cases.jenike import (
     PLATE_TYPE,
     RING_TYPE,
     build_jenike_case,
+    force_sample_every,
 )
 from engines.cases.jenike_cell import circle_intersection_area
 from engines.interface import EngineRunError
@@ -470,3 +471,23 @@ def test_an_earlier_attempt_is_set_aside_with_its_force_history(tmp_path):
     assert (target / "forces.txt").read_text() == "old"
     assert (target / "dumps" / "particles_1.vtk").exists() and not (target / "dumps" / "forces.txt").exists()
     assert not (tmp_path / "forces.txt").exists() and not (tmp_path / "dumps").exists()
+
+
+@pytest.mark.parametrize("output_every, expected", [(87, 3), (100, 10), (9, 1), (120, 12), (7, 1), (10, 1), (20, 2)])
+def test_force_samples_divide_the_output_interval_at_least_ten_times(output_every, expected):
+    assert force_sample_every(output_every) == expected
+    assert output_every % expected == 0
+
+
+def test_force_sampling_refuses_an_empty_output_interval():
+    with pytest.raises(ValueError, match="output_every must be >= 1"):
+        force_sample_every(0)
+
+
+def test_the_liggghts_force_history_averages_the_samples_of_one_output_interval():
+    case = _case()
+    every = case.force_sample_every
+    assert case.output_every % every == 0 and case.output_every // every >= 10
+    deck = render_jenike_deck(case)
+    assert (f"fix force_history all ave/time {every} {case.output_every // every} {case.output_every} "
+            "v_time_now") in deck

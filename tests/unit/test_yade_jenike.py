@@ -13,7 +13,7 @@ from engines.config import validate_config
 from engines.interface import engine_named
 from engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.yade.jenike import (
-    _sample_every, jenike_script_context, read_pair_contacts, read_wall_contacts, render_jenike_script,
+    jenike_script_context, read_pair_contacts, read_wall_contacts, render_jenike_script,
 )
 from engines.yade.outputs import DamagedOutput
 from tests.golden_files import assert_matches_golden
@@ -57,11 +57,6 @@ def test_the_script_has_the_cases_meshes_and_lid():
     assert context["lid"]["mass"] == case.rigid_lid.mass
     servo = jenike_script_context(_case("servo"))["lid"]
     assert servo["kind"] == "servo" and servo["mass"] == _case("servo").servo_lid.mass
-
-
-@pytest.mark.parametrize("output_every, expected", [(87, 3), (100, 10), (9, 1), (120, 12), (7, 1)])
-def test_force_samples_divide_the_output_interval_at_least_ten_times(output_every, expected):
-    assert _sample_every(output_every) == expected
 
 
 def test_yade_accepts_every_jenike_point_of_the_default_sweep():
