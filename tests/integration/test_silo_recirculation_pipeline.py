@@ -180,3 +180,22 @@ def test_validation_rows_of_the_real_run_carry_errors_and_a_verdict(blending_pip
     assert len(rows) == 5 + 3  # one VRR row per layout, RTD peak, t_s/t_d, bulk density drop
     assert all(math.isfinite(row["value"]) and row["value_error"] > 0.0 for row in rows)
     assert {row["scale_shows"] for row in rows} == {"no"} and "particle diameters (>= 10)" in rows[0]["evidence"]
+
+
+def test_the_shortcut_is_measured_against_the_whole_run(blending_pipeline):
+    """The run (Nr 3) goes on past where the shortcut stops (Nr 0.5 + 1): the table compares both analyses. Cutting
+    the run short can only lose the tracer's slow passes, so the shortcut's mean residence time is not longer than
+    the full run's beyond its error."""
+    _, runs, _ = blending_pipeline
+    rows = read_table(runs["blending"] / "metrics" / "shortcut.csv")
+    layouts = [layout["name"] for layout in validate_config(copy.deepcopy(CONFIG))["silo_recirculation"]["layouts"]]
+    assert [row["layout"] for row in rows] == layouts + ["continuous (sine)"]
+    row = rows[0]
+    print({key: row[key] for key in ("recirculations_full", "recirculations_shortcut", "t_mean_full_s",
+                                     "t_mean_shortcut_s", "tracer_exited_shortcut", "model_rms_difference")})
+    assert row["recirculations_full"] > 2.5 and row["recirculations_shortcut"] == pytest.approx(1.5, abs=0.05)
+    assert 0.0 < row["tracer_exited_shortcut"] <= 1.0
+    error = math.hypot(row["t_mean_full_error_s"], row["t_mean_shortcut_error_s"])
+    assert row["t_mean_shortcut_s"] < row["t_mean_full_s"] + 3.0 * error
+    assert math.isfinite(row["model_rms_difference"]) and math.isfinite(rows[-1]["vrr_largest_relative_difference"])
+    assert (runs["blending"] / "plots" / "shortcut.png").read_bytes()[:4] == b"\x89PNG"

@@ -151,6 +151,12 @@ def recirculation_runs(role="blending"):
     return [run for run, case in cases(RECIRCULATION).items() if case.role == role]
 
 
+def shortcut_measured():
+    """Whether the blending runs go on past where the study's shortcut stops, so that it can be measured on them."""
+    blending = config[RECIRCULATION]
+    return blending["recirculations"] > blending["tracer"]["start_recirculations"] + blending["shortcut"]["residence_times"]
+
+
 def recirculation_targets(wildcards=None):
     runs = recirculation_runs()
     targets = [
@@ -160,6 +166,8 @@ def recirculation_targets(wildcards=None):
                      "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
                      "plots/snapshots")
     ]
+    if shortcut_measured():
+        targets += [run_path(RECIRCULATION, name, run) for run in runs for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
     if runs:
         targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
     targets += [

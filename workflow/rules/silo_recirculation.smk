@@ -78,6 +78,23 @@ rule silo_recirculation_analysis:
         "../scripts/silo_recirculation_analysis.py"
 
 
+rule silo_recirculation_shortcut:
+    input:
+        tracks=rules.silo_recirculation_tracks.output.tracks,
+        case=rules.silo_recirculation_deck.output.case,
+    output:
+        table=report(f"{run_dir(RECIRCULATION)}/metrics/shortcut.csv", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut table"}),
+        plot=report(f"{run_dir(RECIRCULATION)}/plots/shortcut.png", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut"}),
+    params:
+        blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
+                                    ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
+                                     "shortcut")},
+    log:
+        f"{run_dir(RECIRCULATION)}/logs/shortcut.log",
+    script:
+        "../scripts/silo_recirculation_shortcut.py"
+
+
 rule silo_recirculation_verification:
     input:
         tracks=rules.silo_recirculation_tracks.output.tracks,

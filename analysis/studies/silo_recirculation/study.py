@@ -413,8 +413,8 @@ def continuous_mode(rtd: ParticleRTD, period_fractions, samples_per_shortest_per
 
 def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_top: float, window_fraction: float,
                      tracer_fraction: float, tracer_start: float, rtd_bins: int, period_fractions, passes: int,
-                     tolerance: float, outlet_z: float = 0.0, window_target_vrr: float | None = None
-                     ) -> BlendingResult:
+                     tolerance: float, outlet_z: float = 0.0, window_target_vrr: float | None = None,
+                     with_transit: bool = True) -> BlendingResult:
     """The whole direct + RTD + LTI analysis of one recirculation run (see the module docstring).
 
     Parameters
@@ -444,6 +444,10 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
         of this size lies a factor :data:`~analysis.numerics.vrr_noise.CEILING_FACTOR` below the counting-noise
         ceiling of the windows (:func:`~analysis.numerics.vrr_noise.window_duration_for_precision` at the measured
         throughput) [-].
+    with_transit : bool, optional
+        False leaves out Little's law on the passes within a horizon (``transit`` and ``tracer_transit_mean`` are
+        then None): a run cut off at the shortcut's length (:mod:`analysis.studies.silo_recirculation.shortcut`) may
+        hold no pass that short.
     """
     events = recirculation_events(tracks, outlet_z, domain_bottom, domain_top)
     timing = loop_timing(tracks, events, outlet_z)
@@ -456,7 +460,8 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
     results = [analyse_layout(layout, initial_height, events, timing, window, rtd, passes, tolerance)
                for layout in layouts]
     sine, square = continuous_mode(rtd, period_fractions)
-    transit, tracer_transit_mean = transit_timing(tracks, events, timing, rtd.tracer, outlet_z=outlet_z)
+    transit, tracer_transit_mean = (transit_timing(tracks, events, timing, rtd.tracer, outlet_z=outlet_z)
+                                    if with_transit else (None, None))
     return BlendingResult(timing=timing, events=events, window=window, rtd=rtd, layouts=results, vrr_sine=sine,
                           vrr_square=square, transit=transit, tracer_transit_mean=tracer_transit_mean)
 

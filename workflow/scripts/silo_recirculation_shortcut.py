@@ -1,0 +1,51 @@
+"""Snakemake adapter: the study's shortcut (RTD from one residence time after the tracer is marked, LTI beyond)
+measured against the full analysis of one recirculation run."""
+
+import json
+from pathlib import Path
+
+from analysis.io.tables import write_flow_table
+from analysis.studies.silo_recirculation.rtd_plots import plot_vrr_versus_period
+from analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
+from analysis.studies.silo_recirculation.study import Layout, analyse_blending
+from analysis.studies.silo_recirculation.tracks_io import load_tracks
+from engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    out = snakemake.output
+    settings = snakemake.params.blending
+    case = json.loads(Path(snakemake.input.case).read_text())
+    tracks = load_tracks(snakemake.input.tracks).tracks
+    bottom, top = case["domain_z"]
+    layouts = [Layout(l["name"], l["blue_fraction"], l["sublayers"], l["blue_at"]) for l in settings["layouts"]]
+    lti, tracer = settings["lti"], settings["tracer"]
+
+    def analyse(run_tracks):
+        return analyse_blending(
+            run_tracks, layouts, bottom, top, settings["concentration_window"], tracer["volume_fraction"],
+            tracer["start_recirculations"], tracer["bins"], lti["period_fractions"], lti["passes"], lti["tolerance"],
+            window_target_vrr=settings["concentration_window_target_vrr"], with_transit=False,
+        )
+
+    full = analyse(tracks)
+    stop_nr = tracer["start_recirculations"] + settings["shortcut"]["residence_times"]
+    t_stop = full.timing.t_open + stop_nr * full.timing.residence_time
+    log.info("full run: Nr = %.2f; the shortcut stops at Nr = %.2f (t = %.4g s)", full.timing.recirculations, stop_nr,
+             t_stop)
+    short = analyse(tracks_until(tracks, t_stop))
+    rows = shortcut_rows(full, short)
+    write_flow_table(out.table, rows)
+    for row in rows:
+        log.info("%s: t_m %.4g +- %.2g s (full) vs %.4g +- %.2g s (shortcut, %.0f %% of its tracer out), "
+                 "%.2f errors apart; homogenised after Nr %s (direct), %s (model, full RTD), %s (model, shortcut); "
+                 "model RMS difference %.3g; largest VRR difference %.3g", row["layout"], row["t_mean_full_s"],
+                 row["t_mean_full_error_s"], row["t_mean_shortcut_s"], row["t_mean_shortcut_error_s"],
+                 100.0 * row["tracer_exited_shortcut"], row["t_mean_difference_over_error"],
+                 row["homogenised_direct"], row["homogenised_model_full"], row["homogenised_model_shortcut"],
+                 row["model_rms_difference"], row["vrr_largest_relative_difference"])
+    plot_vrr_versus_period(
+        full.vrr_sine.period_over_tm,
+        [(f"sine, full run (Nr {full.timing.recirculations:.1f})", full.vrr_sine.vrr),
+         (f"sine, shortcut (Nr {short.timing.recirculations:.1f})", short.vrr_sine.vrr)],
+        out.plot, f"Shortcut vs full run, {case['flow_pattern']} ({case['run_id']})",
+    )
