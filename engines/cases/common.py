@@ -182,14 +182,15 @@ def plan_fill(
     (with ``all_in`` LIGGGHTS keeps each clump's bounding sphere inside the zone, so clumps never overlap the
     front and back walls, and a silo one clump thick still has room for the centres), and its floor sits above
     the highest heap the pile can form, H + (W/2) tan(heap angle), plus two clump diameters. Each insertion
-    event fills the zone to the given solid fraction; the next one comes when the batch has moved one zone
-    height down, so batches never overlap.
+    event fills the zone to the given solid fraction; the next one comes as soon as the batch has fallen one zone
+    height (at the insertion velocity, gravity helping), so batches never overlap.
 
     The pour is gentle: the stream's momentum flux where it lands on the finished fill (mass rate times impact
     velocity, the insertion velocity plus the free fall from the zone's floor to fill_height) stays below
     ``momentum_flux_ratio`` times the fill's weight; the planner puts fewer clumps into each insertion event until
     it does. A stream whose momentum flux is comparable to the weight compacts the bed, which springs back when the
-    pour stops and is then held down by its walls (the settled fill's force balance shows it).
+    pour stops and is then held down by its walls (the settled fill's force balance shows it). The momentum flux, not
+    the spacing of the batches, sets how fast the silo fills.
     """
     if n_clumps is None:
         n_clumps = int(round(fill_config["bulk_density_estimate"] * width * depth * fill_height / particle.mass))
@@ -199,7 +200,8 @@ def plan_fill(
     zone_volume = (x_max - x_min) * (y_max - y_min) * (z_max - z_min)
     clumps_per_insertion = max(1, int(fill_config["volume_fraction"] * zone_volume / particle.volume))
     velocity = fill_config["insertion_velocity"]
-    insert_every = steps_for(fill_config["zone_height"] / velocity, timestep)
+    # A batch has left the zone once it has fallen one zone height, gravity helping.
+    insert_every = steps_for(free_fall_time(velocity, fill_config["zone_height"], gravity), timestep)
     impact_velocity = free_fall_velocity(velocity, z_min - fill_height, gravity)
     weight = n_clumps * particle.mass * gravity
     gentle_rate = fill_config["momentum_flux_ratio"] * weight / (impact_velocity * particle.mass)  # clumps/s
