@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from analysis.studies.silo_recirculation.configured import analyse_configured, configured_layouts
 from analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
 from analysis.studies.silo_recirculation.study import Layout, analyse_blending
 from tests.unit.test_silo_recirculation_study import (
@@ -78,3 +79,18 @@ def test_the_layouts_must_match(tracks):
     short = _analyse(tracks_until(tracks, 2.0 * PASS_TIME), layouts=[Layout("other", 0.5)])
     with pytest.raises(ValueError, match="same batch layouts"):
         shortcut_rows(full, short)
+
+
+def test_the_configured_analysis_is_analyse_blending_with_the_sections_keys(tracks):
+    settings = {"layouts": [{"name": layout.name, "blue_fraction": layout.blue_fraction,
+                             "sublayers": layout.sublayers, "blue_at": layout.blue_at} for layout in LAYOUTS],
+                "concentration_window": WINDOW_FRACTION, "concentration_window_target_vrr": None,
+                "tracer": {"volume_fraction": TRACER_FRACTION, "start_recirculations": TRACER_START, "bins": RTD_BINS},
+                "lti": {"period_fractions": PERIOD_FRACTIONS, "passes": PASSES, "tolerance": TOLERANCE}}
+    configured = analyse_configured(tracks, BOTTOM, TOP, settings, with_transit=False)
+    direct = _analyse(tracks)
+    assert configured_layouts(settings) == LAYOUTS
+    assert configured.window == direct.window and configured.timing.residence_time == direct.timing.residence_time
+    for mine, theirs in zip(configured.layouts, direct.layouts):
+        np.testing.assert_array_equal(mine.model_concentration, theirs.model_concentration)
+    np.testing.assert_array_equal(configured.vrr_sine.vrr, direct.vrr_sine.vrr)

@@ -18,7 +18,8 @@ from analysis.studies.silo_recirculation.rtd_plots import (
     plot_rtd_comparison,
     plot_vrr_versus_period,
 )
-from analysis.studies.silo_recirculation.study import Layout, analyse_blending, main_run_eulerian_rtd, snapshot_frames
+from analysis.studies.silo_recirculation.configured import analyse_configured
+from analysis.studies.silo_recirculation.study import main_run_eulerian_rtd, snapshot_frames
 from analysis.studies.silo_recirculation.tables import (
     blending_summary,
     clumps_per_window,
@@ -39,13 +40,8 @@ with logged_to(snakemake.log[0]) as log:
     loaded = load_tracks(snakemake.input.tracks)
     tracks = loaded.tracks
     bottom, top = case["domain_z"]
-    layouts = [Layout(l["name"], l["blue_fraction"], l["sublayers"], l["blue_at"]) for l in settings["layouts"]]
     lti = settings["lti"]
-    result = analyse_blending(
-        tracks, layouts, bottom, top, settings["concentration_window"], settings["tracer"]["volume_fraction"],
-        settings["tracer"]["start_recirculations"], settings["tracer"]["bins"], lti["period_fractions"],
-        lti["passes"], lti["tolerance"], window_target_vrr=settings["concentration_window_target_vrr"],
-    )
+    result = analyse_configured(tracks, bottom, top, settings)
     timing = result.timing
     log.info("t_res %.4g +- %.2g s (holdup %.1f +- %.2g clumps, throughput %.1f +- %.2g clumps/s), run covers "
              "Nr = %.2f", timing.residence_time, timing.residence_time_error, timing.holdup, timing.holdup_error,

@@ -7,7 +7,7 @@ from pathlib import Path
 from analysis.io.tables import write_flow_table
 from analysis.studies.silo_recirculation.rtd_plots import plot_vrr_versus_period
 from analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
-from analysis.studies.silo_recirculation.study import Layout, analyse_blending
+from analysis.studies.silo_recirculation.configured import analyse_configured
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from engines.logs import logged_to
 
@@ -17,22 +17,15 @@ with logged_to(snakemake.log[0]) as log:
     case = json.loads(Path(snakemake.input.case).read_text())
     tracks = load_tracks(snakemake.input.tracks).tracks
     bottom, top = case["domain_z"]
-    layouts = [Layout(l["name"], l["blue_fraction"], l["sublayers"], l["blue_at"]) for l in settings["layouts"]]
-    lti, tracer = settings["lti"], settings["tracer"]
-
-    def analyse(run_tracks):
-        return analyse_blending(
-            run_tracks, layouts, bottom, top, settings["concentration_window"], tracer["volume_fraction"],
-            tracer["start_recirculations"], tracer["bins"], lti["period_fractions"], lti["passes"], lti["tolerance"],
-            window_target_vrr=settings["concentration_window_target_vrr"], with_transit=False,
-        )
-
-    full = analyse(tracks)
+    tracer = settings["tracer"]
+    # the full run again, without what the shortcut cannot have: a few seconds, and the analysis rule's product
+    # (its tables) does not hold the arrays the comparison needs
+    full = analyse_configured(tracks, bottom, top, settings, with_transit=False)
     stop_nr = tracer["start_recirculations"] + settings["shortcut"]["residence_times"]
     t_stop = full.timing.t_open + stop_nr * full.timing.residence_time
     log.info("full run: Nr = %.2f; the shortcut stops at Nr = %.2f (t = %.4g s)", full.timing.recirculations, stop_nr,
              t_stop)
-    short = analyse(tracks_until(tracks, t_stop))
+    short = analyse_configured(tracks_until(tracks, t_stop), bottom, top, settings, with_transit=False)
     rows = shortcut_rows(full, short)
     write_flow_table(out.table, rows)
     for row in rows:

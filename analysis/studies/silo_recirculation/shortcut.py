@@ -40,12 +40,6 @@ def tracks_until(tracks: ClumpTracks, t_end: float) -> ClumpTracks:
     return ClumpTracks(times=times[:keep], clump_id=tracks.clump_id, position=tracks.position[:keep])
 
 
-def _rtd_mean_error(result: BlendingResult) -> float:
-    """Standard error of the tracer's mean residence time t_m [s] (sample variance over the tracers that left)."""
-    silo = result.rtd.silo
-    return math.sqrt(silo.variance / (silo.n_exited - 1)) if silo.n_exited > 1 else math.nan
-
-
 def _model_on(nr: np.ndarray, model_nr: np.ndarray, model: np.ndarray) -> np.ndarray:
     """A modelled outlet concentration resampled at the recirculation numbers ``nr`` (NaN beyond its end)."""
     return np.interp(nr, model_nr, model, left=np.nan, right=np.nan)
@@ -81,7 +75,7 @@ def shortcut_rows(full: BlendingResult, short: BlendingResult) -> list[dict]:
     """
     if [layout.layout.name for layout in full.layouts] != [layout.layout.name for layout in short.layouts]:
         raise ValueError("the full and the shortcut analysis must cover the same batch layouts in the same order")
-    full_error, short_error = _rtd_mean_error(full), _rtd_mean_error(short)
+    full_error, short_error = full.rtd.silo.t_mean_error, short.rtd.silo.t_mean_error
     t_mean_difference = abs(short.rtd.silo.t_mean - full.rtd.silo.t_mean)
     combined_error = math.hypot(full_error, short_error)
     # plug flow has no spread: equal means are then no difference at all, unequal ones infinitely many errors
