@@ -57,14 +57,18 @@ validate: install
 	$(PYTHON) -m snakemake --snakefile $(CURDIR)/Snakefile --directory $(VALIDATION_DIR) \
 		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report.html
 
+# One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
+# module's engine runs happen once; the long integration modules are collected first and the unit tests fill in.
+PYTEST_PARALLEL := -n $(CORES) --dist loadfile
+
 test: install
-	$(PYTHON) -m pytest tests
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests
 
 test-unit: install
-	$(PYTHON) -m pytest tests/unit
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/unit
 
 test-integration: install
-	$(PYTHON) -m pytest tests/integration
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/integration
 
 # Particle counts, steps, wall time and disk of every run of a config, before running it: make estimate CONFIG=config/thesis.yaml
 estimate: install-python
