@@ -33,7 +33,7 @@ rule all:
         blender_targets,
         f"{RESULTS}/summary/summary.html",
         f"{RESULTS}/summary/validation.csv",
-        f"{RESULTS}/verification/verification.csv",
+        verification_targets(),
     default_target: True
 
 

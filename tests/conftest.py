@@ -72,6 +72,8 @@ TINY_BLENDING = {
 # Pipelines that test other stages leave the blending study and the blender out.
 NO_BLENDING = {"enabled": False}
 NO_BLENDER = {"enabled": False}
+#: the verification suite has its own test (test_verification_suite.py); the other stages' pipelines leave it out
+NO_VERIFICATION = {"enabled": False}
 
 # A tiny blender (about 2,000 two-sphere clumps, one layer deep): a 150 mm hopper with no tube and an insert given
 # by its plate end points, wide enough (passages of 7 clump sizes and more) to flow without arching; continuous

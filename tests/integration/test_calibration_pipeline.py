@@ -22,7 +22,7 @@ from engines.cases import cases_of
 from engines.cases.jenike import build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -39,6 +39,7 @@ TINY_CALIBRATION = {
     "silo_flat": {**TINY_SILO, "parameters": "calibrated"},
     "silo_recirculation": NO_BLENDING,
     "blender": NO_BLENDER,
+    "verification": NO_VERIFICATION,
 }
 
 

@@ -29,7 +29,7 @@ from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
-from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -57,7 +57,8 @@ def tiny_pipeline(tmp_path_factory):
     workdir = tmp_path_factory.mktemp("tiny_silo")
     config_path = workdir / "tiny.yaml"
     silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}}
-    config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}))
+    config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "silo_recirculation": NO_BLENDING,
+                                           "blender": NO_BLENDER, "verification": NO_VERIFICATION}))
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     run_dir = workdir / layout_run_dir("silo_flat", build_silo_case(_validated(silo)).run_id)
@@ -308,7 +309,8 @@ def test_measured_piv_is_compared_with_the_dem_front_wall_within_the_piv_error(t
     config_path = tmp_path / "measured.yaml"
     silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}, "piv": {"measured": measured}}
     config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP,
-                                           "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}))
+                                           "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER,
+                                           "verification": NO_VERIFICATION}))
     record_time = (run_dir / "run.json").stat().st_mtime_ns
     table, plot = run_dir / "metrics" / "piv_comparison.csv", run_dir / "plots" / "piv_comparison.png"
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), "--rerun-triggers", "mtime",
@@ -339,7 +341,8 @@ def test_a_bad_measured_piv_file_stops_the_workflow_before_anything_runs(tiny_pi
         {"image": [0.0, 0.0], "silo": [-0.04, 0.1]}, {"image": [100.0, 100.0], "silo": [0.0, 0.06]}]}}}
     config_path = tmp_path / "bad.yaml"
     config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP,
-                                           "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}))
+                                           "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER,
+                                           "verification": NO_VERIFICATION}))
     before = sorted((p, p.stat().st_mtime_ns) for p in run_dir.rglob("*") if p.is_file())
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
     assert result.returncode != 0

@@ -5,11 +5,12 @@ r: 2^(1/5))."""
 from __future__ import annotations
 
 import pytest
+import yaml
 
 from analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table
 from engines.cases.verification import verification_cases
 from engines.interface import EngineOptions, engine_named
-from tests.conftest import require_liggghts, require_yade
+from tests.conftest import NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -44,3 +45,18 @@ def test_every_closed_form_holds_on_yade_but_the_sphere_wall_contact_time(table)
     wall_time = (yade["problem"] == "wall_impact") & (yade["quantity"] == "contact_time")
     assert yade[~wall_time]["passes"].all(), yade.to_string()
     assert yade[wall_time]["error"].item() == pytest.approx(2 ** 0.2 - 1.0, abs=2e-3)
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_the_default_target_runs_the_suite_only_when_it_is_enabled(tmp_path, enabled):
+    """`verification.enabled: false` leaves the suite out of the default target (the other stages' pipeline tests use
+    it), and nothing else: the silo's run still comes up."""
+    config_path = tmp_path / "config.yaml"
+    config_path.write_text(yaml.safe_dump({"verification": {"enabled": enabled}, "silo_recirculation": NO_BLENDING,
+                                           "blender": NO_BLENDER}))
+    result = run_snakemake(tmp_path, "-n", "--cores", "1", "--configfile", str(config_path))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    jobs = result.stdout + result.stderr
+    assert ("rule verification_run:" in jobs) is enabled
+    assert ("rule verification_table:" in jobs) is enabled
+    assert "rule silo_run:" in jobs

@@ -6,6 +6,12 @@
 VERIFICATION_DIR = f"{RESULTS}/verification"
 VERIFICATION_PROBLEMS = verification_cases()
 
+
+def verification_targets():
+    """The suite's table when the default target runs it (verification.enabled), else nothing."""
+    return [f"{VERIFICATION_DIR}/verification.csv"] if config["verification"]["enabled"] else []
+
+
 #: What each problem checks, for the report page.
 VERIFICATION_EXPLANATIONS = {
     "wall_impact": "A sphere hits the floor at 1 m/s, elastically: it rebounds at its impact speed after the Hertz "
