@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass, field
 
 from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
+from engines.cases.blender_passages import clear_widths, geometry_summary
 from engines.cases.blender_meshes import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import particle_template
@@ -117,7 +118,7 @@ class BlenderCase:
                 "fill_area_m2": self.fill_area,
                 "domain_z": [-self.silo.sink_depth, self.silo.domain_top],
                 "outlet_z": 0.0,
-                "geometry": self.geometry.insert_summary(),
+                "geometry": geometry_summary(self.geometry),
                 "parameters": self.defining_parameters,
             }
         )
@@ -201,7 +202,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
     )
     clump_size = 2.0 * particle.bounding_radius
     narrowest = blender["min_passage_clumps"] * clump_size
-    for passage, width in geometry.clear_widths().items():
+    for passage, width in clear_widths(geometry).items():
         if width < narrowest:
             raise ValueError(
                 f"blender configuration '{configuration}': the {passage} is {width * 1000:.1f} mm wide, narrower than "

@@ -28,7 +28,8 @@ Tube
     Two plates centred on x = +-tw from the insert outlet level z_o (the tube outlet; the reference level when
     there is no insert) up to z_t + ``tube_inlet_above_transition`` (the tube inlet).
 
-The wall solids (closed meshes with outward normals) are built by :mod:`engines.cases.blender_meshes`.
+The wall solids (closed meshes with outward normals) are built by :mod:`engines.cases.blender_meshes`; the clear
+passages between the walls and the plain-data summary by :mod:`engines.cases.blender_passages`.
 """
 
 from __future__ import annotations
@@ -454,108 +455,6 @@ class BlenderGeometry:
             tw = self.tube_half_width
             spans.append(((tw, self.z_tube_outlet), (tw, self.z_tube_inlet)))
         return spans
-
-    # ----------------------------------------------------------------------------------------------- passages
-    def annulus_bounds(self, z: float) -> dict[str, tuple[float, float]]:
-        """Clear x-intervals (right half) of the passages at height ``z``.
-
-        Parameters
-        ----------
-        z : float
-            Height (m) within [0, z_top].
-
-        Returns
-        -------
-        dict
-            ``"tube"`` (0, tw - t/2) where the tube spans z; ``"interior"`` (tw + t/2, or 0 without a tube, up to
-            the plate's left surface) and ``"exterior"`` (the plate's right surface to wall_x(z)) where the
-            insert spans z; otherwise ``"open"`` (tw + t/2 or 0, wall_x(z)). The inclined plate's surfaces are
-            x_plate(z) -+ :attr:`plate_half_thickness_x` (its horizontal cut; its square ends are ignored).
-        """
-        height = finite_number("z", z)
-        wall = self.wall_x(height)
-        t, tw = self.wall_thickness, self.tube_half_width
-        bounds: dict[str, tuple[float, float]] = {}
-        inner = 0.0
-        if self.has_tube and self.z_tube_outlet <= height <= self.z_tube_inlet:
-            bounds["tube"] = (0.0, tw - 0.5 * t)
-            inner = tw + 0.5 * t
-        if self.has_insert and self.insert_outlet[1] <= height <= self.insert_inlet[1]:
-            x_plate, half = self.plate_x(height), self.plate_half_thickness_x
-            bounds["interior"] = (inner, x_plate - half)
-            bounds["exterior"] = (x_plate + half, wall)
-        else:
-            bounds["open"] = (inner, wall)
-        return bounds
-
-    def clear_widths(self) -> dict[str, float]:
-        """Narrowest clear width of each passage (m): wall to wall, wall thicknesses taken off.
-
-        Returns
-        -------
-        dict
-            ``"outlet"`` B0; with a tube ``"tube"`` tube_width - t; with an insert ``"interior annulus"`` and
-            ``"exterior annulus"``, narrowest at the insert inlet or outlet (the interior width is linear and the
-            exterior one concave in z; without a tube the interior passage spans both plates); with a tube and
-            no insert ``"annulus"`` between tube and wall, narrowest at the tube outlet. The inclined plate
-            counts with its horizontal thickness.
-        """
-        t, tw = self.wall_thickness, self.tube_half_width
-        widths = {"outlet": self.outlet_width}
-        if self.has_tube:
-            widths["tube"] = self.tube_width - t
-        if self.has_insert:
-            half = self.plate_half_thickness_x
-            ends = (self.insert_inlet, self.insert_outlet)
-            if self.has_tube:
-                interior = min(x - half - (tw + 0.5 * t) for x, _ in ends)
-            else:
-                interior = min(2.0 * (x - half) for x, _ in ends)
-            widths["interior annulus"] = interior
-            widths["exterior annulus"] = min(self.wall_x(z) - x - half for x, z in ends)
-        elif self.has_tube:
-            widths["annulus"] = self.wall_x(self.z_tube_outlet) - (tw + 0.5 * t)
-        return widths
-
-    def insert_summary(self) -> dict:
-        """Plain-data summary: plate end points, achieved ratios, angle and the key levels (m, degrees).
-
-        Insert entries are None without an insert, tube entries None without a tube.
-        """
-        summary = {
-            "insert": self.insert_name,
-            "inlet": None,
-            "outlet": None,
-            "interior_ratio": None,
-            "exterior_ratio": None,
-            "area_ratio": None,
-            "occupancy": None,
-            "included_angle_deg": None,
-            "plate_length": None,
-            "z_transition": self.z_transition,
-            "z_apex": self.z_apex,
-            "circle_radius": self.circle_radius,
-            "z_top": self.z_top,
-            "z_insert_outlet": self.z_insert_outlet,
-            "tube_width": self.tube_width if self.has_tube else None,
-            "z_tube_outlet": self.z_tube_outlet if self.has_tube else None,
-            "z_tube_inlet": self.z_tube_inlet if self.has_tube else None,
-            "clear_widths": self.clear_widths(),
-        }
-        if self.has_insert:
-            summary.update(
-                {
-                    "inlet": [float(v) for v in self.insert_inlet],
-                    "outlet": [float(v) for v in self.insert_outlet],
-                    "interior_ratio": self.interior_ratio,
-                    "exterior_ratio": self.exterior_ratio,
-                    "area_ratio": self.area_ratio,
-                    "occupancy": self.insert_occupancy,
-                    "included_angle_deg": self.included_angle,
-                    "plate_length": self.plate_length,
-                }
-            )
-        return {key: (float(value) if isinstance(value, (float, np.floating)) else value) for key, value in summary.items()}
 
 
 def blender_geometry(

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from engines.cases.blender_geometry import INSERT_PRESETS, blender_geometry
+from engines.cases.blender_passages import annulus_bounds, clear_widths, geometry_summary
 from engines.cases.blender_meshes import blender_meshes
 
 # The study's full scale (SEED_DIGEST section 5).
@@ -112,12 +113,12 @@ def test_preset_none_has_neither_insert_nor_tube():
     g = full("none")
     assert not g.has_insert and not g.has_tube
     assert list(blender_meshes(g)) == ["hopper_left", "hopper_right"]
-    assert g.clear_widths() == {"outlet": 0.04}
-    assert g.annulus_bounds(0.3) == {"open": (0.0, 0.02 + 0.3 * TAN30)}
+    assert clear_widths(g) == {"outlet": 0.04}
+    assert annulus_bounds(g, 0.3) == {"open": (0.0, 0.02 + 0.3 * TAN30)}
 
 
-def test_insert_summary_is_plain_data():
-    summary = full("diverging").insert_summary()
+def test_geometry_summary_is_plain_data():
+    summary = geometry_summary(full("diverging"))
     assert json.loads(json.dumps(summary)) == summary
     assert summary["interior_ratio"] == pytest.approx(0.5, rel=1e-12)
     assert summary["exterior_ratio"] == pytest.approx(2.6, rel=1e-12)
@@ -125,7 +126,7 @@ def test_insert_summary_is_plain_data():
     assert summary["occupancy"] == pytest.approx(0.63, rel=1e-12)
     assert summary["z_tube_inlet"] == pytest.approx(0.205 * math.sqrt(3.0) + 0.0675, rel=1e-12)
     assert summary["z_tube_outlet"] == summary["z_insert_outlet"] == summary["outlet"][1]
-    none = full("none").insert_summary()
+    none = geometry_summary(full("none"))
     assert none["inlet"] is None and none["z_tube_inlet"] is None
 
 
@@ -145,7 +146,7 @@ def test_annulus_bounds_tile_the_half_width_minus_the_walls():
     # horizontal cut through the inclined plate: t / cos(beta), cos(beta) = dz / length
     plate_cut = t * math.hypot(x_i - x_o, z_i - z_o) / (z_i - z_o)
     for z in (0.30, 0.38):  # in the hopper, and above the transition (both within the insert and the tube)
-        bounds = g.annulus_bounds(z)
+        bounds = annulus_bounds(g, z)
         assert list(bounds) == ["tube", "interior", "exterior"]
         (tube_lo, tube_hi), (int_lo, int_hi), (ext_lo, ext_hi) = bounds.values()
         x_plate = x_o + (z - z_o) * (x_i - x_o) / (z_i - z_o)
@@ -160,10 +161,10 @@ def test_annulus_bounds_tile_the_half_width_minus_the_walls():
 
 def test_annulus_bounds_away_from_the_insert_are_open():
     g = full("diverging")
-    assert g.annulus_bounds(0.1) == {"open": (0.0, pytest.approx(0.02 + 0.1 * TAN30, rel=1e-12))}
+    assert annulus_bounds(g, 0.1) == {"open": (0.0, pytest.approx(0.02 + 0.1 * TAN30, rel=1e-12))}
     between = 0.5 * (g.insert_inlet[1] + g.z_tube_inlet)  # above the insert, inside the tube
-    assert g.annulus_bounds(between) == {"tube": (0.0, 0.0175), "open": (0.0225, 0.225)}
-    assert g.annulus_bounds(1.0) == {"open": (0.0, 0.225)}
+    assert annulus_bounds(g, between) == {"tube": (0.0, 0.0175), "open": (0.0225, 0.225)}
+    assert annulus_bounds(g, 1.0) == {"open": (0.0, 0.225)}
 
 
 def test_clear_widths_of_the_diverging_insert():
@@ -171,7 +172,7 @@ def test_clear_widths_of_the_diverging_insert():
     t = 0.005
     (x_i, z_i), (x_o, z_o) = g.insert_inlet, g.insert_outlet
     half_cut = 0.5 * t * math.hypot(x_i - x_o, z_i - z_o) / (z_i - z_o)
-    widths = g.clear_widths()
+    widths = clear_widths(g)
     assert widths["outlet"] == 0.04
     assert widths["tube"] == pytest.approx(0.04 - t, rel=1e-12)
     # the diverging insert is narrowest inside at its inlet and outside at its outlet
@@ -209,7 +210,7 @@ def test_bad_input_names_the_parameter(changes, insert, message):
 def test_bad_levels_and_a_missing_insert_are_rejected():
     g = full("diverging")
     with pytest.raises(ValueError, match="z must lie within"):
-        g.annulus_bounds(-0.01)
+        annulus_bounds(g, -0.01)
     with pytest.raises(ValueError, match="z must lie within"):
         g.wall_x(g.z_top + 0.01)
     with pytest.raises(ValueError, match="no insert"):
