@@ -29,7 +29,7 @@ from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
-from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -161,7 +161,9 @@ def test_engine_error_quotes_the_log_and_keeps_the_run_directory(tmp_path, tiny_
 def test_an_unsettled_fill_fails_without_a_run_record(tmp_path, tiny_config):
     require_liggghts()
     tiny_config["silo_flat"]["settle"] = {"kinetic_energy_threshold": 1e-30, "check_interval": 0.01, "max_time": 0.02}
-    tiny_config["silo_flat"]["fill_height"] = 0.02  # half the clumps: only the refusal matters here
+    # the micro silo's size (about 350 clumps): only the refusal matters here
+    tiny_config["silo_flat"].update(width=MICRO_SILO["width"], fill_height=MICRO_SILO["fill_height"],
+                                    outlet_width=MICRO_SILO["outlet_width"])
     case = build_silo_case(tiny_config)
     engine = liggghts()
     engine.write_inputs(case, tmp_path)
