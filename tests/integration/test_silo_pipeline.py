@@ -122,7 +122,7 @@ def test_make_estimate_takes_its_cost_model_from_the_finished_runs(tiny_pipeline
     workdir, run_dir, _ = tiny_pipeline
     raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
     for section, values in yaml.safe_load((workdir / "tiny.yaml").read_text()).items():
-        raw[section] = {**raw[section], **values}
+        raw[section] = {**raw.get(section, {}), **values}
     config = validate_config(raw)
     estimates = config_estimates(config)
     results = workdir / "results"

@@ -1,6 +1,7 @@
 """Snakemake adapter: the blender study of one run (profiles, passages, flow channel, pathlines, RTD, modes)."""
 
 import json
+from functools import partial
 from pathlib import Path
 
 from analysis.studies.blender.steady_field import BlenderField
@@ -25,6 +26,7 @@ from analysis.studies.blender.tables import (
 )
 from analysis.io.tables import write_flow_table, write_json
 from engines.cases import case_for_run
+from engines.cases.blender_passages import annulus_bounds
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
@@ -37,7 +39,7 @@ with logged_to(snakemake.log[0]) as log:
     heights = key_heights(case["geometry"], blender["bin_size"], blender["fill_height"], blender["profile_heights_above"])
     window_times = [0.5 * (w.window[0] + w.window[1]) - windows[0].window[0] for w in windows]
     study = analyse_blender(BlenderField.from_planar(steady), [BlenderField.from_planar(w) for w in windows],
-                            window_times, heights, geometry.annulus_bounds, geometry.wall_x, settings)
+                            window_times, heights, partial(annulus_bounds, geometry), geometry.wall_x, settings)
     name = f"{case['configuration']} ({case['gravity_factor']:g} g)"
     rate = steady_flow_rate_estimate(flow["time_since_open_s"], flow["discharged_mass_kg"], tuple(case["steady_window"]))
     frames = [BlenderField.from_planar(frame) for frame in read_frame_fields(snakemake.input.frames)]
