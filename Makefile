@@ -58,7 +58,7 @@ validate: install
 		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report.html
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
-# module's engine runs happen once; the long integration modules are collected first and the unit tests fill in.
+# module's fixture, and so its engine runs, happens once.
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile
 
 test: install
