@@ -1,26 +1,32 @@
-"""What a run will cost before it starts: engine steps, simulated and wall time, dump frames and disk space.
+"""What a run will cost before it starts: engine steps, sphere-steps, simulated and wall time, dump frames and disk.
 
 Pure computation: callers pass case objects (:mod:`engines.cases.silo_flat`, :mod:`engines.cases.silo_recirculation`,
 :mod:`engines.cases.blender`, :mod:`engines.cases.jenike`), log text and numbers; nothing here reads or writes files.
 
-The cost model (:class:`CostModel`) is linear in the work: a run of S steps over N spheres costs
-``N S c`` seconds on one core, with c measured on this machine (each engine package can fit it to the timing
-lines of its own logs). MPI ranks divide that by ``ranks * efficiency^log2(ranks)``.
-Every estimate is a worst case: the settling stage counts all its checks, the sphere count is the largest the
-run holds, and a dumped stage counts the largest number of dump frames its length allows.
+The cost model (:class:`CostModel`) is linear in the work, counted in sphere-steps: the spheres the engine holds,
+summed over its time steps. A run of W sphere-steps costs ``W c`` seconds on one core, with c measured on this
+machine (each engine package measures W and the CPU time from its own logs, :class:`MeasuredWork`). MPI ranks divide
+that by ``ranks * efficiency^log2(ranks)``.
 
-Disk space: binary legacy VTK particle dumps (``bytes_per_sphere_per_dump`` plus a header per file) and text
-contact dumps (``contact_bytes_per_sphere_per_dump``); the analyses keep no cache of parsed frames.
+The sphere count of each stage follows what the case implies (:func:`silo_stage_work`, :func:`jenike_stage_work`):
+a pour ramps it up batch by batch, a settling fill holds it, a batch silo drains at Beverloo's rate
+(:func:`beverloo_clump_rate`), a silo that feeds its outflow back in keeps it, a Jenike cell loses its overfill at
+levelling and gains its lid. The settling stage counts ``settle_fraction`` of its longest time.
+
+Disk space is a worst case: binary legacy VTK particle dumps (``bytes_per_sphere_per_dump`` plus a header per file)
+and text contact dumps (``contact_bytes_per_sphere_per_dump``), every dump at the largest sphere count the run
+holds and a dumped stage at the largest number of dump frames its length allows; the analyses keep no cache of
+parsed frames.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Iterable, Sequence
 
 from engines.cases.blender import BlenderCase
-from engines.cases.jenike import JenikeCase
+from engines.cases.jenike import FILL_SOLID_FRACTION, JenikeCase
 from engines.cases.silo_flat import SiloCase
 from engines.cases.silo_recirculation import RecirculationCase
 
@@ -35,6 +41,12 @@ JENIKE_LEVEL_DELETION_STEPS = 1
 #: Contact snapshots the silo decks write: one local dump of the settled fill (``contacts_<step>.txt``).
 SILO_CONTACT_SNAPSHOTS = 1
 
+#: Beverloo's discharge coefficient C and empty-annulus coefficient k with which the planner drains a batch silo
+#: (-): the usual values for coarse particles, as the silo analysis's defaults. Only the time the silo takes to
+#: empty depends on them, and so only the work of a discharge that runs it empty.
+BEVERLOO_DISCHARGE_COEFFICIENT = 0.58
+BEVERLOO_SHAPE_COEFFICIENT = 1.5
+
 
 @dataclass(frozen=True)
 class CostModel:
@@ -43,7 +55,8 @@ class CostModel:
     Attributes
     ----------
     seconds_per_sphere_step : float
-        CPU time per sphere and time step on one core (s). Measured here: 0.35 to 0.6 microseconds.
+        CPU time per sphere-step on one core (s): per sphere the engine holds and time step, the count taken over
+        time (:class:`MeasuredWork`). Measured here: 0.35 to 0.6 microseconds.
     bytes_per_sphere_per_dump : float
         Size of one sphere in one binary VTK particle dump with the 16 fields siloflow dumps (bytes).
     dump_header_bytes : float
@@ -126,12 +139,71 @@ def dump_frames(stage_steps: int, dump_every: int) -> int:
     return 1 + -(-stage_steps // dump_every)
 
 
+# ---------------------------------------------------------------------------------------------- work
+
+
+@dataclass(frozen=True)
+class StageWork:
+    """The engine work one stage of a run is expected to take.
+
+    Attributes
+    ----------
+    stage : str
+        Stage kind (:data:`engines.cases.stages.STAGE_KINDS`: ``fill``, ``settle``, ``discharge``, ...).
+    steps : int
+        Time steps of the stage (-).
+    sphere_steps : float
+        Spheres the engine holds, summed over the stage's steps (sphere-steps).
+    """
+
+    stage: str
+    steps: int
+    sphere_steps: float
+
+    def __post_init__(self) -> None:
+        _count("steps", self.steps, 0)
+        if not _finite(self.sphere_steps) or self.sphere_steps < 0:
+            raise ValueError(f"sphere_steps must be a finite number >= 0, got {self.sphere_steps!r}")
+
+    @property
+    def mean_spheres(self) -> float:
+        """Spheres held on average over the stage (-); 0 for a stage without steps."""
+        return self.sphere_steps / self.steps if self.steps else 0.0
+
+
+@dataclass(frozen=True)
+class MeasuredWork:
+    """What a finished run took, as its engine timed it.
+
+    Attributes
+    ----------
+    cpu_seconds : float
+        CPU time of the engine's time stepping, summed over its processes and attempts (CPU s).
+    sphere_steps : float
+        Spheres the engine held, summed over the steps it timed (sphere-steps): the count over time, not at the end.
+    """
+
+    cpu_seconds: float
+    sphere_steps: float
+
+    def __post_init__(self) -> None:
+        for name in ("cpu_seconds", "sphere_steps"):
+            value = getattr(self, name)
+            if not _finite(value) or value < 0:
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+
+    @property
+    def seconds_per_sphere_step(self) -> float:
+        """CPU time per sphere-step (s); nan without sphere-steps."""
+        return self.cpu_seconds / self.sphere_steps if self.sphere_steps > 0 else math.nan
+
+
 # ---------------------------------------------------------------------------------------------- estimates
 
 
 @dataclass(frozen=True)
 class RunEstimate:
-    """What one run costs, worst case.
+    """What one run costs: its work stage by stage, and the disk space of its dumps at most.
 
     Attributes
     ----------
@@ -142,9 +214,11 @@ class RunEstimate:
     clumps : int
         Clumps the run holds at most.
     spheres : int
-        Spheres (atoms) the run holds at most: clump spheres plus other atoms such as lid spheres.
+        Spheres (atoms) the run holds at most: clump spheres plus other atoms such as lid spheres (-).
     steps : int
-        Engine time steps in total, every stage at its longest.
+        Engine time steps in total, settling at the model's share of its longest time (-).
+    sphere_steps : float
+        Spheres held, summed over the steps: the sum over :attr:`stages` (sphere-steps).
     simulated_time_s : float
         ``steps * timestep`` (s).
     wall_time_s : float
@@ -155,6 +229,8 @@ class RunEstimate:
         Disk space of particle dumps and contact dumps (bytes).
     mpi_ranks : int
         MPI ranks the estimate assumes.
+    stages : tuple of StageWork
+        Steps and sphere-steps of each stage that runs steps, in order.
     """
 
     run_id: str
@@ -162,11 +238,18 @@ class RunEstimate:
     clumps: int
     spheres: int
     steps: int
+    sphere_steps: float
     simulated_time_s: float
     wall_time_s: float
     dump_frames: int
     dump_bytes: int
     mpi_ranks: int
+    stages: tuple[StageWork, ...] = ()
+
+    @property
+    def core_seconds(self) -> float:
+        """CPU time over all ranks, ``wall_time_s * mpi_ranks`` (CPU s): what the engine's own timing adds up to."""
+        return self.wall_time_s * self.mpi_ranks
 
 
 def _count(name: str, value, minimum: int) -> int:
@@ -188,11 +271,13 @@ def estimate_run(
     *,
     extra_spheres: int = 0,
     contact_frames: int = 0,
+    stages: Sequence[StageWork] | None = None,
 ) -> RunEstimate:
     """The estimate every case kind shares.
 
-    spheres N = clumps * spheres_per_clump + extra_spheres;
-    wall time = N * steps * seconds_per_sphere_step / (ranks * efficiency^log2(ranks));
+    spheres N = clumps * spheres_per_clump + extra_spheres (the most the run holds);
+    work W = the sphere-steps of ``stages``, or N * steps without them (one stage at a constant count);
+    wall time = W * seconds_per_sphere_step / (ranks * efficiency^log2(ranks));
     disk = frames (header + N bytes_per_sphere_per_dump)
     + contact_frames (header + N contact_bytes_per_sphere_per_dump).
 
@@ -220,10 +305,17 @@ def estimate_run(
         Atoms that belong to no clump (a lid of glued spheres, a servo proxy) (>= 0).
     contact_frames : int
         Text contact dump files (>= 0).
+    stages : sequence of StageWork, optional
+        The work of each stage; their steps must add up to ``steps``.
 
     Returns
     -------
     RunEstimate
+
+    Raises
+    ------
+    ValueError
+        Naming a value out of range, or when the stages' steps do not add up to ``steps``.
     """
     if kind not in KINDS:
         raise ValueError(f"unknown run kind {kind!r}; expected one of {', '.join(KINDS)}")
@@ -236,7 +328,13 @@ def estimate_run(
     if not _finite(timestep) or timestep <= 0:
         raise ValueError(f"timestep must be > 0 s, got {timestep!r}")
     spheres = clumps * spheres_per_clump + extra_spheres
-    serial = spheres * steps * model.seconds_per_sphere_step
+    if stages is None:
+        stages = (StageWork("run", steps, float(spheres * steps)),)
+    stages = tuple(stages)
+    if sum(stage.steps for stage in stages) != steps:
+        raise ValueError(f"the stages' steps add up to {sum(stage.steps for stage in stages)}, not to steps = {steps}")
+    work = math.fsum(stage.sphere_steps for stage in stages)
+    serial = work * model.seconds_per_sphere_step
     particle_dumps = dump_frames * (model.dump_header_bytes + spheres * model.bytes_per_sphere_per_dump)
     contacts = contact_frames * (model.dump_header_bytes + spheres * model.contact_bytes_per_sphere_per_dump)
     return RunEstimate(
@@ -245,12 +343,138 @@ def estimate_run(
         clumps=clumps,
         spheres=spheres,
         steps=steps,
+        sphere_steps=work,
         simulated_time_s=steps * timestep,
         wall_time_s=wall_time(serial, mpi_ranks, model),
         dump_frames=dump_frames,
         dump_bytes=math.ceil(particle_dumps + contacts),
         mpi_ranks=mpi_ranks,
+        stages=stages,
     )
+
+
+def pour_sphere_steps(n_clumps: int, clumps_per_insertion: int, insert_every: int, steps: int) -> float:
+    """Clumps held over a pour in batches, summed over its steps (clump-steps).
+
+    An insertion at the start of every interval of ``insert_every`` steps adds ``clumps_per_insertion`` clumps
+    (the last batch what is left) until all ``n_clumps`` are in; the count then holds for the rest of the stage:
+    ``insert_every * sum_k min(N, k b) + N (steps - I insert_every)`` over the I = ceil(N / b) insertions that
+    start inside the stage (a last interval cut by the end of the stage counts its steps inside).
+
+    Parameters
+    ----------
+    n_clumps : int
+        Clumps poured, N (>= 0).
+    clumps_per_insertion : int
+        Clumps per insertion event, b (>= 1).
+    insert_every : int
+        Steps between insertion events (>= 1).
+    steps : int
+        Steps of the stage (>= 0).
+
+    Returns
+    -------
+    float
+        Clump-steps (multiply by the spheres per clump for sphere-steps).
+    """
+    n, b = _count("n_clumps", n_clumps, 0), _count("clumps_per_insertion", clumps_per_insertion, 1)
+    every, steps = _count("insert_every", insert_every, 1), _count("steps", steps, 0)
+    insertions = -(-n // b)
+    whole = min(insertions, steps // every)  # intervals that start and end inside the stage
+    if whole < insertions:  # all but the last batch are full: k b < N for k < insertions
+        held = b * whole * (whole + 1) // 2 * every
+        if steps > whole * every:  # the interval cut by the end of the stage
+            held += min(n, (whole + 1) * b) * (steps - whole * every)
+        return float(held)
+    return float((b * (insertions - 1) * insertions // 2 + n) * every + n * (steps - insertions * every))
+
+
+def drain_sphere_steps(spheres: float, rate: float, delay_steps: float, steps: int) -> float:
+    """Spheres held over a discharge that drains at a constant rate, summed over its steps (sphere-steps).
+
+    The count stays at N for ``delay_steps`` (the first spheres out are still inside the domain), then falls by
+    ``rate`` per step until the silo is empty: the integral of ``N - rate max(0, t - delay)``, floored at 0, over
+    ``steps``. A rate of 0 keeps the count (a silo that feeds its outflow back in).
+
+    Parameters
+    ----------
+    spheres : float
+        Spheres at the start of the discharge, N (>= 0).
+    rate : float
+        Spheres leaving per step once the flow has reached the edge of the domain (>= 0).
+    delay_steps : float
+        Steps before the first spheres leave the domain (>= 0).
+    steps : int
+        Steps of the stage (>= 0).
+
+    Returns
+    -------
+    float
+        Sphere-steps.
+    """
+    for name, value in (("spheres", spheres), ("rate", rate), ("delay_steps", delay_steps)):
+        if not _finite(value) or value < 0:
+            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    steps = _count("steps", steps, 0)
+    held = min(float(steps), delay_steps)
+    draining = steps - held
+    if rate == 0.0 or draining <= spheres / rate:
+        return spheres * steps - 0.5 * rate * draining**2
+    return spheres * held + 0.5 * spheres * spheres / rate
+
+
+def beverloo_clump_rate(
+    clumps_per_volume: float,
+    outlet_width: float,
+    outlet_length: float,
+    particle_diameter: float,
+    gravity: float,
+    discharge_coefficient: float = BEVERLOO_DISCHARGE_COEFFICIENT,
+    shape_coefficient: float = BEVERLOO_SHAPE_COEFFICIENT,
+) -> float:
+    """Clumps per second through a slot outlet by Beverloo's law, ``n C sqrt(g) L (B0 - k d)^1.5``.
+
+    Beverloo's mass flow rate ``C rho_b sqrt(g) L (B0 - k d)^1.5`` over the clump mass, with ``rho_b / m`` the
+    clumps per volume of the fill.
+
+    Parameters
+    ----------
+    clumps_per_volume : float
+        Clumps per unit volume of the fill, n (1/m^3, >= 0).
+    outlet_width : float
+        Slot width B0 (m, > 0).
+    outlet_length : float
+        Slot length L (m, > 0): the silo depth.
+    particle_diameter : float
+        Particle diameter d (m, > 0): the clump's volume-equivalent diameter.
+    gravity : float
+        Gravitational acceleration g (m/s^2, > 0).
+    discharge_coefficient, shape_coefficient : float
+        Beverloo's C and k (-).
+
+    Returns
+    -------
+    float
+        Clumps per second (1/s); 0 when the outlet is no wider than ``k d`` (Beverloo predicts no flow).
+    """
+    for name, value in (("clumps_per_volume", clumps_per_volume), ("discharge_coefficient", discharge_coefficient),
+                        ("shape_coefficient", shape_coefficient)):
+        if not _finite(value) or value < 0:
+            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    for name, value in (("outlet_width", outlet_width), ("outlet_length", outlet_length),
+                        ("particle_diameter", particle_diameter), ("gravity", gravity)):
+        if not _finite(value) or value <= 0:
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    effective = outlet_width - shape_coefficient * particle_diameter
+    if effective <= 0:
+        return 0.0
+    return clumps_per_volume * discharge_coefficient * math.sqrt(gravity) * outlet_length * effective**1.5
+
+
+def settle_checks(silo: SiloCase, settle_fraction: float = 1.0) -> int:
+    """Settling checks a silo fill is expected to need: ``settle_fraction`` of ``settle_max_checks``, rounded up,
+    at least one."""
+    return max(1, math.ceil(settle_fraction * silo.settle_max_checks - 1e-9))
 
 
 def silo_run_steps(silo: SiloCase, settle_fraction: float = 1.0) -> int:
@@ -260,12 +484,86 @@ def silo_run_steps(silo: SiloCase, settle_fraction: float = 1.0) -> int:
     The extra insertion events the deck allows when crowded insertions place fewer clumps than asked are not
     counted (they run only then, ``insert_every`` steps each).
     """
-    checks = max(1, math.ceil(settle_fraction * silo.settle_max_checks - 1e-9))
-    return silo.fill.fill_steps + checks * silo.settle_check_steps + silo.discharge_steps
+    return silo.fill.fill_steps + settle_checks(silo, settle_fraction) * silo.settle_check_steps + silo.discharge_steps
+
+
+def silo_stage_work(
+    silo: SiloCase,
+    settle_fraction: float = 1.0,
+    last: str = "discharge",
+    drain_rate: float = 0.0,
+    drain_delay: float = 0.0,
+) -> tuple[StageWork, ...]:
+    """Steps and sphere-steps of the stages of a silo deck (flat silo, recirculating silo, blender).
+
+    - fill: the pour in batches (:func:`pour_sphere_steps`), from 0 to N clumps;
+    - settle: N clumps for ``settle_fraction`` of the longest settling time, in whole checks;
+    - ``last`` (discharge or recirculate): N clumps draining at ``drain_rate`` once the first have fallen out
+      of the domain (:func:`drain_sphere_steps`); a rate of 0 keeps all N.
+
+    Opening the outlet takes no steps.
+
+    Parameters
+    ----------
+    silo : SiloCase
+        The silo (its fill plan, settle checks, discharge steps and time step).
+    settle_fraction : float
+        Share of the longest settling time counted, in (0, 1] (-).
+    last : str
+        Kind of the last stage.
+    drain_rate : float
+        Clumps leaving per second (1/s, >= 0).
+    drain_delay : float
+        Time from opening until the first clumps leave the domain (s, >= 0).
+
+    Returns
+    -------
+    tuple of StageWork
+        fill, settle and the last stage.
+    """
+    spheres = silo.spheres_per_clump
+    fill = silo.fill
+    settle_steps = settle_checks(silo, settle_fraction) * silo.settle_check_steps
+    dt = silo.timestep
+    return (
+        StageWork("fill", fill.fill_steps, spheres * pour_sphere_steps(
+            fill.n_clumps, fill.clumps_per_insertion, fill.insert_every, fill.fill_steps)),
+        StageWork("settle", settle_steps, float(spheres * fill.n_clumps * settle_steps)),
+        StageWork(last, silo.discharge_steps, drain_sphere_steps(
+            float(spheres * fill.n_clumps), spheres * drain_rate * dt, drain_delay / dt, silo.discharge_steps)),
+    )
+
+
+def sink_fall_time(sink_depth: float, gravity: float) -> float:
+    """Time a clump takes to fall ``sink_depth`` below the outlet from rest, ``sqrt(2 s / g)`` (s): how long the
+    discharged clumps stay in the domain before it loses them."""
+    if not _finite(sink_depth) or sink_depth < 0 or not _finite(gravity) or gravity <= 0:
+        raise ValueError(f"need sink_depth >= 0 m and gravity > 0 m/s^2, got {sink_depth!r}, {gravity!r}")
+    return math.sqrt(2.0 * sink_depth / gravity)
+
+
+def silo_drain_rate(silo: SiloCase, fill_volume: float, gravity: float) -> float:
+    """Clumps per second a batch silo loses through its slot outlet (:func:`beverloo_clump_rate`), with the clumps
+    per volume the fill was sized by (``n_clumps / fill_volume``), the clump's volume-equivalent diameter and the
+    silo depth as slot length.
+
+    Parameters
+    ----------
+    silo : SiloCase
+        The silo.
+    fill_volume : float
+        Volume the fill occupies (m^3, > 0).
+    gravity : float
+        Gravitational acceleration of the run (m/s^2).
+    """
+    if not _finite(fill_volume) or fill_volume <= 0:
+        raise ValueError(f"fill_volume must be > 0 m^3, got {fill_volume!r}")
+    return beverloo_clump_rate(silo.fill.n_clumps / fill_volume, silo.outlet_width, silo.depth,
+                               silo.particle.equivalent_diameter, gravity)
 
 
 def _estimate_silo_deck(
-    run_id: str, kind: str, silo: SiloCase, mpi_ranks: int, model: CostModel
+    run_id: str, kind: str, silo: SiloCase, mpi_ranks: int, model: CostModel, stages: tuple[StageWork, ...]
 ) -> RunEstimate:
     """Silo, recirculating silo and blender decks: fill, settle, open, then the dumped last stage."""
     return estimate_run(
@@ -273,33 +571,51 @@ def _estimate_silo_deck(
         kind,
         clumps=silo.fill.n_clumps,
         spheres_per_clump=silo.spheres_per_clump,
-        steps=silo_run_steps(silo, model.settle_fraction),
+        steps=sum(stage.steps for stage in stages),
         timestep=silo.timestep,
         dump_frames=dump_frames(silo.discharge_steps, silo.dump_every),
         mpi_ranks=mpi_ranks,
         model=model,
         contact_frames=SILO_CONTACT_SNAPSHOTS,
+        stages=stages,
     )
 
 
 def estimate_silo_case(case: SiloCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
     """Estimate a flat-bottom silo run (:class:`engines.cases.silo_flat.SiloCase`).
 
-    All clumps are counted over the whole run, also while the silo drains (worst case).
+    The discharge drains the fill at Beverloo's rate (:func:`silo_drain_rate`, fill volume W T H) once the first
+    clumps have fallen ``sink_depth`` out of the domain (:func:`sink_fall_time`); the stagnant zones a flat floor
+    keeps are left out (a few per cent of the discharge's work, when the silo runs empty at all).
     """
-    return _estimate_silo_deck(case.run_id, SILO_FLAT, case, mpi_ranks, model)
+    gravity = case.gravity
+    rate = silo_drain_rate(case, case.width * case.depth * case.fill_height, gravity)
+    stages = silo_stage_work(case, model.settle_fraction, "discharge", rate, sink_fall_time(case.sink_depth, gravity))
+    return _estimate_silo_deck(case.run_id, SILO_FLAT, case, mpi_ranks, model, stages)
 
 
 def estimate_recirculation_case(
     case: RecirculationCase, mpi_ranks: int = 1, model: CostModel = CostModel()
 ) -> RunEstimate:
-    """Estimate a recirculating-silo run of the blending study (its silo's discharge is the recirculation)."""
-    return _estimate_silo_deck(case.run_id, RECIRCULATION, case.silo, mpi_ranks, model)
+    """Estimate a recirculating-silo run of the blending study: its silo's discharge is the recirculation, whose
+    clumps re-enter at the top, so the count holds."""
+    stages = silo_stage_work(case.silo, model.settle_fraction, "recirculate")
+    return _estimate_silo_deck(case.run_id, RECIRCULATION, case.silo, mpi_ranks, model, stages)
 
 
 def estimate_blender_case(case: BlenderCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
-    """Estimate a blender run; its silo's steps and dump interval are already scaled for the gravity factor."""
-    return _estimate_silo_deck(case.run_id, BLENDER, case.silo, mpi_ranks, model)
+    """Estimate a blender run; its silo's steps and dump interval are already scaled for the gravity factor.
+
+    In ``continuous`` mode the discharged clumps re-enter at the top and the count holds; in ``batch`` mode the
+    hopper drains at Beverloo's rate at the run's gravity (fill volume: the open cross-section below the fill
+    height times the depth) once the first clumps have fallen ``sink_depth`` out of the domain.
+    """
+    silo, rate, delay = case.silo, 0.0, 0.0
+    if case.mode == "batch":
+        rate = silo_drain_rate(silo, case.fill_area * silo.depth, case.gravity)
+        delay = sink_fall_time(silo.sink_depth, case.gravity)
+    stages = silo_stage_work(silo, model.settle_fraction, "discharge", rate, delay)
+    return _estimate_silo_deck(case.run_id, BLENDER, silo, mpi_ranks, model, stages)
 
 
 def jenike_run_steps(case: JenikeCase) -> int:
@@ -319,21 +635,48 @@ def jenike_lid_atoms(case: JenikeCase) -> int:
     return 0
 
 
+def jenike_levelled_clumps(case: JenikeCase) -> int:
+    """Clumps left after levelling: those the sample volume holds at the solid fraction the pour was sized with,
+    ``round(phi A H / V_clump)`` (:data:`engines.cases.jenike.FILL_SOLID_FRACTION`), at most the clumps created."""
+    geometry = case.geometry
+    kept = int(round(FILL_SOLID_FRACTION * geometry.area * geometry.sample_height / case.particle.volume))
+    return min(case.fill.n_clumps, kept)
+
+
+def jenike_stage_work(case: JenikeCase) -> tuple[StageWork, ...]:
+    """Steps and sphere-steps of the stages of a Jenike deck.
+
+    - fill: all clumps created at once, held for the fall and settling;
+    - settle: the deletion step still at that count (the engine removes the spheres of the deleted clumps in
+      it), then the relaxation at the levelled count (:func:`jenike_levelled_clumps`);
+    - consolidate (load ramp and hold) and shear: the levelled clumps plus the lid's atoms, placed after levelling.
+    """
+    spheres = case.particle.n_spheres
+    created = spheres * case.fill.n_clumps
+    levelled = spheres * jenike_levelled_clumps(case)
+    loaded = levelled + jenike_lid_atoms(case)
+    relax = case.fill.relax_steps
+    consolidation = case.ramp_steps + case.hold_steps
+    return (
+        StageWork("fill", case.fill.steps, float(created * case.fill.steps)),
+        StageWork("settle", JENIKE_LEVEL_DELETION_STEPS + relax,
+                  float(created * JENIKE_LEVEL_DELETION_STEPS + levelled * relax)),
+        StageWork("consolidate", consolidation, float(loaded * consolidation)),
+        StageWork("shear", case.shear_steps, float(loaded * case.shear_steps)),
+    )
+
+
 def estimate_jenike_case(case: JenikeCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
-    """Estimate a Jenike shear-cell run.
+    """Estimate a Jenike shear-cell run: work stage by stage (:func:`jenike_stage_work`).
 
-    Approximations (all upper bounds):
-
-    - clumps: the clumps created (``fill.n_clumps``) for every stage; levelling deletes the overfill,
-      about overfill / (1 + overfill) of them, before consolidation and shear;
-    - spheres: their spheres plus the lid's atoms (:func:`jenike_lid_atoms`) for every stage, although the lid
-      is placed only after levelling;
-    - dumps: particle dumps over consolidation and shear (:func:`dump_frames` of ramp + hold + shear at
-      ``dump_every``), and as many pair-and-wall contact dumps (the deck writes one fewer); the calibration
-      analysis keeps no parsed-frame cache.
+    Disk (upper bounds): every dump counts the clumps created (``fill.n_clumps``) and the lid's atoms
+    (:func:`jenike_lid_atoms`), although levelling deletes the overfill first; particle dumps over consolidation
+    and shear (:func:`dump_frames` of ramp + hold + shear at ``dump_every``), and as many pair-and-wall contact
+    dumps (the deck writes one fewer); the calibration analysis keeps no parsed-frame cache.
     """
     dumped_steps = case.ramp_steps + case.hold_steps + case.shear_steps
     frames = dump_frames(dumped_steps, case.dump_every)
+    stages = jenike_stage_work(case)
     return estimate_run(
         case.run_id,
         JENIKE,
@@ -346,6 +689,7 @@ def estimate_jenike_case(case: JenikeCase, mpi_ranks: int = 1, model: CostModel 
         model=model,
         extra_spheres=jenike_lid_atoms(case),
         contact_frames=frames,
+        stages=stages,
     )
 
 
@@ -432,18 +776,19 @@ def format_duration(seconds: float, digits: int = 2) -> str:
 
 #: Columns of :func:`estimate_rows`, in order.
 ESTIMATE_COLUMNS = (
-    "run", "kind", "mpi_ranks", "clumps", "spheres", "steps", "simulated_s", "wall_time", "core_time", "dump_frames",
-    "disk",
+    "run", "kind", "mpi_ranks", "clumps", "spheres", "steps", "sphere_steps", "simulated_s", "wall_time", "core_time",
+    "dump_frames", "disk",
 )
 
 
 def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
     """Rows of the table ``make estimate`` prints: one per run, then a totals row.
 
-    Columns (:data:`ESTIMATE_COLUMNS`): run, kind, mpi_ranks, clumps, spheres, steps, simulated_s (s),
-    wall_time (formatted), core_time (wall time times MPI ranks, formatted: what a cluster account is charged),
-    dump_frames, disk (formatted dumps). The totals row sums wall time (the runs one after another), core time,
-    dump frames and disk; its other cells are empty.
+    Columns (:data:`ESTIMATE_COLUMNS`): run, kind, mpi_ranks, clumps, spheres (the most the run holds), steps,
+    sphere_steps (the work, sphere-steps), simulated_s (s), wall_time (formatted), core_time (wall time times MPI
+    ranks, formatted: what a cluster account is charged), dump_frames, disk (formatted dumps). The totals row sums
+    sphere-steps, wall time (the runs one after another), core time, dump frames and disk; its other cells are
+    empty.
     """
     estimates = list(estimates)
     rows = [
@@ -454,9 +799,10 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
             "clumps": estimate.clumps,
             "spheres": estimate.spheres,
             "steps": estimate.steps,
+            "sphere_steps": estimate.sphere_steps,
             "simulated_s": estimate.simulated_time_s,
             "wall_time": format_duration(estimate.wall_time_s),
-            "core_time": format_duration(estimate.wall_time_s * estimate.mpi_ranks),
+            "core_time": format_duration(estimate.core_seconds),
             "dump_frames": estimate.dump_frames,
             "disk": format_bytes(estimate.dump_bytes),
         }
@@ -465,8 +811,9 @@ def estimate_rows(estimates: Iterable[RunEstimate]) -> list[dict]:
     totals = dict.fromkeys(ESTIMATE_COLUMNS, "")
     totals.update(
         run=f"total ({len(estimates)} run{'s' if len(estimates) != 1 else ''})",
+        sphere_steps=math.fsum(e.sphere_steps for e in estimates),
         wall_time=format_duration(sum(e.wall_time_s for e in estimates)),
-        core_time=format_duration(sum(e.wall_time_s * e.mpi_ranks for e in estimates)),
+        core_time=format_duration(sum(e.core_seconds for e in estimates)),
         dump_frames=sum(e.dump_frames for e in estimates),
         disk=format_bytes(sum(e.dump_bytes for e in estimates)),
     )

@@ -31,6 +31,7 @@ if TYPE_CHECKING:  # the neutral types appear in signatures only
     from analysis.data.frames import ParticleFrame
     from analysis.data.record import RunRecord
     from analysis.data.settled import SettledFill
+    from engines.estimates import MeasuredWork
 
 __all__ = [
     "ENGINE_KINDS",
@@ -127,9 +128,16 @@ class Engine(ABC):
         """
 
     @abstractmethod
+    def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
+        """The CPU time a run took on this machine and the sphere-steps it made (the spheres it held, summed over
+        its steps), from the engine's own timing of every attempt, or None when the run left no timing (not run, or
+        stopped before its first stage ended)."""
+
     def measured_cost(self, run_dir: str | Path) -> float | None:
-        """CPU seconds per sphere and time step that a run took on this machine, from the engine's own timing of
-        every attempt (s), or None when the run left no timing (not run, or stopped before its first stage ended)."""
+        """CPU seconds per sphere-step that a run took on this machine (s), from :meth:`measured_work`, or None when
+        the run left no timing."""
+        work = self.measured_work(run_dir)
+        return work.seconds_per_sphere_step if work is not None else None
 
     @abstractmethod
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:

@@ -21,6 +21,7 @@ from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import SiloCase
 from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.verification import VerificationCase
+from engines.estimates import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from engines.cases.blender import GATE
@@ -39,7 +40,7 @@ from engines.liggghts.jenike import (
     run_jenike,
     write_jenike_inputs,
 )
-from engines.liggghts.cost import calibrate_cost_model
+from engines.liggghts.cost import measured_work as work_from_logs
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs
 from engines.liggghts.settled import read_settled_fill
 from engines.cases.silo_flat import FLOOR_MESHES
@@ -146,12 +147,8 @@ class LiggghtsEngine(Engine):
         return _adapter(case).run(case, Path(run_dir), executable=settings.get("executable", "liggghts"),
                                   mpi_ranks=options.mpi_ranks, mpirun=options.mpirun)
 
-    def measured_cost(self, run_dir: str | Path) -> float | None:
-        text = "\n".join(path.read_text(errors="replace") for path in attempt_logs(run_dir))
-        try:
-            return calibrate_cost_model(text).seconds_per_sphere_step
-        except ValueError:  # no timing line: the run has not finished a stage
-            return None
+    def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
+        return work_from_logs(path.read_text(errors="replace") for path in attempt_logs(run_dir))
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return list(read_frames(Path(run_dir) / "dumps", DUMP_PREFIX, record.timestep_s, on_damaged=on_damaged))

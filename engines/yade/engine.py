@@ -19,10 +19,11 @@ from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import FLOOR_MESHES, SiloCase
 from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase
 from engines.cases.verification import VerificationCase
+from engines.estimates import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.layout import CASE_SUMMARY
-from engines.yade.cost import measured_seconds_per_sphere_step
+from engines.yade.cost import measured_work as work_from_logs
 from engines.yade.blender import run_blender, write_blender_inputs
 from engines.yade.inputs import ENGINE_NAME
 from engines.yade.jenike import FORCES_NAME, check_jenike_case, jenike_contacts, run_jenike, write_jenike_inputs
@@ -90,8 +91,8 @@ class YadeEngine(Engine):
         self.check_case(case)
         return _adapter(case)[2](case, Path(run_dir), options_from(options))
 
-    def measured_cost(self, run_dir: str | Path) -> float | None:
-        return measured_seconds_per_sphere_step(attempt_logs(run_dir))
+    def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
+        return work_from_logs(attempt_logs(run_dir))
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return read_frames(run_dir, DUMP_PREFIX, on_damaged)

@@ -1,4 +1,5 @@
-"""Run estimates before a run starts: steps, times, dump frames, disk space, calibration, formatting."""
+"""Run estimates before a run starts: steps, sphere-steps stage by stage, times, dump frames, disk space,
+calibration from engine logs, formatting."""
 
 from __future__ import annotations
 
@@ -11,13 +12,18 @@ import pytest
 from engines.cases.blender import blender_cases, build_blender_case
 from engines.cases.silo_recirculation import recirculation_cases
 from engines.config import REPO_ROOT, load_config
+from analysis.numerics.flow import beverloo_mass_flow_rate
 from engines.estimates import (
     ESTIMATE_COLUMNS,
     KINDS,
     CostModel,
     InsufficientDiskSpace,
+    MeasuredWork,
     RunEstimate,
+    StageWork,
+    beverloo_clump_rate,
     check_disk_space,
+    drain_sphere_steps,
     dump_frames,
     estimate_blender_case,
     estimate_jenike_case,
@@ -27,14 +33,17 @@ from engines.estimates import (
     estimate_silo_case,
     format_bytes,
     format_duration,
+    jenike_levelled_clumps,
     jenike_run_steps,
     parallel_speedup,
+    pour_sphere_steps,
     silo_run_steps,
+    sink_fall_time,
     total_dump_bytes,
     wall_time,
 )
-from engines.cases.jenike import build_jenike_case
-from engines.liggghts.cost import StageCost, calibrate_cost_model, stage_costs
+from engines.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
+from engines.liggghts.cost import StageCost, TimedRun, calibrate_cost_model, measured_work, stage_costs, timed_runs
 from engines.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
@@ -56,13 +65,27 @@ def config() -> dict:
 
 
 def _silo_like(**overrides) -> SimpleNamespace:
-    """A hand-made silo case: 100 two-sphere clumps, fill 1000 steps, 4 x 50 settle steps, 2000 discharge."""
+    """A hand-made silo case: 100 two-sphere clumps poured in 4 batches of 25, 200 steps apart, over a fill of 1000
+    steps; 4 x 50 settle steps, 2000 discharge steps of 1 ms through a 20 mm slot in a silo 0.1 m wide, 10 mm deep,
+    filled 0.1 m high (10^6 clumps per m^3), clumps 4 mm across, leaving 20 mm below the outlet."""
     values = dict(
-        run_id="silo-test", fill=SimpleNamespace(n_clumps=100, fill_steps=1000), spheres_per_clump=2,
-        settle_check_steps=50, settle_max_checks=4, discharge_steps=2000, dump_every=300, timestep=1.0e-5,
+        run_id="silo-test",
+        fill=SimpleNamespace(n_clumps=100, fill_steps=1000, clumps_per_insertion=25, insert_every=200),
+        spheres_per_clump=2, settle_check_steps=50, settle_max_checks=4, discharge_steps=2000, dump_every=300,
+        timestep=1.0e-3, width=0.1, depth=0.01, fill_height=0.1, outlet_width=0.02,
+        particle=SimpleNamespace(equivalent_diameter=0.004), sink_depth=0.02, gravity=9.81,
     )
     values.update(overrides)
     return SimpleNamespace(**values)
+
+
+#: The hand-made silo's discharge: Beverloo's clumps per second, 10^6 / m^3 * 0.58 sqrt(g) L (B0 - 1.5 d)^1.5, as
+#: spheres per step; the first clumps leave after falling 20 mm from rest.
+SILO_LIKE_RATE = 2 * 1.0e6 * 0.58 * math.sqrt(9.81) * 0.01 * (0.02 - 1.5 * 0.004) ** 1.5 * 1.0e-3
+SILO_LIKE_DELAY = math.sqrt(2 * 0.02 / 9.81) / 1.0e-3
+SILO_LIKE_DISCHARGE = 200 * 2000 - 0.5 * SILO_LIKE_RATE * (2000 - SILO_LIKE_DELAY) ** 2
+#: Its pour: 25, 50, 75, 100 clumps for 200 steps each, then 100 for the last 200 steps (two spheres per clump).
+SILO_LIKE_FILL = 2 * ((25 + 50 + 75 + 100) * 200 + 100 * 200)
 
 
 # ---------------------------------------------------------------------------------------------- model
@@ -116,15 +139,77 @@ Loop time of 1.5 on 1 procs for 100 steps with 0 atoms
 """
 
 
-def test_calibration_divides_cpu_seconds_by_sphere_steps():
-    # (4 * 1 + 3 * 2) / (1000 * 2000 + 500 * 4000); the 0-step and 0-atom lines do not count
+def test_calibration_without_thermo_rows_counts_each_run_at_its_final_atoms():
+    # (4 * 1 + 6.21e-7 + 3 * 2 + 1.5) / (1000 * 2000 + 500 * 4000): every run's CPU time counts, that of the run
+    # with 0 atoms too (the estimate has to cover it); without rows a run's steps count at its line's atoms
     base = CostModel(bytes_per_sphere_per_dump=100.0, parallel_efficiency=0.9)
     model = calibrate_cost_model(SYNTHETIC_LOG, base)
-    assert model.seconds_per_sphere_step == pytest.approx(10.0 / 4.0e6, rel=1e-12)
+    assert model.seconds_per_sphere_step == pytest.approx((4.0 + 6.21e-7 + 6.0 + 1.5) / 4.0e6, rel=1e-12)
     assert dataclasses.replace(model, seconds_per_sphere_step=base.seconds_per_sphere_step) == base
 
 
+def _thermo(rows) -> str:
+    """A thermo block of (step, atoms) rows, two spheres per clump."""
+    lines = ["    Step    Atoms           Time       n_clumps       ke_per_c            CPU"]
+    lines += [f"{step:8d} {atoms:8d} {step * 1e-5:14.8g} {atoms // 2:14d} {1e-9:14.8g} {0.0:14.8g}" for step, atoms in rows]
+    return "\n".join(lines) + "\n"
+
+
+#: A pour from 0 to 1000 atoms over 1000 steps, one row every 100 steps, then a drain from 1000 to 200 atoms over
+#: 400 steps after which the count stays for 200 steps.
+POUR_AND_DRAIN_LOG = (
+    _thermo([(step, step) for step in range(0, 1001, 100)])
+    + "Loop time of 2 on 1 procs for 1000 steps with 1000 atoms, finish time Thu Nov 26 16:28:43 2026\n"
+    + "SILOFLOW opened step=1000 time=0.01 clumps=500 ke_per_clump=1e-13\n"
+    + _thermo([(1000, 1000), (1200, 600), (1400, 200), (1600, 200)])
+    + "Loop time of 3 on 2 procs for 600 steps with 200 atoms\n"
+)
+
+
+def test_a_linear_pour_integrates_to_half_its_final_count_times_its_steps():
+    runs = list(timed_runs(POUR_AND_DRAIN_LOG))
+    assert runs[0] == TimedRun((), 2.0, 1000, 1000 * 1000 / 2)
+    # drain: (1000 + 600) / 2 * 200 + (600 + 200) / 2 * 200 + 200 * 200, not 200 atoms * 600 steps
+    assert runs[1] == TimedRun(("opened",), 6.0, 600, 160_000.0 + 80_000.0 + 40_000.0)
+
+
+def test_calibration_counts_the_atoms_over_time_not_at_the_end():
+    model = calibrate_cost_model(POUR_AND_DRAIN_LOG)
+    assert model.seconds_per_sphere_step == pytest.approx((2.0 + 6.0) / (500_000 + 280_000), rel=1e-12)
+    # what dividing by the final counts gave: 8 / (1000 * 1000 + 200 * 600)
+    assert model.seconds_per_sphere_step != pytest.approx(8.0 / 1_120_000, rel=1e-3)
+
+
+def test_steps_the_rows_do_not_span_count_at_the_final_atoms():
+    text = _thermo([(0, 100), (100, 300)]) + "Loop time of 1 on 1 procs for 150 steps with 300 atoms\n"
+    assert list(timed_runs(text)) == [TimedRun((), 1.0, 150, 20_000.0 + 50 * 300)]
+
+
+def test_a_run_cut_off_before_its_loop_time_counts_for_nothing():
+    cut = POUR_AND_DRAIN_LOG + _thermo([(1600, 200), (1700, 200)]) + "ERROR: Lost atoms\n"
+    assert list(timed_runs(cut)) == list(timed_runs(POUR_AND_DRAIN_LOG))
+
+
+def test_measured_work_adds_the_attempts():
+    resumed = _thermo([(1500, 200), (1600, 200)]) + "Loop time of 0.5 on 1 procs for 100 steps with 200 atoms\n"
+    work = measured_work([POUR_AND_DRAIN_LOG, resumed])
+    assert work == MeasuredWork(8.5, 780_000.0 + 20_000.0)
+    assert work.seconds_per_sphere_step == pytest.approx(8.5 / 800_000, rel=1e-12)
+    assert measured_work(["no timing\n"]) is None
+    # both attempts in one text, the first cut off after step 1700: the resumed run's first row goes back, and the
+    # rows of the run that never finished count for nothing
+    cut = POUR_AND_DRAIN_LOG + _thermo([(1600, 200), (1700, 200)])
+    assert measured_work([cut + resumed]) == work
+
+
+def test_measured_work_refuses_impossible_values():
+    with pytest.raises(ValueError, match="cpu_seconds"):
+        MeasuredWork(-1.0, 10.0)
+    assert math.isnan(MeasuredWork(1.0, 0.0).seconds_per_sphere_step)
+
+
 def test_calibration_of_a_real_log_line_with_mpi():
+    # no thermo rows: the run's steps count at the line's atoms
     line = "Loop time of 296.734 on 4 procs for 103983 steps with 2134 atoms, finish time Sat Nov 21 15:32:15 2026\n"
     model = calibrate_cost_model(line)
     assert model.seconds_per_sphere_step == pytest.approx(296.734 * 4 / (103983 * 2134), rel=1e-12)
@@ -146,7 +231,9 @@ def test_estimate_run_exact_numbers():
                             dump_frames=11)
     assert estimate.spheres == 2000
     assert estimate.simulated_time_s == pytest.approx(0.1, rel=1e-12)
-    # 2000 spheres x 10,000 steps x 0.5 microseconds
+    # 2000 spheres x 10,000 steps x 0.5 microseconds: without stages the count holds over the run
+    assert estimate.sphere_steps == 2.0e7
+    assert estimate.stages == (StageWork("run", 10_000, 2.0e7),)
     assert estimate.wall_time_s == pytest.approx(10.0, rel=1e-12)
     # 11 dumps of 1024 + 2000 x 128 bytes (no frame cache: it did not pay, make bench)
     assert estimate.dump_bytes == 11 * (1024 + 2000 * 128) == 2_827_264
@@ -159,7 +246,33 @@ def test_estimate_run_with_ranks_lid_spheres_and_contacts():
                             dump_frames=5, mpi_ranks=2, extra_spheres=20, contact_frames=4)
     assert estimate.spheres == 320
     assert estimate.wall_time_s == pytest.approx(320 * 1000 * 5.0e-7 / 1.6, rel=1e-12)
+    assert estimate.core_seconds == pytest.approx(2 * estimate.wall_time_s, rel=1e-15)
     assert estimate.dump_bytes == 5 * (1024 + 320 * 128) + 4 * (1024 + 320 * 200)
+
+
+def test_estimate_run_costs_the_work_of_its_stages():
+    stages = (StageWork("fill", 600, 60_000.0), StageWork("shear", 400, 128_000.0))
+    estimate = estimate_run("r", "jenike", clumps=100, spheres_per_clump=3, steps=1000, timestep=2.0e-6,
+                            dump_frames=5, extra_spheres=20, stages=stages)
+    assert estimate.sphere_steps == 188_000.0 and estimate.stages == stages
+    assert estimate.wall_time_s == pytest.approx(188_000 * 5.0e-7, rel=1e-12)
+    # the disk still counts every dump at the most spheres the run holds
+    assert estimate.spheres == 320 and estimate.dump_bytes == 5 * (1024 + 320 * 128)
+    with pytest.raises(ValueError, match="add up to 1000, not to steps = 999"):
+        estimate_run("r", "jenike", clumps=100, spheres_per_clump=3, steps=999, timestep=2.0e-6, dump_frames=5,
+                     stages=stages)
+
+
+@pytest.mark.parametrize("steps, sphere_steps, message", [(-1, 0.0, "steps"), (1.5, 0.0, "steps"),
+                                                          (10, -1.0, "sphere_steps"), (10, math.inf, "sphere_steps")])
+def test_stage_work_refuses_impossible_values(steps, sphere_steps, message):
+    with pytest.raises(ValueError, match=message):
+        StageWork("fill", steps, sphere_steps)
+
+
+def test_stage_work_mean_spheres():
+    assert StageWork("settle", 400, 1_000_000.0).mean_spheres == 2500.0
+    assert StageWork("open", 0, 0.0).mean_spheres == 0.0
 
 
 @pytest.mark.parametrize(
@@ -188,6 +301,60 @@ def test_dump_frames_refuses_a_zero_interval():
         dump_frames(100, 0)
 
 
+# ---------------------------------------------------------------------------------------------- work over time
+
+
+@pytest.mark.parametrize(
+    "n, per_insertion, every, steps, held",
+    [
+        (100, 10, 50, 500, 10 * 50 * (1 + 2 + 3 + 4 + 5 + 6 + 7 + 8 + 9 + 10)),  # 27,500: the last batch ends the stage
+        (100, 10, 50, 600, 27_500 + 100 * 100),  # then the full silo for 100 steps more
+        (95, 10, 50, 600, (10 * (1 + 2 + 3 + 4 + 5 + 6 + 7 + 8 + 9) + 95) * 50 + 95 * 100),  # a last batch of 5
+        (100, 10, 50, 275, 10 * 50 * (1 + 2 + 3 + 4 + 5) + 60 * 25),  # cut off in the sixth batch
+        (100, 100, 50, 400, 100 * 400),  # one batch: the count at once
+        (1000, 1, 1, 1000, 1000 * 1001 // 2),  # a clump a step: a linear ramp, N (N + 1) / 2
+        (0, 5, 10, 100, 0),
+    ],
+)
+def test_a_pour_holds_each_batch_from_its_insertion_on(n, per_insertion, every, steps, held):
+    assert pour_sphere_steps(n, per_insertion, every, steps) == held
+
+
+def test_a_pour_refuses_impossible_batches():
+    with pytest.raises(ValueError, match="clumps_per_insertion"):
+        pour_sphere_steps(100, 0, 50, 500)
+
+
+@pytest.mark.parametrize(
+    "spheres, rate, delay, steps, held",
+    [
+        (1000.0, 0.0, 0.0, 500, 500_000.0),  # nothing leaves: the count holds
+        (1000.0, 1.0, 100.0, 500, 1000 * 500 - 0.5 * 400**2),  # draining, not empty by the end
+        (100.0, 1.0, 0.0, 500, 0.5 * 100 * 100),  # empty after 100 steps: N^2 / (2 rate)
+        (100.0, 1.0, 50.0, 500, 100 * 50 + 0.5 * 100 * 100),  # the same, 50 steps later
+        (100.0, 2.0, 600.0, 500, 100 * 500),  # the first clumps have not left by the end
+    ],
+)
+def test_a_drain_loses_its_rate_per_step_after_the_delay(spheres, rate, delay, steps, held):
+    assert drain_sphere_steps(spheres, rate, delay, steps) == pytest.approx(held, rel=1e-15)
+
+
+def test_beverloo_rate_is_the_mass_flow_rate_over_the_clump_mass():
+    n, mass = 1.2e6, 1.3e-5  # clumps per m^3 and kg per clump: bulk density 15.6 kg/m^3
+    rate = beverloo_clump_rate(n, 0.04, 0.012, 0.0033, 9.81)
+    assert rate == pytest.approx(n * 0.58 * math.sqrt(9.81) * 0.012 * (0.04 - 1.5 * 0.0033) ** 1.5, rel=1e-15)
+    assert rate * mass == pytest.approx(beverloo_mass_flow_rate(n * mass, 0.04, 0.012, 0.0033, gravity=9.81), rel=1e-12)
+    # an outlet no wider than k d: Beverloo predicts no flow, and the count holds
+    assert beverloo_clump_rate(n, 0.0045, 0.012, 0.003, 9.81) == 0.0
+    with pytest.raises(ValueError, match="gravity"):
+        beverloo_clump_rate(n, 0.04, 0.012, 0.0033, 0.0)
+
+
+def test_sink_fall_time_is_a_free_fall_from_rest():
+    assert sink_fall_time(0.02, 9.81) == pytest.approx(math.sqrt(0.04 / 9.81), rel=1e-15)
+    assert sink_fall_time(0.0, 9.81) == 0.0
+
+
 # ---------------------------------------------------------------------------------------------- case kinds
 
 
@@ -196,8 +363,15 @@ def test_hand_made_silo_case_exact_numbers():
     assert estimate.steps == 1000 + 4 * 50 + 2000 == 3200
     assert estimate.spheres == 200
     assert estimate.dump_frames == 1 + math.ceil(2000 / 300) == 8
-    assert estimate.simulated_time_s == pytest.approx(0.032, rel=1e-12)
-    assert estimate.wall_time_s == pytest.approx(200 * 3200 * 5.0e-7, rel=1e-12)
+    assert estimate.simulated_time_s == pytest.approx(3.2, rel=1e-12)
+    assert [(stage.stage, stage.steps) for stage in estimate.stages] == [("fill", 1000), ("settle", 200),
+                                                                         ("discharge", 2000)]
+    fill, settle, discharge = (stage.sphere_steps for stage in estimate.stages)
+    assert fill == SILO_LIKE_FILL == 140_000
+    assert settle == 200 * 200
+    assert discharge == pytest.approx(SILO_LIKE_DISCHARGE, rel=1e-12)
+    assert 0.5 < discharge / (200 * 2000) < 0.8  # it drains: 30 clumps/s for about 1.94 s out of the 100
+    assert estimate.wall_time_s == pytest.approx((SILO_LIKE_FILL + 40_000 + SILO_LIKE_DISCHARGE) * 5.0e-7, rel=1e-12)
     # 8 dumps, plus the one contact snapshot of the settled fill
     assert estimate.dump_bytes == 8 * (1024 + 200 * 128) + (1024 + 200 * 200) == 254_016
     assert (estimate.run_id, estimate.kind) == ("silo-test", "silo_flat")
@@ -211,11 +385,29 @@ def test_silo_case_from_config_counts_the_settle_stage_at_its_longest(config):
     assert estimate.clumps == case.fill.n_clumps
     assert estimate.spheres == case.fill.n_clumps * case.particle.n_spheres
     assert estimate.simulated_time_s == pytest.approx(expected_steps * case.timestep, rel=1e-12)
-    assert estimate.wall_time_s == pytest.approx(estimate.spheres * expected_steps * 5.0e-7 / 1.6, rel=1e-12)
+    assert estimate.wall_time_s == pytest.approx(estimate.sphere_steps * 5.0e-7 / 1.6, rel=1e-12)
     assert estimate.dump_frames == 1 + math.ceil(case.discharge_steps / case.dump_every)
     frames_bytes = estimate.dump_frames * (1024 + estimate.spheres * 128)
     assert estimate.dump_bytes == frames_bytes + 1024 + estimate.spheres * 200
     assert estimate.run_id == case.run_id and estimate.mpi_ranks == 2
+
+
+def test_silo_case_from_config_counts_its_spheres_stage_by_stage(config):
+    case = build_silo_case(config)
+    spheres = case.fill.n_clumps * case.particle.n_spheres
+    fill, settle, discharge = estimate_silo_case(case, model=WORST_CASE).stages
+    # the pour ramps the count up: about half the fill on average while it pours, all of it once poured
+    assert 0.5 * spheres < fill.mean_spheres < spheres
+    assert settle.sphere_steps == spheres * settle.steps
+    # the discharge drains at Beverloo's rate for the bulk density the fill was sized with (n_clumps rounds it:
+    # the same to 1e-3), once the first clumps have fallen out of the domain
+    clumps_per_s = beverloo_mass_flow_rate(config["defaults"]["fill"]["bulk_density_estimate"], case.outlet_width,
+                                           case.depth, case.particle.equivalent_diameter) / case.particle.mass
+    delay = sink_fall_time(case.sink_depth, case.gravity) / case.timestep
+    drained = drain_sphere_steps(float(spheres), clumps_per_s * case.particle.n_spheres * case.timestep, delay,
+                                 discharge.steps)
+    assert discharge.sphere_steps == pytest.approx(drained, rel=1e-3)
+    assert discharge.sphere_steps < 0.9 * spheres * discharge.steps
 
 
 def test_changing_a_silo_case_changes_its_estimate_exactly(config):
@@ -244,8 +436,10 @@ def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
         assert estimate.steps == silo.fill.fill_steps + silo.settle_max_checks * silo.settle_check_steps + silo.discharge_steps
         assert estimate.dump_frames == 1 + math.ceil(silo.discharge_steps / silo.dump_every)
         assert estimate.spheres == silo.fill.n_clumps * silo.particle.n_spheres
-        # the recirculation stage is the silo's discharge stage
+        # the recirculation stage is the silo's discharge stage; its clumps re-enter at the top, so all stay
         assert silo.discharge_steps * silo.timestep == pytest.approx(case.recirculation_time, rel=1e-12)
+        assert estimate.stages[-1] == StageWork("recirculate", silo.discharge_steps,
+                                                float(estimate.spheres * silo.discharge_steps))
 
 
 def test_blender_cases_use_their_gravity_scaled_silo(config):
@@ -264,14 +458,42 @@ def test_blender_cases_use_their_gravity_scaled_silo(config):
     assert heavy.dump_frames == normal.dump_frames
 
 
+def test_a_continuous_blender_keeps_its_clumps_and_a_batch_blender_drains(config):
+    configuration = config["blender"]["configurations"][0]
+    assert config["blender"]["discharge"]["mode"] == "continuous"
+    case = build_blender_case(config, configuration)
+    continuous = estimate_blender_case(case, model=WORST_CASE).stages[-1]
+    assert continuous == StageWork("discharge", case.silo.discharge_steps,
+                                   float(case.silo.fill.n_clumps * case.silo.spheres_per_clump * case.silo.discharge_steps))
+    batch = dataclasses.replace(case, mode="batch")
+    silo = case.silo
+    drained = estimate_blender_case(batch, model=WORST_CASE).stages[-1]
+    clumps_per_s = beverloo_clump_rate(silo.fill.n_clumps / (case.fill_area * silo.depth), silo.outlet_width,
+                                       silo.depth, silo.particle.equivalent_diameter, case.gravity)
+    assert drained.sphere_steps == pytest.approx(drain_sphere_steps(
+        continuous.sphere_steps / continuous.steps, clumps_per_s * silo.spheres_per_clump * silo.timestep,
+        sink_fall_time(silo.sink_depth, case.gravity) / silo.timestep, silo.discharge_steps), rel=1e-12)
+    assert drained.sphere_steps < continuous.sphere_steps
+
+
 def test_hand_made_jenike_case_exact_numbers():
     case = SimpleNamespace(
-        run_id="jenike-test", particle=SimpleNamespace(n_spheres=2), timestep=1.0e-5,
+        run_id="jenike-test", particle=SimpleNamespace(n_spheres=2, volume=1.45e-8), timestep=1.0e-5,
         fill=SimpleNamespace(n_clumps=453, steps=16900, relax_steps=1734),
         ramp_steps=1083, hold_steps=3250, shear_steps=17331, dump_every=1733,
         rigid_lid=SimpleNamespace(n_spheres=280), servo_lid=None,
+        geometry=SimpleNamespace(area=1.0e-3, sample_height=0.01),
     )
     estimate = estimate_jenike_case(case)
+    # levelling keeps 0.58 * 1e-3 m^2 * 0.01 m / 1.45e-8 m^3 = 400 clumps; the lid comes after it
+    assert jenike_levelled_clumps(case) == 400
+    assert estimate.stages == (
+        StageWork("fill", 16900, 906.0 * 16900),
+        StageWork("settle", 1 + 1734, 906.0 * 1 + 800.0 * 1734),  # the deletion step still holds all 906
+        StageWork("consolidate", 1083 + 3250, 1080.0 * (1083 + 3250)),
+        StageWork("shear", 17331, 1080.0 * 17331),
+    )
+    assert estimate.sphere_steps == 906 * 16901 + 800 * 1734 + 1080 * (1083 + 3250 + 17331)
     # 40299: the last step of the recorded calibration run with these numbers
     assert estimate.steps == jenike_run_steps(case) == 16900 + 1 + 1734 + 1083 + 3250 + 17331 == 40299
     assert estimate.clumps == 453 and estimate.spheres == 906 + 280
@@ -291,6 +513,13 @@ def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
                                   + case.shear_steps)
         lid_atoms = case.rigid_lid.n_spheres if lid == "rigid" else 2
         assert estimate.spheres == case.fill.n_clumps * case.particle.n_spheres + lid_atoms
+        # the pour was sized for 1 + overfill times the sample: levelling keeps about 1 / (1 + overfill) of it
+        overfill = config["jenike"]["fill"]["overfill"]
+        assert jenike_levelled_clumps(case) == pytest.approx(case.fill.n_clumps / (1 + overfill), abs=1)
+        assert jenike_levelled_clumps(case) == round(FILL_SOLID_FRACTION * case.geometry.area
+                                                     * case.geometry.sample_height / case.particle.volume)
+        shear = estimate.stages[-1]
+        assert shear.sphere_steps == (jenike_levelled_clumps(case) * case.particle.n_spheres + lid_atoms) * shear.steps
         dumped = case.ramp_steps + case.hold_steps + case.shear_steps
         assert estimate.dump_frames == 1 + math.ceil(dumped / case.dump_every)
         assert estimate.run_id == case.run_id
@@ -364,21 +593,22 @@ def test_formatting_refuses_negative_values(function):
 
 def test_estimate_rows_have_stable_columns_and_a_totals_row():
     first = estimate_silo_case(_silo_like(), model=WORST_CASE)
-    second = RunEstimate(run_id="b", kind="blender", clumps=10, spheres=20, steps=100, simulated_time_s=0.5,
-                         wall_time_s=3600.0, dump_frames=7, dump_bytes=2_000_000_000, mpi_ranks=2)
+    second = RunEstimate(run_id="b", kind="blender", clumps=10, spheres=20, steps=100, sphere_steps=1500.0,
+                         simulated_time_s=0.5, wall_time_s=3600.0, dump_frames=7, dump_bytes=2_000_000_000, mpi_ranks=2)
     rows = estimate_rows([first, second])
     assert [list(row) for row in rows] == [list(ESTIMATE_COLUMNS)] * 3
     assert rows[1] == {"run": "b", "kind": "blender", "mpi_ranks": 2, "clumps": 10, "spheres": 20, "steps": 100,
-                       "simulated_s": 0.5, "wall_time": "1 h", "core_time": "2 h", "dump_frames": 7,
-                       "disk": "2 GB"}
-    assert rows[0]["disk"] == "254 kB" and rows[0]["wall_time"] == "0.32 s" and rows[0]["core_time"] == "0.32 s"
+                       "sphere_steps": 1500.0, "simulated_s": 0.5, "wall_time": "1 h", "core_time": "2 h",
+                       "dump_frames": 7, "disk": "2 GB"}
+    assert rows[0]["disk"] == "254 kB" and rows[0]["sphere_steps"] == first.sphere_steps
+    assert rows[0]["wall_time"] == rows[0]["core_time"] == format_duration(first.sphere_steps * 5.0e-7) == "0.23 s"
     assert rows[2] == {"run": "total (2 runs)", "kind": "", "mpi_ranks": "", "clumps": "", "spheres": "",
-                       "steps": "", "simulated_s": "", "wall_time": "1 h", "core_time": "2 h", "dump_frames": 15,
-                       "disk": "2 GB"}
+                       "steps": "", "sphere_steps": first.sphere_steps + 1500.0, "simulated_s": "",
+                       "wall_time": "1 h", "core_time": "2 h", "dump_frames": 15, "disk": "2 GB"}
 
 
 def test_estimate_rows_of_no_runs_is_a_zero_totals_row():
-    assert estimate_rows([]) == [{**dict.fromkeys(ESTIMATE_COLUMNS, ""), "run": "total (0 runs)",
+    assert estimate_rows([]) == [{**dict.fromkeys(ESTIMATE_COLUMNS, ""), "run": "total (0 runs)", "sphere_steps": 0.0,
                                   "wall_time": "0 s", "core_time": "0 s", "dump_frames": 0, "disk": "0 B"}]
 
 

@@ -1,21 +1,31 @@
-"""Planning a configuration: every run estimated, runs still to do, and the disk check before starting."""
+"""Planning a configuration: every run estimated, runs still to do, the disk check before starting, and the
+estimates of finished runs against what they took."""
 
 import json
+import math
 
 import pytest
 
+import engines.planning as planning
+from analysis.data.record import RunRecord
 from engines.config import load_config
-from engines.estimates import InsufficientDiskSpace
+from engines.estimates import InsufficientDiskSpace, MeasuredWork, RunEstimate
 from engines.planning import (
+    COMPARISON_COLUMNS,
     check_run_disk_space,
+    comparison_rows,
+    comparison_total,
     config_estimates,
+    cost_model,
     ensure_disk_space,
     estimate_table,
     main,
     measured_cost_model,
+    measured_runs,
     pending,
     preflight,
     run_directory,
+    run_steps,
 )
 from tests.conftest import DEFAULT_CONFIG
 
@@ -71,3 +81,78 @@ def test_a_finished_run_without_engine_timing_leaves_the_config_cost_model(estim
     (run_dir / "run.json").write_text(json.dumps({}))
     assert measured_cost_model(load_config(DEFAULT_CONFIG), estimates, tmp_path) is None
     assert measured_cost_model(load_config(DEFAULT_CONFIG), estimates, tmp_path / "nothing here") is None
+
+
+def _estimate(run_id: str, sphere_steps: float, wall_time_s: float, mpi_ranks: int = 1, steps: int = 1000) -> RunEstimate:
+    return RunEstimate(run_id=run_id, kind="silo_flat", clumps=10, spheres=20, steps=steps, sphere_steps=sphere_steps,
+                       simulated_time_s=0.01, wall_time_s=wall_time_s, dump_frames=1, dump_bytes=1000,
+                       mpi_ranks=mpi_ranks)
+
+
+def test_comparison_rows_set_each_estimate_against_its_measurement():
+    measured = [(_estimate("a", 2.0e6, 1.0), MeasuredWork(1.25, 1.6e6)),
+                (_estimate("b", 1.0e6, 3.0, mpi_ranks=2), MeasuredWork(8.0, 1.0e6))]
+    rows = comparison_rows(measured, [800, None])
+    assert [list(row) for row in rows] == [list(COMPARISON_COLUMNS)] * 2
+    assert rows[0] == {"run": "a", "kind": "silo_flat", "estimated_cpu_s": 1.0, "measured_cpu_s": 1.25, "ratio": 0.8,
+                       "estimated_sphere_steps": 2.0e6, "measured_sphere_steps": 1.6e6, "work_ratio": 1.25,
+                       "steps_ratio": 1.25, "measured_rate": 1.28e6}
+    # two ranks: the estimate's core time is twice its wall time; an unknown step count leaves the steps ratio out
+    assert rows[1]["estimated_cpu_s"] == 6.0 and rows[1]["ratio"] == 0.75 and math.isnan(rows[1]["steps_ratio"])
+    # total: (1 + 6) s estimated against (1.25 + 8) s measured, in core-hours
+    assert comparison_total(measured) == pytest.approx((7.0 / 3600, 9.25 / 3600, 7.0 / 9.25), rel=1e-12)
+    with pytest.raises(ValueError, match="steps has 1 entries for 2 runs"):
+        comparison_rows(measured, [1])
+
+
+def test_run_steps_is_the_last_step_of_the_run_record(estimates, tmp_path):
+    run_dir = run_directory(tmp_path, estimates[0])
+    run_dir.mkdir(parents=True)
+    assert run_steps(tmp_path, estimates[0]) is None
+    (run_dir / "run.json").write_text(json.dumps({}))
+    assert run_steps(tmp_path, estimates[0]) is None  # not a valid record
+    record = RunRecord(engine="liggghts", case="jenike", run_id=estimates[0].run_id, timestep_s=1e-5, n_clumps=10,
+                       n_frames=0, mpi_ranks=1, stages={"fill": {"step": 400.0}, "shear": {"step": 1200.0}})
+    (run_dir / "run.json").write_text(record.to_json())
+    assert run_steps(tmp_path, estimates[0]) == 1200
+
+
+class _TimedEngine:
+    """An engine whose finished runs each took 90 CPU s for 3e8 sphere-steps."""
+
+    def measured_work(self, run_dir):
+        return MeasuredWork(90.0, 3.0e8)
+
+
+def test_finished_runs_are_compared_with_their_estimates(estimates, tmp_path, monkeypatch, capsys):
+    config = load_config(DEFAULT_CONFIG)
+    monkeypatch.setattr(planning, "engine_for", lambda config, kind: _TimedEngine())
+    done = estimates[:2]
+    for estimate in done:
+        run_dir = run_directory(tmp_path, estimate)
+        run_dir.mkdir(parents=True)
+        (run_dir / "run.json").write_text(json.dumps({}))
+    assert measured_runs(config, estimates, tmp_path) == [(e, MeasuredWork(90.0, 3.0e8)) for e in done]
+    model, count = measured_cost_model(config, estimates, tmp_path)
+    assert (model.seconds_per_sphere_step, count) == (3.0e-7, 2)
+    assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "3e-07 s per sphere-step on one core, measured on this machine, the median of 2 finished run(s)" in out
+    lines = out.splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("run ") and "measured_cpu" in line)
+    assert lines[header].split() == ["run", "kind", "estimated_cpu", "measured_cpu", "ratio", "estimated_sphere_steps",
+                                     "measured_sphere_steps", "work_ratio", "steps_ratio", "measured_rate"]
+    assert [line.split()[0] for line in lines[header + 1:header + 3]] == [e.run_id for e in done]
+    # estimated with the config's rate, as before the runs
+    apriori = cost_model(config).seconds_per_sphere_step
+    estimated = sum(e.sphere_steps for e in done) * apriori / 3600
+    assert lines[header + 3] == (f"total: estimated {estimated:.3g} core-h, measured {180 / 3600:.3g} core-h, "
+                                 f"ratio {estimated * 3600 / 180:.3g}")
+    assert lines[header + 4] == (f"total with the measured median 3e-07 s per sphere-step: estimated "
+                                 f"{estimated * 3e-7 / apriori:.3g} core-h, ratio {estimated * 3600 / 180 * 3e-7 / apriori:.3g}")
+
+
+def test_without_finished_runs_only_the_estimates_are_printed(tmp_path, capsys):
+    assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "no run of it has finished here yet" in out and "measured_cpu" not in out and "core-h" not in out

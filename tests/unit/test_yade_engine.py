@@ -21,7 +21,8 @@ from engines.cases.silo_recirculation import build_recirculation_case
 from engines.config import ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_named
 from engines.templating import UnsafeDeckValue, deck_string, render_deck
-from engines.yade.cost import measured_seconds_per_sphere_step
+from engines.estimates import MeasuredWork
+from engines.yade.cost import measured_seconds_per_sphere_step, measured_work
 from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
 from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
 from engines.yade.progress import ScriptProgress
@@ -267,7 +268,17 @@ def test_measured_cost_sums_every_attempts_last_timing(tmp_path):
     first, resumed = tmp_path / "log.yade", tmp_path / "resume1.log.yade"
     first.write_text("SILOFLOW filled cpu_s=10.0 sphere_steps=1000000\nSILOFLOW opened cpu_s=20.0 sphere_steps=4000000\n")
     resumed.write_text("SILOFLOW resumed step=5\nSILOFLOW discharged cpu_s=5.0 sphere_steps=1000000\n")
+    # each attempt is its own process: its last timed marker holds its totals, and the attempts add up
+    assert measured_work([first, resumed]) == MeasuredWork(25.0, 5e6)
     assert measured_seconds_per_sphere_step([first, resumed]) == pytest.approx(25.0 / 5e6, rel=1e-15)
     empty = tmp_path / "empty.log"
     empty.write_text("Traceback\n")
     assert measured_seconds_per_sphere_step([empty]) is None
+    assert measured_work([empty]) is None
+
+
+def test_measured_work_skips_markers_with_unusable_timing(tmp_path):
+    log = tmp_path / "log.yade"
+    log.write_text("SILOFLOW filled cpu_s=10.0 sphere_steps=1000000\nSILOFLOW opened cpu_s=nan sphere_steps=4000000\n"
+                   "SILOFLOW settled cpu_s=12.0 sphere_steps=-1\n")
+    assert measured_work([log]) == MeasuredWork(10.0, 1e6)
