@@ -4,9 +4,10 @@ The schema in ``workflow/schemas/config.schema.yaml`` is the single source of tr
 with a description and a default. Validation first lets the silo-type case sections (``silo_flat``,
 ``silo_recirculation``, ``blender``) inherit, leaf by leaf, every shared key they leave out from the ``defaults``
 section (:data:`SHARED_KEYS`), then fills the schema's defaults (as Snakemake's ``validate`` does) and checks what a
-JSON schema cannot express: that names refer to defined materials and particle models, and that every material pair
-a case brings into contact has contact parameters. Limits of one engine (LIGGGHTS' restitution > 0.05) are not
-checked here but by that engine when it accepts a case (:meth:`engines.interface.Engine.check_case`).
+JSON schema cannot express: that names refer to defined materials and particle models, that every material pair
+a case brings into contact has contact parameters, and that a section's settling criterion is given once. Limits of
+one engine (LIGGGHTS' restitution > 0.05) are not checked here but by that engine when it accepts a case
+(:meth:`engines.interface.Engine.check_case`).
 
 Errors are reported as one :class:`ConfigError` naming the offending key, before any simulation starts.
 """
@@ -22,6 +23,7 @@ import jsonschema
 import yaml
 
 from engines.cases.blender_geometry import INSERT_PRESETS
+from engines.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -45,6 +47,19 @@ RENAMED_KEYS = {
     ("engine", "executable"): "engine.liggghts.executable",
     ("blender", "timestep_fraction"): None,  # only its null ("take silo_flat's") is gone
 }
+#: Keys of earlier siloflow versions replaced by a key of another unit: a config using one is refused with what to
+#: set instead.
+REPLACED_KEYS = {
+    ("blender", "settle_threshold"): (
+        "blender.settle_kinetic_energy_ratio", "the mean kinetic energy per clump over the clump's m g d (-); 1.7e-2 "
+        "is about the 1e-8 J of the sphere2 clump of hdpe at 1 g",
+    ),
+}
+#: Settings given by either of two keys of a case section's mapping, one at most: a section that sets one inherits
+#: neither from ``defaults`` (a silo that sets an absolute settle threshold drops the ratio of ``defaults``).
+ALTERNATIVE_KEYS = {"settle": (SETTLE_RATIO_KEY, SETTLE_ENERGY_KEY)}
+#: The sections whose ``settle`` criterion is used: the blender settles to its own ``settle_kinetic_energy_ratio``.
+SETTLE_CRITERION_SECTIONS = ("defaults", "silo_flat", "silo_recirculation")
 
 
 def _deep_merge(base: Mapping, override: Mapping) -> dict:
@@ -73,7 +88,21 @@ def inherit_defaults(config: Mapping) -> dict:
             own = {}
         if isinstance(own, Mapping):
             inherited[section] = _deep_merge(shared, own)
+            _drop_inherited_alternatives(inherited[section], own)
     return inherited
+
+
+def _drop_inherited_alternatives(merged: dict, own: Mapping) -> None:
+    """Where the section's own mapping sets one of :data:`ALTERNATIVE_KEYS` (not null), drop the others it
+    inherited from ``defaults``."""
+    for key, alternatives in ALTERNATIVE_KEYS.items():
+        given = own.get(key)
+        if not (isinstance(given, Mapping) and isinstance(merged.get(key), dict)):
+            continue
+        if any(given.get(name) is not None for name in alternatives):
+            for name in alternatives:
+                if name not in given:
+                    merged[key].pop(name, None)
 
 
 def _check_renamed(config: Mapping) -> None:
@@ -90,6 +119,12 @@ def _check_renamed(config: Mapping) -> None:
                                   "defaults.timestep_fraction")
             continue
         raise ConfigError(f"config key '{old}' was renamed '{new}'; rename it in your config file")
+    for path, (new, meaning) in REPLACED_KEYS.items():
+        node = config
+        for part in path[:-1]:
+            node = node.get(part) if isinstance(node, Mapping) else None
+        if isinstance(node, Mapping) and path[-1] in node:
+            raise ConfigError(f"config key '{'.'.join(path)}' was replaced by '{new}', {meaning}; set that instead")
 
 
 def load_schema(path: Path = SCHEMA_PATH) -> dict:
@@ -189,6 +224,8 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
     schema = load_schema() if schema is None else schema
     _check_renamed(config)
     filled = inherit_defaults(config)
+    # What the user set, before the schema fills its defaults (a filled default is no choice of theirs).
+    given = copy.deepcopy(filled)
     validator = _with_defaults(jsonschema.Draft7Validator, schema.get("definitions", {}))(schema)
     errors = sorted(validator.iter_errors(filled), key=_error_depth_key)
     if errors:
@@ -200,7 +237,36 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
     _check_finite(filled, ())
     _check_references(filled)
     _check_engine_settings(config, filled)
+    _check_settle_criteria(config, given)
+    _settle_criteria_in_use(filled)
     return filled
+
+
+def _check_settle_criteria(raw: Mapping, given: Mapping) -> None:
+    """Refuse a settle criterion given twice (a ratio and an absolute threshold, in one section or in ``defaults``
+    for a section that sets neither) or given to the blender's ``settle``, which does not use it.
+
+    ``raw`` is the configuration as given, ``given`` the same after inheritance from ``defaults``, before the
+    schema's defaults."""
+    ratio, energy = ALTERNATIVE_KEYS["settle"]
+    for section in SETTLE_CRITERION_SECTIONS:
+        settle = (given.get(section) or {}).get("settle") or {}
+        if settle.get(ratio) is not None and settle.get(energy) is not None:
+            raise ConfigError(
+                f"config keys '{section}.settle.{ratio}' and '{section}.settle.{energy}' are both set; set one: the "
+                f"ratio of the kinetic energy per clump to the clump's m g d (-), or an absolute threshold (J)"
+            )
+        if ratio in settle and settle[ratio] is None and settle.get(energy) is None:
+            raise ConfigError(
+                f"config key '{section}.settle.{ratio}': null needs {section}.settle.{energy} (J); set one of them"
+            )
+    blender_settle = (raw.get("blender") or {}).get("settle") or {}
+    for name in (ratio, energy):
+        if blender_settle.get(name) is not None:
+            raise ConfigError(
+                f"config key 'blender.settle.{name}': the blender settles to blender.settle_kinetic_energy_ratio; "
+                "set that instead"
+            )
 
 
 #: The case sections, each run by its own ``engine`` or by ``engine.kind``.
@@ -354,6 +420,18 @@ def _check_blender_references(config: dict, require) -> None:
             f"config key 'blender.discharge.steady_window': {[start, end]} must be an increasing window within "
             f"blender.discharge.time ({blender['discharge']['time']} s)"
         )
+
+
+def _settle_criteria_in_use(filled: dict) -> None:
+    """Null, in a validated configuration, the settle keys that are not in use: the ratio of a section with an
+    absolute threshold, both in the blender's ``settle``. The schema fills the ratio's default wherever it is left
+    out; nulled, a validated configuration validates again as it is."""
+    ratio, energy = ALTERNATIVE_KEYS["settle"]
+    for section in SETTLE_CRITERION_SECTIONS:
+        settle = filled[section]["settle"]
+        if settle[energy] is not None:
+            settle[ratio] = None
+    filled["blender"]["settle"].update({ratio: None, energy: None})
 
 
 def _require_subset(chosen, among, key: str, among_key: str) -> None:

@@ -25,6 +25,10 @@ def check_silo_run(
     drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
     ``clumps_conserved`` (periodic runs, where nothing may leave) the clump count must be unchanged at its end.
 
+    The ``settled`` stage carries, besides the marker's values, the settling criterion: ``ke_threshold_J`` (J),
+    ``ke_threshold_ratio`` (the threshold over the clump's m g d, -) and ``ke_ratio`` (the settled fill's kinetic
+    energy per clump over m g d, -).
+
     Raises
     ------
     EngineRunError
@@ -44,12 +48,18 @@ def check_silo_run(
             "widen silo_flat.fill.zone_width_fraction or lower silo_flat.fill.volume_fraction"
         )
     settled = by_event["settled"][-1].values
-    if not settled["ke_per_clump"] < case.settle_threshold:
+    criterion = case.settle_criterion
+    if not settled["ke_per_clump"] < criterion.threshold:
+        section = criterion.key.split(".")[0]
         raise EngineRunError(
-            f"{run_dir}: the fill did not settle: kinetic energy per clump {settled['ke_per_clump']:.3g} J is above "
-            f"the threshold {case.settle_threshold:.3g} J after the longest settling time; raise "
-            "silo_flat.settle.max_time or the threshold"
+            f"{run_dir}: the fill did not settle: kinetic energy per clump {settled['ke_per_clump']:.3g} J "
+            f"({settled['ke_per_clump'] / criterion.energy_scale:.3g} of the clump's m g d) is above the threshold "
+            f"{criterion.threshold:.3g} J ({criterion.ratio:.3g} of m g d, set by {criterion.key}) after the longest "
+            f"settling time; raise {section}.settle.max_time or {criterion.key}"
         )
+    # The record keeps the criterion the fill was held to, in joules and in the clump's own scale.
+    settled = {**settled, "ke_ratio": settled["ke_per_clump"] / criterion.energy_scale,
+               "ke_threshold_J": criterion.threshold, "ke_threshold_ratio": criterion.ratio}
     if len(dump_files) < 2:
         raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
     final = int(round(by_event[last_stage][-1].values["clumps"]))

@@ -4,15 +4,17 @@ Geometry (SI units, :mod:`engines.cases.blender_geometry`): a planar silo of inn
 section sits on a planar hopper of half-angle alpha with a slot outlet of width B0 at z = 0; inside, a
 cone-in-cone insert (two inclined plates) and a central blending tube, every wall ``wall_thickness`` thick.
 
-Stages: pour clumps centrally from a zone above the pile, settle (to ``blender.settle_threshold``, looser than the
-flat silo's: the heap over the internals creeps for long), remove the gate, discharge. In ``batch`` mode
-the silo empties and clumps leave the domain below the outlet; in ``continuous`` mode the vertical boundary is
-periodic, so a clump that leaves the outlet falls ``sink_depth`` and re-enters at the top of the silo with its
-id: the head stays constant and the silo is fed centrally with its own outflow (SEED_DIGEST section 5).
+Stages: pour clumps centrally from a zone above the pile, settle (to ``blender.settle_kinetic_energy_ratio`` of the
+clump's m g d, looser than the flat silo's: the heap over the internals creeps for long), remove the gate,
+discharge. In ``batch`` mode the silo empties and clumps leave the domain below the outlet; in ``continuous`` mode
+the vertical boundary is periodic, so a clump that leaves the outlet falls ``sink_depth`` and re-enters at the top
+of the silo with its id: the head stays constant and the silo is fed centrally with its own outflow (SEED_DIGEST
+section 5).
 
 Gravity scaling: at gravity factor f, gravity is f g and every time of the flow (discharge time, steady window,
 dump interval, settling checks) is divided by sqrt(f); the time step is not (the contact time does not depend
-on g). The settling threshold (a kinetic energy) scales by f; the pour keeps its insertion velocity.
+on g). The settling threshold is a fraction of m g d, so as a kinetic energy it scales by f; the pour keeps its
+insertion velocity.
 """
 
 from __future__ import annotations
@@ -28,7 +30,10 @@ from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import particle_template
 from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from analysis.data.constants import GRAVITY
-from engines.cases.common import engine_kind, largest_impact_velocity, material_table, plan_fill, run_id, without_fill_checks
+from engines.cases.common import (
+    SettleCriterion, clump_energy_scale, defining_settle, engine_kind, largest_impact_velocity, material_table,
+    plan_fill, run_id, without_fill_checks,
+)
 from engines.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"
@@ -241,6 +246,10 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
             "blender.vertical_height or lower blender.fill_height"
         )
     settle = blender["settle"]
+    # The blender's own, looser criterion; settle gives only the check interval and the longest time.
+    energy_scale = clump_energy_scale(particle, gravity)
+    criterion = SettleCriterion(blender["settle_kinetic_energy_ratio"] * energy_scale, energy_scale,
+                                "blender.settle_kinetic_energy_ratio")
     settle_check_steps = steps_for(settle["check_interval"] * scale, timestep)
     settle_max_checks = max(1, math.ceil(settle["max_time"] * scale / (settle_check_steps * timestep)))
     discharge = blender["discharge"]
@@ -267,9 +276,12 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         "engine": engine_kind(config, CASE_NAME),
         # the inserts enter through "insert"; the steady and profile windows only steer the analysis
         "blender": without_fill_checks({k: copy.deepcopy(v) for k, v in blender.items()
-                                        if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine")}),
+                                        if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine",
+                                                     "settle_kinetic_energy_ratio")}),
         "discharge": {"mode": discharge["mode"], "time": discharge["time"]},
     }
+    # The threshold in joules defines the run; settle's own criterion keys (inherited, unused here) do not.
+    defining["blender"]["settle"] = defining_settle(settle, criterion.threshold)
     silo = SiloCase(
         particle=particle,
         materials=table,
@@ -281,7 +293,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         front_back_walls=True,
         timestep_choice=timestep_choice,
         fill=fill,
-        settle_threshold=blender["settle_threshold"] * gravity_factor,
+        settle_criterion=criterion,
         settle_check_steps=settle_check_steps,
         settle_max_checks=settle_max_checks,
         discharge_steps=steps_for(discharge["time"] * scale, timestep),

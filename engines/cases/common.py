@@ -128,6 +128,90 @@ def without_fill_checks(section: dict) -> dict:
     return dict(section)
 
 
+#: The keys of a case section's ``settle`` that give its settling criterion, one at most: a ratio to the clump's own
+#: energy scale m g d (the default), or an absolute kinetic energy (J), which wins when set.
+SETTLE_RATIO_KEY = "kinetic_energy_ratio"
+SETTLE_ENERGY_KEY = "kinetic_energy_threshold"
+
+
+@dataclass(frozen=True)
+class SettleCriterion:
+    """The kinetic energy per clump below which a fill counts as settled, and where it came from.
+
+    Attributes
+    ----------
+    threshold : float
+        Mean translational kinetic energy per clump below which the fill counts as settled (J).
+    energy_scale : float
+        The clump's energy scale m g d: clump mass times the case's gravity times the volume-equivalent
+        diameter (J).
+    key : str
+        The config key that set it (e.g. ``silo_flat.settle.kinetic_energy_ratio``), for messages.
+    """
+
+    threshold: float
+    energy_scale: float
+    key: str
+
+    @property
+    def ratio(self) -> float:
+        """The threshold over m g d (-), also when an absolute threshold set it."""
+        return self.threshold / self.energy_scale
+
+
+def clump_energy_scale(particle: ParticleTemplate, gravity: float) -> float:
+    """The energy scale of a clump at rest in a fill: m g d (J).
+
+    Parameters
+    ----------
+    particle : ParticleTemplate
+        The clump: its mass m (kg) and volume-equivalent diameter d (m).
+    gravity : float
+        The case's gravity magnitude g (m/s^2), including any gravity factor.
+
+    Returns
+    -------
+    float
+        m g d (J): the work of lifting the clump by its own size.
+    """
+    if not gravity > 0:
+        raise ValueError(f"gravity must be > 0, got {gravity!r}")
+    return particle.mass * gravity * particle.equivalent_diameter
+
+
+def settle_criterion(settle: dict, particle: ParticleTemplate, gravity: float, section: str) -> SettleCriterion:
+    """The settling criterion of a case section's validated ``settle`` (keys :data:`SETTLE_RATIO_KEY`,
+    :data:`SETTLE_ENERGY_KEY`).
+
+    Parameters
+    ----------
+    settle : dict
+        The section's ``settle``: ``kinetic_energy_ratio`` (-) and ``kinetic_energy_threshold`` (J or None).
+    particle : ParticleTemplate
+        The clump.
+    gravity : float
+        The case's gravity magnitude (m/s^2).
+    section : str
+        The config section, for the key the criterion names.
+
+    Returns
+    -------
+    SettleCriterion
+        The absolute threshold when one is set (J), else ratio times m g d.
+    """
+    scale = clump_energy_scale(particle, gravity)
+    if settle.get(SETTLE_ENERGY_KEY) is not None:
+        return SettleCriterion(float(settle[SETTLE_ENERGY_KEY]), scale, f"{section}.settle.{SETTLE_ENERGY_KEY}")
+    return SettleCriterion(settle[SETTLE_RATIO_KEY] * scale, scale, f"{section}.settle.{SETTLE_RATIO_KEY}")
+
+
+def defining_settle(settle: dict, threshold: float) -> dict:
+    """A section's ``settle`` for the parameters that define a run: its threshold in joules instead of the keys
+    that gave it, so a ratio and an absolute threshold of equal energy define the same run."""
+    defining = {key: value for key, value in settle.items() if key not in (SETTLE_RATIO_KEY, SETTLE_ENERGY_KEY)}
+    return {**defining, SETTLE_ENERGY_KEY: threshold}
+
+
 def run_id(prefix: str, parameters: dict) -> str:
     """Stable run directory name: ``<prefix>-<first 10 hex digits of sha256 of canonical JSON>``."""
     canonical = json.dumps(parameters, sort_keys=True, separators=(",", ":"))

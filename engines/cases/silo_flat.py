@@ -5,8 +5,9 @@ at y = 0, back wall at y = T), z up with the floor and outlet plane at z = 0. A 
 centred on x = 0, spans the full depth; a gate closes it until the fill has settled.
 
 Stages: pour clumps centrally from an insertion zone above the pile, settle until the mean kinetic energy
-per clump is below a threshold, remove the gate, discharge for a given time. Discharged clumps fall
-``sink_depth`` below the outlet plane and leave the domain through its bottom boundary.
+per clump is below a threshold (a fraction of the clump's m g d, or an absolute energy), remove the gate,
+discharge for a given time. Discharged clumps fall ``sink_depth`` below the outlet plane and leave the domain
+through its bottom boundary.
 """
 
 from __future__ import annotations
@@ -17,8 +18,8 @@ from dataclasses import asdict, dataclass, field
 
 from analysis.data.constants import GRAVITY
 from engines.cases.common import (
-    FillPlan, MaterialTable, engine_kind, fill_zone, largest_impact_velocity, material_table, plan_fill, run_id,
-    without_fill_checks,
+    FillPlan, MaterialTable, SettleCriterion, defining_settle, engine_kind, fill_zone, largest_impact_velocity,
+    material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
 )
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import ParticleTemplate, particle_template
@@ -47,7 +48,7 @@ class SiloCase(ChosenTimestep):
     front_back_walls: bool
     timestep_choice: TimestepChoice
     fill: FillPlan
-    settle_threshold: float
+    settle_criterion: SettleCriterion
     settle_check_steps: int
     settle_max_checks: int
     discharge_steps: int
@@ -56,6 +57,11 @@ class SiloCase(ChosenTimestep):
     domain_top: float
     seeds: tuple[int, ...]
     defining_parameters: dict = field(repr=False)
+
+    @property
+    def settle_threshold(self) -> float:
+        """Mean translational kinetic energy per clump below which the fill counts as settled (J)."""
+        return self.settle_criterion.threshold
 
     @property
     def run_id(self) -> str:
@@ -69,6 +75,7 @@ class SiloCase(ChosenTimestep):
             Stage("fill", {"n_clumps": self.fill.n_clumps, "insertion_velocity_m_s": self.fill.insertion_velocity,
                            "duration_s": self.fill.fill_steps * self.timestep}, ("wall_forces",)),
             Stage("settle", {"kinetic_energy_threshold_J": self.settle_threshold,
+                             "kinetic_energy_ratio": self.settle_criterion.ratio,
                              "max_duration_s": self.settle_max_checks * self.settle_check_steps * self.timestep},
                   ("contacts", "wall_forces")),
             Stage("open", {"gate": "outlet_gate"}),
@@ -104,6 +111,9 @@ class SiloCase(ChosenTimestep):
             "outlet_width_m": self.outlet_width,
             "fill": asdict(self.fill),
             "settle_threshold_J": self.settle_threshold,
+            "settle_kinetic_energy_ratio": self.settle_criterion.ratio,
+            "settle_energy_scale_J": self.settle_criterion.energy_scale,
+            "settle_criterion": self.settle_criterion.key,
             "discharge_time_s": self.discharge_steps * self.timestep,
             "materials": list(self.materials.names),
             "parameters": self.defining_parameters,
@@ -164,6 +174,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
     timestep = timestep_choice.timestep
     fill = plan_fill(particle, silo["width"], silo["depth"], silo["fill_height"], silo["fill"], timestep, GRAVITY)
     settle = silo["settle"]
+    criterion = settle_criterion(settle, particle, GRAVITY, section)
     settle_check_steps = steps_for(settle["check_interval"], timestep)
     settle_max_checks = max(1, math.ceil(settle["max_time"] / (settle_check_steps * timestep)))
     sink_depth = silo["sink_depth"]
@@ -183,6 +194,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
         ),
         "silo": without_fill_checks({k: v for k, v in silo.items() if k not in (*ANALYSIS_ONLY_KEYS, "engine")}),
     }
+    defining["silo"]["settle"] = defining_settle(settle, criterion.threshold)
     # Normalise the contact pair order so [a, b] and [b, a] key the same run.
     defining["contacts"] = [{**c, "materials": sorted(c["materials"])} for c in defining["contacts"]]
 
@@ -197,7 +209,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
         front_back_walls=silo["front_back_walls"],
         timestep_choice=timestep_choice,
         fill=fill,
-        settle_threshold=settle["kinetic_energy_threshold"],
+        settle_criterion=criterion,
         settle_check_steps=settle_check_steps,
         settle_max_checks=settle_max_checks,
         discharge_steps=steps_for(silo["discharge_time"], timestep),

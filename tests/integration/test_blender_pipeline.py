@@ -1,8 +1,9 @@
 """The real blender pipeline on a tiny blender: LIGGGHTS discharging a hopper past an insert, at gravity 1 and 4.
 
 About 2,300 two-sphere clumps, one layer deep, in a 150 mm hopper with an insert given by its plate end points;
-continuous discharge at constant head for 0.8 s (0.4 s at gravity factor 4), both runs side by side on 2 cores.
-A few minutes in all.
+continuous discharge at constant head for 0.8 s (0.4 s at gravity factor 4). `make test` runs the pipeline at
+gravity factor 1 only (the same run as the pair's at 1 g); `make test-physics` runs both factors side by side on
+2 cores for the scaling with gravity. A few minutes in all.
 """
 
 from __future__ import annotations
@@ -50,13 +51,26 @@ def blender_pipeline(tmp_path_factory):
     yield workdir, runs
 
 
+@pytest.fixture(scope="module")
+def blender_at_one_g(tmp_path_factory):
+    """The blender targets at gravity factor 1 only (the same run as the pipeline's at 1 g); yields its run directory."""
+    require_liggghts()
+    workdir = tmp_path_factory.mktemp("blender_1g")
+    config = {**CONFIG, "blender": {**TINY_BLENDER, "gravity_factors": [1.0]}}
+    config_path = workdir / "blender.yaml"
+    config_path.write_text(yaml.safe_dump(config))
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["blender_all"])
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    (run,) = blender_cases(validate_config(copy.deepcopy(config)))
+    yield workdir / run_dir("blender", run)
+
+
 def _flow(run_dir: Path) -> dict:
     return json.loads((run_dir / "metrics" / "flow.json").read_text())
 
 
-def test_clumps_discharge_through_the_outlet_past_the_insert(blender_pipeline):
-    _, runs = blender_pipeline
-    run = runs[1.0]
+def test_clumps_discharge_through_the_outlet_past_the_insert(blender_at_one_g):
+    run = blender_at_one_g
     case = json.loads((run / "deck" / "case.json").read_text())
     record = read_run_record(run / "run.json")
     tracks = recirculation_tracks(liggghts().read_frames(run, record), record.domain_z).tracks
@@ -87,6 +101,7 @@ def test_clumps_discharge_through_the_outlet_past_the_insert(blender_pipeline):
     assert inside > 50 and outside >= 1
 
 
+@pytest.mark.physics  # a second run, at gravity factor 4
 def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipeline):
     workdir, runs = blender_pipeline
     slow, fast = _flow(runs[1.0]), _flow(runs[4.0])
@@ -99,6 +114,7 @@ def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipelin
     assert len(rows) >= 2
 
 
+@pytest.mark.physics  # the gravity rows need the run at gravity factor 4
 def test_validation_rows_of_the_real_runs_normalise_passages_and_scale_with_gravity(blender_pipeline):
     """The validation table's blender rows from the runs' own files (the tiny insert is the mass-flow one here)."""
     _, runs = blender_pipeline

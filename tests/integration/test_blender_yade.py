@@ -32,7 +32,7 @@ MICRO_BLENDER = {
     "profile_heights_above": [0.01],
     "pathlines": {"release_height": 0.04, "spacing": 0.0075, "integration_step": 0.001, "max_time": 100.0},
     "fill": FAST_POUR,
-    "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
+    "settle": {"max_time": 1.0},  # the blender settles to its own blender.settle_kinetic_energy_ratio
 }
 
 

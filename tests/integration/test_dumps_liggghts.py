@@ -39,7 +39,7 @@ from engines.liggghts.dumps import (
     read_frame,
 )
 from engines.liggghts.run import DUMP_PREFIX
-from tests.conftest import DEFAULT_CONFIG, FAST_POUR, liggghts
+from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, liggghts
 from tests.dump_fixtures import write_liggghts_dump
 
 pytestmark = pytest.mark.integration
@@ -51,7 +51,7 @@ DRAINING_SILO = {
     "fill_height": 0.015,
     "outlet_width": 0.029,
     "fill": FAST_POUR,
-    "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
+    "settle": TINY_SETTLE,
     "discharge_time": 0.2,  # the last clump leaves after about 0.13 s
     "dump_interval": 0.02,
 }

@@ -31,7 +31,9 @@ from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, require_liggghts
 
-pytestmark = pytest.mark.integration
+# physics: two extra fills of a narrow silo (the gentle one settles for a minute) check the pours' force balance;
+# the fill and settle stages themselves run in every silo test of the fast tier
+pytestmark = [pytest.mark.integration, pytest.mark.physics]
 
 NARROW_SILO = {
     "width": 0.02,

@@ -10,7 +10,7 @@ import pytest
 
 from analysis.data.frames import clumps_from_frame
 from engines.config import validate_config
-from tests.conftest import FAST_POUR, require_yade, run_first_case
+from tests.conftest import FAST_POUR, TINY_SETTLE, require_yade, run_first_case
 
 pytestmark = pytest.mark.integration
 
@@ -26,7 +26,7 @@ MICRO_RECIRCULATION = {
     "recirculations": 0.6,   # about 0.3 s: t_res = W H / (B0 V r) = 0.5 s
     "dump_interval": 0.01,
     "fill": FAST_POUR,
-    "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
+    "settle": TINY_SETTLE,
     "verification": {"enabled": False},
 }
 

@@ -1,8 +1,9 @@
 """A run killed with SIGKILL resumes from its newest restart file on the next workflow call.
 
-The tiny silo (about 1,400 clumps) runs twice side by side: once uninterrupted, once killed (the whole process
-group: Snakemake, the script and LIGGGHTS) after its discharge has written two restart files. The killed workflow
-is unlocked and called again; it resumes, and both runs end with the same clumps and flow rates within noise.
+The tiny silo (about 1,400 clumps) runs killed (the whole process group: Snakemake, the script and LIGGGHTS) after
+its discharge has written two restart files. The killed workflow is unlocked and called again; it resumes. In
+`make test-physics` the tiny silo also runs uninterrupted, and both runs end with the same clumps and flow rates
+within noise.
 """
 
 from __future__ import annotations
@@ -35,22 +36,28 @@ def _snakemake_command(workdir, config_path, target):
             str(workdir), "--cores", "1", "--configfile", str(config_path)]
 
 
-@pytest.fixture(scope="module")
-def killed_and_uninterrupted(tmp_path_factory):
-    require_liggghts()
+def _run_id() -> str:
     raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
     raw["silo_flat"] = {**raw["silo_flat"], **TINY_SILO}
-    run_id = build_silo_case(validate_config(raw)).run_id
+    return build_silo_case(validate_config(raw)).run_id
+
+
+def _workdir(tmp_path_factory, name):
+    workdir = tmp_path_factory.mktemp(name)
+    (workdir / "tiny.yaml").write_text(yaml.safe_dump(CONFIG))
+    return workdir
+
+
+@pytest.fixture(scope="module")
+def killed_and_resumed(tmp_path_factory):
+    """The tiny silo's workflow killed during its discharge, unlocked and called again; yields the run directory."""
+    require_liggghts()
+    run_id = _run_id()
     target = run_path("silo_flat", "metrics/flow.csv", run_id)
-    dirs = {}
-    for name in ("killed", "uninterrupted"):
-        dirs[name] = tmp_path_factory.mktemp(name)
-        (dirs[name] / "tiny.yaml").write_text(yaml.safe_dump(CONFIG))
-    uninterrupted = subprocess.Popen(_snakemake_command(dirs["uninterrupted"], dirs["uninterrupted"] / "tiny.yaml", target),
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    killed = subprocess.Popen(_snakemake_command(dirs["killed"], dirs["killed"] / "tiny.yaml", target),
+    workdir = _workdir(tmp_path_factory, "killed")
+    killed = subprocess.Popen(_snakemake_command(workdir, workdir / "tiny.yaml", target),
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-    run_dir = dirs["killed"] / layout_run_dir("silo_flat", run_id)
+    run_dir = workdir / layout_run_dir("silo_flat", run_id)
     deadline = time.monotonic() + 600
     while len(restart_files(run_dir)) < 2 and killed.poll() is None and time.monotonic() < deadline:
         time.sleep(0.5)
@@ -61,18 +68,28 @@ def killed_and_uninterrupted(tmp_path_factory):
     # let the orphaned engine die with its group before looking at the run directory
     time.sleep(1.0)
     assert not (run_dir / "run.json").exists()
-    unlock = run_snakemake(dirs["killed"], "--unlock", "--configfile", str(dirs["killed"] / "tiny.yaml"))
+    unlock = run_snakemake(workdir, "--unlock", "--configfile", str(workdir / "tiny.yaml"))
     assert unlock.returncode == 0, unlock.stdout[-2000:] + unlock.stderr[-2000:]
-    resumed = run_snakemake(dirs["killed"], "--cores", "1", "--rerun-incomplete", "--configfile",
-                            str(dirs["killed"] / "tiny.yaml"), targets=[target])
+    resumed = run_snakemake(workdir, "--cores", "1", "--rerun-incomplete", "--configfile",
+                            str(workdir / "tiny.yaml"), targets=[target])
     assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
-    output, _ = uninterrupted.communicate(timeout=900)
-    assert uninterrupted.returncode == 0, output[-3000:]
-    yield run_dir, dirs["uninterrupted"] / layout_run_dir("silo_flat", run_id)
+    yield run_dir
 
 
-def test_the_killed_run_resumes_from_its_restart_file(killed_and_uninterrupted):
-    run_dir, _ = killed_and_uninterrupted
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    """The tiny silo's workflow run through once; yields the run directory."""
+    require_liggghts()
+    run_id = _run_id()
+    workdir = _workdir(tmp_path_factory, "uninterrupted")
+    result = run_snakemake(workdir, "--cores", "1", "--configfile", str(workdir / "tiny.yaml"),
+                           targets=[run_path("silo_flat", "metrics/flow.csv", run_id)])
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    yield workdir / layout_run_dir("silo_flat", run_id)
+
+
+def test_the_killed_run_resumes_from_its_restart_file(killed_and_resumed):
+    run_dir = killed_and_resumed
     log = (run_dir / "logs" / "run.log").read_text()
     assert "resuming" in log and "from restart file restart/state_" in log
     record = read_run_record(run_dir / "run.json")
@@ -82,8 +99,9 @@ def test_the_killed_run_resumes_from_its_restart_file(killed_and_uninterrupted):
     assert not (run_dir / "restart").exists()
 
 
-def test_resumed_and_uninterrupted_runs_agree(killed_and_uninterrupted):
-    resumed_dir, uninterrupted_dir = killed_and_uninterrupted
+@pytest.mark.physics  # a second run of the tiny silo, uninterrupted
+def test_resumed_and_uninterrupted_runs_agree(killed_and_resumed, uninterrupted):
+    resumed_dir, uninterrupted_dir = killed_and_resumed, uninterrupted
     resumed = read_run_record(resumed_dir / "run.json")
     uninterrupted = read_run_record(uninterrupted_dir / "run.json")
     assert resumed.stage("fill")["clumps"] == uninterrupted.stage("fill")["clumps"] == resumed.n_clumps

@@ -181,6 +181,7 @@ def test_invalid_config_stops_the_workflow_with_the_key_named(tmp_path):
     assert "config key 'silo_flat.outlet_width': -0.04 is less than or equal to the minimum of 0" in result.stdout + result.stderr
 
 
+@pytest.mark.physics  # a second engine run of the tiny silo, on two MPI ranks
 def test_two_mpi_ranks_give_the_same_flow_within_noise(tiny_pipeline, tmp_path, tiny_config):
     """Trajectories differ between rank counts; the steady flow rate must not (beyond noise)."""
     _, serial_dir, _ = tiny_pipeline
@@ -290,6 +291,7 @@ def _write_measured_piv(run_dir, folder, resolution=(250, 350), frame_rate=100.0
     return measured, start
 
 
+@pytest.mark.physics  # OpenPIV on rendered front-wall images, then the comparison step of the workflow
 def test_measured_piv_is_compared_with_the_dem_front_wall_within_the_piv_error(tiny_pipeline, tmp_path):
     """PIV of the run's own front wall, brought in as a measured OpenPIV sequence in pixels with two wall markers, is
     compared with the DEM at the three profile heights. Stated tolerance: at each height the RMS difference lies

@@ -1,8 +1,8 @@
 """The real blending pipeline on a tiny recirculating silo: LIGGGHTS under MPI with a periodic vertical boundary.
 
 About 1,000 two-sphere clumps recirculate for about four mean residence times on 2 MPI ranks, the domain split
-along the periodic direction; a one-particle-thick silo of about 400 clumps verifies the Eulerian RTD. A few
-minutes in all.
+along the periodic direction; a one-particle-thick silo of about 400 clumps verifies the Eulerian RTD (a run of its
+own, in `make test-physics` only). A few minutes in all.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from analysis.studies.silo_recirculation.tracks_io import load_tracks
 from engines.cases.silo_recirculation import recirculation_cases
 from analysis.data.record import read_run_record
 from engines.config import validate_config
-from engines.layout import case_root, run_dir
+from engines.layout import case_root, run_dir, run_path
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
@@ -38,21 +38,41 @@ CONFIG = {
     # the recirculating silo inherits fill and settle from defaults
     "defaults": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
 }
+#: the blending study without the thin verification silo (the same blending run)
+BLENDING_ONLY = {**CONFIG, "silo_recirculation": {**TINY_BLENDING,
+                                                  "verification": {**TINY_BLENDING["verification"], "enabled": False}}}
 
 
 @pytest.fixture(scope="module")
 def blending_pipeline(tmp_path_factory):
-    """Run the blending targets once; yields (workdir, {role: run directory}, snakemake result)."""
+    """Run the blending targets once, without the thin verification silo; yields (workdir, {role: run directory},
+    cases)."""
     require_liggghts()
     workdir = tmp_path_factory.mktemp("blending")
     config_path = workdir / "blending.yaml"
-    config_path.write_text(yaml.safe_dump(CONFIG))
+    config_path.write_text(yaml.safe_dump(BLENDING_ONLY))
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["silo_recirculation_all"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus CONFIG.
-    cases = recirculation_cases(validate_config(copy.deepcopy(CONFIG)))
+    cases = recirculation_cases(validate_config(copy.deepcopy(BLENDING_ONLY)))
     runs = {case.role: workdir / run_dir("silo_recirculation", run) for run, case in cases.items()}
     yield workdir, runs, cases
+
+
+@pytest.fixture(scope="module")
+def thin_silo(tmp_path_factory):
+    """Run the thin verification silo's targets only (CONFIG's blending run is not made); yields its run directory."""
+    require_liggghts()
+    workdir = tmp_path_factory.mktemp("thin_silo")
+    config_path = workdir / "blending.yaml"
+    config_path.write_text(yaml.safe_dump(CONFIG))
+    cases = recirculation_cases(validate_config(copy.deepcopy(CONFIG)))
+    (run,) = [run for run, case in cases.items() if case.role == "verification"]
+    targets = [run_path("silo_recirculation", f"verification/{name}", run)
+               for name in ("verification.json", "paths.png", "residence_times.png")]
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=targets)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    yield workdir / run_dir("silo_recirculation", run)
 
 
 def _tracks_and_case(run_dir: Path):
@@ -153,9 +173,9 @@ def test_littles_law_holds_on_the_real_run(blending_pipeline):
     assert summary["residence_time_s"] >= transit - 3.0 * math.hypot(transit_error, summary["residence_time_s_error"])
 
 
-def test_thin_silo_compares_tracks_with_three_bin_sizes(blending_pipeline):
-    _, runs, _ = blending_pipeline
-    verification = runs["verification"] / "verification"
+@pytest.mark.physics  # a second engine run: the one-particle-thick silo
+def test_thin_silo_compares_tracks_with_three_bin_sizes(thin_silo):
+    verification = thin_silo / "verification"
     summary = json.loads((verification / "verification.json").read_text())
     assert sorted(summary["eulerian"]) == ["10 mm", "15 mm", "5 mm"]
     particle_mean = summary["particles"]["mean_s"]

@@ -16,7 +16,7 @@ from analysis.data.constants import GRAVITY
 from engines.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import DEFAULT_CONFIG, FAST_POUR, require_liggghts
+from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, require_liggghts
 
 pytestmark = pytest.mark.integration
 
@@ -27,7 +27,7 @@ TINY_FILL = {
     "outlet_width": 0.012,
     "front_back_walls": True,
     "fill": FAST_POUR,
-    "settle": {"kinetic_energy_threshold": 1.0e-10, "max_time": 1.0},
+    "settle": TINY_SETTLE,
     "discharge_time": 0.02,
 }
 

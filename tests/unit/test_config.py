@@ -37,7 +37,9 @@ def test_empty_config_gets_every_default():
                                 "liggghts": {"executable": "liggghts"},
                                 "yade": {"python": "/usr/bin/python3", "threads": 1}}
     assert config["silo_flat"]["width"] == 0.15
-    assert config["silo_flat"]["settle"]["kinetic_energy_threshold"] == 1e-12
+    assert config["silo_flat"]["settle"]["kinetic_energy_ratio"] == 1e-4
+    assert config["silo_flat"]["settle"]["kinetic_energy_threshold"] is None
+    assert config["blender"]["settle_kinetic_energy_ratio"] == 1.7e-2
     assert config["silo_flat"]["beverloo"] == {
         "discharge_coefficient": 0.58,
         "shape_coefficient": 1.5,

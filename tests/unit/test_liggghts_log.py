@@ -54,6 +54,11 @@ def test_a_complete_run_passes_the_checks(tiny_config, tmp_path):
     assert record["open_step"] == 34194
     assert record["n_clumps"] == case.fill.n_clumps
     assert len(record["settle_checks"]) == 1
+    # the settled stage keeps the criterion it was held to, in joules and over the clump's m g d
+    scale = case.settle_criterion.energy_scale
+    assert record["settled"]["ke_threshold_J"] == case.settle_threshold == pytest.approx(1.67e-4 * scale, rel=1e-12)
+    assert record["settled"]["ke_threshold_ratio"] == pytest.approx(1.67e-4, rel=1e-12)
+    assert record["settled"]["ke_ratio"] == pytest.approx(5.43629662393841e-11 / scale, rel=1e-12)
 
 
 def test_missing_clumps_are_reported(tiny_config, tmp_path):
@@ -65,7 +70,11 @@ def test_missing_clumps_are_reported(tiny_config, tmp_path):
 def test_an_unsettled_fill_is_reported(tiny_config, tmp_path):
     case = build_silo_case(tiny_config)
     log = LOG.replace("clumps=1395", f"clumps={case.fill.n_clumps}").replace("5.43629662393841e-11", "3e-9")
-    with pytest.raises(EngineRunError, match="did not settle: kinetic energy per clump 3e-09 J is above the threshold 1e-10 J"):
+    # the tiny silo settles to 1.67e-4 of the clump's m g d (6.0e-7 J): 1.0e-10 J
+    expected = (r"did not settle: kinetic energy per clump 3e-09 J \(0.005 of the clump's m g d\) is above the "
+                r"threshold 1e-10 J \(0.000167 of m g d, set by silo_flat.settle.kinetic_energy_ratio\) .* raise "
+                r"silo_flat.settle.max_time or silo_flat.settle.kinetic_energy_ratio")
+    with pytest.raises(EngineRunError, match=expected):
         check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path)
 
 
