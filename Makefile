@@ -8,7 +8,7 @@ SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 
-.PHONY: install install-system install-python run validate test test-unit test-integration dry-run bench estimate
+.PHONY: install install-system install-python run verify validate test test-physics test-unit test-integration dry-run bench estimate
 
 install: install-system install-python
 
@@ -35,12 +35,31 @@ install-system:
 install-python:
 	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
-# The report collects every plot with its caption and the summary page (results/report.html).
+# Snakemake goes through engines.workflow_lock: after a killed run it removes the stale Snakemake lock first, and it
+# refuses to start (unlocking nothing) while another run is live in the same directory.
+RUN_SNAKEMAKE = $(PYTHON) -m engines.workflow_lock --snakefile $(CURDIR)/Snakefile
+
+# The report collects every plot with its caption and the summary page (RUN_DIR/results/report.html).
 # Reruns follow changed inputs and parameters, not changed siloflow code: an upgrade must not repeat hours of
-# finished simulations (run ids already change with every parameter that defines a run).
+# finished simulations (run ids already change with every parameter that defines a run). --rerun-incomplete redoes
+# the outputs a killed run left unfinished. RUN_DIR is where results/ and .snakemake/ go.
+RUN_DIR ?= .
+
 run: install
-	$(PYTHON) -m snakemake --cores $(CORES) --configfile $(CONFIG) --rerun-incomplete --rerun-triggers mtime params input
-	$(PYTHON) -m snakemake --report results/report.html --configfile $(CONFIG)
+	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES) \
+		--rerun-incomplete --rerun-triggers mtime params input
+	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
+		--report $(abspath $(RUN_DIR))/results/report.html
+
+# The checks the demo tier leaves out of `make run` (config/checks.yaml over CONFIG): the DEM verification suite,
+# the one-particle-thick recirculating silo and the lid comparison, then the report with their pages.
+CHECKS_CONFIG := $(CURDIR)/config/checks.yaml
+
+verify: install
+	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
+		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input
+	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
+		--report $(abspath $(RUN_DIR))/results/report.html
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it, about
 # 16 core-hours (make estimate CONFIG=config/validation.yaml). It works in results/validation/ (its own results/
@@ -52,17 +71,24 @@ VALIDATION_DIR    ?= results/validation
 validate: install
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results
-	$(PYTHON) -m snakemake --cores $(CORES) --snakefile $(CURDIR)/Snakefile --directory $(VALIDATION_DIR) \
-		--configfile $(abspath $(VALIDATION_CONFIG)) --rerun-incomplete --rerun-triggers mtime params input --keep-going
-	$(PYTHON) -m snakemake --snakefile $(CURDIR)/Snakefile --directory $(VALIDATION_DIR) \
-		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report.html
+	$(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG)) \
+		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input --keep-going
+	$(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG)) \
+		--report $(abspath $(VALIDATION_DIR))/report.html
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
 # module's fixture, and so its engine runs, happens once.
+# Two tiers. `make test`: the unit tests and the integration tests that run every engine on every case and stage at
+# the smallest size that exercises them. `make test-physics`: the tests marked `physics` (pyproject.toml), physics
+# checks that need larger or extra runs. .ci/run runs both; test-unit and test-integration run their folder's tests
+# of both tiers.
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile
 
 test: install
-	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests
+
+test-physics: install
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m physics tests
 
 test-unit: install
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/unit
