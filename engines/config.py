@@ -376,6 +376,8 @@ def _check_recirculation_references(config: dict, require) -> None:
     for index, pattern in enumerate(blending["flow_patterns"]):
         require(pattern, presets, f"silo_recirculation.flow_patterns[{index}]", "preset")
     require(blending["verification"]["flow_pattern"], presets, "silo_recirculation.verification.flow_pattern", "preset")
+    for pattern in blending["residence_time_ratios"]:
+        require(pattern, presets, f"silo_recirculation.residence_time_ratios.{pattern}", "preset")
     names = [layout["name"] for layout in blending["layouts"]]
     for index, name in enumerate(names):
         if names.index(name) != index:

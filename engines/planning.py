@@ -48,6 +48,30 @@ def config_estimates(config: dict, model: CostModel | None = None) -> list[RunEs
     return [estimate_case(case, ranks, model) for kind in CASE_BUILDERS for case in cases_of(config, kind).values()]
 
 
+def run_priorities(estimates: list[RunEstimate]) -> dict[str, int]:
+    """The Snakemake priority of each case kind's engine runs: the kind whose longest run costs most comes first.
+
+    With two runs at a time, the run that starts last sets the end: starting the longest runs first lets the short
+    ones fill the other core meanwhile instead of leaving one core idle at the end. Snakemake takes priorities per
+    rule, so a kind ranks by its longest run.
+
+    Parameters
+    ----------
+    estimates : list of RunEstimate
+        The runs of a configuration (:func:`config_estimates`).
+
+    Returns
+    -------
+    dict
+        ``{kind: priority}`` with priorities 1, 2, ... in the order of the kinds' longest estimated runs (CPU s);
+        a kind without runs is absent (its rule takes Snakemake's default, 0).
+    """
+    longest: dict[str, float] = {}
+    for estimate in estimates:
+        longest[estimate.kind] = max(longest.get(estimate.kind, 0.0), estimate.core_seconds)
+    return {kind: rank for rank, kind in enumerate(sorted(longest, key=lambda kind: (longest[kind], kind)), start=1)}
+
+
 def run_directory(results: str | Path, estimate: RunEstimate) -> Path:
     """Directory of the run an estimate describes."""
     return Path(run_dir(estimate.kind, estimate.run_id, str(results)))

@@ -196,7 +196,10 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         known = ", ".join(sorted(section["presets"]))
         raise KeyError(f"unknown flow pattern '{pattern}'; {SECTION}.presets defines: {known}")
     geometry = section if role == "blending" else section["verification"]
-    recirculations = geometry["recirculations"]
+    # The a-priori time misjudges each pattern differently (dead zones, a looser channel): the blending runs scale it
+    # by the pattern's measured ratio, so that every pattern reaches the same number of measured recirculations.
+    ratio = section["residence_time_ratios"].get(pattern, 1.0) if role == "blending" else 1.0
+    recirculations = geometry["recirculations"] * ratio
     t_res = estimated_residence_time(
         geometry["width"], geometry["fill_height"], section["outlet_width"], section["feeder_velocity"],
         section["channel_density_ratio"],

@@ -10,7 +10,8 @@ import yaml
 from analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table
 from engines.cases.verification import verification_cases
 from engines.interface import EngineOptions, engine_named
-from tests.conftest import NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake
+from engines.config import REPO_ROOT
+from tests.conftest import DEFAULT_CONFIG, NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -60,3 +61,17 @@ def test_the_default_target_runs_the_suite_only_when_it_is_enabled(tmp_path, ena
     assert ("rule verification_run:" in jobs) is enabled
     assert ("rule verification_table:" in jobs) is enabled
     assert "rule silo_run:" in jobs
+
+
+@pytest.mark.parametrize("checks", [False, True])
+def test_make_verify_adds_the_checks_the_default_run_leaves_out(tmp_path, checks):
+    """The default config's plan leaves out the suite, the thin recirculating silo and the lid comparison; the overlay
+    that `make verify` lays over it (config/checks.yaml) brings all three back and keeps every default run."""
+    overlay = [str(REPO_ROOT / "config" / "checks.yaml")] if checks else []
+    result = run_snakemake(tmp_path, "-n", "--cores", "1", "--configfile", str(DEFAULT_CONFIG), *overlay)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    jobs = result.stdout + result.stderr
+    for rule in ("verification_table", "silo_recirculation_verification", "lid_comparison"):
+        assert (f"rule {rule}:" in jobs) is checks, rule
+    for rule in ("silo_run", "silo_recirculation_run", "blender_run", "jenike_run", "report_summary"):
+        assert f"rule {rule}:" in jobs, rule

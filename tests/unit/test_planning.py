@@ -25,6 +25,7 @@ from engines.planning import (
     pending,
     preflight,
     run_directory,
+    run_priorities,
     run_steps,
 )
 from tests.conftest import DEFAULT_CONFIG
@@ -37,8 +38,10 @@ def estimates():
 
 def test_every_run_of_the_default_config_is_estimated(estimates):
     kinds = [e.kind for e in estimates]
-    assert kinds.count("jenike") == 15 and kinds.count("silo_flat") == 1
-    assert kinds.count("silo_recirculation") == 3 and kinds.count("blender") == 3
+    # the demo tier: 2 Jenike tests (internal, aluminium) x 3 sliding x 2 rolling frictions, the two blending silos (the thin one
+    # is make verify's) and three blenders
+    assert kinds.count("jenike") == 12 and kinds.count("silo_flat") == 1
+    assert kinds.count("silo_recirculation") == 2 and kinds.count("blender") == 3
     assert all(e.dump_bytes > 0 and e.wall_time_s > 0 for e in estimates)
 
 
@@ -69,7 +72,7 @@ def test_one_run_is_checked_where_it_writes_unless_disabled(estimates, tmp_path)
 def test_the_estimate_table_and_command(estimates, capsys):
     table = estimate_table(estimates).splitlines()
     assert table[0].split()[:3] == ["run", "kind", "mpi_ranks"]
-    assert table[-1].startswith("total (22 runs)")
+    assert table[-1].startswith("total (18 runs)")
     assert main([str(DEFAULT_CONFIG)]) == 0
     assert "runs still to do" in capsys.readouterr().out
     assert main([]) == 2
@@ -156,3 +159,16 @@ def test_without_finished_runs_only_the_estimates_are_printed(tmp_path, capsys):
     assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "no run of it has finished here yet" in out and "measured_cpu" not in out and "core-h" not in out
+
+
+def _timed(kind: str, wall_time_s: float, mpi_ranks: int = 1) -> RunEstimate:
+    return RunEstimate(run_id=f"{kind}-{wall_time_s}", kind=kind, clumps=1, spheres=1, steps=1, sphere_steps=1.0,
+                       simulated_time_s=1.0, wall_time_s=wall_time_s, dump_frames=0, dump_bytes=0, mpi_ranks=mpi_ranks)
+
+
+def test_the_kind_with_the_longest_run_gets_the_highest_priority():
+    estimates = [_timed("jenike", 30.0), _timed("jenike", 40.0), _timed("blender", 300.0), _timed("blender", 500.0),
+                 _timed("silo_flat", 200.0, mpi_ranks=4), _timed("silo_recirculation", 450.0)]
+    # silo_flat: 800 CPU s on 4 ranks outranks the blender's 500
+    assert run_priorities(estimates) == {"jenike": 1, "silo_recirculation": 2, "blender": 3, "silo_flat": 4}
+    assert run_priorities([]) == {}

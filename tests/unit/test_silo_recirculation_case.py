@@ -17,6 +17,7 @@ from engines.cases.silo_recirculation import (
     recirculation_case_for_run,
     recirculation_cases,
 )
+from engines.cases.physics import steps_for
 from engines.config import ConfigError, load_config, validate_config
 from engines.cases.silo_recirculation import recirculation_meshes
 from engines.liggghts.silo_recirculation import render_recirculation_deck, write_recirculation_inputs
@@ -128,6 +129,9 @@ def test_write_inputs_writes_deck_meshes_and_case(tmp_path, golden_config):
     [
         (lambda b: b.update(flow_patterns=["funnel"]), "silo_recirculation.flow_patterns\\[0\\]': unknown preset 'funnel'"),
         (lambda b: b["verification"].update(flow_pattern="nope"), "silo_recirculation.verification.flow_pattern"),
+        (lambda b: b.update(residence_time_ratios={"funnel": 0.5}),
+         "silo_recirculation.residence_time_ratios.funnel': unknown preset 'funnel'"),
+        (lambda b: b.update(residence_time_ratios={"internal_flow": 0.0}), "residence_time_ratios"),
         (lambda b: b.update(outlet_width=0.2), "silo_recirculation.outlet_width"),
         (lambda b: b.update(layouts=[{"name": "a", "blue_fraction": 0.2}, {"name": "a", "blue_fraction": 0.3}]),
          "used twice"),
@@ -148,3 +152,20 @@ def test_clumps_re_entering_at_the_feeder_velocity_set_the_largest_impact(golden
     silo = case.silo
     fall = silo.domain_top - silo.fill_height
     assert silo.timestep_choice.impact_velocity == pytest.approx(math.sqrt(5.0**2 + 2 * 9.81 * fall), rel=1e-12)
+
+
+def test_a_patterns_residence_time_ratio_scales_its_blending_run_and_not_the_thin_silo(golden_config):
+    config = copy.deepcopy(golden_config)
+    config["silo_recirculation"]["residence_time_ratios"] = {"internal_flow": 0.5}
+    raw = validate_config(config)
+    base = validate_config(copy.deepcopy(golden_config))
+    scaled, plain = build_recirculation_case(raw, "internal_flow"), build_recirculation_case(base, "internal_flow")
+    section = raw["silo_recirculation"]
+    expected = 0.5 * section["recirculations"] * scaled.estimated_residence_time
+    assert scaled.estimated_residence_time == plain.estimated_residence_time
+    assert scaled.silo.discharge_steps == steps_for(expected, scaled.silo.timestep)
+    assert plain.silo.discharge_steps == steps_for(2 * expected, plain.silo.timestep)
+    assert scaled.run_id != plain.run_id
+    thin = build_recirculation_case(raw, section["verification"]["flow_pattern"], role="verification")
+    thin_base = build_recirculation_case(base, section["verification"]["flow_pattern"], role="verification")
+    assert thin.run_id == thin_base.run_id

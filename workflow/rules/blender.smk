@@ -25,8 +25,7 @@ rule blender_run:
     resources:
         tasks=config["engine"]["mpi_ranks"],
     threads: config["engine"]["mpi_ranks"]
-    # long runs: start them early
-    priority: 4
+    priority: RUN_PRIORITY.get("blender", 0)
     log:
         run_path("blender", "logs/run.log"),
     script:

@@ -18,7 +18,7 @@ from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_c
 from engines.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from engines.layout import CASE_SUMMARY, RESULTS, RUN_RECORD, case_root, run_dir, run_path
-from engines.planning import config_estimates, ensure_disk_space
+from engines.planning import config_estimates, ensure_disk_space, run_priorities
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.
@@ -46,6 +46,10 @@ def check_cases(configuration):
 
 #: Every case the validated configuration defines (the flat-bottom silo's as configured, before calibration).
 CASES = check_cases(config)
+
+#: Snakemake priority of each case kind's engine runs, longest estimated run first, so that both cores stay busy to
+#: the end (the Jenike runs, short, fill in).
+RUN_PRIORITY = run_priorities(config_estimates(config))
 
 
 def check_measured_piv(measured):

@@ -30,8 +30,7 @@ rule silo_run:
     resources:
         tasks=config["engine"]["mpi_ranks"],
     threads: config["engine"]["mpi_ranks"]
-    # the longest job: start it first so the short calibration runs fill the other cores meanwhile
-    priority: 10
+    priority: RUN_PRIORITY.get("silo_flat", 0)
     log:
         run_path("silo_flat", "logs/run.log"),
     script:

@@ -25,8 +25,7 @@ rule silo_recirculation_run:
     resources:
         tasks=config["engine"]["mpi_ranks"],
     threads: config["engine"]["mpi_ranks"]
-    # long runs: start them early, after the batch silo
-    priority: 5
+    priority: RUN_PRIORITY.get("silo_recirculation", 0)
     log:
         run_path(RECIRCULATION, "logs/run.log"),
     script:
