@@ -43,6 +43,7 @@ NARROW_SILO = {
     "front_back_walls": True,
     "settle": {"kinetic_energy_threshold": 1.0e-12, "max_time": 1.0},
     "discharge_time": 0.01,
+    "timestep_fraction": 0.1,   # the study's step and rest criterion, at which both pours' balances were measured
 }
 POURS = {
     "gentle": {"insertion_velocity": 0.5, "momentum_flux_ratio": 0.03, "zone_height": 0.01, "zone_width_fraction": 0.6},
