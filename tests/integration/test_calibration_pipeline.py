@@ -26,13 +26,12 @@ from engines.cases import cases_of
 from engines.cases.jenike import build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import STAGE_TIMESTEP_FRACTION, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
 TINY_CALIBRATION = {
     "jenike": {
-        "timestep_fraction": STAGE_TIMESTEP_FRACTION,
         "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
         "fill": {"settle_time": 0.1},
         "consolidation": {"time": 0.05},

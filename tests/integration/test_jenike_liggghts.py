@@ -31,12 +31,11 @@ from engines.liggghts.jenike import (
 )
 from engines.jenike_checks import read_jenike_force_history
 from engines.interface import EngineOptions
-from tests.conftest import STAGE_TIMESTEP_FRACTION, liggghts, require_liggghts
+from tests.conftest import liggghts, require_liggghts
 
 pytestmark = pytest.mark.integration
 
 SMALL_JENIKE = {
-    "timestep_fraction": STAGE_TIMESTEP_FRACTION,
     "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01},
     "fill": {"settle_time": 0.1},
     "consolidation": {"time": 0.05},

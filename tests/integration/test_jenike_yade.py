@@ -23,12 +23,11 @@ from calibration.shear import ShearSignals, shear_signals
 from engines.cases.jenike import JenikeCase, build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_named
-from tests.conftest import STAGE_TIMESTEP_FRACTION, require_yade
+from tests.conftest import require_yade
 
 pytestmark = pytest.mark.integration
 
 YADE_JENIKE = {
-    "timestep_fraction": STAGE_TIMESTEP_FRACTION,
     "engine": "yade",
     "cell": {"inner_diameter": 0.03, "bottom_ring_height": 0.006, "shear_ring_height": 0.008},
     "fill": {"settle_time": 0.05},

@@ -20,13 +20,12 @@ import pytest
 import yaml
 
 from engines.config import REPO_ROOT
-from tests.conftest import STAGE_TIMESTEP_FRACTION, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts
 
 pytestmark = pytest.mark.integration
 
 # One tiny shear test: the calibration stage is part of every run.
 TINY_JENIKE_SWEEP = {
-    "timestep_fraction": STAGE_TIMESTEP_FRACTION,
     "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
     "fill": {"settle_time": 0.1},
     "consolidation": {"time": 0.05},

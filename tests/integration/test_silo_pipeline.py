@@ -29,13 +29,12 @@ from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
-from tests.conftest import STAGE_TIMESTEP_FRACTION, MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
 # The silo tests need the calibration stage too (it is part of the workflow): one tiny shear test.
 TINY_JENIKE_SWEEP = {
-    "timestep_fraction": STAGE_TIMESTEP_FRACTION,
     "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
     "fill": {"settle_time": 0.1},
     "consolidation": {"time": 0.05},
