@@ -43,20 +43,33 @@ BLENDING_ONLY = {**CONFIG, "silo_recirculation": {**TINY_BLENDING,
                                                   "verification": {**TINY_BLENDING["verification"], "enabled": False}}}
 
 
+def _blending(workdir, config: dict):
+    require_liggghts()
+    config_path = workdir / "blending.yaml"
+    config_path.write_text(yaml.safe_dump(config))
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["silo_recirculation_all"])
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus the config.
+    cases = recirculation_cases(validate_config(copy.deepcopy(config)))
+    runs = {case.role: workdir / run_dir("silo_recirculation", run) for run, case in cases.items()}
+    return workdir, runs, cases
+
+
 @pytest.fixture(scope="module")
 def blending_pipeline(tmp_path_factory):
     """Run the blending targets once, without the thin verification silo; yields (workdir, {role: run directory},
     cases)."""
-    require_liggghts()
-    workdir = tmp_path_factory.mktemp("blending")
-    config_path = workdir / "blending.yaml"
-    config_path.write_text(yaml.safe_dump(BLENDING_ONLY))
-    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=["silo_recirculation_all"])
-    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-    # Run from another directory, the workflow finds no config/config.yaml there: the schema defaults plus CONFIG.
-    cases = recirculation_cases(validate_config(copy.deepcopy(BLENDING_ONLY)))
-    runs = {case.role: workdir / run_dir("silo_recirculation", run) for run, case in cases.items()}
-    yield workdir, runs, cases
+    yield _blending(tmp_path_factory.mktemp("blending"), BLENDING_ONLY)
+
+
+#: the same run at the study's step: Little's law and the shortcut compare two estimates of the residence time, and at
+#: the stages' 0.2 of the Rayleigh time the tiny run's transit and holdup estimates part beyond their errors
+AT_THE_STUDY_STEP = {**BLENDING_ONLY, "silo_recirculation": {**BLENDING_ONLY["silo_recirculation"], "timestep_fraction": 0.1}}
+
+
+@pytest.fixture(scope="module")
+def blending_pipeline_at_the_study_step(tmp_path_factory):
+    yield _blending(tmp_path_factory.mktemp("blending_study_step"), AT_THE_STUDY_STEP)
 
 
 @pytest.fixture(scope="module")
@@ -151,7 +164,9 @@ def test_make_run_outputs_exist_and_the_prediction_tracks_the_measurement(blendi
     assert len(rows) == 5
 
 
-def test_littles_law_holds_on_the_real_run(blending_pipeline):
+@pytest.mark.physics
+def test_littles_law_holds_on_the_real_run(blending_pipeline_at_the_study_step):
+    blending_pipeline = blending_pipeline_at_the_study_step
     _, runs, _ = blending_pipeline
     summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
     tracer = summary["rtd_particle_ids"]
@@ -202,10 +217,12 @@ def test_validation_rows_of_the_real_run_carry_errors_and_a_verdict(blending_pip
     assert {row["scale_shows"] for row in rows} == {"no"} and "particle diameters (>= 10)" in rows[0]["evidence"]
 
 
-def test_the_shortcut_is_measured_against_the_whole_run(blending_pipeline):
+@pytest.mark.physics
+def test_the_shortcut_is_measured_against_the_whole_run(blending_pipeline_at_the_study_step):
     """The run (Nr 3) goes on past where the shortcut stops (Nr 0.5 + 1): the table compares both analyses. Cutting
     the run short can only lose the tracer's slow passes, so the shortcut's mean residence time is not longer than
     the full run's beyond its error."""
+    blending_pipeline = blending_pipeline_at_the_study_step
     _, runs, _ = blending_pipeline
     rows = read_table(runs["blending"] / "metrics" / "shortcut.csv")
     layouts = [layout["name"] for layout in validate_config(copy.deepcopy(CONFIG))["silo_recirculation"]["layouts"]]
