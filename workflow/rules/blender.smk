@@ -8,6 +8,9 @@ rule blender_deck:
     params:
         case="blender",
         defining=lambda wildcards: cases("blender")[wildcards.run].defining_parameters,
+    # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
+    # once its deck is written
+    priority: RUN_PRIORITY.get("blender", 0)
     log:
         run_path("blender", "logs/deck.log"),
     script:

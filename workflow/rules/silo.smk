@@ -12,6 +12,9 @@ rule silo_deck:
     params:
         case="silo_flat",
         defining=lambda wildcards: cases("silo_flat")[wildcards.run].defining_parameters,
+    # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
+    # once its deck is written
+    priority: RUN_PRIORITY.get("silo_flat", 0)
     log:
         run_path("silo_flat", "logs/deck.log"),
     script:

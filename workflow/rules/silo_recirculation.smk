@@ -8,6 +8,9 @@ rule silo_recirculation_deck:
     params:
         case=RECIRCULATION,
         defining=lambda wildcards: cases(RECIRCULATION)[wildcards.run].defining_parameters,
+    # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
+    # once its deck is written
+    priority: RUN_PRIORITY.get("silo_recirculation", 0)
     log:
         run_path(RECIRCULATION, "logs/deck.log"),
     script:
