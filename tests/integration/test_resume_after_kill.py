@@ -20,19 +20,10 @@ import pytest
 import yaml
 
 from engines.config import REPO_ROOT
-from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO, require_liggghts
 
 pytestmark = pytest.mark.integration
 
-# One tiny shear test: the calibration stage is part of every run.
-TINY_JENIKE_SWEEP = {
-    "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
-    "fill": {"settle_time": 0.1},
-    "consolidation": {"time": 0.05},
-    "shear": {"velocity": 0.03, "displacement": 0.004},
-    "sweep": {"tests": ["internal"], "sliding_friction": [0.3], "rolling_friction": [0.1], "lid_comparison": False,
-              "diagnostics": "none"},
-}
 
 CONFIG = {
     "silo_flat": {**TINY_SILO, "piv": {"enabled": False}},

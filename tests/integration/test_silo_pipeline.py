@@ -29,19 +29,10 @@ from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
-from tests.conftest import MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO, liggghts, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
-# The silo tests need the calibration stage too (it is part of the workflow): one tiny shear test.
-TINY_JENIKE_SWEEP = {
-    "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
-    "fill": {"settle_time": 0.1},
-    "consolidation": {"time": 0.05},
-    "shear": {"velocity": 0.03, "displacement": 0.004},
-    "sweep": {"tests": ["internal"], "sliding_friction": [0.3], "rolling_friction": [0.1], "lid_comparison": False,
-              "diagnostics": "none"},
-}
 
 
 def _validated(silo: dict) -> dict:

@@ -168,8 +168,7 @@ def test_make_run_outputs_exist_and_the_prediction_tracks_the_measurement(blendi
 
 @pytest.mark.physics
 def test_littles_law_holds_on_the_real_run(blending_pipeline_at_the_study_step):
-    blending_pipeline = blending_pipeline_at_the_study_step
-    _, runs, _ = blending_pipeline
+    _, runs, _ = blending_pipeline_at_the_study_step
     summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
     tracer = summary["rtd_particle_ids"]
     transit, transit_error = summary["transit_residence_time_s"], summary["transit_residence_time_s_error"]
@@ -224,8 +223,7 @@ def test_the_shortcut_is_measured_against_the_whole_run(blending_pipeline_at_the
     """The run (Nr 3) goes on past where the shortcut stops (Nr 0.5 + 1): the table compares both analyses. Cutting
     the run short can only lose the tracer's slow passes, so the shortcut's mean residence time is not longer than
     the full run's beyond its error."""
-    blending_pipeline = blending_pipeline_at_the_study_step
-    _, runs, _ = blending_pipeline
+    _, runs, _ = blending_pipeline_at_the_study_step
     rows = read_table(runs["blending"] / "metrics" / "shortcut.csv")
     layouts = [layout["name"] for layout in validate_config(copy.deepcopy(CONFIG))["silo_recirculation"]["layouts"]]
     assert [row["layout"] for row in rows] == layouts + ["continuous (sine)"]

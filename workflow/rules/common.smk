@@ -49,7 +49,9 @@ CASES = check_cases(config)
 
 #: Snakemake priority of each case kind's engine runs, longest estimated run first, so that both cores stay busy to
 #: the end (the Jenike runs, short, fill in).
-RUN_PRIORITY = run_priorities(config_estimates(config))
+#: The estimate of every run, made once: the priorities below and the disk check at the start read it.
+ESTIMATES = config_estimates(config)
+RUN_PRIORITY = run_priorities(ESTIMATES)
 
 
 def check_measured_piv(measured):
@@ -80,7 +82,7 @@ def check_disk_for_pending_runs():
     if not config["estimates"]["disk_check"]:
         return
     try:
-        margin = ensure_disk_space(config_estimates(config), RESULTS)
+        margin = ensure_disk_space(ESTIMATES, RESULTS)
     except InsufficientDiskSpace as error:
         raise WorkflowError(f"Not enough disk space: {error}") from None
     print(f"siloflow: the runs still to do fit on the disk of {RESULTS}/ ({format_bytes(margin)} to spare)")
