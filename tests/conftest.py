@@ -26,9 +26,11 @@ FAST_POUR = {"zone_width_fraction": 0.6, "zone_height": 0.03, "insertion_velocit
 # the default 1e-4, as the short tests need no more rest than their force balance tolerates.
 TINY_SETTLE = {"kinetic_energy_ratio": 1.67e-4, "max_time": 1.0}
 
-# The tests of the stages whose runs no physics test reads step at the demo tier's 0.2 of the Rayleigh time
-# (config/config.yaml); a pipeline run in a temporary directory would otherwise take the schema's 0.1. The runs that
-# physics tests read stay at the study's 0.1, at which their bounds were measured.
+# The silos and blenders of the tests step at the demo tier's 0.2 of the Rayleigh time (config/config.yaml); a pipeline
+# run in a temporary directory would otherwise take the schema's 0.1. The physics tests whose bounds compare two
+# estimates of one figure on the tiny cases (the fill's force balance, Little's law, the gravity scaling) read runs at
+# the study's 0.1, at which those bounds were measured; the ones that compare a run with its own rerun (two MPI ranks,
+# a resumed run, measured PIV of the same run) hold at either step.
 STAGE_TIMESTEP_FRACTION = 0.2
 
 # A silo small enough for a real LIGGGHTS run in well under a minute (~1,400 two-sphere clumps), with an
@@ -40,9 +42,7 @@ TINY_SILO = {
     "outlet_width": 0.024,
     "fill": FAST_POUR,
     "settle": TINY_SETTLE,
-    # the study's step: the physics tier compares this silo's runs (two ranks, a resumed run, measured PIV) with
-    # bounds measured at it
-    "timestep_fraction": 0.1,
+    "timestep_fraction": STAGE_TIMESTEP_FRACTION,
     "discharge_time": 0.6,
     # the fill is only 40 mm high: profiles low enough to stay inside it during the steady discharge
     "fields": {"profile_heights": [0.01, 0.02, 0.03]},
@@ -63,6 +63,12 @@ MICRO_SILO = {
     "fields": {"profile_heights": [0.005, 0.01]},
     "engine": "yade",
 }
+
+# A small silo on LIGGGHTS (about 650 clumps, half a minute of one core) for the pipelines whose tests read no silo
+# figure (the calibrated silo, the workflow lock): deep enough for the fields step's Janssen comparison, which the micro
+# silo's 20 mm fill leaves without a row; no synthetic PIV.
+SMALL_SILO = {**MICRO_SILO, "engine": "liggghts", "width": 0.05, "fill_height": 0.03,
+              "fields": {"profile_heights": [0.01, 0.02]}, "piv": {"enabled": False}}
 
 
 # A tiny recirculating silo (about 1,000 clumps, Nr about 4 in 1.8 s) and a thin one (about 400 clumps).

@@ -3,12 +3,11 @@
 Three tiny shear tests (internal friction, particle friction 0.1, 0.2 and 0.3) make a three-point chart (three, so
 that the calibration can estimate the error of reading its bend as straight lines; in this small, fast-sheared cell
 bulk friction peaks near particle friction 0.3: 0.5 gave 0.56 against 0.61 at 0.3); a target between their bulk
-friction angles is inverted, and a tiny silo runs with the chosen parameters; a third shear test
-at the chosen friction checks that it reproduces the target angle.
+friction angles is inverted, and a small silo (no synthetic PIV: test_silo_pipeline.py has it) runs with the chosen
+parameters; a third shear test at the chosen friction checks that it reproduces the target angle.
 
-`make test` runs the pipeline without the lid comparison (the three points with the rigid lid only: the same runs)
-and without the silo's synthetic PIV study (test_silo_pipeline.py has it); `make test-physics` runs it whole, with the
-servo lid at every point, and the further shear test.
+`make test` runs the pipeline without the lid comparison (the three points with the rigid lid only: the same runs);
+`make test-physics` runs it whole, with the servo lid at every point, and the further shear test.
 """
 
 from __future__ import annotations
@@ -26,7 +25,7 @@ from engines.cases import cases_of
 from engines.cases.jenike import build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, require_liggghts, run_snakemake
 
 pytestmark = pytest.mark.integration
 
@@ -40,16 +39,15 @@ TINY_CALIBRATION = {
     },
     "calibration": {"targets_deg": {"internal": 24.0, "aluminium": 9.5}, "tolerance_deg": 1.0, "shape": "sphere2",
                     "rolling_friction": 0.0},
-    "silo_flat": {**TINY_SILO, "parameters": "calibrated"},
+    "silo_flat": {**SMALL_SILO, "parameters": "calibrated"},
     "silo_recirculation": NO_BLENDING,
     "blender": NO_BLENDER,
     "verification": NO_VERIFICATION,
 }
-#: the same calibration with the rigid lid only and a silo without the synthetic PIV study
+#: the same calibration with the rigid lid only
 RIGID_LID_ONLY = {
     **TINY_CALIBRATION,
     "jenike": {**TINY_CALIBRATION["jenike"], "sweep": {**TINY_CALIBRATION["jenike"]["sweep"], "lid_comparison": False}},
-    "silo_flat": {**TINY_CALIBRATION["silo_flat"], "piv": {"enabled": False}},
 }
 
 

@@ -1,9 +1,8 @@
 """`make run` after a SIGKILL: the next call removes the killed run's stale Snakemake lock and completes, without a
 manual `snakemake --unlock`; a second call while a run is live is refused and leaves that run's locks alone.
 
-A small pipeline `make run` runs whole: the tiny silo (about 1,400 clumps; the micro silo is too shallow for the
-Janssen comparison of the fields step) on LIGGGHTS without PIV, one tiny Jenike shear test, and no blending study,
-blender or verification. The README's run command starts it in its own session; once an engine job runs, a second
+A small pipeline `make run` runs whole: the small silo (about 650 clumps) on LIGGGHTS without PIV, one tiny Jenike
+shear test, and no blending study, blender or verification. The README's run command starts it in its own session; once an engine job runs, a second
 `make run` is refused, then the whole session is killed with SIGKILL and the same `make run` is called again.
 """
 
@@ -20,13 +19,13 @@ import pytest
 import yaml
 
 from engines.config import REPO_ROOT
-from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO, require_liggghts
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts
 
 pytestmark = pytest.mark.integration
 
 
 CONFIG = {
-    "silo_flat": {**TINY_SILO, "piv": {"enabled": False}},
+    "silo_flat": SMALL_SILO,
     "jenike": TINY_JENIKE_SWEEP,
     "silo_recirculation": NO_BLENDING,
     "blender": NO_BLENDER,

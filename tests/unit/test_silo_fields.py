@@ -128,6 +128,13 @@ def test_janssen_comparison_of_a_janssen_stress_field_is_exact():
     assert np.all(np.isnan(comparison.simulated_error)) and np.all(np.isnan(comparison.hydrostatic_error))
 
 
+def test_a_fill_too_shallow_for_the_kernel_is_refused_with_both_heights():
+    grid = silo_grid(0.04, 0.012, 0.03, (0.006, 0.004, 0.006))
+    stress = np.zeros(grid.shape + (3, 3))
+    with pytest.raises(ValueError, match=r"kernel's reach \(0\.0135 m\).*surface \(0\.025 m\).*above 0\.027 m"):
+        compare_janssen(stress, grid, 0.025, 600.0, 0.04, 0.012, 0.0, 0.0, 30.0, margin=0.0135)
+
+
 def test_janssen_error_is_the_difference_of_mirror_bins_and_hydrostatic_carries_the_density_error():
     grid = silo_grid(0.08, 0.012, 0.06, (0.01, 0.004, 0.006))  # 8 columns of 10 mm, 10 rows
     # sigma_zz = c_i (k + 1) in column i, row k: the mirror bins of two columns have means (2, 5) on the left and

@@ -412,7 +412,8 @@ def compare_janssen(
 ) -> JanssenComparison:
     """Cross-section mean vertical contact stress per grid row against Janssen's formula and hydrostatic.
 
-    Rows within ``margin`` (m) of the floor or of the surface are left out (boundary rows of the kernel);
+    Rows within ``margin`` (m) of the floor or of the surface are left out (boundary rows of the kernel), and a fill
+    that leaves no row is refused (ValueError naming both heights);
     ``gravity`` is g (m/s2) of the unit weight rho_b g of Janssen's formula and of the hydrostatic stress
     ``rho_b g h``.
 
@@ -429,6 +430,11 @@ def compare_janssen(
     sigma_zz = stress[..., 2, 2]
     mean = sigma_zz.mean(axis=(0, 1))
     rows = (grid.z > margin) & (grid.z < surface_height - margin)
+    if not rows.any():
+        raise ValueError(
+            f"no grid row lies more than the kernel's reach ({margin:.4g} m) above the floor and below the settled "
+            f"surface ({surface_height:.4g} m): the fill is too shallow for the Janssen comparison; fill above "
+            f"{2.0 * margin:.4g} m, or narrow the kernel (silo_flat.fields.width_radii)")
     h = surface_height - grid.z[rows]
     janssen = janssen_vertical_stress(
         h, bulk_density, width, depth, side_wall_friction, front_wall_friction, internal_friction_angle_deg, gravity
