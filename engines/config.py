@@ -15,6 +15,7 @@ Errors are reported as one :class:`ConfigError` naming the offending key, before
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from pathlib import Path
 from typing import Any, Iterable, Mapping
@@ -127,10 +128,24 @@ def _check_renamed(config: Mapping) -> None:
             raise ConfigError(f"config key '{'.'.join(path)}' was replaced by '{new}', {meaning}; set that instead")
 
 
-def load_schema(path: Path = SCHEMA_PATH) -> dict:
-    """Read the configuration JSON schema (YAML syntax)."""
+#: PyYAML's C loader where libyaml is there (Debian's python3-yaml and the PyPI wheels have it): the schema is
+#: 1,800 lines, which the pure-Python loader takes a quarter of a second to read.
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+@functools.lru_cache(maxsize=8)
+def _parsed_schema(path: Path, modified_ns: int) -> dict:
+    # keyed by the file's modification time, so that an edited schema is read again
     with open(path, encoding="utf-8") as handle:
-        return yaml.safe_load(handle)
+        return yaml.load(handle, Loader=SAFE_LOADER)
+
+
+def load_schema(path: Path = SCHEMA_PATH) -> dict:
+    """Read the configuration JSON schema (YAML syntax): parsed once per process and file version, a fresh copy
+    for each caller. Every validation reads it, and parsing it every time took most of a validation's half second.
+    """
+    path = Path(path)
+    return copy.deepcopy(_parsed_schema(path, path.stat().st_mtime_ns))
 
 
 def load_config_file(path: str | Path) -> dict:
