@@ -3,7 +3,9 @@ and the lid + shear ring estimate agrees with the bottom-ring estimate; the leve
 (force balance of its settled-fill snapshot).
 
 The cell is scaled down (inner diameter 40 mm, rings 8 + 10 mm, about 650 two-sphere clumps after levelling)
-and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, and two run side by side.
+and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, and two run side by side. `make test`
+runs the rigid lid's three points; the servo lid's run is the physics tier's (make test-physics), which also compares
+both lids over a whole calibration (test_calibration_pipeline.py).
 """
 
 from __future__ import annotations
@@ -83,20 +85,45 @@ def _run(case: JenikeCase, run_dir: Path) -> Run:
     return Run(case, run_dir, record, history, signals, friction)
 
 
+#: the runs of the physics tier only
+PHYSICS_RUNS = ("servo_0.5",)
+
+
+def _case(name: str) -> JenikeCase:
+    lid, point = RUNS[name]
+    return build_jenike_case(validate_config({"jenike": {**SMALL_JENIKE, "lid": lid}}), point)
+
+
+class _Runs(dict):
+    """The fast tier's runs, made side by side up front; a physics tier's run is made on first use."""
+
+    def __init__(self, root: Path):
+        super().__init__()
+        self.root = root
+        cases = {name: _case(name) for name in RUNS if name not in PHYSICS_RUNS}
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            futures = {name: pool.submit(_run, case, root / case.run_id) for name, case in cases.items()}
+            self.update({name: future.result() for name, future in futures.items()})
+
+    def __missing__(self, name: str) -> Run:
+        case = _case(name)
+        self[name] = _run(case, self.root / case.run_id)
+        return self[name]
+
+
+def _tiered(names) -> list:
+    """Parameters over runs, the physics tier's marked as such."""
+    return [pytest.param(name, marks=pytest.mark.physics) if name in PHYSICS_RUNS else name for name in names]
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> dict[str, Run]:
     require_liggghts()
-    root = tmp_path_factory.mktemp("jenike")
-    cases = {}
-    for name, (lid, point) in RUNS.items():
-        config = validate_config({"jenike": {**SMALL_JENIKE, "lid": lid}})
-        cases[name] = build_jenike_case(config, point)
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(_run, case, root / case.run_id) for name, case in cases.items()}
-        return {name: future.result() for name, future in futures.items()}
+    return _Runs(tmp_path_factory.mktemp("jenike"))
 
 
 def test_runs_fill_level_and_keep_every_clump(runs):
+    # the runs made so far: the fast tier's, and the physics tier's once one of its tests asked for them
     for name, run in runs.items():
         record = run.record
         assert record.labels["n_clumps_created"] == run.case.fill.n_clumps, name
@@ -113,6 +140,7 @@ def test_rigid_lid_holds_the_normal_force_during_shear(name, runs):
     assert abs(deviation.mean()) <= 0.01
 
 
+@pytest.mark.physics
 def test_servo_lid_holds_the_normal_force_during_shear(runs):
     run = runs["servo_0.5"]
     deviation = run.signals.normal_force / run.case.normal_force - 1.0
@@ -126,7 +154,7 @@ def test_bulk_friction_grows_with_particle_friction(runs):
     assert high.bottom_coefficient > low.bottom_coefficient
 
 
-@pytest.mark.parametrize("name", list(RUNS))
+@pytest.mark.parametrize("name", _tiered(RUNS))
 def test_lid_and_ring_estimate_agrees_with_the_bottom_estimate(name, runs):
     friction = runs[name].friction
     assert friction.coefficient > 0
@@ -172,7 +200,7 @@ def test_contact_dumps_carry_the_plate_load(runs):
     assert load == pytest.approx(measured, rel=0.02)
 
 
-@pytest.mark.parametrize("name", list(RUNS))
+@pytest.mark.parametrize("name", _tiered(RUNS))
 def test_the_levelled_sample_carries_its_weight_before_the_lid(name, runs):
     run = runs[name]
     settled = liggghts().settled_fill(run.run_dir, run.record)
