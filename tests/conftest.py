@@ -89,13 +89,13 @@ TINY_BLENDING = {
                      "bin_sizes": [0.005, 0.01, 0.015]},
 }
 
-# The calibration stage is part of every workflow run: pipelines that test other stages run one tiny shear test, in the
-# YADE tests' 30 mm cell (about 300 clumps after levelling) sheared 3 mm.
+# The calibration stage is part of every workflow run: pipelines that test other stages run one tiny shear test in the
+# default 40 mm cell (a 30 mm cell's levelled sample puts 1.025 of its weight on the walls and floor, outside 1 %).
 TINY_JENIKE_SWEEP = {
-    "cell": {"inner_diameter": 0.03, "bottom_ring_height": 0.006, "shear_ring_height": 0.008},
-    "fill": {"settle_time": 0.05},
-    "consolidation": {"time": 0.03},
-    "shear": {"velocity": 0.03, "displacement": 0.003},
+    "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01, "plate_size": 0.07},
+    "fill": {"settle_time": 0.1},
+    "consolidation": {"time": 0.05},
+    "shear": {"velocity": 0.03, "displacement": 0.004},
     "sweep": {"tests": ["internal"], "sliding_friction": [0.3], "rolling_friction": [0.1], "lid_comparison": False,
               "diagnostics": "none"},
 }
