@@ -151,7 +151,7 @@ def load_schema(path: Path = SCHEMA_PATH) -> dict:
 def load_config_file(path: str | Path) -> dict:
     """Read a YAML configuration file into a dict (no validation)."""
     with open(path, encoding="utf-8") as handle:
-        loaded = yaml.safe_load(handle)
+        loaded = yaml.load(handle, Loader=SAFE_LOADER)
     if loaded is None:
         return {}
     if not isinstance(loaded, dict):

@@ -6,6 +6,7 @@ import copy
 import shutil
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -128,6 +129,22 @@ TINY_BLENDER = {
     "pathlines": {"release_height": 0.13, "spacing": 0.0075, "integration_step": 0.001, "max_time": 100.0},
     "continuous": {"period_fractions": [0.2, 0.5, 1.0, 2.0], "comparison_fractions": [0.5, 1.0]},
 }
+
+
+class RunsOnDemand(dict):
+    """Engine runs of a test module by name: ``make(name)`` runs one. The names in ``ahead`` (the fast tier's) are made
+    up front, two side by side; any other (a physics tier's) on first use, so that a tier makes only what it reads."""
+
+    def __init__(self, make, ahead=()):
+        super().__init__()
+        self.make = make
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            futures = {name: pool.submit(make, name) for name in ahead}
+            self.update({name: future.result() for name, future in futures.items()})
+
+    def __missing__(self, name):
+        self[name] = self.make(name)
+        return self[name]
 
 
 @pytest.fixture

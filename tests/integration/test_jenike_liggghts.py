@@ -10,7 +10,6 @@ both lids over a whole calibration (test_calibration_pipeline.py).
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +32,7 @@ from engines.liggghts.jenike import (
 )
 from engines.jenike_checks import read_jenike_force_history
 from engines.interface import EngineOptions
-from tests.conftest import liggghts, require_liggghts
+from tests.conftest import RunsOnDemand, liggghts, require_liggghts
 
 pytestmark = pytest.mark.integration
 
@@ -94,23 +93,6 @@ def _case(name: str) -> JenikeCase:
     return build_jenike_case(validate_config({"jenike": {**SMALL_JENIKE, "lid": lid}}), point)
 
 
-class _Runs(dict):
-    """The fast tier's runs, made side by side up front; a physics tier's run is made on first use."""
-
-    def __init__(self, root: Path):
-        super().__init__()
-        self.root = root
-        cases = {name: _case(name) for name in RUNS if name not in PHYSICS_RUNS}
-        with ThreadPoolExecutor(max_workers=2) as pool:
-            futures = {name: pool.submit(_run, case, root / case.run_id) for name, case in cases.items()}
-            self.update({name: future.result() for name, future in futures.items()})
-
-    def __missing__(self, name: str) -> Run:
-        case = _case(name)
-        self[name] = _run(case, self.root / case.run_id)
-        return self[name]
-
-
 def _tiered(names) -> list:
     """Parameters over runs, the physics tier's marked as such."""
     return [pytest.param(name, marks=pytest.mark.physics) if name in PHYSICS_RUNS else name for name in names]
@@ -119,7 +101,13 @@ def _tiered(names) -> list:
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> dict[str, Run]:
     require_liggghts()
-    return _Runs(tmp_path_factory.mktemp("jenike"))
+    root = tmp_path_factory.mktemp("jenike")
+
+    def make(name: str) -> Run:
+        case = _case(name)
+        return _run(case, root / case.run_id)
+
+    return RunsOnDemand(make, ahead=[name for name in RUNS if name not in PHYSICS_RUNS])
 
 
 def test_runs_fill_level_and_keep_every_clump(runs):

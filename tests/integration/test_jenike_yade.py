@@ -22,7 +22,7 @@ from calibration.shear import ShearSignals, shear_signals
 from engines.cases.jenike import JenikeCase, build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_named
-from tests.conftest import require_yade
+from tests.conftest import RunsOnDemand, require_yade
 
 pytestmark = pytest.mark.integration
 
@@ -59,23 +59,16 @@ def _run(case: JenikeCase, run_dir: Path) -> Run:
     return Run(case, run_dir, record, signals, friction)
 
 
-class _RunsByLid(dict):
-    """The point's run with each lid, made on first use: the fast tier asks for the rigid lid only."""
-
-    def __init__(self, root):
-        super().__init__()
-        self.root = root
-
-    def __missing__(self, lid: str) -> Run:
-        case = build_jenike_case(validate_config({"jenike": {**YADE_JENIKE, "lid": lid}}), POINT)
-        self[lid] = _run(case, self.root / lid)
-        return self[lid]
-
-
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> dict[str, Run]:
     require_yade()
-    return _RunsByLid(tmp_path_factory.mktemp("jenike_yade"))
+    root = tmp_path_factory.mktemp("jenike_yade")
+
+    def make(lid: str) -> Run:
+        # the point's run with that lid, made on first use: the fast tier asks for the rigid lid only
+        return _run(build_jenike_case(validate_config({"jenike": {**YADE_JENIKE, "lid": lid}}), POINT), root / lid)
+
+    return RunsOnDemand(make)
 
 
 #: the rigid lid in the fast tier; the servo lid's run (the same stages with the other lid) in the physics tier

@@ -2,8 +2,9 @@
 manual `snakemake --unlock`; a second call while a run is live is refused and leaves that run's locks alone.
 
 A small pipeline `make run` runs whole: the small silo (about 650 clumps) on LIGGGHTS without PIV, one tiny Jenike
-shear test, and no blending study, blender or verification. The README's run command starts it in its own session; once an engine job runs, a second
-`make run` is refused, then the whole session is killed with SIGKILL and the same `make run` is called again.
+shear test, and no blending study, blender or verification. The README's run command starts it in its own session;
+once an engine job runs, a second `make run` is refused, then the whole session is killed with SIGKILL and the same
+`make run` is called again.
 """
 
 from __future__ import annotations
