@@ -77,12 +77,13 @@ validate: install
 		--report $(abspath $(VALIDATION_DIR))/report.html
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
-# module's fixture, and so its engine runs, happens once.
+# module's fixture, and so its engine runs, happens once. Files go out in the order tests/conftest.py sorts them,
+# the longest first (--no-loadscope-reorder keeps xdist from putting the files with the most tests first).
 # Two tiers. `make test`: the unit tests and the integration tests that run every engine on every case and stage at
 # the smallest size that exercises them. `make test-physics`: the tests marked `physics` (pyproject.toml), physics
 # checks that need larger or extra runs. .ci/run runs both; test-unit and test-integration run their folder's tests
 # of both tiers.
-PYTEST_PARALLEL := -n $(CORES) --dist loadfile
+PYTEST_PARALLEL := -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 test: install
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests

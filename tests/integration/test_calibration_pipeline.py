@@ -6,7 +6,7 @@ bulk friction peaks near particle friction 0.3: 0.5 gave 0.56 against 0.61 at 0.
 friction angles is inverted, and a small silo (no synthetic PIV: test_silo_pipeline.py has it) runs with the chosen
 parameters; a third shear test at the chosen friction checks that it reproduces the target angle.
 
-`make test` runs the pipeline without the lid comparison (the three points with the rigid lid only: the same runs);
+`make test` runs the pipeline without the lid comparison, on the chart's two end points with the rigid lid;
 `make test-physics` runs it whole, with the servo lid at every point, and the further shear test.
 """
 
@@ -25,7 +25,8 @@ from engines.cases import cases_of
 from engines.cases.jenike import build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_for
-from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, require_liggghts, run_snakemake
+from tests.conftest import (NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts,
+                            run_snakemake)
 
 pytestmark = pytest.mark.integration
 
@@ -44,10 +45,14 @@ TINY_CALIBRATION = {
     "blender": NO_BLENDER,
     "verification": NO_VERIFICATION,
 }
-#: the same calibration with the rigid lid only
+#: the fast tier's calibration: the rigid lid only, at the ends of the three-point chart (a two-point chart inverts the
+#: target as well; its interpolation error is the physics tier's), with the shorter stages of the other pipelines' shear
+#: test
 RIGID_LID_ONLY = {
     **TINY_CALIBRATION,
-    "jenike": {**TINY_CALIBRATION["jenike"], "sweep": {**TINY_CALIBRATION["jenike"]["sweep"], "lid_comparison": False}},
+    "jenike": {**TINY_CALIBRATION["jenike"],
+               **{stage: TINY_JENIKE_SWEEP[stage] for stage in ("fill", "consolidation", "shear")},
+               "sweep": {**TINY_CALIBRATION["jenike"]["sweep"], "lid_comparison": False, "sliding_friction": [0.1, 0.3]}},
 }
 
 
@@ -74,12 +79,10 @@ def calibrated_pipeline_with_lid_comparison(tmp_path_factory):
 
 def test_table_has_one_row_per_point_and_friction_grows(calibrated_pipeline):
     table = list(csv.DictReader((calibrated_pipeline / "results" / "calibration" / "bulk_friction.csv").open()))
-    assert sorted((r["lid"], float(r["particle_friction"])) for r in table) == [
-        ("rigid", 0.1), ("rigid", 0.2), ("rigid", 0.3)
-    ]
+    assert sorted((r["lid"], float(r["particle_friction"])) for r in table) == [("rigid", 0.1), ("rigid", 0.3)]
     rows = [r for r in table if r["lid"] == "rigid"]
-    low, middle, high = (float(r["bulk_friction"]) for r in sorted(rows, key=lambda r: float(r["particle_friction"])))
-    assert high > middle > low > 0.0
+    low, high = (float(r["bulk_friction"]) for r in sorted(rows, key=lambda r: float(r["particle_friction"])))
+    assert high > low > 0.0
     for row in rows:
         assert float(row["ring_sides_relative_difference"]) < 0.10
 

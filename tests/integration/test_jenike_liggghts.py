@@ -3,9 +3,10 @@ and the lid + shear ring estimate agrees with the bottom-ring estimate; the leve
 (force balance of its settled-fill snapshot).
 
 The cell is scaled down (inner diameter 40 mm, rings 8 + 10 mm, about 650 two-sphere clumps after levelling)
-and sheared faster (0.03 m/s over 4 mm); each run takes about 25 s on one core, and two run side by side. `make test`
-runs the rigid lid's three points; the servo lid's run is the physics tier's (make test-physics), which also compares
-both lids over a whole calibration (test_calibration_pipeline.py).
+and sheared faster (0.03 m/s over 4 mm); each run takes about 45 s on one core, and two run side by side. `make test`
+runs the rigid lid's internal point at particle friction 0.5 and its wall point; the physics tier (make test-physics)
+adds the internal point at 0.1 (bulk friction grows with particle friction) and the servo lid's run, and compares both
+lids over a whole calibration (test_calibration_pipeline.py).
 """
 
 from __future__ import annotations
@@ -84,8 +85,9 @@ def _run(case: JenikeCase, run_dir: Path) -> Run:
     return Run(case, run_dir, record, history, signals, friction)
 
 
-#: the runs of the physics tier only
-PHYSICS_RUNS = ("servo_0.5",)
+#: the runs of the physics tier only: the servo lid, and the low-friction point of the rigid lid's growth with particle
+#: friction (the calibration pipeline's fast tier checks that growth over its own points)
+PHYSICS_RUNS = ("servo_0.5", "rigid_0.1")
 
 
 def _case(name: str) -> JenikeCase:
@@ -120,7 +122,7 @@ def test_runs_fill_level_and_keep_every_clump(runs):
         assert (run.run_dir / "run.json").exists() and list_dumps(run.run_dir / "dumps", DUMP_PREFIX), name
 
 
-@pytest.mark.parametrize("name", ["rigid_0.1", "rigid_0.5", "wall_0.3"])
+@pytest.mark.parametrize("name", _tiered(["rigid_0.1", "rigid_0.5", "wall_0.3"]))
 def test_rigid_lid_holds_the_normal_force_during_shear(name, runs):
     run = runs[name]
     deviation = run.signals.normal_force / run.case.normal_force - 1.0
@@ -136,6 +138,7 @@ def test_servo_lid_holds_the_normal_force_during_shear(runs):
     assert abs(deviation.mean()) <= 0.01
 
 
+@pytest.mark.physics
 def test_bulk_friction_grows_with_particle_friction(runs):
     low, high = runs["rigid_0.1"].friction, runs["rigid_0.5"].friction
     assert high.coefficient > low.coefficient + 3 * (high.standard_error + low.standard_error)
