@@ -28,7 +28,7 @@ from engines.layout import case_root, run_dir
 from tests.conftest import (FAST_POUR, NO_BLENDING, STAGE_TIMESTEP_FRACTION, TINY_BLENDER, TINY_SILO, liggghts,
                             require_liggghts, run_snakemake)
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(130)]
 
 CONFIG = {
     "blender": TINY_BLENDER,

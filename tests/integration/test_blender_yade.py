@@ -13,7 +13,7 @@ from analysis.data.frames import clumps_from_frame
 from engines.config import validate_config
 from tests.conftest import FAST_POUR, require_yade, run_first_case
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(65)]
 
 MICRO_BLENDER = {
     "engine": "yade",

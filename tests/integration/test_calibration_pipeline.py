@@ -28,7 +28,7 @@ from engines.interface import EngineOptions, engine_for
 from tests.conftest import (NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts,
                             run_snakemake)
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(150)]
 
 TINY_CALIBRATION = {
     "jenike": {

@@ -42,7 +42,7 @@ from engines.liggghts.run import DUMP_PREFIX
 from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, liggghts
 from tests.dump_fixtures import write_liggghts_dump
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(10)]
 
 # The outlet leaves 0.5 mm of floor on each side, less than a sphere radius (1.5 mm): no clump stays, the silo drains.
 DRAINING_SILO = {

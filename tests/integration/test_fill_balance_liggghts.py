@@ -33,7 +33,7 @@ from tests.conftest import DEFAULT_CONFIG, require_liggghts
 
 # physics: two extra fills of a narrow silo (the gentle one settles for a minute) check the pours' force balance;
 # the fill and settle stages themselves run in every silo test of the fast tier
-pytestmark = [pytest.mark.integration, pytest.mark.physics]
+pytestmark = [pytest.mark.integration, pytest.mark.physics, pytest.mark.core_seconds(10)]
 
 NARROW_SILO = {
     "width": 0.02,

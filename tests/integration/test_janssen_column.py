@@ -33,7 +33,7 @@ from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_liggghts, require
 
 # physics: eight settled columns on two engines (three seeds each of the frictional one) check the walls' share of
 # the weight; the stages themselves run in test_silo_pipeline.py and test_silo_yade.py
-pytestmark = [pytest.mark.integration, pytest.mark.physics]
+pytestmark = [pytest.mark.integration, pytest.mark.physics, pytest.mark.core_seconds(10)]
 
 #: poured gently (the default fill): a fast pour locks in a state in which the walls hold the fill down (measured
 #: here with MICRO_SILO's fast pour: walls -0.022 of the weight on LIGGGHTS, -0.122 on YADE)

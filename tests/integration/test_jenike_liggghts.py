@@ -35,7 +35,7 @@ from engines.jenike_checks import read_jenike_force_history
 from engines.interface import EngineOptions
 from tests.conftest import RunsOnDemand, liggghts, require_liggghts
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(100)]
 
 SMALL_JENIKE = {
     "cell": {"inner_diameter": 0.04, "bottom_ring_height": 0.008, "shear_ring_height": 0.01},

@@ -24,7 +24,7 @@ from engines.config import validate_config
 from engines.interface import EngineOptions, engine_named
 from tests.conftest import RunsOnDemand, require_yade
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(170)]
 
 YADE_JENIKE = {
     "engine": "yade",

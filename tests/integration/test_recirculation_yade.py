@@ -12,7 +12,7 @@ from analysis.data.frames import clumps_from_frame
 from engines.config import validate_config
 from tests.conftest import FAST_POUR, TINY_SETTLE, require_yade, run_first_case
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(90)]
 
 MICRO_RECIRCULATION = {
     "engine": "yade",

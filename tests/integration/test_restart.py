@@ -26,7 +26,7 @@ from engines.liggghts.run import restart_files
 from engines.cases.silo_flat import build_silo_case
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(100)]
 
 CONFIG = {"silo_flat": TINY_SILO, "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}
 

@@ -22,7 +22,7 @@ import yaml
 from engines.config import REPO_ROOT
 from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(90)]
 
 
 CONFIG = {

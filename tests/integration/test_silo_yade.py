@@ -23,7 +23,7 @@ from engines.interface import EngineOptions, EngineRunError, engine_for
 from engines.yade.run import restart_files
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(45)]
 
 
 def listening_inodes() -> set[str]:

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
 
 from engines.config import REPO_ROOT
 from tests.conftest import run_snakemake
+
+pytestmark = pytest.mark.core_seconds(20)
 
 
 def test_slurm_profile_plans_the_thesis_config(tmp_path):

@@ -13,7 +13,7 @@ from engines.interface import EngineOptions, engine_named
 from engines.config import REPO_ROOT
 from tests.conftest import DEFAULT_CONFIG, NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(40)]
 
 
 @pytest.fixture(scope="module")

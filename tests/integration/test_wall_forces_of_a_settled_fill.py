@@ -18,7 +18,7 @@ from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, require_liggghts
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(10)]
 
 TINY_FILL = {
     "width": 0.04,
