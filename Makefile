@@ -8,7 +8,7 @@ SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 
-.PHONY: install install-system install-python run verify validate test test-physics test-unit test-integration dry-run bench estimate
+.PHONY: install install-system install-python run verify validate validate-status test test-physics test-unit test-integration dry-run bench estimate
 
 install: install-system install-python
 
@@ -61,20 +61,29 @@ verify: install
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
 		--report $(abspath $(RUN_DIR))/results/report.html
 
-# The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it, about
-# 16 core-hours (make estimate CONFIG=config/validation.yaml). It works in results/validation/ (its own results/
-# and report there, so that it never overwrites the default run's), prints the estimate of every run first and
-# resumes where an interrupted run stopped.
+# The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
+# (make estimate CONFIG=config/validation.yaml prints its cost, per group). It works in results/validation/ (its own
+# results/ and report there, so that it never overwrites the default run's), prints the estimate of every run first
+# and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group (engines.validation_groups:
+# calibration, silo, blending, blender); `make validate-status` says which groups of the record in docs/validation/
+# are complete, stale or missing.
 VALIDATION_CONFIG ?= config/validation.yaml
 VALIDATION_DIR    ?= results/validation
+VALIDATION_RECORD ?= docs/validation
+GROUP             ?=
 
 validate: install
+	$(if $(GROUP),$(PYTHON) -m engines.validation_status check '$(GROUP)')
 	@mkdir -p $(VALIDATION_DIR)/results
-	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results
-	$(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG)) \
+	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
+	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
+		--configfile $(abspath $(VALIDATION_CONFIG)) \
 		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input --keep-going
-	$(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG)) \
-		--report $(abspath $(VALIDATION_DIR))/report.html
+	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
+		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report$(if $(GROUP),-$(GROUP)).html
+
+validate-status: install-python
+	$(PYTHON) -m engines.validation_status status $(VALIDATION_CONFIG) $(VALIDATION_RECORD)
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
 # module's fixture, and so its engine runs, happens once. Files go out in the order tests/conftest.py sorts them,
@@ -99,7 +108,7 @@ test-integration: install
 
 # Particle counts, steps, wall time and disk of every run of a config, before running it: make estimate CONFIG=config/thesis.yaml
 estimate: install-python
-	$(PYTHON) -m engines.planning $(CONFIG)
+	$(PYTHON) -m engines.planning $(CONFIG) --cores $(CORES)
 
 dry-run: install
 	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)

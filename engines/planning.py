@@ -31,6 +31,7 @@ from engines.estimates import (
     total_dump_bytes,
 )
 from engines.layout import RUN_RECORD, run_dir
+from engines.validation_groups import cost_lines, group_costs
 
 
 def cost_model(config: dict) -> CostModel:
@@ -270,11 +271,18 @@ def comparison_report(measured: list[tuple[RunEstimate, MeasuredWork]], steps: l
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Print the estimate table of a configuration file, the free space of the results folder and, for the runs
-    that have finished there, estimated against measured CPU time."""
+    """Print the estimate table of a configuration file, the cost of each validation group on ``--cores`` cores
+    (default 2), the free space of the results folder and, for the runs that have finished there, estimated against
+    measured CPU time."""
     argv = sys.argv[1:] if argv is None else argv
+    cores = 2
+    if len(argv) >= 2 and argv[-2] == "--cores":
+        if not argv[-1].isdigit() or int(argv[-1]) < 1:
+            print(f"--cores takes a whole number of cores >= 1, got {argv[-1]!r}", file=sys.stderr)
+            return 2
+        cores, argv = int(argv[-1]), argv[:-2]
     if len(argv) not in (1, 2):
-        print("usage: python -m engines.planning CONFIG [RESULTS_DIR]", file=sys.stderr)
+        print("usage: python -m engines.planning CONFIG [RESULTS_DIR] [--cores N]", file=sys.stderr)
         return 2
     config = load_config(argv[0])
     results = argv[1] if len(argv) == 2 else "results"
@@ -292,6 +300,8 @@ def main(argv: list[str] | None = None) -> int:
           f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
           f"{model.settle_fraction:.0%} of its longest time)")
     print(estimate_table(config_estimates(config, model) if measured else estimates))
+    print()
+    print("\n".join(cost_lines(group_costs(config_estimates(config, model) if measured else estimates, cores), cores)))
     waiting = pending(estimates, results)
     print(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
           f"{format_bytes(total_dump_bytes(waiting))}; {format_bytes(free_bytes(results))} free for {results}/")

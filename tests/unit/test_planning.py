@@ -74,7 +74,12 @@ def test_the_estimate_table_and_command(estimates, capsys):
     assert table[0].split()[:3] == ["run", "kind", "mpi_ranks"]
     assert len(table) == len(estimates) + 2 and table[-1].startswith(f"total ({len(estimates)} runs)")
     assert main([str(DEFAULT_CONFIG)]) == 0
-    assert "runs still to do" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "runs still to do" in out and "Validation groups (make validate GROUP=<name>) on 2 core(s)" in out
+    assert main([str(DEFAULT_CONFIG), "--cores", "8"]) == 0
+    assert "on 8 core(s)" in capsys.readouterr().out
+    assert main([str(DEFAULT_CONFIG), "--cores", "0"]) == 2
+    assert "--cores takes a whole number of cores >= 1, got '0'" in capsys.readouterr().err
     assert main([]) == 2
 
 
@@ -158,7 +163,7 @@ def test_finished_runs_are_compared_with_their_estimates(estimates, tmp_path, mo
 def test_without_finished_runs_only_the_estimates_are_printed(tmp_path, capsys):
     assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "no run of it has finished here yet" in out and "measured_cpu" not in out and "core-h" not in out
+    assert "no run of it has finished here yet" in out and "measured_cpu" not in out and "total: estimated" not in out
 
 
 def _timed(kind: str, wall_time_s: float, mpi_ranks: int = 1) -> RunEstimate:

@@ -2,6 +2,8 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
+from engines.validation_groups import GROUPS
+
 VALIDATION = f"{RESULTS}/summary"
 SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
               "balance": "metrics/fill_balance.json"}
@@ -61,3 +63,21 @@ rule validation_table:
         f"{VALIDATION}/validation.log",
     script:
         "../scripts/validation_table.py"
+
+
+# The validation tier in groups (engines.validation_groups): `make validate GROUP=<name>` asks for the products of one
+# group's case kinds, here their targets per kind.
+KIND_TARGETS = {
+    "jenike": calibration_targets,
+    "silo_flat": lambda: [*silo_flat_targets(), *parametric_targets()],
+    RECIRCULATION: recirculation_targets,
+    "blender": blender_targets,
+}
+
+for _group, _kinds in GROUPS.items():
+
+    rule:
+        name:
+            f"validate_{_group}"
+        input:
+            [target for kind in _kinds for target in KIND_TARGETS[kind]()],

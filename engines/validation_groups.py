@@ -1,0 +1,171 @@
+"""The validation tier in groups: which runs each group makes, what it costs on the cores at hand, and whether the
+record in the repository still matches what the configuration plans.
+
+`make validate GROUP=<name>` runs one group (`make validate` all of them); `make estimate` prints each group's cost;
+`make validate-status` says which groups of the record are complete, stale or missing. Pure computation: callers
+pass estimates and run ids; the record's files are read at the edge (:mod:`analysis.studies.validation.record`).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+from typing import Iterable, Mapping, Sequence
+
+from engines.estimates import BLENDER, JENIKE, RECIRCULATION, SILO_FLAT, RunEstimate
+
+#: The groups in the order `make validate` runs them, each with the case kinds whose runs it makes: a group is one
+#: stage of the study, so that its rows can be judged on its own runs.
+GROUPS: dict[str, tuple[str, ...]] = {
+    "calibration": (JENIKE,),
+    "silo": (SILO_FLAT,),
+    "blending": (RECIRCULATION,),
+    "blender": (BLENDER,),
+}
+
+#: The longest a group may take on the cores of one machine (s): a working session.
+GROUP_BUDGET_S = 2.5 * 3600.0
+
+#: A group's status against the record (:func:`group_status`).
+COMPLETE, STALE, MISSING = "complete", "stale", "missing"
+
+
+def group_of(kind: str) -> str:
+    """The group that makes the runs of case kind ``kind``."""
+    for name, kinds in GROUPS.items():
+        if kind in kinds:
+            return name
+    raise KeyError(f"no validation group makes runs of kind {kind!r}; the groups are {', '.join(GROUPS)}")
+
+
+def check_group(name: str) -> str:
+    """``name`` when it is a group; otherwise a ValueError that lists the groups."""
+    if name not in GROUPS:
+        raise ValueError(f"unknown validation group {name!r}; the groups are {', '.join(GROUPS)}")
+    return name
+
+
+def makespan(core_seconds: Iterable[float], cores: int) -> float:
+    """Wall time of independent single-core jobs on ``cores`` cores, the longest started first (s).
+
+    Snakemake starts the longest runs first (:func:`engines.planning.run_priorities`); each job goes to the core
+    that frees up first (longest-processing-time scheduling, within 4/3 of the best possible).
+
+    Parameters
+    ----------
+    core_seconds : iterable of float
+        Each job's time on one core (s), >= 0.
+    cores : int
+        Cores, >= 1.
+
+    Returns
+    -------
+    float
+        The time the last job ends (s); 0 without jobs.
+    """
+    if cores < 1:
+        raise ValueError(f"cores must be >= 1, got {cores!r}")
+    jobs = sorted((float(t) for t in core_seconds), reverse=True)
+    if any(not math.isfinite(t) or t < 0.0 for t in jobs):
+        raise ValueError("job times must be finite and >= 0")
+    ends = [0.0] * min(cores, max(len(jobs), 1))
+    for job in jobs:
+        heapq.heappush(ends, heapq.heappop(ends) + job)
+    return max(ends)
+
+
+@dataclass(frozen=True)
+class GroupCost:
+    """What one group costs.
+
+    Attributes
+    ----------
+    name : str
+        The group.
+    runs : int
+        Engine runs it makes.
+    core_seconds : float
+        Their CPU time together (s).
+    wall_time_s : float
+        Its wall time on the cores given (s): :func:`makespan` of its runs, each on its MPI ranks.
+    over_budget : bool
+        Whether the wall time exceeds :data:`GROUP_BUDGET_S`.
+    """
+
+    name: str
+    runs: int
+    core_seconds: float
+    wall_time_s: float
+    over_budget: bool
+
+
+def group_costs(estimates: Sequence[RunEstimate], cores: int) -> list[GroupCost]:
+    """The cost of each group (in :data:`GROUPS` order) of a configuration's run estimates on ``cores`` cores; a
+    run on several MPI ranks takes that many cores for its wall time."""
+    costs = []
+    for name, kinds in GROUPS.items():
+        members = [e for e in estimates if e.kind in kinds]
+        # a run on r ranks holds r cores for its wall time: as r jobs of that length
+        jobs = [e.wall_time_s for e in members for _ in range(min(e.mpi_ranks, cores))]
+        wall = makespan(jobs, cores)
+        costs.append(GroupCost(name, len(members), math.fsum(e.core_seconds for e in members), wall,
+                               wall > GROUP_BUDGET_S))
+    return costs
+
+
+def planned_runs(estimates: Sequence[RunEstimate]) -> dict[str, set[str]]:
+    """The run ids each group plans, from a configuration's estimates: ``{group: {run id}}``."""
+    planned: dict[str, set[str]] = {name: set() for name in GROUPS}
+    for estimate in estimates:
+        planned[group_of(estimate.kind)].add(estimate.run_id)
+    return planned
+
+
+def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]]) -> dict[str, str]:
+    """Each group's status in the record against the plan.
+
+    Parameters
+    ----------
+    planned : mapping
+        ``{group: {run id}}`` the configuration plans (:func:`planned_runs`).
+    recorded : mapping
+        ``{group: {run id}}`` of the runs behind the record's rows (its provenance); a group absent or empty has no
+        record.
+
+    Returns
+    -------
+    dict
+        ``{group: status}`` for every group of ``planned``: :data:`MISSING` without a record, :data:`COMPLETE` when
+        the record's runs are exactly those planned, else :data:`STALE` (a run changed, was added or left out).
+    """
+    status = {}
+    for name, runs in planned.items():
+        held = set(recorded.get(name, ()))
+        status[name] = MISSING if not held else COMPLETE if held == set(runs) else STALE
+    return status
+
+
+def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]]) -> list[str]:
+    """`make validate-status`'s lines: per group, its status and the runs that differ from the plan."""
+    lines = []
+    for name, status in group_status(planned, recorded).items():
+        held, runs = set(recorded.get(name, ())), set(planned[name])
+        line = f"{name:12s} {status:9s} {len(held & runs)} of {len(runs)} planned runs recorded"
+        if status == STALE:
+            gone, new = sorted(held - runs), sorted(runs - held)
+            line += (f"; recorded but no longer planned: {', '.join(gone) or 'none'}; planned but not recorded: "
+                     f"{', '.join(new) or 'none'}")
+        lines.append(line)
+    return lines
+
+
+def cost_lines(costs: Sequence[GroupCost], cores: int) -> list[str]:
+    """`make estimate`'s lines on the groups: each group's runs, core time and wall time on ``cores`` cores."""
+    lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s), each at most "
+             f"{GROUP_BUDGET_S / 3600:g} h:"]
+    for cost in costs:
+        flag = "  OVER BUDGET: split it" if cost.over_budget else ""
+        lines.append(f"  {cost.name:12s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
+                     f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
+    return lines

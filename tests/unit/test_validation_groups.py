@@ -1,0 +1,138 @@
+"""The validation groups: their cost on the cores at hand and their status against the record, on synthetic runs."""
+
+from __future__ import annotations
+
+import pytest
+
+from engines.config import REPO_ROOT, load_config
+from engines.estimates import RunEstimate
+from engines.planning import config_estimates
+from engines.validation_groups import (
+    COMPLETE,
+    GROUP_BUDGET_S,
+    GROUPS,
+    MISSING,
+    STALE,
+    check_group,
+    cost_lines,
+    group_costs,
+    group_of,
+    group_status,
+    makespan,
+    planned_runs,
+    status_lines,
+)
+from engines.validation_status import RECORD_RUNS, main as status_main, recorded_runs
+
+
+def _estimate(run_id: str, kind: str, wall_time_s: float, mpi_ranks: int = 1) -> RunEstimate:
+    return RunEstimate(run_id=run_id, kind=kind, clumps=10, spheres=20, steps=1000, sphere_steps=1.0e6,
+                       simulated_time_s=0.01, wall_time_s=wall_time_s, dump_frames=1, dump_bytes=1000,
+                       mpi_ranks=mpi_ranks)
+
+
+def test_every_case_kind_of_the_study_is_in_exactly_one_group():
+    kinds = [kind for kinds in GROUPS.values() for kind in kinds]
+    assert sorted(kinds) == sorted({"jenike", "silo_flat", "silo_recirculation", "blender"})
+    assert group_of("silo_flat") == "silo" and group_of("jenike") == "calibration"
+    with pytest.raises(KeyError, match="verification"):
+        group_of("verification")
+
+
+def test_an_unknown_group_is_refused_with_the_groups_named():
+    assert check_group("blender") == "blender"
+    with pytest.raises(ValueError, match="unknown validation group 'silos'; the groups are calibration, silo"):
+        check_group("silos")
+
+
+@pytest.mark.parametrize("jobs, cores, expected", [
+    ([], 2, 0.0),
+    ([5.0], 2, 5.0),
+    ([3.0, 3.0, 2.0, 2.0, 2.0], 2, 7.0),   # 3+2+2 on one core, 3+2 on the other
+    ([4.0, 1.0, 1.0, 1.0, 1.0], 2, 4.0),   # the short ones fill the second core
+    ([2.0, 2.0, 2.0], 1, 6.0),
+    ([2.0, 2.0, 2.0], 8, 2.0),
+])
+def test_makespan_starts_the_longest_first(jobs, cores, expected):
+    assert makespan(jobs, cores) == expected
+
+
+def test_makespan_refuses_no_cores_and_negative_times():
+    with pytest.raises(ValueError, match="cores"):
+        makespan([1.0], 0)
+    with pytest.raises(ValueError, match="finite"):
+        makespan([-1.0], 2)
+
+
+def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
+    hour = 3600.0
+    estimates = [_estimate("j1", "jenike", 0.5 * hour), _estimate("j2", "jenike", 0.5 * hour),
+                 _estimate("j3", "jenike", 0.5 * hour),
+                 _estimate("s1", "silo_flat", 1.0 * hour), _estimate("s2", "silo_flat", 1.0 * hour),
+                 _estimate("s3", "silo_flat", 1.0 * hour),
+                 _estimate("b1", "blender", 1.0 * hour, mpi_ranks=2)]
+    costs = {cost.name: cost for cost in group_costs(estimates, cores=2)}
+    assert list(costs) == list(GROUPS)
+    assert costs["calibration"].runs == 3 and costs["calibration"].wall_time_s == pytest.approx(1.0 * hour)
+    assert costs["silo"].core_seconds == pytest.approx(3.0 * hour)
+    assert costs["silo"].wall_time_s == pytest.approx(2.0 * hour) and not costs["silo"].over_budget
+    # a two-rank run holds both cores for its wall time
+    assert costs["blender"].wall_time_s == pytest.approx(1.0 * hour) and costs["blender"].core_seconds == 2.0 * hour
+    assert costs["blending"].runs == 0 and costs["blending"].wall_time_s == 0.0
+    one_core = {cost.name: cost for cost in group_costs(estimates, cores=1)}
+    assert one_core["silo"].wall_time_s == pytest.approx(3.0 * hour)
+    assert one_core["silo"].wall_time_s > GROUP_BUDGET_S and one_core["silo"].over_budget
+    lines = cost_lines(group_costs(estimates, cores=1), cores=1)
+    assert lines[0].startswith("Validation groups (make validate GROUP=<name>) on 1 core(s), each at most 2.5 h")
+    assert lines[2].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
+                                "split", "it"]
+
+
+def test_status_is_complete_stale_or_missing_against_the_plan():
+    estimates = [_estimate("j1", "jenike", 1.0), _estimate("j2", "jenike", 1.0), _estimate("s1", "silo_flat", 1.0),
+                 _estimate("r1", "silo_recirculation", 1.0), _estimate("b1", "blender", 1.0)]
+    planned = planned_runs(estimates)
+    assert planned == {"calibration": {"j1", "j2"}, "silo": {"s1"}, "blending": {"r1"}, "blender": {"b1"}}
+    recorded = {"calibration": {"j1", "j2"},   # as planned
+                "silo": {"s0"},                 # a run the config no longer plans (its parameters changed)
+                "blending": {"r1", "r2"},       # a run more than planned
+                }                               # blender: never recorded
+    assert group_status(planned, recorded) == {"calibration": COMPLETE, "silo": STALE, "blending": STALE,
+                                               "blender": MISSING}
+    lines = status_lines(planned, recorded)
+    assert lines[0].split() == ["calibration", "complete", "2", "of", "2", "planned", "runs", "recorded"]
+    assert lines[1].endswith("recorded but no longer planned: s0; planned but not recorded: s1")
+    assert lines[2].endswith("recorded but no longer planned: r2; planned but not recorded: none")
+    assert lines[3].split()[:2] == ["blender", "missing"]
+
+
+def _write_runs(directory, run_ids):
+    directory.mkdir(parents=True)
+    (directory / RECORD_RUNS).write_text("run_id,case\n" + "".join(f"{run},x\n" for run in run_ids))
+
+
+def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys):
+    config = REPO_ROOT / "config" / "config.yaml"
+    planned = planned_runs(config_estimates(load_config(config)))
+    _write_runs(tmp_path / "calibration", sorted(planned["calibration"]))
+    _write_runs(tmp_path / "silo", ["sphere2-0000000000"])
+    assert recorded_runs(tmp_path) == {"calibration": planned["calibration"], "silo": {"sphere2-0000000000"}}
+    assert status_main(["status", str(config), str(tmp_path)]) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].split()[:2] == ["calibration", "complete"]
+    assert lines[2].split()[:2] == ["silo", "stale"] and "no longer planned: sphere2-0000000000" in lines[2]
+    assert lines[3].split()[:2] == ["blending", "missing"]
+    for name in ("silo", "blending", "blender"):
+        (tmp_path / name).mkdir(exist_ok=True)
+        (tmp_path / name / RECORD_RUNS).write_text("run_id\n" + "".join(f"{run}\n" for run in sorted(planned[name])))
+    assert status_main(["status", str(config), str(tmp_path)]) == 0
+    (tmp_path / "blender" / RECORD_RUNS).write_text("run,case\na,b\n")
+    with pytest.raises(ValueError, match="blender/runs.csv: the provenance has no run_id column"):
+        recorded_runs(tmp_path)
+
+
+def test_validate_checks_the_group_before_anything_runs(capsys):
+    assert status_main(["check", "blending"]) == 0
+    assert status_main(["check", "silos"]) == 2
+    assert "unknown validation group 'silos'" in capsys.readouterr().err
+    assert status_main(["status"]) == 2
