@@ -70,10 +70,12 @@ verify: install
 VALIDATION_CONFIG ?= config/validation.yaml
 VALIDATION_DIR    ?= results/validation
 VALIDATION_RECORD ?= docs/validation
+FULL_SCALE_CONFIG ?= config/thesis.yaml
+VALIDATION_RECORD_CLI = $(PYTHON) $(CURDIR)/workflow/scripts/validation_record_cli.py
 GROUP             ?=
 
 validate: install
-	$(if $(GROUP),$(PYTHON) -m engines.validation_status check '$(GROUP)')
+	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)')
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
@@ -81,9 +83,11 @@ validate: install
 		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input --keep-going
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
 		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report$(if $(GROUP),-$(GROUP)).html
+	$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $(if $(GROUP),'$(GROUP)')
+	$(VALIDATION_RECORD_CLI) page $(VALIDATION_CONFIG) $(FULL_SCALE_CONFIG) $(VALIDATION_RECORD)
 
 validate-status: install-python
-	$(PYTHON) -m engines.validation_status status $(VALIDATION_CONFIG) $(VALIDATION_RECORD)
+	$(VALIDATION_RECORD_CLI) status $(VALIDATION_CONFIG) $(VALIDATION_RECORD)
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
 # module's fixture, and so its engine runs, happens once. Files go out in the order tests/conftest.py sorts them,

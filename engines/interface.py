@@ -17,6 +17,7 @@ Adding an engine: create ``engines/<name>/`` with an :class:`Engine` subclass, i
 from __future__ import annotations
 
 import importlib
+import subprocess
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from pathlib import Path
@@ -99,6 +100,17 @@ class Engine(ABC):
     name: ClassVar[str]
     #: The engine's base template under ``templates/``; each case template extends it.
     base_template: ClassVar[str]
+    #: The Debian package that installs the engine (`make install`), whose version the validation record states.
+    debian_package: ClassVar[str]
+
+    def installed_version(self) -> str:
+        """The installed version of :attr:`debian_package` (dpkg's), or ``"unknown"`` where dpkg does not know it."""
+        try:
+            found = subprocess.run(["dpkg-query", "--show", "--showformat=${Version}", self.debian_package],
+                                   capture_output=True, text=True, check=False, timeout=30)
+        except (OSError, subprocess.TimeoutExpired):
+            return "unknown"
+        return found.stdout.strip() if found.returncode == 0 and found.stdout.strip() else "unknown"
 
     @abstractmethod
     def check_case(self, case) -> None:

@@ -5,7 +5,7 @@ The workflow's rules, the run planning (estimates, disk checks) and the tests al
     results/<case root>/<run id>/
         deck/            the engine's input files; deck/case.json (the neutral case summary) is written last
         run.json         the typed run record (analysis.data.record), written last, only when the run passed its checks
-        logs/            one log per workflow step
+        logs/            one log per workflow step, and the run step's timing (logs/run_benchmark.tsv)
         metrics/ fields/ plots/ tracks.npz ...   analysis products
         failed_attempts/ output of unfinished earlier attempts, moved aside, never deleted
 
@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 from pathlib import Path, PurePosixPath
 
-__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_RECORD", "case_root", "run_dir", "run_path", "write_text_atomic"]
+__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_BENCHMARK", "RUN_RECORD", "VALIDATION_RECORD", "case_root", "run_dir", "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
 RESULTS = "results"
@@ -34,6 +34,12 @@ CASE_ROOTS = {
 CASE_SUMMARY = "deck/case.json"
 #: The typed run record (the product of a run step).
 RUN_RECORD = "run.json"
+#: Snakemake's benchmark of a run step: its wall time (column ``s``) and memory.
+RUN_BENCHMARK = "logs/run_benchmark.tsv"
+
+#: Each validation group's record as the pipeline writes it (``<group>/``), before `make validate` copies it into
+#: the repository's ``docs/validation/``.
+VALIDATION_RECORD = f"{RESULTS}/summary/record"
 
 #: The wildcard rules use for a run id.
 RUN_WILDCARD = "{run}"

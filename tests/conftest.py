@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import importlib.util
 import shutil
 import subprocess
 import sys
@@ -192,6 +193,16 @@ def run_snakemake(workdir, *arguments: str, targets=()) -> subprocess.CompletedP
         text=True,
         check=False,
     )
+
+
+def validation_record_cli():
+    """The validation record's command line (workflow/scripts/validation_record_cli.py, a script of the workflow
+    layer, not a package module), loaded as a module."""
+    spec = importlib.util.spec_from_file_location("validation_record_cli",
+                                                  REPO_ROOT / "workflow" / "scripts" / "validation_record_cli.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def liggghts():

@@ -113,6 +113,7 @@ class LiggghtsEngine(Engine):
     """LIGGGHTS-PUBLIC 3.8: decks from ``templates/liggghts/``, run serially or under MPI, read back."""
 
     name = ENGINE_NAME
+    debian_package = "liggghts"
     base_template = "liggghts/base.lmp.j2"
 
     def check_case(self, case) -> None:

@@ -67,6 +67,7 @@ class YadeEngine(Engine):
     """YADE 2023.02: scripts from ``templates/yade/``, run headless with the system Python 3, read back."""
 
     name = ENGINE_NAME
+    debian_package = "yade"
     base_template = "yade/base.py.j2"
 
     def check_case(self, case) -> None:

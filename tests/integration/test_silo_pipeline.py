@@ -19,17 +19,20 @@ import pyvista
 from analysis.data.frames import clumps_from_frame
 from analysis.data.record import read_run_record
 from analysis.io.tables import read_table
+from analysis.io.validation_record import read_group_record
 from analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
 from analysis.piv.front_wall import front_wall_image, front_wall_spheres
 from analysis.piv.synthetic import piv_displacements
 from analysis.studies.silo_flat.metrics import silo_flow_metrics
+from engines.cases import cases_of
 from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
-from tests.conftest import MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
+                            liggghts, require_liggghts, run_snakemake, validation_record_cli)
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(240)]
 
@@ -41,13 +44,17 @@ def _validated(silo: dict) -> dict:
     return validate_config(raw)
 
 
+#: one parametric run beside the base run: the front-wall friction series' rows and plot
+SILO_PARAMETRIC = {"parametric": {"restitution": [0.6], "profile_height": 0.02}}
+
+
 @pytest.fixture(scope="module")
 def tiny_pipeline(tmp_path_factory):
     """Run the whole workflow once on the tiny silo; yields (workdir, run directory)."""
     require_liggghts()
     workdir = tmp_path_factory.mktemp("tiny_silo")
     config_path = workdir / "tiny.yaml"
-    silo = {**TINY_SILO, "parametric": {"restitution": [0.6], "profile_height": 0.02}}
+    silo = {**TINY_SILO, **SILO_PARAMETRIC}
     config_path.write_text(yaml.safe_dump({"silo_flat": silo, "jenike": TINY_JENIKE_SWEEP, "silo_recirculation": NO_BLENDING,
                                            "blender": NO_BLENDER, "verification": NO_VERIFICATION}))
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path))
@@ -107,6 +114,31 @@ def test_outputs_and_logs_are_where_the_workflow_says(tiny_pipeline):
     assert f"siloflow result: {run_dir / 'metrics' / 'flow.csv'}" in result.stdout + result.stderr
     # no frame cache: it was as large as the dumps and not faster (make bench)
     assert not (run_dir / "frames").exists()
+
+
+def test_the_silo_group_is_recorded_with_the_provenance_of_its_runs_and_its_page(tiny_pipeline, tmp_path):
+    """`make validate GROUP=silo`'s steps on the tiny configuration: the group's target writes its record (no engine
+    runs again), publish copies it, and the page shows it complete against the configuration."""
+    workdir, run_dir, _ = tiny_pipeline
+    config_path = workdir / "tiny.yaml"
+    result = run_snakemake(workdir, "--cores", "1", "--configfile", str(config_path), targets=["validate_silo"])
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "silo_run" not in result.stdout + result.stderr
+    record_dir, cli = tmp_path / "docs", validation_record_cli()
+    assert cli.publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
+    record = read_group_record(record_dir / "silo")
+    planned = {case.run_id for case in cases_of(_validated({**TINY_SILO, **SILO_PARAMETRIC}), "silo_flat").values()}
+    assert {run["run_id"] for run in record.runs} == planned and len(planned) == 2
+    base = next(run for run in record.runs if run["run_id"] == run_dir.name)
+    assert base["engine"] == "liggghts" and base["engine_version"] == liggghts().installed_version() != "unknown"
+    assert float(base["wall_time_s"]) > 0.0 and base["cores"] == "1" and len(base["commit"]) >= 40
+    assert float(base["simulated_time_s"]) == pytest.approx(max(
+        stage["time"] for stage in read_run_record(run_dir / "run.json").stages.values() if "time" in stage))
+    assert {row["group"] for row in record.rows} == {"Flat-bottom silo", "Front-wall friction series"}
+    assert record.plots == ["janssen.png", "profiles.png", "restitution.png"]
+    # the page judges the record against the configuration that made it: the silo group complete, no other recorded
+    text = cli.page(str(config_path), str(config_path), record_dir)
+    assert "| silo | complete | 2 |" in text and "| calibration | missing | 0 |" in text
 
 
 def test_make_estimate_takes_its_cost_model_from_the_finished_runs(tiny_pipeline):

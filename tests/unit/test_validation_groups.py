@@ -22,7 +22,11 @@ from engines.validation_groups import (
     planned_runs,
     status_lines,
 )
-from engines.validation_status import RECORD_RUNS, main as status_main, recorded_runs
+from analysis.io.validation_record import RUNS as RECORD_RUNS
+from tests.conftest import validation_record_cli
+
+CLI = validation_record_cli()
+status_main, recorded_runs = CLI.main, CLI.recorded_runs
 
 
 def _estimate(run_id: str, kind: str, wall_time_s: float, mpi_ranks: int = 1) -> RunEstimate:

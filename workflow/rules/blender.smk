@@ -31,6 +31,8 @@ rule blender_run:
     priority: RUN_PRIORITY.get("blender", 0)
     log:
         run_path("blender", "logs/run.log"),
+    benchmark:
+        run_benchmark("blender"),
     script:
         "../scripts/case_run.py"
 

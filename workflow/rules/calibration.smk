@@ -74,6 +74,8 @@ rule jenike_run:
     threads: config["engine"]["mpi_ranks"]
     log:
         run_path("jenike", "logs/run.log"),
+    benchmark:
+        run_benchmark("jenike"),
     script:
         "../scripts/case_run.py"
 

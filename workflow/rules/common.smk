@@ -17,7 +17,7 @@ from engines.estimates import InsufficientDiskSpace, format_bytes
 from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from engines.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
-from engines.layout import CASE_SUMMARY, RESULTS, RUN_RECORD, case_root, run_dir, run_path
+from engines.layout import CASE_SUMMARY, RESULTS, RUN_BENCHMARK, RUN_RECORD, case_root, run_dir, run_path
 from engines.planning import config_estimates, ensure_disk_space, run_priorities
 
 try:
@@ -220,3 +220,8 @@ def deck_rule_output(kind):
 
 def run_rule_output(kind):
     return run_path(kind, RUN_RECORD)
+
+
+def run_benchmark(kind):
+    """Snakemake's timing of a run step (wall time, memory): the validation record's provenance reads it."""
+    return run_path(kind, RUN_BENCHMARK)

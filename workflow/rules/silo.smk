@@ -36,6 +36,8 @@ rule silo_run:
     priority: RUN_PRIORITY.get("silo_flat", 0)
     log:
         run_path("silo_flat", "logs/run.log"),
+    benchmark:
+        run_benchmark("silo_flat"),
     script:
         "../scripts/case_run.py"
 

@@ -31,6 +31,8 @@ rule silo_recirculation_run:
     priority: RUN_PRIORITY.get("silo_recirculation", 0)
     log:
         run_path(RECIRCULATION, "logs/run.log"),
+    benchmark:
+        run_benchmark(RECIRCULATION),
     script:
         "../scripts/case_run.py"
 

@@ -2,6 +2,7 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
+from engines.layout import VALIDATION_RECORD
 from engines.validation_groups import GROUPS
 
 VALIDATION = f"{RESULTS}/summary"
@@ -24,41 +25,69 @@ def front_wall_label():
     return f"mu_fw={contact['sliding_friction']:g}"
 
 
-def validation_inputs(wildcards):
-    base = run_ids("silo_flat")[0]
-    inputs = {
-        "bulk": f"{CALIBRATION}/bulk_friction.csv",
-        "parameters": f"{CALIBRATION}/parameters.yaml",
-        "janssen": run_path("silo_flat", "metrics/janssen.csv", base),
-        "kinematic": run_path("silo_flat", "metrics/kinematic.csv", base),
-        "boundary": run_path("silo_flat", "metrics/flow_channel_boundary.csv", base),
-        "recirculation_cases": [run_path(RECIRCULATION, CASE_SUMMARY, run) for run in recirculation_runs()],
-        "recirculation_summaries": [run_path(RECIRCULATION, "metrics/blending.json", run) for run in recirculation_runs()],
-        "recirculation_rtds": [run_path(RECIRCULATION, "metrics/rtd.csv", run) for run in recirculation_runs()],
-        "blender": [run_path("blender", "metrics/blender.json", run) for run in blender_runs()],
-        "blender_cases": [run_path("blender", CASE_SUMMARY, run) for run in blender_runs()],
-    }
-    for key, name in SILO_FILES.items():
-        inputs[f"silo_{key}"] = [run_path("silo_flat", name, run) for _, run in validation_silo_runs()]
+def group_rows_inputs(group):
+    """The products each group's rows are read from (an input function of the group)."""
+
+    def inputs(wildcards):
+        if group == "calibration":
+            return {"bulk": f"{CALIBRATION}/bulk_friction.csv", "parameters": f"{CALIBRATION}/parameters.yaml"}
+        if group == "silo":
+            base = run_ids("silo_flat")[0]
+            found = {
+                "janssen": run_path("silo_flat", "metrics/janssen.csv", base),
+                "kinematic": run_path("silo_flat", "metrics/kinematic.csv", base),
+                "boundary": run_path("silo_flat", "metrics/flow_channel_boundary.csv", base),
+            }
+            for key, name in SILO_FILES.items():
+                found[f"silo_{key}"] = [run_path("silo_flat", name, run) for _, run in validation_silo_runs()]
+            return found
+        if group == "blending":
+            runs = recirculation_runs()
+            return {"cases": [run_path(RECIRCULATION, CASE_SUMMARY, run) for run in runs],
+                    "summaries": [run_path(RECIRCULATION, "metrics/blending.json", run) for run in runs],
+                    "rtds": [run_path(RECIRCULATION, "metrics/rtd.csv", run) for run in runs]}
+        return {"summaries": [run_path("blender", "metrics/blender.json", run) for run in blender_runs()],
+                "cases": [run_path("blender", CASE_SUMMARY, run) for run in blender_runs()]}
+
     return inputs
+
+
+#: The groups whose rows this configuration makes: a group without runs (a study switched off) has none.
+ROW_GROUPS = [group for group, kinds in GROUPS.items() if any(CASES[kind] for kind in kinds)]
+
+
+for _group in ROW_GROUPS:
+
+    rule:
+        name:
+            f"validation_rows_{_group}"
+        input:
+            unpack(group_rows_inputs(_group)),
+        output:
+            rows=f"{VALIDATION}/rows/{_group}.csv",
+        params:
+            group=_group,
+            criteria=config["validation"],
+            cell_diameter=config["jenike"]["cell"]["inner_diameter"],
+            shapes={shape: config["particle_models"][shape] for shape in config["jenike"]["sweep"]["shapes"]},
+            density=config["materials"][config["jenike"]["particle_material"]]["density"],
+            base_restitution=config["jenike"]["sweep"]["restitution"],
+            lid=config["jenike"]["lid"],
+            profile_height=config["silo_flat"]["parametric"]["profile_height"],
+            labels=lambda wildcards: [label for label, _ in validation_silo_runs()],
+        log:
+            f"{VALIDATION}/rows/{_group}.log",
+        script:
+            "../scripts/validation_rows.py"
 
 
 rule validation_table:
     input:
-        unpack(validation_inputs),
+        rows=[f"{VALIDATION}/rows/{group}.csv" for group in ROW_GROUPS],
     output:
         table=f"{VALIDATION}/validation.csv",
         page=report(f"{VALIDATION}/validation.html", caption="../report/validation.rst", category="0 Summary",
                     labels={"figure": "validation table"}),
-    params:
-        criteria=config["validation"],
-        cell_diameter=config["jenike"]["cell"]["inner_diameter"],
-        shapes={shape: config["particle_models"][shape] for shape in config["jenike"]["sweep"]["shapes"]},
-        density=config["materials"][config["jenike"]["particle_material"]]["density"],
-        base_restitution=config["jenike"]["sweep"]["restitution"],
-        lid=config["jenike"]["lid"],
-        profile_height=config["silo_flat"]["parametric"]["profile_height"],
-        labels=lambda wildcards: [label for label, _ in validation_silo_runs()],
     log:
         f"{VALIDATION}/validation.log",
     script:
@@ -81,3 +110,54 @@ for _group, _kinds in GROUPS.items():
             f"validate_{_group}"
         input:
             [target for kind in _kinds for target in KIND_TARGETS[kind]()],
+            [f"{VALIDATION_RECORD}/{_group}/{name}" for name in ("runs.csv", "table.csv")] if _group in ROW_GROUPS else [],
+
+
+def run_seeds(case):
+    """The random seeds a run's engine was given (a recirculating silo's are those of its silo)."""
+    return list(case.seeds if hasattr(case, "seeds") else case.silo.seeds)
+
+
+def record_plots(group):
+    """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
+    profiles and Janssen comparison with the front-wall series, VRR against Nr, the blender's passage velocities
+    and gravity series."""
+    if group == "calibration":
+        plots = {f"{name}.png": f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()}
+        plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
+        return plots
+    if group == "silo":
+        base = run_ids("silo_flat")[0]
+        plots = {f"{name}.png": run_path("silo_flat", f"plots/{name}.png", base) for name in ("profiles", "janssen")}
+        plots.update({f"{study}.png": f"{case_root('silo_flat')}/parametric/{study}.png" for study in parametric_studies()})
+        return plots
+    if group == "blending":
+        return {"vrr.png": f"{case_root(RECIRCULATION)}/summary/vrr.png"}
+    plots = {f"insert_velocities_{cases('blender')[run].configuration}_g{cases('blender')[run].gravity_factor:g}.png":
+             run_path("blender", "plots/insert_velocities.png", run) for run in blender_runs()}
+    if len(config["blender"]["gravity_factors"]) > 1:
+        plots["gravity_scaling.png"] = f"{case_root('blender')}/gravity/scaling.png"
+    return plots
+
+
+for _group in ROW_GROUPS:
+
+    rule:
+        name:
+            f"validation_record_{_group}"
+        input:
+            rows=f"{VALIDATION}/rows/{_group}.csv",
+            records=[run_path(kind, RUN_RECORD, run) for kind in GROUPS[_group] for run in run_ids(kind)],
+            benchmarks=[run_path(kind, RUN_BENCHMARK, run) for kind in GROUPS[_group] for run in run_ids(kind)],
+            plots=list(record_plots(_group).values()),
+        output:
+            runs=f"{VALIDATION_RECORD}/{_group}/runs.csv",
+            table=f"{VALIDATION_RECORD}/{_group}/table.csv",
+        params:
+            kinds=GROUPS[_group],
+            plot_names=list(record_plots(_group)),
+            seeds={run: run_seeds(case) for kind in GROUPS[_group] for run, case in cases(kind).items()},
+        log:
+            f"{VALIDATION_RECORD}/{_group}.log",
+        script:
+            "../scripts/validation_record.py"

@@ -1,0 +1,88 @@
+"""Reader and writer of the validation record's files (``docs/validation/<group>/``): ``table.csv``, ``runs.csv`` and
+the group's plots. The record itself (its columns, its page) is :mod:`analysis.studies.validation.record`."""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+
+from analysis.checks import number_or_nan
+from analysis.io.tables import write_flow_table
+from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
+from analysis.studies.validation.rows import COLUMNS
+
+__all__ = ["TABLE", "RUNS", "benchmark_wall_time", "read_validation_rows", "write_group_record", "read_group_record", "read_record"]
+
+#: A group's table rows and its runs' provenance, in its folder.
+TABLE, RUNS = "table.csv", "runs.csv"
+
+
+def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], runs: Sequence[Mapping],
+                       plots: Mapping[str, str | os.PathLike]) -> Path:
+    """Write one group's record into ``directory``: its rows, its runs and its plots (``{name: source file}``),
+    replacing the group's previous record there (a plot no longer made is removed). Returns the folder."""
+    directory = Path(directory)
+    if not rows or not runs:
+        raise ValueError(f"a group's record needs rows and runs; got {len(rows)} rows and {len(runs)} runs")
+    directory.mkdir(parents=True, exist_ok=True)
+    write_flow_table(directory / TABLE, [{column: row[column] for column in COLUMNS} for row in rows])
+    write_flow_table(directory / RUNS, [{column: run[column] for column in RUN_COLUMNS} for run in runs])
+    for stale in directory.glob("*.png"):
+        if stale.name not in plots:
+            stale.unlink()
+    for name, source in plots.items():
+        if Path(name).name != name or not name.endswith(".png"):
+            raise ValueError(f"a record plot is a PNG file name without a folder, got {name!r}")
+        shutil.copyfile(source, directory / name)
+    return directory
+
+
+def benchmark_wall_time(path: str | os.PathLike) -> float:
+    """Wall time of a job (s) from the tab-separated benchmark Snakemake writes (its column ``s``; the last row when
+    the job was repeated)."""
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle, delimiter="\t"))
+    if not rows or "s" not in rows[-1]:
+        raise ValueError(f"{path}: not a Snakemake benchmark (no row with a column s)")
+    return float(rows[-1]["s"])
+
+
+#: The numeric columns of the validation table; the others are text (a study value such as "667" stays as written).
+NUMBERS = ("value", "value_error")
+
+
+def read_validation_rows(path: str | os.PathLike) -> list[dict]:
+    """Rows of a validation table CSV (:data:`analysis.studies.validation.rows.COLUMNS`): value and error as float
+    (NaN where empty), every other column as text."""
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    missing = [column for column in COLUMNS if rows and column not in rows[0]]
+    if missing:
+        raise ValueError(f"{path}: a validation table needs the columns {', '.join(missing)}")
+    return [{column: number_or_nan(row[column] or None) if column in NUMBERS else row[column] for column in COLUMNS}
+            for row in rows]
+
+
+def _runs(path: Path) -> list[dict]:
+    # as text: a commit or a seed list must not be read as a number
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    if rows and "run_id" not in rows[0]:
+        raise ValueError(f"{path}: the provenance has no run_id column")
+    return rows
+
+
+def read_group_record(directory: str | os.PathLike) -> GroupRecord:
+    """One group's record from its folder (written by :func:`write_group_record`)."""
+    directory = Path(directory)
+    rows = read_validation_rows(directory / TABLE) if (directory / TABLE).is_file() else []
+    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=sorted(p.name for p in directory.glob("*.png")))
+
+
+def read_record(record_dir: str | os.PathLike, groups: Iterable[str]) -> dict[str, GroupRecord]:
+    """``{group: GroupRecord}`` of the groups with a record (a ``runs.csv``) under ``record_dir``."""
+    return {name: read_group_record(Path(record_dir) / name) for name in groups
+            if (Path(record_dir) / name / RUNS).is_file()}

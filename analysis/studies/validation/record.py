@@ -1,0 +1,163 @@
+"""The validation record kept in the repository (``docs/validation/``): each group's table rows, the runs behind
+them, and the page that renders them.
+
+A group's record is three things the pipeline writes (``make validate GROUP=<name>``): ``table.csv`` (its rows of
+the validation table, :data:`analysis.studies.validation.rows.COLUMNS`), ``runs.csv`` (one provenance row per run,
+:data:`RUN_COLUMNS`) and a few plots. :func:`record_page` renders every group's record as one Markdown page, with
+each group's freshness against the configuration and, for the rows the scale does not show, what would show them
+and at what cost. Pure: the readers and writers are :mod:`analysis.io.validation_record`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from analysis.checks import number_or_nan
+from analysis.data.record import RunRecord
+from analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
+
+__all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "simulated_time", "record_page"]
+
+#: The columns of a group's ``runs.csv``, in order.
+RUN_COLUMNS = ("run_id", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
+               "cores", "date")
+
+
+@dataclass(frozen=True)
+class GroupRecord:
+    """One group's record as read back.
+
+    Attributes
+    ----------
+    rows : list of dict
+        Its validation table rows.
+    runs : list of dict
+        Its provenance rows (:data:`RUN_COLUMNS`).
+    plots : list of str
+        Its plot file names, relative to the group's folder.
+    """
+
+    rows: list = field(default_factory=list)
+    runs: list = field(default_factory=list)
+    plots: list = field(default_factory=list)
+
+
+def simulated_time(record: RunRecord) -> float:
+    """The simulated time a run reached (s): the latest ``time`` of its stages; NaN when no stage gives one."""
+    times = [float(stage["time"]) for stage in record.stages.values() if isinstance(stage.get("time"), (int, float))]
+    return max(times) if times else math.nan
+
+
+def provenance_row(record: RunRecord, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
+                   date: str) -> dict:
+    """One row of ``runs.csv`` for a finished run.
+
+    Parameters
+    ----------
+    record : RunRecord
+        The run's record (run id, case kind, engine, MPI ranks, stages).
+    engine_version : str
+        The engine's installed version.
+    seeds : sequence of int
+        The random seeds the engine was given.
+    commit : str
+        The commit of siloflow's code that wrote the record (``-dirty`` appended with uncommitted changes).
+    wall_time_s : float
+        Wall time of the run step (s), Snakemake's benchmark of it.
+    date : str
+        When the run finished (ISO 8601 date).
+    """
+    return {"run_id": record.run_id, "case": record.case, "engine": record.engine, "engine_version": engine_version,
+            "seeds": " ".join(str(int(seed)) for seed in seeds), "commit": commit,
+            "simulated_time_s": simulated_time(record), "wall_time_s": float(wall_time_s),
+            "cores": int(record.mpi_ranks), "date": date}
+
+
+def _value(row: Mapping) -> str:
+    value, error = number_or_nan(row["value"]), number_or_nan(row["value_error"])
+    if not math.isfinite(value):
+        return "not measured"
+    unit = f" {row['unit']}" if row["unit"] and row["unit"] != "-" else ""
+    return plus_minus(value, error) + unit
+
+
+def _cell(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _hours(seconds: float) -> str:
+    return f"{seconds / 3600.0:.2f} h"
+
+
+def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
+                config_name: str, full_scale_config: str) -> str:
+    """The record's page (Markdown): per group its freshness, runs and rows, and for each row the scale does not
+    show, what scale would show it and what that scale costs.
+
+    Parameters
+    ----------
+    groups : mapping
+        ``{group: GroupRecord}`` of the groups recorded (absent: none yet).
+    status : mapping
+        ``{group: "complete" | "stale" | "missing"}`` for every group, in the order of the page
+        (:func:`engines.validation_groups.group_status`).
+    full_scale_core_s : mapping
+        ``{group: CPU s}`` of each group at the study's full scale (the estimate of ``full_scale_config``).
+    config_name, full_scale_config : str
+        The configuration the record comes from and the full-scale one, as the page names them.
+
+    Returns
+    -------
+    str
+    """
+    lines = [
+        "# The validation record",
+        "",
+        f"The study's comparisons at the validation scale (`{config_name}`), each as value ± standard error, written "
+        "by `make validate GROUP=<name>` from the runs' own files: nothing here is typed in. \"Scale shows\" is judged "
+        "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
+        "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
+        "",
+        "| group | status | runs | wall time | rows | shown at this scale |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, state in status.items():
+        record = groups.get(name, GroupRecord())
+        wall = math.fsum(float(run["wall_time_s"]) for run in record.runs)
+        shown = sum(row["scale_shows"] == YES for row in record.rows)
+        lines.append(f"| {name} | {state} | {len(record.runs)} | {_hours(wall) if record.runs else '-'} | "
+                     f"{len(record.rows)} | {shown} |")
+    for name, state in status.items():
+        record = groups.get(name)
+        lines += ["", f"## {name}", ""]
+        if record is None:
+            lines.append(f"Not recorded yet: `make validate GROUP={name}`.")
+            continue
+        if state != "complete":
+            lines += [f"**Stale**: the runs below are not those `{config_name}` now plans; `make validate "
+                      f"GROUP={name}` brings the record up to date.", ""]
+        engines = sorted({f"{run['engine']} {run['engine_version']}" for run in record.runs})
+        commits = sorted({str(run["commit"]) for run in record.runs})
+        dates = sorted(str(run["date"]) for run in record.runs)
+        cores = sorted({int(run["cores"]) for run in record.runs})
+        lines.append(f"{len(record.runs)} runs on {', '.join(engines)}, {'/'.join(map(str, cores))} core(s) each, "
+                     f"code {', '.join(commits)}, {dates[0]} to {dates[-1]}; run ids and seeds in "
+                     f"[`{name}/runs.csv`]({name}/runs.csv)." if record.runs else "No runs recorded.")
+        lines += ["", "| table | figure | case | value | study | scale shows | evidence |",
+                  "|---|---|---|---|---|---|---|"]
+        for row in record.rows:
+            lines.append(f"| {_cell(row['group'])} | {_cell(row['figure'])} | {_cell(row['case'])} | "
+                         f"{_cell(_value(row))} | {_cell(row['study_value'] or '-')} | {row['scale_shows']} | "
+                         f"{_cell(row['evidence'])} |")
+        unshown = [row for row in record.rows if row["scale_shows"] in (NO, UNKNOWN)]
+        if unshown:
+            cost = full_scale_core_s.get(name, math.nan)
+            lines += ["", f"Rows this scale does not show ({len(unshown)}): each would need the scale its evidence "
+                      f"names; the study's full scale (`{full_scale_config}`) runs this group in about "
+                      f"{cost / 86400.0:.3g} core-days (`make estimate CONFIG={full_scale_config}`).", ""]
+            lines += [f"- {_cell(row['figure'])} ({_cell(row['case'])}): {_cell(row['evidence'])}" for row in unshown]
+        if record.plots:
+            lines += [""] + [f"![{plot}]({name}/{plot})" for plot in record.plots]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,125 @@
+"""The validation record: provenance rows, the files of a group's record, and its page, on synthetic records."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from analysis.data.record import RunRecord
+from analysis.io.validation_record import (RUNS, TABLE, benchmark_wall_time, read_group_record, read_record, read_validation_rows,
+                                           write_group_record)
+from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time
+from analysis.studies.validation.rows import COLUMNS, row
+from engines.config import REPO_ROOT
+from tests.conftest import validation_record_cli
+
+CLI = validation_record_cli()
+RECORD_PAGE, page, publish = CLI.RECORD_PAGE, CLI.page, CLI.publish
+
+PNG = b"\x89PNG\r\n\x1a\n" + b"\x00" * 8
+
+
+def _record(run_id="sphere2-abc", stages=None, ranks=1) -> RunRecord:
+    stages = {"fill": {"step": 10, "time": 0.25}, "discharge": {"step": 30, "time": 1.75}} if stages is None else stages
+    return RunRecord(engine="liggghts", case="silo_flat", run_id=run_id, timestep_s=1e-5, n_clumps=100, n_frames=3,
+                     mpi_ranks=ranks, stages=stages)
+
+
+def _rows():
+    return [row("Flat-bottom silo", "Filling bulk density", "sphere2-abc", 547.6, 1.7, "kg/m3", "667", "yes",
+                "depth 40 mm = 12.0 particle diameters (>= 10)"),
+            row("Flat-bottom silo", "Wall share | of weight", "sphere2-abc", math.nan, math.nan, "-", "", "no",
+                "depth 12 mm = 3.6 particle diameters (>= 10)")]
+
+
+def test_the_provenance_row_names_the_run_its_engine_and_its_time():
+    got = provenance_row(_record(ranks=2), "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, "2026-11-28")
+    assert list(got) == list(RUN_COLUMNS)
+    assert got == {"run_id": "sphere2-abc", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
+                   "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5, "cores": 2,
+                   "date": "2026-11-28"}
+    assert math.isnan(simulated_time(_record(stages={"fill": {"step": 3}})))
+
+
+def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
+    plot = tmp_path / "source.png"
+    plot.write_bytes(PNG)
+    runs = [provenance_row(_record(), "3.8", [1, 2, 3], "0123456789", 60.0, "2026-11-28")]
+    folder = tmp_path / "silo"
+    folder.mkdir()
+    (folder / "old.png").write_bytes(PNG)
+    write_group_record(folder, _rows(), runs, {"profiles.png": plot})
+    back = read_group_record(folder)
+    assert back.plots == ["profiles.png"] and (folder / "profiles.png").read_bytes() == PNG
+    assert back.runs == [{**{k: str(v) for k, v in runs[0].items()}}]  # text: a commit of digits stays text
+    assert back.rows[0] == _rows()[0]
+    assert math.isnan(back.rows[1]["value"]) and back.rows[1]["study_value"] == ""
+    assert read_validation_rows(folder / TABLE)[0]["study_value"] == "667"
+    assert read_record(tmp_path, ["calibration", "silo"]) == {"silo": back}
+    with pytest.raises(ValueError, match="a PNG file name without a folder"):
+        write_group_record(folder, _rows(), runs, {"../x.png": plot})
+    with pytest.raises(ValueError, match="needs rows and runs"):
+        write_group_record(folder, [], runs, {})
+
+
+def test_a_table_without_the_validation_columns_is_refused(tmp_path):
+    path = tmp_path / "table.csv"
+    path.write_text("figure,value\nx,1\n")
+    with pytest.raises(ValueError, match="needs the columns group, case, value_error"):
+        read_validation_rows(path)
+
+
+def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
+    runs = [provenance_row(_record(), "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
+            provenance_row(_record("sphere2-def"), "3.8", [2], "c0ffee", 1800.0, "2026-11-29")]
+    groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"])}
+    status = {"calibration": "missing", "silo": "stale"}
+    text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, "config/validation.yaml",
+                       "config/thesis.yaml")
+    lines = text.splitlines()
+    assert lines[0] == "# The validation record"
+    assert "| calibration | missing | 0 | - | 0 | 0 |" in lines
+    assert "| silo | stale | 2 | 2.00 h | 2 | 1 |" in lines
+    assert "Not recorded yet: `make validate GROUP=calibration`." in lines
+    assert any(line.startswith("**Stale**") for line in lines)
+    assert ("2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
+            "[`silo/runs.csv`](silo/runs.csv).") in lines
+    assert ("| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | 667 | yes | "
+            "depth 40 mm = 12.0 particle diameters (>= 10) |") in lines
+    assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | no |" in text
+    assert "runs this group in about 2 core-days (`make estimate CONFIG=config/thesis.yaml`)" in text
+    assert "- Wall share \\| of weight (sphere2-abc): depth 12 mm = 3.6 particle diameters (>= 10)" in lines
+    assert lines[-1] == "![profiles.png](silo/profiles.png)"
+    assert list(COLUMNS) == ["group", "figure", "case", "value", "value_error", "unit", "study_value", "scale_shows",
+                             "evidence"]
+
+
+def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_path):
+    workdir, record_dir = tmp_path / "work", tmp_path / "docs"
+    plot = tmp_path / "p.png"
+    plot.write_bytes(PNG)
+    runs = [provenance_row(_record(), "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs, {"janssen.png": plot})
+    write_group_record(record_dir / "blender", _rows(), runs, {})
+    assert publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
+    assert (record_dir / "silo" / "janssen.png").read_bytes() == PNG and (record_dir / "silo" / RUNS).is_file()
+    assert (record_dir / "blender" / RUNS).is_file()
+
+
+def test_the_committed_page_is_rebuilt_from_the_committed_record(monkeypatch):
+    """docs/validation/README.md is what `make validate` writes from the record files beside it, nothing typed in."""
+    monkeypatch.chdir(REPO_ROOT)  # the page names the configs as `make validate` passes them, from the repository
+    record_dir = REPO_ROOT / "docs" / "validation"
+    assert (record_dir / RECORD_PAGE).read_text() == page("config/validation.yaml", "config/thesis.yaml", record_dir)
+
+
+def test_the_wall_time_is_read_from_snakemake_s_benchmark(tmp_path):
+    path = tmp_path / "run_benchmark.tsv"
+    path.write_text("s\th:m:s\tmax_rss\tcpu_time\n121.57\t0:02:01\t132.63\t51.95\n")
+    assert benchmark_wall_time(path) == 121.57
+    path.write_text("s\th:m:s\n1.5\t0:00:01\n2.5\t0:00:02\n")
+    assert benchmark_wall_time(path) == 2.5
+    path.write_text("time,rss\n1,2\n")
+    with pytest.raises(ValueError, match="not a Snakemake benchmark"):
+        benchmark_wall_time(path)

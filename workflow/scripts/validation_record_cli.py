@@ -1,0 +1,102 @@
+"""Command line of the validation record: `make validate-status`, the record's copy into the repository and its page,
+and `make validate GROUP=<name>`'s check. An adapter of the workflow layer (it joins the planner and the record's
+analysis): ``python workflow/scripts/validation_record_cli.py <command> ...``.
+
+``status CONFIG RECORD_DIR`` prints, per group, whether the record in ``RECORD_DIR`` (``docs/validation``) is
+complete, stale or missing against the runs ``CONFIG`` plans (:func:`engines.validation_groups.group_status`);
+``publish WORKDIR RECORD_DIR [GROUP]`` copies the records a `make validate` wrote in ``WORKDIR`` into ``RECORD_DIR``;
+``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
+(:func:`analysis.studies.validation.record.record_page`); ``check GROUP`` refuses an unknown group before anything
+runs.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from typing import Sequence
+
+from analysis.io.tables import write_text
+from analysis.io.validation_record import read_group_record, read_record, write_group_record
+from analysis.studies.validation.record import record_page
+from engines.config import load_config
+from engines.layout import VALIDATION_RECORD
+from engines.planning import config_estimates
+from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, group_costs, group_status, planned_runs,
+                                       status_lines)
+
+#: The record's page, in its folder.
+RECORD_PAGE = "README.md"
+
+
+def recorded_runs(record_dir: str | Path) -> dict[str, set[str]]:
+    """``{group: {run id}}`` from each group's provenance (``<record_dir>/<group>/runs.csv``); a group without the
+    file is absent."""
+    return {name: {run["run_id"] for run in record.runs} for name, record in read_record(record_dir, GROUPS).items()}
+
+
+def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) -> list[str]:
+    """Copy the records the pipeline wrote under ``workdir`` (:data:`engines.layout.VALIDATION_RECORD`) of
+    ``groups`` into ``record_dir``, each replacing that group's previous record; returns the groups copied (a group
+    the pipeline has not recorded is left as it is)."""
+    copied = []
+    for name in groups:
+        source = Path(workdir) / VALIDATION_RECORD / name
+        if (source / "runs.csv").is_file():
+            record = read_group_record(source)
+            write_group_record(Path(record_dir) / name, record.rows, record.runs,
+                               {plot: source / plot for plot in record.plots})
+            copied.append(name)
+    return copied
+
+
+def page(config_path: str, full_scale_path: str, record_dir: str | Path) -> str:
+    """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
+    group's cost at the scale of ``full_scale_path``."""
+    planned = planned_runs(config_estimates(load_config(config_path)))
+    record = read_record(record_dir, GROUPS)
+    status = group_status(planned, {name: {run["run_id"] for run in group.runs} for name, group in record.items()})
+    full_scale = {cost.name: cost.core_seconds for cost in group_costs(config_estimates(load_config(full_scale_path)),
+                                                                          cores=1)}
+    return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS}, config_path,
+                       full_scale_path)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line; returns 0 when every group is complete (status) or the group exists (check), 1 when a group is
+    stale or missing, 2 on a usage error."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) == 2 and argv[0] == "check":
+        try:
+            check_group(argv[1])
+        except ValueError as error:
+            print(f"siloflow: {error}", file=sys.stderr)
+            return 2
+        return 0
+    if len(argv) == 3 and argv[0] == "status":
+        planned = planned_runs(config_estimates(load_config(argv[1])))
+        recorded = recorded_runs(argv[2])
+        print(f"The validation record in {argv[2]} against the runs {argv[1]} plans:")
+        print("\n".join(status_lines(planned, recorded)))
+        return 1 if {STALE, MISSING} & set(group_status(planned, recorded).values()) else 0
+    if len(argv) in (3, 4) and argv[0] == "publish":
+        try:
+            groups = [check_group(argv[3])] if len(argv) == 4 else list(GROUPS)
+        except ValueError as error:
+            print(f"siloflow: {error}", file=sys.stderr)
+            return 2
+        copied = publish(argv[1], argv[2], groups)
+        print(f"validation record of {', '.join(copied) or 'no group'} copied into {argv[2]}")
+        return 0
+    if len(argv) == 4 and argv[0] == "page":
+        path = write_text(Path(argv[3]) / RECORD_PAGE, page(argv[1], argv[2], argv[3]))
+        print(f"siloflow result: {path.resolve()}")
+        return 0
+    print("usage: validation_record_cli.py status CONFIG RECORD_DIR | publish WORKDIR RECORD_DIR [GROUP] | "
+          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP", file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
