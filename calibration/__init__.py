@@ -1,1 +1,1 @@
-"""Calibration of particle-scale DEM parameters against Jenike shear tests (see issue 3)."""
+"""Calibration of particle-scale DEM parameters against Jenike shear tests."""

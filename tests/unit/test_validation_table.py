@@ -32,9 +32,11 @@ def test_verdict_ratio_and_resolution():
 # --------------------------------------------------------------------------- calibration
 
 
-def _bulk(shape, mu, bulk, error, lid="rigid", restitution=0.1, blocked=False, test="internal", rolling=0.0):
+def _bulk(shape, mu, bulk, error, lid="rigid", restitution=0.1, blocked=False, test="internal", rolling=0.0,
+          window="steady"):
     return {"shape": shape, "test": test, "lid": lid, "rolling_friction": rolling, "restitution": restitution,
-            "rotation_blocked": blocked, "particle_friction": mu, "bulk_friction": bulk, "bulk_friction_error": error}
+            "rotation_blocked": blocked, "particle_friction": mu, "bulk_friction": bulk, "bulk_friction_error": error,
+            "window_method": window}
 
 
 PARAMETERS = {"shape": "sphere2", "rolling_friction": 0.0, "tolerance_deg": 1.0, "targets_deg": {"internal": 30.0},
@@ -66,6 +68,26 @@ def test_a_curve_that_rises_then_levels_off_in_a_wide_cell_shows_where_bulk_fric
     # the same curves in a 40 mm cell: 10 diameters, below 20
     small = calibration_rows(rows, PARAMETERS, 0.04, diameters, 0.1, "rigid", CRITERIA)
     assert all(r["scale_shows"] == NO for r in small if r["figure"].startswith("Bulk friction at"))
+
+
+def test_a_row_whose_shear_tests_did_not_all_reach_a_steady_window_does_not_show_its_physics():
+    """A bulk friction averaged over the second half of a shear that never reached a plateau is a transient."""
+    steady = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01), _bulk("sphere2", 0.5, 0.56, 0.01),
+              _bulk("sphere2", 0.3, 0.60, 0.01, lid="servo")]
+    transient = [*steady[:2], _bulk("sphere2", 0.5, 0.56, 0.01, window="second half"), steady[3]]
+    unsaid = [*steady[:2], _bulk("sphere2", 0.5, 0.56, 0.01, window=""), steady[3]]
+    judged = {}
+    for name, rows in (("steady", steady), ("transient", transient), ("unsaid", unsaid)):
+        table = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", CRITERIA)
+        judged[name] = {r["figure"].split(" (")[0].split(",")[0]: r for r in table}
+    curve, lid, chosen = "Bulk friction at particle friction 0.5", "Bulk friction", "Calibrated particle sliding friction"
+    assert [judged["steady"][f]["scale_shows"] for f in (curve, lid, chosen)] == [YES, YES, YES]
+    assert "steady shear window in 3 of 3 shear tests" in judged["steady"][curve]["evidence"]
+    assert "steady shear window in 4 of 4 shear tests" in judged["steady"][lid]["evidence"]  # both lids' points
+    assert [judged["transient"][f]["scale_shows"] for f in (curve, lid, chosen)] == [NO, NO, NO]
+    assert "steady shear window in 2 of 3 shear tests (the others a transient)" in judged["transient"][curve]["evidence"]
+    assert [judged["unsaid"][f]["scale_shows"] for f in (curve, lid, chosen)] == [UNKNOWN, UNKNOWN, UNKNOWN]
+    assert "(the others do not say)" in judged["unsaid"][chosen]["evidence"]
 
 
 def test_a_curve_of_two_points_cannot_show_where_it_stops_rising():

@@ -9,6 +9,10 @@ Rows (see :mod:`analysis.studies.validation.rows`):
   against the base one, on the same sweep points;
 - the calibrated particle-scale friction coefficients.
 
+Every row says whether the shear tests it draws on reached a steady window (``window_method`` of each point,
+:func:`calibration.friction.bulk_friction_of_shear`): a bulk friction averaged over the second half of a shear that
+never reached a plateau is a transient, and the row's scale does not show the physics.
+
 Inputs are the rows of ``calibration/bulk_friction.csv`` as read (strings are fine) and the calibration's
 ``parameters.yaml`` as read.
 """
@@ -41,13 +45,31 @@ def _point(entry: Mapping) -> tuple[float, float, float]:
             number_or_nan(entry.get("bulk_friction_error")))
 
 
-def _curves(rows: Sequence[Mapping], keep) -> dict[tuple, list[tuple[float, float, float]]]:
+def _entries(rows: Sequence[Mapping], keep) -> dict[tuple, list[Mapping]]:
+    """The sweep points ``keep`` selects, per curve (shape, test, rolling friction), by particle friction."""
     curves: dict[tuple, list] = {}
     for entry in rows:
         if keep(entry):
             key = (entry["shape"], entry["test"], float(entry["rolling_friction"]))
-            curves.setdefault(key, []).append(_point(entry))
-    return {key: sorted(points) for key, points in sorted(curves.items())}
+            curves.setdefault(key, []).append(entry)
+    return {key: sorted(entries, key=_point) for key, entries in sorted(curves.items())}
+
+
+def _curves(rows: Sequence[Mapping], keep) -> dict[tuple, list[tuple[float, float, float]]]:
+    return {key: [_point(entry) for entry in entries] for key, entries in _entries(rows, keep).items()}
+
+
+def _steady(entries: Sequence[Mapping]) -> tuple[bool | None, str]:
+    """Whether every shear test of ``entries`` reached a steady window (None when one does not say), and the
+    evidence text."""
+    if not entries:
+        return None, "no shear test of this curve in the table"
+    methods = [entry.get("window_method") or None for entry in entries]
+    steady = sum(method == "steady" for method in methods)
+    text = f"steady shear window in {steady} of {len(methods)} shear tests"
+    if None in methods:
+        return None, text + " (the others do not say)"
+    return steady == len(methods), text if steady == len(methods) else text + " (the others a transient)"
 
 
 def _not(condition):
@@ -60,8 +82,21 @@ def _cell_text(cell_diameter: float, diameter: float, criteria: Criteria) -> tup
         f"cell {cell_diameter * 1000:.0f} mm = {ratio:.1f} particle diameters (>= {criteria.min_cell_diameters:g})")
 
 
-def _curve_row(label: str, key: tuple, points: list, cell_ok: bool, cell_text: str, criteria: Criteria) -> dict:
+def _both(a: bool | None, b: bool | None) -> bool | None:
+    """Both conditions: False when one fails, None when one is not known, else True."""
+    return False if False in (a, b) else None if None in (a, b) else True
+
+
+def _judged(cell: tuple[bool, str], entries: Sequence[Mapping]) -> tuple[bool | None, str]:
+    """The cell's judgement joined with the steadiness of the shear tests a row draws on."""
+    steady_ok, steady_text = _steady(entries)
+    return _both(cell[0], steady_ok), f"{cell[1]}; {steady_text}"
+
+
+def _curve_row(label: str, key: tuple, entries: list, cell_ok: bool, cell_text: str, criteria: Criteria) -> dict:
     shape, test, rolling = key
+    points = [_point(entry) for entry in entries]
+    cell_ok, cell_text = _judged((cell_ok, cell_text), entries)
     k = criteria.coverage_factor
     text = "; ".join(f"{mu:g}: {plus_minus(b, e)}" for mu, b, e in points)
     mu, bulk, error = points[-1]
@@ -134,39 +169,38 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
                 and entry["lid"] == lid)
 
     curves = _curves(bulk_rows, chart)
-    blocked = _curves(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and e["lid"] == lid
-                      and float(e["restitution"]) == base_restitution)
-    other_lid = _curves(bulk_rows, lambda e: e["lid"] != lid and not _flag(e["rotation_blocked"])
-                        and float(e["restitution"]) == base_restitution)
+    chart_entries = _entries(bulk_rows, chart)
+    blocked = _entries(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and e["lid"] == lid
+                       and float(e["restitution"]) == base_restitution)
+    other_lid = _entries(bulk_rows, lambda e: e["lid"] != lid and not _flag(e["rotation_blocked"])
+                         and float(e["restitution"]) == base_restitution)
     restitutions = sorted({float(e["restitution"]) for e in bulk_rows} - {base_restitution})
     rows = []
-    for key, points in curves.items():
+    for key, entries in chart_entries.items():
         cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
-        rows.append(_curve_row(f"{lid} lid", key, points, cell_ok, cell_text, criteria))
-    for figure, others, study, expect in (
-        ("Bulk friction, rotation blocked - free", blocked, "higher with rotation blocked", True),
-        (f"Bulk friction, {'servo' if lid == 'rigid' else 'rigid'} lid - {lid} lid", other_lid,
-         "a servo lid that cannot tilt overestimates", True),
-    ):
-        for key in others:
-            cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
-            rows += _paired_rows(figure, curves, {key: others[key]}, cell_ok, cell_text, criteria, study, expect)
+        rows.append(_curve_row(f"{lid} lid", key, entries, cell_ok, cell_text, criteria))
+    comparisons = [("Bulk friction, rotation blocked - free", blocked, "higher with rotation blocked", True),
+                   (f"Bulk friction, {'servo' if lid == 'rigid' else 'rigid'} lid - {lid} lid", other_lid,
+                    "a servo lid that cannot tilt overestimates", True)]
     for restitution in restitutions:
-        extra = _curves(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and e["lid"] == lid
-                        and not _flag(e["rotation_blocked"]))
-        for key in extra:
-            cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
-            rows += _paired_rows(f"Bulk friction, restitution {restitution:g} - {base_restitution:g}", curves,
-                                 {key: extra[key]}, cell_ok, cell_text, criteria,
-                                 "insensitive to restitution", False)
-    rows += _calibrated_rows(parameters, cell_diameter, particle_diameters, criteria)
+        extra = _entries(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and e["lid"] == lid
+                         and not _flag(e["rotation_blocked"]))
+        comparisons.append((f"Bulk friction, restitution {restitution:g} - {base_restitution:g}", extra,
+                            "insensitive to restitution", False))
+    for figure, others, study, expect in comparisons:
+        for key, entries in others.items():
+            cell_ok, cell_text = _judged(_cell_text(cell_diameter, particle_diameters[key[0]], criteria),
+                                         [*chart_entries.get(key, []), *entries])
+            rows += _paired_rows(figure, curves, {key: [_point(entry) for entry in entries]}, cell_ok, cell_text,
+                                 criteria, study, expect)
+    rows += _calibrated_rows(parameters, cell_diameter, particle_diameters, chart_entries, criteria)
     return rows
 
 
 def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diameters: Mapping[str, float],
-                     criteria: Criteria) -> list[dict]:
+                     chart_entries: Mapping[tuple, list], criteria: Criteria) -> list[dict]:
     shape = parameters["shape"]
-    cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[shape], criteria)
+    cell = _cell_text(cell_diameter, particle_diameters[shape], criteria)
     found = [("internal", parameters.get("particle_particle"))]
     found += sorted((parameters.get("particle_wall") or {}).items())
     rows = []
@@ -175,6 +209,8 @@ def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diamete
             continue
         target = parameters["targets_deg"].get(test)
         clipped = bool(result.get("band_clipped"))
+        # the chart this coefficient was read from: the calibration shape's curve of this test
+        cell_ok, cell_text = _judged(cell, chart_entries.get((shape, test, float(parameters["rolling_friction"])), []))
         rows.append(row(
             GROUP, f"Calibrated particle sliding friction ({'particle-particle' if test == 'internal' else 'particle-' + test})",
             f"{shape}, rolling {parameters['rolling_friction']:g}", result["sliding_friction"],
