@@ -109,7 +109,9 @@ for _group, _kinds in GROUPS.items():
         name:
             f"validate_{_group}"
         input:
-            [target for kind in _kinds for target in KIND_TARGETS[kind]()],
+            # input functions: the flat-bottom silo's runs are known only after the calibration when it uses
+            # calibrated parameters
+            lambda wildcards, kinds=_kinds: [target for kind in kinds for target in KIND_TARGETS[kind]()],
             [f"{VALIDATION_RECORD}/{_group}/{name}" for name in ("runs.csv", "table.csv")] if _group in ROW_GROUPS else [],
 
 
@@ -146,17 +148,20 @@ for _group in ROW_GROUPS:
         name:
             f"validation_record_{_group}"
         input:
+            # input functions, as above: the runs of a calibrated silo are known after the calibration
             rows=f"{VALIDATION}/rows/{_group}.csv",
-            records=[run_path(kind, RUN_RECORD, run) for kind in GROUPS[_group] for run in run_ids(kind)],
-            benchmarks=[run_path(kind, RUN_BENCHMARK, run) for kind in GROUPS[_group] for run in run_ids(kind)],
-            plots=list(record_plots(_group).values()),
+            records=lambda wildcards, kinds=GROUPS[_group]: [run_path(kind, RUN_RECORD, run) for kind in kinds
+                                                             for run in run_ids(kind)],
+            benchmarks=lambda wildcards, kinds=GROUPS[_group]: [run_path(kind, RUN_BENCHMARK, run) for kind in kinds
+                                                                for run in run_ids(kind)],
+            plots=lambda wildcards, group=_group: list(record_plots(group).values()),
         output:
             runs=f"{VALIDATION_RECORD}/{_group}/runs.csv",
             table=f"{VALIDATION_RECORD}/{_group}/table.csv",
         params:
-            kinds=GROUPS[_group],
-            plot_names=list(record_plots(_group)),
-            seeds={run: run_seeds(case) for kind in GROUPS[_group] for run, case in cases(kind).items()},
+            plot_names=lambda wildcards, group=_group: list(record_plots(group)),
+            seeds=lambda wildcards, kinds=GROUPS[_group]: {run: run_seeds(case) for kind in kinds
+                                                           for run, case in cases(kind).items()},
         log:
             f"{VALIDATION_RECORD}/{_group}.log",
         script:
