@@ -1,7 +1,7 @@
 """The real blending pipeline on a tiny recirculating silo: LIGGGHTS under MPI with a periodic vertical boundary.
 
-About 1,000 two-sphere clumps recirculate for about four mean residence times on 2 MPI ranks, the domain split
-along the periodic direction; a one-particle-thick silo of about 400 clumps verifies the Eulerian RTD (a run of its
+About 1,000 two-sphere clumps recirculate for about four mean residence times, on one rank in `make test` and on 2
+MPI ranks in `make test-physics` (the domain split along the periodic direction); a one-particle-thick silo of about 400 clumps verifies the Eulerian RTD (a run of its
 own, in `make test-physics` only). A few minutes in all.
 """
 
@@ -38,9 +38,12 @@ CONFIG = {
     # the recirculating silo inherits fill and settle from defaults
     "defaults": {"fill": TINY_SILO["fill"], "settle": TINY_SILO["settle"]},
 }
-#: the blending study without the thin verification silo (the same blending run)
+#: the blending study without the thin verification silo (the same blending run), on 2 MPI ranks
 BLENDING_ONLY = {**CONFIG, "silo_recirculation": {**TINY_BLENDING,
                                                   "verification": {**TINY_BLENDING["verification"], "enabled": False}}}
+#: the fast tier's run: the same on one rank (the run on 2 ranks, the domain split along the periodic direction, is
+#: the physics tier's study-step run below)
+ONE_RANK = {**BLENDING_ONLY, "engine": {"mpi_ranks": 1}}
 
 
 def _blending(workdir, config: dict):
@@ -59,7 +62,7 @@ def _blending(workdir, config: dict):
 def blending_pipeline(tmp_path_factory):
     """Run the blending targets once, without the thin verification silo; yields (workdir, {role: run directory},
     cases)."""
-    yield _blending(tmp_path_factory.mktemp("blending"), BLENDING_ONLY)
+    yield _blending(tmp_path_factory.mktemp("blending"), ONE_RANK)
 
 
 #: the same run at the study's step: Little's law and the shortcut compare two estimates of the residence time, and at
@@ -99,7 +102,7 @@ def test_clump_count_is_conserved_over_more_than_one_recirculation(blending_pipe
     loaded, case = _tracks_and_case(runs["blending"])
     tracks = loaded.tracks
     record = read_run_record(runs["blending"] / "run.json")
-    assert record.mpi_ranks == 2
+    assert record.mpi_ranks == 1
     # Every clump is in every dump, with its id: none lost or duplicated at the periodic boundary.
     assert tracks.n_clumps == case["n_clumps"] == int(record.stage("recirculate")["clumps"])
     assert tracks.present.all()
@@ -164,6 +167,20 @@ def test_make_run_outputs_exist_and_the_prediction_tracks_the_measurement(blendi
         assert layout["prediction_rms_error"] < 0.7 * (p * (1.0 - p)) ** 0.5
     rows = list(csv.DictReader((workdir / case_root("silo_recirculation") / "summary" / "blending.csv").open()))
     assert len(rows) == 5
+
+
+@pytest.mark.physics  # the run on 2 MPI ranks
+def test_no_clump_is_lost_or_duplicated_where_the_periodic_boundary_crosses_the_ranks(
+        blending_pipeline_at_the_study_step):
+    _, runs, _ = blending_pipeline_at_the_study_step
+    loaded, case = _tracks_and_case(runs["blending"])
+    record = read_run_record(runs["blending"] / "run.json")
+    assert record.mpi_ranks == 2
+    assert loaded.tracks.n_clumps == case["n_clumps"] == int(record.stage("recirculate")["clumps"])
+    assert loaded.tracks.present.all()
+    events = recirculation_events(loaded.tracks, 0.0, *case["domain_z"])
+    summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
+    assert events.exit_times_all.size > summary["holdup_clumps"]
 
 
 @pytest.mark.physics
