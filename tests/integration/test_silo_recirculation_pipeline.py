@@ -29,7 +29,7 @@ from engines.config import validate_config
 from engines.layout import case_root, run_dir, run_path
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(220)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(170)]
 
 CONFIG = {
     "silo_recirculation": TINY_BLENDING,
