@@ -87,6 +87,11 @@ class RecirculationCase:
         return self.silo.gravity
 
     @property
+    def seeds(self) -> tuple[int, ...]:
+        """The random seeds the engine is given: the silo's."""
+        return self.silo.seeds
+
+    @property
     def run_id(self) -> str:
         """Directory name: role, flow pattern and a hash of every defining parameter."""
         prefix = self.pattern if self.role == "blending" else f"thin-{self.pattern}"

@@ -115,11 +115,6 @@ for _group, _kinds in GROUPS.items():
             [f"{VALIDATION_RECORD}/{_group}/{name}" for name in ("runs.csv", "table.csv")] if _group in ROW_GROUPS else [],
 
 
-def run_seeds(case):
-    """The random seeds a run's engine was given (a recirculating silo's are those of its silo)."""
-    return list(case.seeds if hasattr(case, "seeds") else case.silo.seeds)
-
-
 def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
     profiles and Janssen comparison with the front-wall series, VRR against Nr, the blender's passage velocities
@@ -160,7 +155,7 @@ for _group in ROW_GROUPS:
             table=f"{VALIDATION_RECORD}/{_group}/table.csv",
         params:
             plot_names=lambda wildcards, group=_group: list(record_plots(group)),
-            seeds=lambda wildcards, kinds=GROUPS[_group]: {run: run_seeds(case) for kind in kinds
+            seeds=lambda wildcards, kinds=GROUPS[_group]: {run: list(case.seeds) for kind in kinds
                                                            for run, case in cases(kind).items()},
         log:
             f"{VALIDATION_RECORD}/{_group}.log",

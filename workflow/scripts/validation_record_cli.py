@@ -30,10 +30,15 @@ from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, grou
 RECORD_PAGE = "README.md"
 
 
+def _run_ids(record: dict) -> dict[str, set[str]]:
+    """``{group: {run id}}`` of a record read with :func:`analysis.io.validation_record.read_record`."""
+    return {name: {run["run_id"] for run in group.runs} for name, group in record.items()}
+
+
 def recorded_runs(record_dir: str | Path) -> dict[str, set[str]]:
     """``{group: {run id}}`` from each group's provenance (``<record_dir>/<group>/runs.csv``); a group without the
     file is absent."""
-    return {name: {run["run_id"] for run in record.runs} for name, record in read_record(record_dir, GROUPS).items()}
+    return _run_ids(read_record(record_dir, GROUPS))
 
 
 def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) -> list[str]:
@@ -56,7 +61,7 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path) -> str:
     group's cost at the scale of ``full_scale_path``."""
     planned = planned_runs(config_estimates(load_config(config_path)))
     record = read_record(record_dir, GROUPS)
-    status = group_status(planned, {name: {run["run_id"] for run in group.runs} for name, group in record.items()})
+    status = group_status(planned, _run_ids(record))
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(config_estimates(load_config(full_scale_path)),
                                                                           cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS}, config_path,
