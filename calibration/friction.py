@@ -40,7 +40,13 @@ __all__ = [
     "friction_coefficient",
     "bulk_friction_of_shear",
     "bulk_friction_summary",
+    "STEADY",
+    "SECOND_HALF",
+    "combined_window_method",
 ]
+
+#: How a shear test's window was chosen (:func:`bulk_friction_of_shear`).
+STEADY, SECOND_HALF = "steady", "second half"
 
 
 # --------------------------------------------------------------------------- results
@@ -549,13 +555,29 @@ def bulk_friction_of_shear(signals) -> tuple[BulkFriction, str]:
         signals.weight_above,
     )
     try:
-        return bulk_friction(*arguments), "steady"
+        return bulk_friction(*arguments), STEADY
     except ValueError as error:
         if "no steady shear" not in str(error):
             raise
     time = np.asarray(signals.time, dtype=float)
     half = time[0] + 0.5 * (time[-1] - time[0])
-    return bulk_friction(*arguments, window=(half, time[-1])), "second half"
+    return bulk_friction(*arguments, window=(half, time[-1])), SECOND_HALF
+
+
+def combined_window_method(methods) -> str:
+    """The window method of a point run with several seeds: :data:`STEADY` only when every seed's shear reached a
+    steady window, else :data:`SECOND_HALF`.
+
+    Raises
+    ------
+    ValueError
+        Without methods, or with one that is neither.
+    """
+    methods = list(methods)
+    unknown = sorted(set(methods) - {STEADY, SECOND_HALF})
+    if not methods or unknown:
+        raise ValueError(f"window methods must be {STEADY!r} or {SECOND_HALF!r}, at least one; got {methods!r}")
+    return STEADY if all(method == STEADY for method in methods) else SECOND_HALF
 
 
 def bulk_friction_summary(friction: BulkFriction, window_method: str) -> dict:

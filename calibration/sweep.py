@@ -14,15 +14,17 @@ from __future__ import annotations
 INTERNAL = "internal"
 
 def is_chart_point(point: dict, base_restitution: float) -> bool:
-    """Whether a point belongs on the calibration chart (base restitution, rotation free, configured lid)."""
-    return point["restitution"] == base_restitution and not point["rotation_blocked"] and "lid" not in point
+    """Whether a point belongs on the calibration chart (base restitution, rotation free, configured lid and shear
+    velocity)."""
+    return (point["restitution"] == base_restitution and not point["rotation_blocked"] and "lid" not in point
+            and "shear_velocity" not in point)
 
 
-def chart_rows(rows, base_restitution: float, lid: str) -> list[dict]:
+def chart_rows(rows, base_restitution: float, lid: str, shear_velocity: float) -> list[dict]:
     """Rows of the calibration table (as read from CSV) that belong on the chart.
 
-    The chart holds the base restitution, free rotation and the configured lid; the sensitivity,
-    rotation-blocked and lid-comparison rows are left out.
+    The chart holds the base restitution, free rotation, the configured lid and the configured shear velocity (m/s);
+    the sensitivity, rotation-blocked, lid-comparison and shear-speed rows are left out.
     """
     return [
         row
@@ -30,10 +32,11 @@ def chart_rows(rows, base_restitution: float, lid: str) -> list[dict]:
         if float(row["restitution"]) == base_restitution
         and str(row["rotation_blocked"]) == "False"
         and row["lid"] == lid
+        and float(row["shear_velocity"]) == shear_velocity
     ]
 
 
-def lid_comparison(rows, base_restitution: float) -> list[dict]:
+def lid_comparison(rows, base_restitution: float, shear_velocity: float) -> list[dict]:
     """Pair the internal-friction results of the two lids at the same shape, rolling and sliding friction.
 
     Parameters
@@ -42,6 +45,8 @@ def lid_comparison(rows, base_restitution: float) -> list[dict]:
         Calibration table rows (strings as read from CSV are fine) with ``lid`` and ``bulk_friction``.
     base_restitution : float
         Only rows at this restitution, with free rotation, are compared.
+    shear_velocity : float
+        Only rows sheared at this velocity (m/s) are compared.
 
     Returns
     -------
@@ -53,7 +58,7 @@ def lid_comparison(rows, base_restitution: float) -> list[dict]:
     for row in rows:
         if row["test"] != "internal" or str(row["rotation_blocked"]) != "False":
             continue
-        if float(row["restitution"]) != base_restitution:
+        if float(row["restitution"]) != base_restitution or float(row["shear_velocity"]) != shear_velocity:
             continue
         key = (row["shape"], float(row["rolling_friction"]), float(row["particle_friction"]))
         by_lid.setdefault(key, {})[row["lid"]] = float(row["bulk_friction"])

@@ -37,7 +37,7 @@ class ConfigError(ValueError):
 #: Keys a silo-type case section inherits from ``defaults`` when it leaves them out.
 SHARED_KEYS = (
     "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction", "timestep_hertz_fraction",
-    "seed", "replicates",
+    "seed", "replicates", "reference_replicates",
 )
 #: The case sections that inherit from ``defaults``.
 INHERITING_SECTIONS = ("silo_flat", "silo_recirculation", "blender")

@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from analysis.data.record import RunRecordError, read_run_record
-from engines.cases import CASE_BUILDERS, cases_of
+from engines.cases import CASE_BUILDERS, cases_of, reference_runs
 from engines.config import load_config
 from engines.interface import engine_for
 from engines.estimates import (
@@ -31,7 +31,7 @@ from engines.estimates import (
     total_dump_bytes,
 )
 from engines.layout import RUN_RECORD, run_dir
-from engines.validation_groups import cost_lines, group_costs
+from engines.validation_groups import assign, cost_lines, group_costs
 
 
 def cost_model(config: dict) -> CostModel:
@@ -270,6 +270,11 @@ def comparison_report(measured: list[tuple[RunEstimate, MeasuredWork]], steps: l
     return "\n".join(lines)
 
 
+def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[RunEstimate]]:
+    """The runs each validation group makes, of a configuration's ``estimates`` (:func:`engines.validation_groups.assign`)."""
+    return assign(estimates, {kind: reference_runs(config, kind) for kind in CASE_BUILDERS})
+
+
 def main(argv: list[str] | None = None) -> int:
     """Print the estimate table of a configuration file, the cost of each validation group on ``--cores`` cores
     (default 2), the free space of the results folder and, for the runs that have finished there, estimated against
@@ -301,7 +306,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{model.settle_fraction:.0%} of its longest time)")
     print(estimate_table(config_estimates(config, model) if measured else estimates))
     print()
-    print("\n".join(cost_lines(group_costs(config_estimates(config, model) if measured else estimates, cores), cores)))
+    made = group_runs(config, config_estimates(config, model) if measured else estimates)
+    print("\n".join(cost_lines(group_costs(made, cores), cores)))
     waiting = pending(estimates, results)
     print(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
           f"{format_bytes(total_dump_bytes(waiting))}; {format_bytes(free_bytes(results))} free for {results}/")

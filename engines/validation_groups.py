@@ -15,13 +15,43 @@ from typing import Iterable, Mapping, Sequence
 
 from engines.estimates import BLENDER, JENIKE, RECIRCULATION, SILO_FLAT, RunEstimate
 
-#: The groups in the order `make validate` runs them, each with the case kinds whose runs it makes: a group is one
-#: stage of the study, so that its rows can be judged on its own runs.
-GROUPS: dict[str, tuple[str, ...]] = {
-    "calibration": (JENIKE,),
-    "silo": (SILO_FLAT,),
-    "blending": (RECIRCULATION,),
-    "blender": (BLENDER,),
+#: Which runs of its case kind a group makes: all of them, the reference configuration's (one per seed,
+#: :func:`engines.cases.reference_runs`) or the others.
+ALL, REFERENCE, VARIANTS = "all", "reference", "variants"
+
+
+@dataclass(frozen=True)
+class Group:
+    """One validation group: the runs it makes and the groups whose runs its rows also draw on.
+
+    Attributes
+    ----------
+    kind : str
+        The case kind whose runs it makes.
+    part : str
+        :data:`ALL`, :data:`REFERENCE` or :data:`VARIANTS` of that kind's runs.
+    reads : tuple of str
+        Groups (earlier in :data:`GROUPS`) whose runs its rows compare against.
+    """
+
+    kind: str
+    part: str = ALL
+    reads: tuple[str, ...] = ()
+
+    def makes(self, kind: str, reference: bool) -> bool:
+        """Whether this group makes a run of ``kind``, a run of the reference configuration or not."""
+        return kind == self.kind and (self.part == ALL or (self.part == REFERENCE) == reference)
+
+
+#: The groups in the order `make validate` runs them: a group is one stage of the study, so that its rows can be
+#: judged on its own runs. The flat-bottom silo is two: its base configuration over seeds (every figure of the silo)
+#: and the front-wall friction series that is compared against it, each inside the budget.
+GROUPS: dict[str, Group] = {
+    "calibration": Group(JENIKE),
+    "silo": Group(SILO_FLAT, REFERENCE),
+    "silo_series": Group(SILO_FLAT, VARIANTS, reads=("silo",)),
+    "blending": Group(RECIRCULATION),
+    "blender": Group(BLENDER),
 }
 
 #: The longest a group may take on the cores of one machine (s): a working session.
@@ -31,12 +61,29 @@ GROUP_BUDGET_S = 2.5 * 3600.0
 COMPLETE, STALE, MISSING = "complete", "stale", "missing"
 
 
-def group_of(kind: str) -> str:
-    """The group that makes the runs of case kind ``kind``."""
-    for name, kinds in GROUPS.items():
-        if kind in kinds:
+def group_of(kind: str, reference: bool) -> str:
+    """The group that makes a run of case kind ``kind`` (of the reference configuration or not)."""
+    for name, group in GROUPS.items():
+        if group.makes(kind, reference):
             return name
     raise KeyError(f"no validation group makes runs of kind {kind!r}; the groups are {', '.join(GROUPS)}")
+
+
+def assign(estimates: Sequence[RunEstimate], references: Mapping[str, Iterable[str]]) -> dict[str, list[RunEstimate]]:
+    """The runs each group makes: ``{group: [estimate]}`` in :data:`GROUPS` order.
+
+    Parameters
+    ----------
+    estimates : sequence of RunEstimate
+        A configuration's run estimates (:func:`engines.planning.config_estimates`).
+    references : mapping
+        ``{case kind: run ids of its reference configuration}`` (:func:`engines.cases.reference_runs`).
+    """
+    reference = {kind: set(runs) for kind, runs in references.items()}
+    made: dict[str, list[RunEstimate]] = {name: [] for name in GROUPS}
+    for estimate in estimates:
+        made[group_of(estimate.kind, estimate.run_id in reference.get(estimate.kind, ()))].append(estimate)
+    return made
 
 
 def check_group(name: str) -> str:
@@ -100,12 +147,11 @@ class GroupCost:
     over_budget: bool
 
 
-def group_costs(estimates: Sequence[RunEstimate], cores: int) -> list[GroupCost]:
-    """The cost of each group (in :data:`GROUPS` order) of a configuration's run estimates on ``cores`` cores; a
-    run on several MPI ranks takes that many cores for its wall time."""
+def group_costs(made: Mapping[str, Sequence[RunEstimate]], cores: int) -> list[GroupCost]:
+    """The cost of each group of the runs it makes (:func:`assign`) on ``cores`` cores; a run on several MPI ranks
+    takes that many cores for its wall time."""
     costs = []
-    for name, kinds in GROUPS.items():
-        members = [e for e in estimates if e.kind in kinds]
+    for name, members in made.items():
         # a run on r ranks holds r cores for its wall time: as r jobs of that length
         jobs = [e.wall_time_s for e in members for _ in range(min(e.mpi_ranks, cores))]
         wall = makespan(jobs, cores)
@@ -114,12 +160,13 @@ def group_costs(estimates: Sequence[RunEstimate], cores: int) -> list[GroupCost]
     return costs
 
 
-def planned_runs(estimates: Sequence[RunEstimate]) -> dict[str, set[str]]:
-    """The run ids each group plans, from a configuration's estimates: ``{group: {run id}}``."""
-    planned: dict[str, set[str]] = {name: set() for name in GROUPS}
-    for estimate in estimates:
-        planned[group_of(estimate.kind)].add(estimate.run_id)
-    return planned
+def planned_runs(made: Mapping[str, Sequence[RunEstimate]]) -> dict[str, set[str]]:
+    """The run ids behind each group's rows (:func:`assign`'s runs it makes and those of the groups it reads):
+    ``{group: {run id}}`` of the groups that make a run in this configuration (a silo without a front-wall series
+    has no series group)."""
+    own = {name: {estimate.run_id for estimate in members} for name, members in made.items()}
+    return {name: own[name].union(*(own.get(other, set()) for other in GROUPS[name].reads))
+            for name in own if own[name]}
 
 
 def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]]) -> dict[str, str]:

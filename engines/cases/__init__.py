@@ -13,7 +13,7 @@ from engines.cases.jenike import jenike_cases
 from engines.cases.silo_flat import silo_cases
 from engines.cases.silo_recirculation import recirculation_cases
 
-__all__ = ["CASE_BUILDERS", "case_for_run", "cases_of"]
+__all__ = ["CASE_BUILDERS", "case_for_run", "cases_of", "reference_runs"]
 
 #: Case kind -> function of a validated configuration returning its runs ``{run id: case}``.
 CASE_BUILDERS = {
@@ -29,22 +29,49 @@ CASE_BUILDERS = {
 REPLICATED_CASES = ("silo_flat", "silo_recirculation", "blender")
 
 
+def _replicates(config: dict, case: str) -> tuple[int, int]:
+    """``(N, M)``: runs of every configuration and of the reference configuration (M >= N)."""
+    section = config.get(case, {}) if case in REPLICATED_CASES else {}
+    replicates = section.get("replicates", 1)
+    return replicates, max(replicates, section.get("reference_replicates", 1))
+
+
+def _reseeded(config: dict, case: str, offset: int) -> dict:
+    """The runs of ``case`` with its section's seed raised by ``offset``, in the builder's order."""
+    reseeded = copy.deepcopy(config)
+    reseeded[case]["seed"] += offset
+    return CASE_BUILDERS[case](reseeded)
+
+
 def cases_of(config: dict, case: str) -> dict:
     """The runs of case kind ``case`` a validated configuration defines, keyed by run id.
 
     With ``replicates: N`` (N >= 2) in the case's section, every run is there N times, with the section's seed
     plus 0, 1, ..., N - 1 (distinct engine seeds, so distinct run ids); the first replicate is the run that
-    ``replicates: 1`` gives, so raising N keeps the runs already done.
+    ``replicates: 1`` gives, so raising N keeps the runs already done. With ``reference_replicates: M`` only the
+    reference configuration (:func:`reference_runs`) is there ``max(N, M)`` times, so that a comparison of
+    configurations knows the spread between seeds at the cost of M - N runs.
     """
     if case not in CASE_BUILDERS:
         raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_BUILDERS)}")
     runs = CASE_BUILDERS[case](config)
-    replicates = config.get(case, {}).get("replicates", 1) if case in REPLICATED_CASES else 1
-    for offset in range(1, replicates):
-        reseeded = copy.deepcopy(config)
-        reseeded[case]["seed"] += offset
-        runs.update(CASE_BUILDERS[case](reseeded))
+    replicates, reference = _replicates(config, case)
+    for offset in range(1, reference):
+        others = _reseeded(config, case, offset)
+        # the builders list the reference configuration first
+        runs.update(others if offset < replicates else dict([next(iter(others.items()))]))
     return runs
+
+
+def reference_runs(config: dict, case: str) -> list[str]:
+    """Run ids of the reference configuration of case kind ``case``, one per seed: the first run its builder
+    defines (the base flat-bottom silo, the first flow pattern, the first blender configuration at the lowest
+    gravity factor, the first Jenike sweep point), then its reseeded replicates (:func:`cases_of`)."""
+    if case not in CASE_BUILDERS:
+        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_BUILDERS)}")
+    first = [next(iter(CASE_BUILDERS[case](config)), None)]
+    first += [next(iter(_reseeded(config, case, offset))) for offset in range(1, _replicates(config, case)[1])]
+    return [run for run in first if run is not None]
 
 
 def case_for_run(config: dict, case: str, run: str):

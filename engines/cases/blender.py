@@ -43,7 +43,7 @@ MODES = ("continuous", "batch")
 #: simulation (a replicate is defined by its seed).
 ANALYSIS_ONLY_KEYS = (
     "enabled", "configurations", "gravity_factors", "gravity_configurations", "bin_size", "profile_heights_above",
-    "pathlines", "rtd", "discontinuous", "continuous", "replicates",
+    "pathlines", "rtd", "discontinuous", "continuous", "replicates", "reference_replicates",
 )
 
 
@@ -91,6 +91,11 @@ class BlenderCase:
     def run_id(self) -> str:
         """Directory name: configuration, gravity factor and a hash of every defining parameter."""
         return run_id(f"{self.configuration}-g{self.gravity_factor:g}", self.defining_parameters)
+
+    @property
+    def seeds(self) -> tuple[int, ...]:
+        """The random seeds the engine is given: its silo deck's."""
+        return self.silo.seeds
 
     @property
     def gravity(self) -> float:

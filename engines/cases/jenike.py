@@ -402,7 +402,9 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     point : dict
         ``{"shape": <particle model>, "test": "internal" | <wall material>, "sliding_friction": float,
         "rolling_friction": float, "restitution": float, "rotation_blocked": bool}``, optionally with
-        ``"lid": "rigid" | "servo"`` overriding ``jenike.lid`` (used to compare the two lids on the same points).
+        ``"lid": "rigid" | "servo"`` overriding ``jenike.lid`` (used to compare the two lids on the same points)
+        ``"replicate": k`` adding k to ``jenike.seed`` (the reference point's extra seeds) and
+        ``"shear_velocity"`` overriding ``jenike.shear.velocity`` (m/s, the shear-speed study).
 
     Raises
     ------
@@ -413,8 +415,15 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     lid = point.get("lid", config["jenike"]["lid"])
     if lid not in LID_KINDS:
         raise ValueError(f"jenike point: lid must be one of {', '.join(LID_KINDS)}, got {lid!r}")
-    point = _check_point({key: value for key, value in point.items() if key != "lid"})
-    jenike = {**config["jenike"], "lid": lid}
+    replicate = point.get("replicate", 0)
+    if not isinstance(replicate, int) or isinstance(replicate, bool) or replicate < 0:
+        raise ValueError(f"jenike point: replicate must be a whole number >= 0, got {replicate!r}")
+    velocity = float(point.get("shear_velocity", config["jenike"]["shear"]["velocity"]))
+    if not velocity > 0.0:
+        raise ValueError(f"jenike point: shear_velocity must be > 0 m/s, got {velocity!r}")
+    point = _check_point({key: value for key, value in point.items() if key not in ("lid", "replicate", "shear_velocity")})
+    jenike = {**config["jenike"], "lid": lid, "seed": config["jenike"]["seed"] + replicate,
+              "shear": {**config["jenike"]["shear"], "velocity": velocity}}
     cell = jenike["cell"]
     materials = config["materials"]
     particle_material = jenike["particle_material"]

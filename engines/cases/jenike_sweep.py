@@ -4,6 +4,9 @@ A sweep point is a plain dict (it keys the run and travels through Snakemake unc
 
     {"shape": "sphere2", "test": "internal" | <wall material>, "sliding_friction": 0.3,
      "rolling_friction": 0.1, "restitution": 0.1, "rotation_blocked": False}
+
+with ``"lid"`` on the lid comparison's points, ``"replicate"`` (>= 1, added to the seed) on the reference point's
+extra seeds and ``"shear_velocity"`` (m/s) on its shear-speed study.
 """
 
 from __future__ import annotations
@@ -27,7 +30,9 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
     test at every sliding friction and the first rolling friction with the other lid (key ``"lid"``).
     These three studies go to the shapes of ``sensitivity_shapes`` and (the first two) the tests of
     ``sensitivity_tests`` (null: all). Duplicates are dropped, order is
-    stable.
+    stable. With ``reference_replicates: M`` the reference point (:func:`reference_point`) runs M times: the
+    copies carry ``"replicate": 1 ... M - 1``, which the case adds to its seed. The shear-speed study runs the
+    reference point at each velocity of ``shear_velocity_sensitivity`` (key ``"shear_velocity"``, m/s).
 
     Parameters
     ----------
@@ -88,4 +93,22 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
                 }
                 if point not in points:
                     points.append(point)
+    reference = reference_point(sweep)
+    if reference is not None and reference in points:
+        points += [{**reference, "replicate": k} for k in range(1, sweep.get("reference_replicates", 1))]
+        points += [{**reference, "shear_velocity": float(v)} for v in sweep.get("shear_velocity_sensitivity", [])]
     return points
+
+
+def reference_point(sweep: dict) -> dict | None:
+    """The sweep point whose seeds give the spread between seeds of every comparison of the sweep: the first
+    sensitivity shape's first sensitivity test at the middle sliding friction, the first rolling friction and the
+    base restitution (the point the restitution study also runs); None without a sensitivity shape."""
+    shapes = sweep.get("sensitivity_shapes") or sweep["shapes"]
+    tests = sweep.get("sensitivity_tests") or sweep["tests"]
+    if not shapes or not tests:
+        return None
+    return {"shape": shapes[0], "test": tests[0],
+            "sliding_friction": float(sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]),
+            "rolling_friction": float(sweep["rolling_friction"][0]), "restitution": float(sweep["restitution"]),
+            "rotation_blocked": False}

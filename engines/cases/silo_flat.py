@@ -31,7 +31,7 @@ CASE_NAME = "silo_flat"
 #: Keys of ``silo_flat`` that only steer the analysis; they do not define (or rerun) the simulation.
 #: Keys that do not define a run: analysis settings, and the replicate count (each replicate is its own run, defined
 #: by its seed).
-ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates", "piv")
+ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates", "reference_replicates", "piv")
 
 
 @dataclass(frozen=True)

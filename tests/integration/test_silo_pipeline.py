@@ -116,29 +116,40 @@ def test_outputs_and_logs_are_where_the_workflow_says(tiny_pipeline):
     assert not (run_dir / "frames").exists()
 
 
-def test_the_silo_group_is_recorded_with_the_provenance_of_its_runs_and_its_page(tiny_pipeline, tmp_path):
-    """`make validate GROUP=silo`'s steps on the tiny configuration: the group's target writes its record (no engine
-    runs again), publish copies it, and the page shows it complete against the configuration."""
+def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_their_page(tiny_pipeline, tmp_path):
+    """`make validate GROUP=silo` and `GROUP=silo_series`'s steps on the tiny configuration: each group's target
+    writes its record (no engine runs again), publish copies them, and the page shows them complete against the
+    configuration. The series' record also lists the base run its rows compare against, made by the silo group."""
     workdir, run_dir, _ = tiny_pipeline
     config_path = workdir / "tiny.yaml"
-    result = run_snakemake(workdir, "--cores", "1", "--configfile", str(config_path), targets=["validate_silo"])
+    result = run_snakemake(workdir, "--cores", "1", "--configfile", str(config_path),
+                           targets=["validate_silo", "validate_silo_series"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "silo_run" not in result.stdout + result.stderr
     record_dir, cli = tmp_path / "docs", validation_record_cli()
-    assert cli.publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
-    record = read_group_record(record_dir / "silo")
+    assert cli.publish(workdir, record_dir, ["calibration", "silo", "silo_series"]) == ["silo", "silo_series"]
+    record, series = read_group_record(record_dir / "silo"), read_group_record(record_dir / "silo_series")
     planned = {case.run_id for case in cases_of(_validated({**TINY_SILO, **SILO_PARAMETRIC}), "silo_flat").values()}
-    assert {run["run_id"] for run in record.runs} == planned and len(planned) == 2
-    base = next(run for run in record.runs if run["run_id"] == run_dir.name)
+    assert len(planned) == 2 and [run["run_id"] for run in record.runs] == [run_dir.name]
+    assert {run["run_id"] for run in series.runs} == planned
+    assert {run["run_id"]: run["group"] for run in series.runs}[run_dir.name] == "silo"
+    (base,) = record.runs
+    assert base["group"] == "silo" and base["seeds"] == " ".join(map(str, next(
+        case for case in cases_of(_validated({**TINY_SILO, **SILO_PARAMETRIC}), "silo_flat").values()
+        if case.run_id == run_dir.name).seeds))
     assert base["engine"] == "liggghts" and base["engine_version"] == liggghts().installed_version() != "unknown"
     assert float(base["wall_time_s"]) > 0.0 and base["cores"] == "1" and len(base["commit"]) >= 40
     assert float(base["simulated_time_s"]) == pytest.approx(max(
         stage["time"] for stage in read_run_record(run_dir / "run.json").stages.values() if "time" in stage))
-    assert {row["group"] for row in record.rows} == {"Flat-bottom silo", "Front-wall friction series"}
-    assert record.plots == ["janssen.png", "profiles.png", "restitution.png"]
-    # the page judges the record against the configuration that made it: the silo group complete, no other recorded
+    assert {row["group"] for row in record.rows} == {"Flat-bottom silo"}
+    assert {row["group"] for row in series.rows} == {"Front-wall friction series"}
+    assert all("one seed: within-run error only" in row["evidence"] for row in record.rows + series.rows)
+    assert record.plots == ["janssen.png", "profiles.png"] and series.plots == ["restitution.png"]
+    # the page judges the record against the configuration that made it: both silo groups complete, each with the
+    # one run it makes
     text = cli.page(str(config_path), str(config_path), record_dir)
-    assert "| silo | complete | 2 |" in text and "| calibration | missing | 0 |" in text
+    assert "| silo | complete | 1 |" in text and "| silo_series | complete | 1 |" in text
+    assert "| calibration | missing | 0 |" in text
 
 
 def test_make_estimate_takes_its_cost_model_from_the_finished_runs(tiny_pipeline):

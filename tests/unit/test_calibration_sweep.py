@@ -61,17 +61,20 @@ def test_lid_comparison_runs_the_internal_points_with_the_other_lid():
 
 def test_lid_comparison_pairs_rows_of_both_lids():
     base = {"shape": "sphere2", "test": "internal", "rolling_friction": "0.0", "restitution": "0.1",
-            "rotation_blocked": "False"}
+            "rotation_blocked": "False", "shear_velocity": "0.03"}
     rows = [
         {**base, "particle_friction": "0.1", "lid": "rigid", "bulk_friction": "0.40"},
         {**base, "particle_friction": "0.1", "lid": "servo", "bulk_friction": "0.46"},
         {**base, "particle_friction": "0.3", "lid": "rigid", "bulk_friction": "0.55"},
         {**base, "test": "wall", "particle_friction": "0.1", "lid": "servo", "bulk_friction": "0.2"},
+        # the shear-speed study's point: in neither the pairs nor the chart
+        {**base, "particle_friction": "0.3", "lid": "servo", "bulk_friction": "0.7", "shear_velocity": "0.015"},
+        {**base, "particle_friction": "0.3", "lid": "rigid", "bulk_friction": "0.7", "shear_velocity": "0.015"},
     ]
-    (pair,) = lid_comparison(rows, 0.1)
+    (pair,) = lid_comparison(rows, 0.1, 0.03)
     assert pair["particle_friction"] == 0.1
     assert pair["servo_minus_rigid"] == 0.46 - 0.40
-    assert [r["lid"] for r in chart_rows(rows, 0.1, "rigid")] == ["rigid", "rigid"]
+    assert [r["lid"] for r in chart_rows(rows, 0.1, "rigid", 0.03)] == ["rigid", "rigid"]
 
 
 def test_diagnostic_points_are_the_middle_friction_of_each_curve():

@@ -6,13 +6,14 @@ import pytest
 
 from engines.config import REPO_ROOT, load_config
 from engines.estimates import RunEstimate
-from engines.planning import config_estimates
+from engines.planning import config_estimates, group_runs
 from engines.validation_groups import (
     COMPLETE,
     GROUP_BUDGET_S,
     GROUPS,
     MISSING,
     STALE,
+    assign,
     check_group,
     cost_lines,
     group_costs,
@@ -35,12 +36,17 @@ def _estimate(run_id: str, kind: str, wall_time_s: float, mpi_ranks: int = 1) ->
                        mpi_ranks=mpi_ranks)
 
 
-def test_every_case_kind_of_the_study_is_in_exactly_one_group():
-    kinds = [kind for kinds in GROUPS.values() for kind in kinds]
-    assert sorted(kinds) == sorted({"jenike", "silo_flat", "silo_recirculation", "blender"})
-    assert group_of("silo_flat") == "silo" and group_of("jenike") == "calibration"
+def test_every_run_of_the_study_is_made_by_exactly_one_group():
+    kinds = {"jenike", "silo_flat", "silo_recirculation", "blender"}
+    for kind in kinds:
+        makers = [name for name, group in GROUPS.items() for reference in (True, False) if group.makes(kind, reference)]
+        assert len(makers) == 2   # once for the reference configuration's runs, once for the others
+    assert group_of("silo_flat", True) == "silo" and group_of("silo_flat", False) == "silo_series"
+    assert group_of("jenike", True) == group_of("jenike", False) == "calibration"
+    # the series' rows compare against the base silo, which the silo group makes
+    assert GROUPS["silo_series"].reads == ("silo",)
     with pytest.raises(KeyError, match="verification"):
-        group_of("verification")
+        group_of("verification", False)
 
 
 def test_an_unknown_group_is_refused_with_the_groups_named():
@@ -75,7 +81,10 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
                  _estimate("s1", "silo_flat", 1.0 * hour), _estimate("s2", "silo_flat", 1.0 * hour),
                  _estimate("s3", "silo_flat", 1.0 * hour),
                  _estimate("b1", "blender", 1.0 * hour, mpi_ranks=2)]
-    costs = {cost.name: cost for cost in group_costs(estimates, cores=2)}
+    references = {"silo_flat": ["s1", "s2", "s3"]}
+    made = assign(estimates, references)
+    assert [e.run_id for e in made["silo"]] == ["s1", "s2", "s3"] and made["silo_series"] == []
+    costs = {cost.name: cost for cost in group_costs(made, cores=2)}
     assert list(costs) == list(GROUPS)
     assert costs["calibration"].runs == 3 and costs["calibration"].wall_time_s == pytest.approx(1.0 * hour)
     assert costs["silo"].core_seconds == pytest.approx(3.0 * hour)
@@ -83,10 +92,10 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
     # a two-rank run holds both cores for its wall time
     assert costs["blender"].wall_time_s == pytest.approx(1.0 * hour) and costs["blender"].core_seconds == 2.0 * hour
     assert costs["blending"].runs == 0 and costs["blending"].wall_time_s == 0.0
-    one_core = {cost.name: cost for cost in group_costs(estimates, cores=1)}
+    one_core = {cost.name: cost for cost in group_costs(made, cores=1)}
     assert one_core["silo"].wall_time_s == pytest.approx(3.0 * hour)
     assert one_core["silo"].wall_time_s > GROUP_BUDGET_S and one_core["silo"].over_budget
-    lines = cost_lines(group_costs(estimates, cores=1), cores=1)
+    lines = cost_lines(group_costs(made, cores=1), cores=1)
     assert lines[0].startswith("Validation groups (make validate GROUP=<name>) on 1 core(s), each at most 2.5 h")
     assert lines[2].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
                                 "split", "it"]
@@ -95,8 +104,12 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
 def test_status_is_complete_stale_or_missing_against_the_plan():
     estimates = [_estimate("j1", "jenike", 1.0), _estimate("j2", "jenike", 1.0), _estimate("s1", "silo_flat", 1.0),
                  _estimate("r1", "silo_recirculation", 1.0), _estimate("b1", "blender", 1.0)]
-    planned = planned_runs(estimates)
+    planned = planned_runs(assign(estimates, {"silo_flat": ["s1"]}))
+    # no front-wall series: no series group
     assert planned == {"calibration": {"j1", "j2"}, "silo": {"s1"}, "blending": {"r1"}, "blender": {"b1"}}
+    series = planned_runs(assign([*estimates, _estimate("v1", "silo_flat", 1.0)], {"silo_flat": ["s1"]}))
+    # the series' rows draw on the base run too: its record holds both
+    assert series["silo_series"] == {"v1", "s1"} and series["silo"] == {"s1"}
     recorded = {"calibration": {"j1", "j2"},   # as planned
                 "silo": {"s0"},                 # a run the config no longer plans (its parameters changed)
                 "blending": {"r1", "r2"},       # a run more than planned
@@ -117,7 +130,8 @@ def _write_runs(directory, run_ids):
 
 def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys):
     config = REPO_ROOT / "config" / "config.yaml"
-    planned = planned_runs(config_estimates(load_config(config)))
+    loaded = load_config(config)
+    planned = planned_runs(group_runs(loaded, config_estimates(loaded)))
     _write_runs(tmp_path / "calibration", sorted(planned["calibration"]))
     _write_runs(tmp_path / "silo", ["sphere2-0000000000"])
     assert recorded_runs(tmp_path) == {"calibration": planned["calibration"], "silo": {"sphere2-0000000000"}}

@@ -34,9 +34,9 @@ def _rows():
 
 
 def test_the_provenance_row_names_the_run_its_engine_and_its_time():
-    got = provenance_row(_record(ranks=2), "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, "2026-11-28")
+    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, "2026-11-28")
     assert list(got) == list(RUN_COLUMNS)
-    assert got == {"run_id": "sphere2-abc", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
+    assert got == {"run_id": "sphere2-abc", "group": "silo", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
                    "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5, "cores": 2,
                    "date": "2026-11-28"}
     assert math.isnan(simulated_time(_record(stages={"fill": {"step": 3}})))
@@ -45,7 +45,7 @@ def test_the_provenance_row_names_the_run_its_engine_and_its_time():
 def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
     plot = tmp_path / "source.png"
     plot.write_bytes(PNG)
-    runs = [provenance_row(_record(), "3.8", [1, 2, 3], "0123456789", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, "2026-11-28")]
     folder = tmp_path / "silo"
     folder.mkdir()
     (folder / "old.png").write_bytes(PNG)
@@ -71,16 +71,23 @@ def test_a_table_without_the_validation_columns_is_refused(tmp_path):
 
 
 def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
-    runs = [provenance_row(_record(), "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
-            provenance_row(_record("sphere2-def"), "3.8", [2], "c0ffee", 1800.0, "2026-11-29")]
-    groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"])}
-    status = {"calibration": "missing", "silo": "stale"}
-    text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, "config/validation.yaml",
-                       "config/thesis.yaml")
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
+            provenance_row(_record("sphere2-def"), "silo", "3.8", [2], "c0ffee", 1800.0, "2026-11-29")]
+    # the series' record also lists the base run it compares against, made by the silo group
+    series = [provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, "2026-11-29"),
+              runs[0]]
+    groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"]),
+              "silo_series": GroupRecord(rows=_rows()[:1], runs=series)}
+    status = {"calibration": "missing", "silo": "stale", "silo_series": "complete"}
+    wall = CLI.measured_wall_times(groups, cores=2)
+    assert wall == {"silo": 5400.0, "silo_series": 3600.0}
+    text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, wall, 2,
+                       "config/validation.yaml", "config/thesis.yaml")
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
-    assert "| calibration | missing | 0 | - | 0 | 0 |" in lines
-    assert "| silo | stale | 2 | 2.00 h | 2 | 1 |" in lines
+    assert "| calibration | missing | 0 | - | - | 0 | 0 |" in lines
+    assert "| silo | stale | 2 | 2.00 h | 1.50 h | 2 | 1 |" in lines
+    assert "| silo_series | complete | 1 | 1.00 h | 1.00 h | 1 | 1 |" in lines
     assert "Not recorded yet: `make validate GROUP=calibration`." in lines
     assert any(line.startswith("**Stale**") for line in lines)
     assert ("2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
@@ -90,7 +97,7 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
     assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | no |" in text
     assert "runs this group in about 2 core-days (`make estimate CONFIG=config/thesis.yaml`)" in text
     assert "- Wall share \\| of weight (sphere2-abc): depth 12 mm = 3.6 particle diameters (>= 10)" in lines
-    assert lines[-1] == "![profiles.png](silo/profiles.png)"
+    assert "![profiles.png](silo/profiles.png)" in lines
     assert list(COLUMNS) == ["group", "figure", "case", "value", "value_error", "unit", "study_value", "scale_shows",
                              "evidence"]
 
@@ -99,7 +106,7 @@ def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_p
     workdir, record_dir = tmp_path / "work", tmp_path / "docs"
     plot = tmp_path / "p.png"
     plot.write_bytes(PNG)
-    runs = [provenance_row(_record(), "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
     write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs, {"janssen.png": plot})
     write_group_record(record_dir / "blender", _rows(), runs, {})
     assert publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]

@@ -33,10 +33,10 @@ def test_verdict_ratio_and_resolution():
 
 
 def _bulk(shape, mu, bulk, error, lid="rigid", restitution=0.1, blocked=False, test="internal", rolling=0.0,
-          window="steady"):
+          window="steady", speed=0.03):
     return {"shape": shape, "test": test, "lid": lid, "rolling_friction": rolling, "restitution": restitution,
             "rotation_blocked": blocked, "particle_friction": mu, "bulk_friction": bulk, "bulk_friction_error": error,
-            "window_method": window}
+            "window_method": window, "shear_velocity": speed}
 
 
 PARAMETERS = {"shape": "sphere2", "rolling_friction": 0.0, "tolerance_deg": 1.0, "targets_deg": {"internal": 30.0},
@@ -50,9 +50,11 @@ def test_a_curve_that_rises_then_levels_off_in_a_wide_cell_shows_where_bulk_fric
             _bulk("sphere", 0.1, 0.30, 0.01), _bulk("sphere", 0.3, 0.40, 0.01), _bulk("sphere", 0.5, 0.50, 0.01),
             _bulk("sphere2", 0.1, 0.45, 0.01, lid="servo"), _bulk("sphere2", 0.3, 0.58, 0.01, lid="servo"),
             # restitution 0.6 at 0.3: 0.55 -> 0.552 (not resolved, precise): insensitive
-            _bulk("sphere2", 0.3, 0.552, 0.01, restitution=0.6)]
+            _bulk("sphere2", 0.3, 0.552, 0.01, restitution=0.6),
+            # half the shear speed at 0.3: 0.55 -> 0.58 (resolved at 2 standard errors: 0.03 > 2 x 0.01414)
+            _bulk("sphere2", 0.3, 0.58, 0.01, speed=0.015)]
     diameters = {"sphere": 0.0038, "sphere2": 0.004}
-    table = calibration_rows(rows, PARAMETERS, 0.095, diameters, 0.1, "rigid", CRITERIA)
+    table = calibration_rows(rows, PARAMETERS, 0.095, diameters, 0.1, "rigid", 0.03, CRITERIA)
     curves = {r["case"]: r for r in table if r["figure"].startswith("Bulk friction at")}
     levelled = curves["sphere2, internal, rolling 0"]
     assert levelled["value"] == 0.56 and levelled["value_error"] == 0.01 and levelled["scale_shows"] == YES
@@ -63,10 +65,14 @@ def test_a_curve_that_rises_then_levels_off_in_a_wide_cell_shows_where_bulk_fric
     assert lid["value_error"] == pytest.approx(math.sqrt(4 * 1e-4) / 2, rel=1e-12) and lid["scale_shows"] == YES
     (restitution,) = [r for r in table if "restitution 0.6 - 0.1" in r["figure"]]
     assert restitution["value"] == pytest.approx(0.002, abs=1e-12) and restitution["scale_shows"] == YES
+    # the speed point stays off the chart's curve; its difference is resolved, so the speed independence is not shown
+    (speed,) = [r for r in table if "shear velocity 0.015 - 0.03 m/s" in r["figure"]]
+    assert speed["value"] == pytest.approx(0.03, abs=1e-12) and speed["scale_shows"] == NO
+    assert speed["study_value"] == "independent of the shear speed (quasi-static)"
     (calibrated,) = [r for r in table if r["figure"].startswith("Calibrated")]
     assert calibrated["value"] == 0.3 and calibrated["study_value"] == "0.35" and calibrated["scale_shows"] == YES
     # the same curves in a 40 mm cell: 10 diameters, below 20
-    small = calibration_rows(rows, PARAMETERS, 0.04, diameters, 0.1, "rigid", CRITERIA)
+    small = calibration_rows(rows, PARAMETERS, 0.04, diameters, 0.1, "rigid", 0.03, CRITERIA)
     assert all(r["scale_shows"] == NO for r in small if r["figure"].startswith("Bulk friction at"))
 
 
@@ -78,7 +84,7 @@ def test_a_row_whose_shear_tests_did_not_all_reach_a_steady_window_does_not_show
     unsaid = [*steady[:2], _bulk("sphere2", 0.5, 0.56, 0.01, window=""), steady[3]]
     judged = {}
     for name, rows in (("steady", steady), ("transient", transient), ("unsaid", unsaid)):
-        table = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", CRITERIA)
+        table = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)
         judged[name] = {r["figure"].split(" (")[0].split(",")[0]: r for r in table}
     curve, lid, chosen = "Bulk friction at particle friction 0.5", "Bulk friction", "Calibrated particle sliding friction"
     assert [judged["steady"][f]["scale_shows"] for f in (curve, lid, chosen)] == [YES, YES, YES]
@@ -92,7 +98,7 @@ def test_a_row_whose_shear_tests_did_not_all_reach_a_steady_window_does_not_show
 
 def test_a_curve_of_two_points_cannot_show_where_it_stops_rising():
     rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01)]
-    (curve, _) = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", CRITERIA)
+    (curve, _) = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)
     assert curve["scale_shows"] == NO and "fewer than three points" in curve["evidence"]
 
 

@@ -7,9 +7,9 @@ CALIBRATION = f"{RESULTS}/calibration"
 
 
 def jenike_point(run):
-    """The sweep point of a Jenike run, with the lid it ran with."""
+    """The sweep point of a Jenike run, with the lid and shear velocity (m/s) it ran with."""
     case = JENIKE_CASES[run]
-    return {**case.point, "lid": case.lid_kind}
+    return {**case.point, "lid": case.lid_kind, "shear_velocity": case.shear_velocity}
 
 
 def calibration_chart_names():
@@ -25,10 +25,12 @@ def lid_comparison_targets():
 
 
 def _sweep_point(run):
-    """The point as the sweep designed it (the lid only where it differs from jenike.lid)."""
+    """The point as the sweep designed it (the lid and shear velocity only where they differ from the configured)."""
     point = dict(JENIKE_CASES[run].point)
     if JENIKE_CASES[run].lid_kind != config["jenike"]["lid"]:
         point["lid"] = JENIKE_CASES[run].lid_kind
+    if JENIKE_CASES[run].shear_velocity != config["jenike"]["shear"]["velocity"]:
+        point["shear_velocity"] = JENIKE_CASES[run].shear_velocity
     return point
 
 
@@ -118,6 +120,7 @@ rule calibration_charts:
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
+        shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
     log:
         f"{CALIBRATION}/logs/charts.log",
@@ -133,6 +136,7 @@ checkpoint calibration_parameters:
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
+        shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
     log:
         f"{CALIBRATION}/logs/parameters.log",
@@ -148,6 +152,7 @@ rule lid_comparison:
         plot=report(f"{CALIBRATION}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
     params:
         base_restitution=config["jenike"]["sweep"]["restitution"],
+        shear_velocity=config["jenike"]["shear"]["velocity"],
     log:
         f"{CALIBRATION}/logs/lid_comparison.log",
     script:

@@ -111,10 +111,11 @@ def run_ids(kind):
     return list(cases(kind))
 
 
-def silo_flat_targets(wildcards=None):
+def silo_flat_targets(wildcards=None, runs=None):
+    """The products of the flat-bottom silo's runs (``runs``: its run ids, all when None)."""
     return [
         run_path("silo_flat", name, run)
-        for run in run_ids("silo_flat")
+        for run in (run_ids("silo_flat") if runs is None else runs)
         for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
                      "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names(),
                      *piv_names())

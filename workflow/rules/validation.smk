@@ -2,46 +2,59 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
+from engines.cases import reference_runs
 from engines.layout import VALIDATION_RECORD
-from engines.validation_groups import GROUPS
+from engines.validation_groups import ALL, GROUPS
 
 VALIDATION = f"{RESULTS}/summary"
 SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
-              "balance": "metrics/fill_balance.json"}
+              "balance": "metrics/fill_balance.json", "janssen": "metrics/janssen.csv",
+              "kinematic": "metrics/kinematic.csv", "boundary": "metrics/flow_channel_boundary.csv"}
 
 
-def validation_silo_runs():
-    """``[(label, run id)]``: the base silo run first, then the front-wall friction series (labels mu_fw=<value>)."""
-    base = run_ids("silo_flat")[0]
-    series = parametric_studies().get("front_back_friction", [])
-    return [(front_wall_label(), base)] + [(label, run) for label, run in series if label != "base"]
+def references(kind):
+    """Run ids of the reference configuration of case ``kind``, one per seed (the flat-bottom silo's with calibrated
+    parameters applied when asked for)."""
+    return reference_runs(silo_config() if kind == "silo_flat" else config, kind)
 
 
-def front_wall_label():
-    """The base run's label in the front-wall series: its particle-front wall sliding friction."""
+def group_made(group):
+    """Run ids a validation group makes."""
+    spec = GROUPS[group]
+    if spec.part == ALL:
+        return run_ids(spec.kind)
+    reference = set(references(spec.kind))
+    return [run for run in run_ids(spec.kind) if spec.makes(spec.kind, run in reference)]
+
+
+def group_runs(group):
+    """Run ids behind a validation group's rows: those it makes, then those of the groups it reads."""
+    return [*group_made(group), *(run for other in GROUPS[group].reads for run in group_made(other))]
+
+
+def front_wall_labels():
+    """``{run id: label}`` of the front-wall friction series: the base run's seeds by their particle-front wall
+    sliding friction (mu_fw=<value>), the variants by their study label."""
     silo = config["silo_flat"]
     pair = sorted([silo["particle_material"], silo["wall_materials"]["front_back"]])
     contact = next(c for c in silo_config()["contacts"] if sorted(c["materials"]) == pair)
-    return f"mu_fw={contact['sliding_friction']:g}"
+    labels = {run: f"mu_fw={contact['sliding_friction']:g}" for run in references("silo_flat")}
+    labels.update({run: label for label, run in parametric_studies().get("front_back_friction", []) if label != "base"})
+    return labels
 
 
 def group_rows_inputs(group):
-    """The products each group's rows are read from (an input function of the group)."""
+    """The products a group's rows are read from (an input function of the group)."""
 
     def inputs(wildcards):
-        if group == "calibration":
+        kind = GROUPS[group].kind
+        if kind == "jenike":
             return {"bulk": f"{CALIBRATION}/bulk_friction.csv", "parameters": f"{CALIBRATION}/parameters.yaml"}
-        if group == "silo":
-            base = run_ids("silo_flat")[0]
-            found = {
-                "janssen": run_path("silo_flat", "metrics/janssen.csv", base),
-                "kinematic": run_path("silo_flat", "metrics/kinematic.csv", base),
-                "boundary": run_path("silo_flat", "metrics/flow_channel_boundary.csv", base),
-            }
-            for key, name in SILO_FILES.items():
-                found[f"silo_{key}"] = [run_path("silo_flat", name, run) for _, run in validation_silo_runs()]
-            return found
-        if group == "blending":
+        if kind == "silo_flat":
+            labels = front_wall_labels()
+            runs = [run for run in group_runs(group) if run in labels]
+            return {key: [run_path("silo_flat", name, run) for run in runs] for key, name in SILO_FILES.items()}
+        if kind == RECIRCULATION:
             runs = recirculation_runs()
             return {"cases": [run_path(RECIRCULATION, CASE_SUMMARY, run) for run in runs],
                     "summaries": [run_path(RECIRCULATION, "metrics/blending.json", run) for run in runs],
@@ -52,8 +65,31 @@ def group_rows_inputs(group):
     return inputs
 
 
-#: The groups whose rows this configuration makes: a group without runs (a study switched off) has none.
-ROW_GROUPS = [group for group, kinds in GROUPS.items() if any(CASES[kind] for kind in kinds)]
+def group_rows_params(group):
+    """The configuration a group's rows use: the keys of its case kind only."""
+    kind = GROUPS[group].kind
+    params = {"group": group, "kind": kind, "criteria": config["validation"]}
+    if kind == "jenike":
+        jenike = config["jenike"]
+        params.update(cell_diameter=jenike["cell"]["inner_diameter"],
+                      shapes={shape: config["particle_models"][shape] for shape in jenike["sweep"]["shapes"]},
+                      density=config["materials"][jenike["particle_material"]]["density"],
+                      base_restitution=jenike["sweep"]["restitution"], lid=jenike["lid"],
+                      shear_velocity=jenike["shear"]["velocity"])
+    elif kind == "silo_flat":
+        params.update(profile_height=config["silo_flat"]["parametric"]["profile_height"])
+    return params
+
+
+def makes_runs(spec):
+    """Whether a group makes any run of this configuration."""
+    reference = set(reference_runs(config, spec.kind)) if spec.part != ALL else set()
+    return any(spec.makes(spec.kind, run in reference) for run in CASES[spec.kind])
+
+
+#: The groups whose rows this configuration makes: a group without runs (a study switched off, a silo without a
+#: front-wall series) has none.
+ROW_GROUPS = [group for group, spec in GROUPS.items() if makes_runs(spec)]
 
 
 for _group in ROW_GROUPS:
@@ -66,15 +102,9 @@ for _group in ROW_GROUPS:
         output:
             rows=f"{VALIDATION}/rows/{_group}.csv",
         params:
-            group=_group,
-            criteria=config["validation"],
-            cell_diameter=config["jenike"]["cell"]["inner_diameter"],
-            shapes={shape: config["particle_models"][shape] for shape in config["jenike"]["sweep"]["shapes"]},
-            density=config["materials"][config["jenike"]["particle_material"]]["density"],
-            base_restitution=config["jenike"]["sweep"]["restitution"],
-            lid=config["jenike"]["lid"],
-            profile_height=config["silo_flat"]["parametric"]["profile_height"],
-            labels=lambda wildcards: [label for label, _ in validation_silo_runs()],
+            **group_rows_params(_group),
+            reference=lambda wildcards, kind=GROUPS[_group].kind: references(kind),
+            labels=lambda wildcards, group=_group: front_wall_labels() if GROUPS[group].kind == "silo_flat" else {},
         log:
             f"{VALIDATION}/rows/{_group}.log",
         script:
@@ -94,16 +124,26 @@ rule validation_table:
         "../scripts/validation_table.py"
 
 
-# The validation tier in groups (engines.validation_groups): `make validate GROUP=<name>` asks for the products of one
-# group's case kinds, here their targets per kind.
+# The validation tier in groups (engines.validation_groups): `make validate GROUP=<name>` asks for the products of the
+# runs one group makes.
 KIND_TARGETS = {
     "jenike": calibration_targets,
-    "silo_flat": lambda: [*silo_flat_targets(), *parametric_targets()],
     RECIRCULATION: recirculation_targets,
     "blender": blender_targets,
 }
 
-for _group, _kinds in GROUPS.items():
+
+def group_targets(group):
+    """The products of the runs a group makes: the flat-bottom silo's per run (and its parametric studies' with the
+    series), every other kind's as a whole."""
+    spec = GROUPS[group]
+    if spec.kind != "silo_flat":
+        return KIND_TARGETS[spec.kind]()
+    return [*silo_flat_targets(runs=group_made(group)), *(parametric_targets() if group_made(group) and
+                                                          spec.makes(spec.kind, False) else [])]
+
+
+for _group in GROUPS:
 
     rule:
         name:
@@ -111,7 +151,7 @@ for _group, _kinds in GROUPS.items():
         input:
             # input functions: the flat-bottom silo's runs are known only after the calibration when it uses
             # calibrated parameters
-            lambda wildcards, kinds=_kinds: [target for kind in kinds for target in KIND_TARGETS[kind]()],
+            lambda wildcards, group=_group: group_targets(group),
             [f"{VALIDATION_RECORD}/{_group}/{name}" for name in ("runs.csv", "table.csv")] if _group in ROW_GROUPS else [],
 
 
@@ -119,16 +159,20 @@ def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
     profiles and Janssen comparison with the front-wall series, VRR against Nr, the blender's passage velocities
     and gravity series."""
-    if group == "calibration":
+    kind = GROUPS[group].kind
+    if kind == "jenike":
         plots = {f"{name}.png": f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()}
         plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
         return plots
-    if group == "silo":
-        base = run_ids("silo_flat")[0]
-        plots = {f"{name}.png": run_path("silo_flat", f"plots/{name}.png", base) for name in ("profiles", "janssen")}
-        plots.update({f"{study}.png": f"{case_root('silo_flat')}/parametric/{study}.png" for study in parametric_studies()})
+    if kind == "silo_flat":
+        plots = {}
+        if GROUPS[group].makes(kind, True):
+            base = run_ids("silo_flat")[0]
+            plots.update({f"{name}.png": run_path("silo_flat", f"plots/{name}.png", base) for name in ("profiles", "janssen")})
+        if GROUPS[group].makes(kind, False):
+            plots.update({f"{study}.png": f"{case_root('silo_flat')}/parametric/{study}.png" for study in parametric_studies()})
         return plots
-    if group == "blending":
+    if kind == RECIRCULATION:
         return {"vrr.png": f"{case_root(RECIRCULATION)}/summary/vrr.png"}
     plots = {f"insert_velocities_{cases('blender')[run].configuration}_g{cases('blender')[run].gravity_factor:g}.png":
              run_path("blender", "plots/insert_velocities.png", run) for run in blender_runs()}
@@ -145,18 +189,20 @@ for _group in ROW_GROUPS:
         input:
             # input functions, as above: the runs of a calibrated silo are known after the calibration
             rows=f"{VALIDATION}/rows/{_group}.csv",
-            records=lambda wildcards, kinds=GROUPS[_group]: [run_path(kind, RUN_RECORD, run) for kind in kinds
-                                                             for run in run_ids(kind)],
-            benchmarks=lambda wildcards, kinds=GROUPS[_group]: [run_path(kind, RUN_BENCHMARK, run) for kind in kinds
-                                                                for run in run_ids(kind)],
+            records=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_RECORD, run)
+                                                     for run in group_runs(group)],
+            benchmarks=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_BENCHMARK, run)
+                                                        for run in group_runs(group)],
             plots=lambda wildcards, group=_group: list(record_plots(group).values()),
         output:
             runs=f"{VALIDATION_RECORD}/{_group}/runs.csv",
             table=f"{VALIDATION_RECORD}/{_group}/table.csv",
         params:
             plot_names=lambda wildcards, group=_group: list(record_plots(group)),
-            seeds=lambda wildcards, kinds=GROUPS[_group]: {run: list(case.seeds) for kind in kinds
-                                                           for run, case in cases(kind).items()},
+            seeds=lambda wildcards, group=_group: {run: list(case.seeds) for run, case in
+                                                   cases(GROUPS[group].kind).items()},
+            made_by=lambda wildcards, group=_group: {run: name for name in (group, *GROUPS[group].reads)
+                                                     for run in group_made(name)},
         log:
             f"{VALIDATION_RECORD}/{_group}.log",
         script:

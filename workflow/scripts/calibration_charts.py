@@ -11,7 +11,8 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     calibration = snakemake.params.calibration
     with open(snakemake.input.table, newline="") as handle:
-        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid)
+        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid,
+                          snakemake.params.shear_velocity)
     curves = curves_from_table(rows)
     for path in snakemake.output.charts:
         shape, test = Path(path).stem.split("_", 1)

@@ -11,7 +11,8 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     calibration = snakemake.params.calibration
     with open(snakemake.input.table, newline="") as handle:
-        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid)
+        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid,
+                          snakemake.params.shear_velocity)
     curves = curves_from_table(rows)
     tested = {"internal" if c.test == "internal" else c.wall_material for c in curves}
     targets = {name: angle for name, angle in calibration["targets_deg"].items() if name in tested}

@@ -1,13 +1,23 @@
-"""Snakemake adapter: collect the bulk friction of every sweep point into one table."""
+"""Snakemake adapter: collect the bulk friction of every sweep point into one table, one row per point (a point run
+with several seeds as their mean, its error and their standard deviation)."""
 
 import json
 from pathlib import Path
 
 from analysis.io.tables import write_flow_table
+from analysis.numerics.replicates import combine_replicates
+from calibration.friction import combined_window_method
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
-    rows = [json.loads(Path(path).read_text()) for path in snakemake.input.summaries]
+    runs = [json.loads(Path(path).read_text()) for path in snakemake.input.summaries]
+    point = ["shape", "test", "wall_material", "lid", "rolling_friction", "restitution", "rotation_blocked",
+             "particle_friction", "shear_velocity"]
+    rows = combine_replicates(runs, point)
+    for row in rows:
+        # a point is steady only when every seed's shear reached a steady window
+        row["window_method"] = combined_window_method([run["window_method"] for run in runs
+                                                       if all(run[key] == row[key] for key in point)])
     rows.sort(key=lambda row: (row["shape"], row["test"], row["rolling_friction"], row["restitution"],
                                row["rotation_blocked"], row["particle_friction"]))
     leading = ["shape", "test", "wall_material", "lid", "rolling_friction", "restitution", "rotation_blocked",

@@ -28,6 +28,7 @@ with logged_to(snakemake.log[0]) as log:
         "rotation_blocked": point["rotation_blocked"],
         "lid": point["lid"],
         "particle_friction": point["sliding_friction"],
+        "shear_velocity": point["shear_velocity"],
         **bulk_friction_summary(friction, window_method),
         "n_clumps": record.n_clumps,
     }

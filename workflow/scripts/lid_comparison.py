@@ -9,7 +9,8 @@ from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     with open(snakemake.input.table, newline="") as handle:
-        rows = lid_comparison(csv.DictReader(handle), snakemake.params.base_restitution)
+        rows = lid_comparison(csv.DictReader(handle), snakemake.params.base_restitution,
+                              snakemake.params.shear_velocity)
     if not rows:
         raise ValueError("no sweep point was run with both lids; enable jenike.sweep.lid_comparison")
     write_flow_table(snakemake.output.table, rows)

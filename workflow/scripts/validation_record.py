@@ -31,8 +31,8 @@ with logged_to(snakemake.log[0]) as log:
         if record.engine not in versions:
             versions[record.engine] = engine_named(record.engine).installed_version()
         finished = datetime.fromtimestamp(Path(record_path).stat().st_mtime, tz=timezone.utc).date().isoformat()
-        runs.append(provenance_row(record, versions[record.engine], params.seeds[record.run_id], commit,
-                                   benchmark_wall_time(benchmark), finished))
+        runs.append(provenance_row(record, params.made_by[record.run_id], versions[record.engine],
+                                   params.seeds[record.run_id], commit, benchmark_wall_time(benchmark), finished))
     directory = write_group_record(Path(snakemake.output.runs).parent, read_validation_rows(inputs.rows), runs,
                                    dict(zip(params.plot_names, inputs.plots)))
     log.info("record of %d runs in %s (code %s)", len(runs), directory, commit)

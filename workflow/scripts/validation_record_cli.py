@@ -22,9 +22,9 @@ from analysis.io.validation_record import read_group_record, read_record, write_
 from analysis.studies.validation.record import record_page
 from engines.config import load_config
 from engines.layout import VALIDATION_RECORD
-from engines.planning import config_estimates
-from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, group_costs, group_status, planned_runs,
-                                       status_lines)
+from engines.planning import config_estimates, group_runs
+from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, group_costs, group_status, makespan,
+                                       planned_runs, status_lines)
 
 #: The record's page, in its folder.
 RECORD_PAGE = "README.md"
@@ -56,16 +56,25 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
     return copied
 
 
-def page(config_path: str, full_scale_path: str, record_dir: str | Path) -> str:
+def measured_wall_times(record: dict, cores: int) -> dict[str, float]:
+    """``{group: s}``: the wall time of the runs each recorded group makes, from their measured times, on ``cores``
+    cores (:func:`engines.validation_groups.makespan`; a run on r ranks holds r cores)."""
+    return {name: makespan([float(run["wall_time_s"]) for run in group.runs if run.get("group", name) == name
+                            for _ in range(min(int(run["cores"]), cores))], cores)
+            for name, group in record.items()}
+
+
+def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: int = 2) -> str:
     """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
-    group's cost at the scale of ``full_scale_path``."""
-    planned = planned_runs(config_estimates(load_config(config_path)))
+    group's measured wall time on ``cores`` cores and its cost at the scale of ``full_scale_path``."""
+    config = load_config(config_path)
+    planned = planned_runs(group_runs(config, config_estimates(config)))
     record = read_record(record_dir, GROUPS)
     status = group_status(planned, _run_ids(record))
-    full_scale = {cost.name: cost.core_seconds for cost in group_costs(config_estimates(load_config(full_scale_path)),
-                                                                          cores=1)}
-    return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS}, config_path,
-                       full_scale_path)
+    full = load_config(full_scale_path)
+    full_scale = {cost.name: cost.core_seconds for cost in group_costs(group_runs(full, config_estimates(full)), cores=1)}
+    return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
+                       measured_wall_times(record, cores), cores, config_path, full_scale_path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -80,7 +89,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 2
         return 0
     if len(argv) == 3 and argv[0] == "status":
-        planned = planned_runs(config_estimates(load_config(argv[1])))
+        config = load_config(argv[1])
+        planned = planned_runs(group_runs(config, config_estimates(config)))
         recorded = recorded_runs(argv[2])
         print(f"The validation record in {argv[2]} against the runs {argv[1]} plans:")
         print("\n".join(status_lines(planned, recorded)))

@@ -5,8 +5,8 @@ Rows (see :mod:`analysis.studies.validation.rows`):
 - one per calibration curve (shape, test, rolling friction): bulk friction at the largest particle friction;
   the scale shows the curve's physics when the cell is wide in particle diameters and the curve is seen to stop
   rising (its first step resolved, its last step not);
-- rotation blocked against free rotation, the other lid against the configured one and each extra restitution
-  against the base one, on the same sweep points;
+- rotation blocked against free rotation, the other lid against the configured one, each extra restitution
+  against the base one and each other shear velocity against the configured one, on the same sweep points;
 - the calibrated particle-scale friction coefficients.
 
 Every row says whether the shear tests it draws on reached a steady window (``window_method`` of each point,
@@ -144,7 +144,7 @@ def _paired_rows(figure: str, reference: dict, other: dict, cell_ok: bool, cell_
 
 def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_diameter: float,
                      particle_diameters: Mapping[str, float], base_restitution: float, lid: str,
-                     criteria: Criteria) -> list[dict]:
+                     shear_velocity: float, criteria: Criteria) -> list[dict]:
     """The calibration's validation rows.
 
     Parameters
@@ -162,19 +162,25 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
         The sweep's base restitution (-).
     lid : str
         The configured lid; rows with the other lid are the lid comparison.
+    shear_velocity : float
+        The configured shear velocity (m/s); rows at another are the shear-speed study.
     criteria : Criteria
     """
+    def base_speed(entry):
+        return float(entry["shear_velocity"]) == shear_velocity
+
     def chart(entry):
         return (float(entry["restitution"]) == base_restitution and not _flag(entry["rotation_blocked"])
-                and entry["lid"] == lid)
+                and entry["lid"] == lid and base_speed(entry))
 
     curves = _curves(bulk_rows, chart)
     chart_entries = _entries(bulk_rows, chart)
     blocked = _entries(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and e["lid"] == lid
-                       and float(e["restitution"]) == base_restitution)
+                       and float(e["restitution"]) == base_restitution and base_speed(e))
     other_lid = _entries(bulk_rows, lambda e: e["lid"] != lid and not _flag(e["rotation_blocked"])
-                         and float(e["restitution"]) == base_restitution)
-    restitutions = sorted({float(e["restitution"]) for e in bulk_rows} - {base_restitution})
+                         and float(e["restitution"]) == base_restitution and base_speed(e))
+    restitutions = sorted({float(e["restitution"]) for e in bulk_rows if base_speed(e)} - {base_restitution})
+    speeds = sorted({float(e["shear_velocity"]) for e in bulk_rows} - {shear_velocity})
     rows = []
     for key, entries in chart_entries.items():
         cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
@@ -184,9 +190,14 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
                     "a servo lid that cannot tilt overestimates", True)]
     for restitution in restitutions:
         extra = _entries(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and e["lid"] == lid
-                         and not _flag(e["rotation_blocked"]))
+                         and not _flag(e["rotation_blocked"]) and base_speed(e))
         comparisons.append((f"Bulk friction, restitution {restitution:g} - {base_restitution:g}", extra,
                             "insensitive to restitution", False))
+    for speed in speeds:
+        slower = _entries(bulk_rows, lambda e, v=speed: float(e["shear_velocity"]) == v and e["lid"] == lid
+                          and not _flag(e["rotation_blocked"]) and float(e["restitution"]) == base_restitution)
+        comparisons.append((f"Bulk friction, shear velocity {speed:g} - {shear_velocity:g} m/s", slower,
+                            "independent of the shear speed (quasi-static)", False))
     for figure, others, study, expect in comparisons:
         for key, entries in others.items():
             cell_ok, cell_text = _judged(_cell_text(cell_diameter, particle_diameters[key[0]], criteria),

@@ -21,7 +21,7 @@ from analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
 __all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "simulated_time", "record_page"]
 
 #: The columns of a group's ``runs.csv``, in order.
-RUN_COLUMNS = ("run_id", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
+RUN_COLUMNS = ("run_id", "group", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
                "cores", "date")
 
 
@@ -50,7 +50,7 @@ def simulated_time(record: RunRecord) -> float:
     return max(times) if times else math.nan
 
 
-def provenance_row(record: RunRecord, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
+def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
                    date: str) -> dict:
     """One row of ``runs.csv`` for a finished run.
 
@@ -58,6 +58,8 @@ def provenance_row(record: RunRecord, engine_version: str, seeds: Sequence[int],
     ----------
     record : RunRecord
         The run's record (run id, case kind, engine, MPI ranks, stages).
+    group : str
+        The validation group that makes the run (a group's rows may also draw on the runs of a group it reads).
     engine_version : str
         The engine's installed version.
     seeds : sequence of int
@@ -69,7 +71,7 @@ def provenance_row(record: RunRecord, engine_version: str, seeds: Sequence[int],
     date : str
         When the run finished (ISO 8601 date).
     """
-    return {"run_id": record.run_id, "case": record.case, "engine": record.engine, "engine_version": engine_version,
+    return {"run_id": record.run_id, "group": group, "case": record.case, "engine": record.engine, "engine_version": engine_version,
             "seeds": " ".join(str(int(seed)) for seed in seeds), "commit": commit,
             "simulated_time_s": simulated_time(record), "wall_time_s": float(wall_time_s),
             "cores": int(record.mpi_ranks), "date": date}
@@ -92,7 +94,7 @@ def _hours(seconds: float) -> str:
 
 
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
-                config_name: str, full_scale_config: str) -> str:
+                wall_s: Mapping[str, float], cores: int, config_name: str, full_scale_config: str) -> str:
     """The record's page (Markdown): per group its freshness, runs and rows, and for each row the scale does not
     show, what scale would show it and what that scale costs.
 
@@ -105,6 +107,10 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         (:func:`engines.validation_groups.group_status`).
     full_scale_core_s : mapping
         ``{group: CPU s}`` of each group at the study's full scale (the estimate of ``full_scale_config``).
+    wall_s : mapping
+        ``{group: s}``: the wall time of the runs each group makes on ``cores`` cores, from their measured times.
+    cores : int
+        The cores ``wall_s`` is for.
     config_name, full_scale_config : str
         The configuration the record comes from and the full-scale one, as the page names them.
 
@@ -120,15 +126,16 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
         "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
         "",
-        "| group | status | runs | wall time | rows | shown at this scale |",
-        "|---|---|---|---|---|---|",
+        f"| group | status | runs it makes | core time | wall time on {cores} cores | rows | shown at this scale |",
+        "|---|---|---|---|---|---|---|",
     ]
     for name, state in status.items():
         record = groups.get(name, GroupRecord())
-        wall = math.fsum(float(run["wall_time_s"]) for run in record.runs)
+        made = [run for run in record.runs if run.get("group", name) == name]
+        core = math.fsum(float(run["wall_time_s"]) * int(run["cores"]) for run in made)
         shown = sum(row["scale_shows"] == YES for row in record.rows)
-        lines.append(f"| {name} | {state} | {len(record.runs)} | {_hours(wall) if record.runs else '-'} | "
-                     f"{len(record.rows)} | {shown} |")
+        lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | "
+                     f"{_hours(wall_s[name]) if made and name in wall_s else '-'} | {len(record.rows)} | {shown} |")
     for name, state in status.items():
         record = groups.get(name)
         lines += ["", f"## {name}", ""]
