@@ -4,6 +4,7 @@ import json
 from pathlib import Path
 
 from analysis.io.tables import write_flow_table
+from analysis.numerics.reference_spread import floor_errors, table_spread
 from analysis.numerics.replicates import combine_replicates
 from analysis.studies.silo_recirculation.plots import plot_vrr_versus_recirculations
 from analysis.studies.silo_recirculation.tables import summary_rows
@@ -13,6 +14,9 @@ with logged_to(snakemake.log[0]) as log:
     rows, curves = summary_rows([json.loads(Path(path).read_text()) for path in snakemake.input.summaries])
     # replicates (the same flow pattern with other seeds) become one row per layout: their mean and its error
     rows = combine_replicates(rows, ["flow_pattern", "layout"])
+    # a flow pattern run once takes the relative spread of the one run with several seeds (reference_replicates)
+    spread, replicated = table_spread(rows)
+    rows = [row if row in replicated else floor_errors(row, spread) for row in rows]
     write_flow_table(snakemake.output.table, rows)
     plot_vrr_versus_recirculations(curves, snakemake.output.vrr_plot, "VRR per recirculation: flow patterns and layouts")
     log.info("%d flow pattern x layout rows", len(rows))

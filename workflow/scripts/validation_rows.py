@@ -1,7 +1,7 @@
 """Snakemake adapter: one validation group's rows of the validation table, from the products of the runs behind it.
 
 The reference configuration's seeds (params.reference) become one summary and lend their spread to the
-configurations run once (analysis.studies.validation.seeds) before the rows are judged.
+configurations run once (analysis.numerics.reference_spread) before the rows are judged.
 """
 
 import json
@@ -13,7 +13,7 @@ from analysis.io.tables import read_table, write_flow_table
 from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows
 from analysis.studies.validation.calibration import calibration_rows
 from analysis.studies.validation.rows import Criteria
-from analysis.studies.validation.seeds import combine_seeds, floor_errors, seed_note, table_spread
+from analysis.numerics.reference_spread import combine_seeds, floor_errors, seed_note, table_spread
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
 from engines.cases.particles import particle_template
 from engines.logs import logged_to

@@ -1,5 +1,5 @@
-"""The spread between seeds in the validation rows: the reference configuration of a comparison runs with several
-seeds, the others with one.
+"""The spread between seeds when only the reference configuration of a comparison runs with several seeds and the
+others with one (``reference_replicates``, :func:`engines.cases.cases_of`).
 
 A run's figures come as a nested summary (its JSON files, its CSV tables as lists of rows): every number ``x`` whose
 standard error sits at the same place under the name ``x_error`` (``{"flow": 0.1, "flow_error": 0.002}``,
@@ -10,7 +10,8 @@ errors). :func:`relative_spread` is each figure's standard deviation over the se
 :func:`floor_errors` applies it to a configuration run once: its figure's error becomes the larger of its within-run
 error and that relative spread times its value, which is what another seed would move it by. Relative, because the
 configurations of a comparison differ in level (flow rates, velocities, residence times) more than in the scatter
-of a seed relative to it. The row functions then judge the combined and floored summaries as they judge one run.
+of a seed relative to it. The validation rows, the blender's comparison of inserts and the recirculating silos'
+summary then judge the combined and floored figures as they judge one run's.
 
 Pure: summaries in, summaries out. Strings that read as numbers (CSV rows as read) count as numbers.
 """
@@ -21,7 +22,7 @@ import math
 import numbers
 from collections.abc import Mapping, Sequence
 
-from analysis.numerics.replicates import ERROR_SUFFIX, replicate_error
+from analysis.numerics.replicates import ERROR_SUFFIX, SEED_STD_SUFFIX, replicate_error
 
 __all__ = ["SeedSpread", "combine_seeds", "relative_spread", "table_spread", "floor_errors", "seed_note"]
 
@@ -176,7 +177,7 @@ def relative_spread(summaries: Sequence) -> SeedSpread:
     return SeedSpread(spread, len(summaries))
 
 
-def table_spread(rows: Sequence[Mapping], figures: Sequence[str]) -> tuple[SeedSpread, list[Mapping]]:
+def table_spread(rows: Sequence[Mapping], figures: Sequence[str] | None = None) -> tuple[SeedSpread, list[Mapping]]:
     """The relative spread between seeds of a table whose replicated rows are already combined
     (:func:`analysis.numerics.replicates.combine_replicates`: ``replicates``, ``<figure>_seed_std``).
 
@@ -184,8 +185,8 @@ def table_spread(rows: Sequence[Mapping], figures: Sequence[str]) -> tuple[SeedS
     ----------
     rows : sequence of mapping
         The table's rows (strings that read as numbers count as numbers).
-    figures : sequence of str
-        The columns whose spread to take.
+    figures : sequence of str, optional
+        The columns whose spread to take; default: every column with a ``<figure>_seed_std`` in a replicated row.
 
     Returns
     -------
@@ -196,11 +197,14 @@ def table_spread(rows: Sequence[Mapping], figures: Sequence[str]) -> tuple[SeedS
         The replicated rows.
     """
     replicated = [row for row in rows if (_number(row.get("replicates")) or 1) >= 2]
+    if figures is None:
+        figures = list(dict.fromkeys(column[: -len(SEED_STD_SUFFIX)] for row in replicated for column in row
+                                     if column.endswith(SEED_STD_SUFFIX)))
     spread = {}
     for figure in figures:
         ratios = []
         for row in replicated:
-            value, std = _number(row.get(figure)), _number(row.get(figure + "_seed_std"))
+            value, std = _number(row.get(figure)), _number(row.get(figure + SEED_STD_SUFFIX))
             if value and std is not None and math.isfinite(std) and math.isfinite(value):
                 ratios.append(std / abs(value))
         if ratios:

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from analysis.studies.validation.seeds import combine_seeds, floor_errors, relative_spread, seed_note, table_spread
+from analysis.numerics.reference_spread import combine_seeds, floor_errors, relative_spread, seed_note, table_spread
 from calibration.friction import SECOND_HALF, STEADY, combined_window_method
 from engines.cases import cases_of, reference_runs
 from engines.cases.jenike import jenike_cases
@@ -69,6 +69,8 @@ def test_csv_rows_as_read_count_as_numbers_and_a_combined_table_gives_its_spread
     assert floor_errors(rows[1], spread)["bulk_friction_error"] == pytest.approx(0.024)
     none, _ = table_spread(rows[1:], ("bulk_friction",))
     assert none == {} and none.seeds == 1
+    # by default every figure with a seed spread in a replicated row
+    assert table_spread(rows)[0] == {("bulk_friction",): pytest.approx(0.04)}
 
 
 def test_the_seed_note_says_which_error_a_row_carries():
