@@ -22,8 +22,8 @@ parsed frames.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Iterable, Mapping, Sequence
 
 from engines.cases.blender import BlenderCase
 from engines.cases.jenike import FILL_SOLID_FRACTION, JenikeCase
@@ -57,6 +57,9 @@ class CostModel:
     seconds_per_sphere_step : float
         CPU time per sphere-step on one core (s): per sphere the engine holds and time step, the count taken over
         time (:class:`MeasuredWork`). Measured here: 0.35 to 0.6 microseconds.
+    kind_seconds_per_sphere_step : mapping
+        The same for the case kinds that differ from it (``{kind: s}``): a sphere-step of the 95 mm Jenike cell,
+        with its finely facetted ring walls and lid of glued spheres, costs about twice one of a silo.
     bytes_per_sphere_per_dump : float
         Size of one sphere in one binary VTK particle dump with the 16 fields siloflow dumps (bytes).
     dump_header_bytes : float
@@ -78,10 +81,17 @@ class CostModel:
     parallel_efficiency: float = 0.8
     contact_bytes_per_sphere_per_dump: float = 200.0
     settle_fraction: float = 0.25
+    kind_seconds_per_sphere_step: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not _finite(self.seconds_per_sphere_step) or self.seconds_per_sphere_step <= 0:
             raise ValueError(f"seconds_per_sphere_step must be > 0 s, got {self.seconds_per_sphere_step!r}")
+        for kind, value in self.kind_seconds_per_sphere_step.items():
+            if kind not in KINDS:
+                raise ValueError(f"kind_seconds_per_sphere_step: unknown run kind {kind!r}; expected one of "
+                                 f"{', '.join(KINDS)}")
+            if not _finite(value) or value <= 0:
+                raise ValueError(f"kind_seconds_per_sphere_step[{kind!r}] must be > 0 s, got {value!r}")
         for name in ("bytes_per_sphere_per_dump", "dump_header_bytes",
                      "contact_bytes_per_sphere_per_dump"):
             value = getattr(self, name)
@@ -91,6 +101,10 @@ class CostModel:
             value = getattr(self, name)
             if not _finite(value) or not 0 < value <= 1:
                 raise ValueError(f"{name} must lie in (0, 1], got {value!r}")
+
+    def seconds_for(self, kind: str) -> float:
+        """CPU time per sphere-step of a run of case kind ``kind`` on one core (s)."""
+        return self.kind_seconds_per_sphere_step.get(kind, self.seconds_per_sphere_step)
 
 
 def _finite(value) -> bool:
@@ -334,7 +348,7 @@ def estimate_run(
     if sum(stage.steps for stage in stages) != steps:
         raise ValueError(f"the stages' steps add up to {sum(stage.steps for stage in stages)}, not to steps = {steps}")
     work = math.fsum(stage.sphere_steps for stage in stages)
-    serial = work * model.seconds_per_sphere_step
+    serial = work * model.seconds_for(kind)
     particle_dumps = dump_frames * (model.dump_header_bytes + spheres * model.bytes_per_sphere_per_dump)
     contacts = contact_frames * (model.dump_header_bytes + spheres * model.contact_bytes_per_sphere_per_dump)
     return RunEstimate(

@@ -9,9 +9,10 @@ import pytest
 import engines.planning as planning
 from analysis.data.record import RunRecord
 from engines.config import load_config
-from engines.estimates import InsufficientDiskSpace, MeasuredWork, RunEstimate
+from engines.estimates import CostModel, InsufficientDiskSpace, MeasuredWork, RunEstimate
 from engines.planning import (
     COMPARISON_COLUMNS,
+    calibrated_model,
     check_run_disk_space,
     comparison_rows,
     comparison_total,
@@ -177,3 +178,32 @@ def test_the_kind_with_the_longest_run_gets_the_highest_priority():
     # silo_flat: 800 CPU s on 4 ranks outranks the blender's 500
     assert run_priorities(estimates) == {"jenike": 1, "silo_recirculation": 2, "blender": 3, "silo_flat": 4}
     assert run_priorities([]) == {}
+
+
+def test_each_measured_kind_takes_its_own_cost_and_an_unmeasured_one_keeps_its_ratio():
+    def timed(run_id, kind, seconds_per_sphere_step):
+        estimate = RunEstimate(run_id=run_id, kind=kind, clumps=10, spheres=20, steps=100, sphere_steps=1.0e6,
+                               simulated_time_s=0.01, wall_time_s=1.0, dump_frames=1, dump_bytes=1000, mpi_ranks=1)
+        return estimate, MeasuredWork(seconds_per_sphere_step * 1.0e6, 1.0e6)
+
+    model = CostModel(seconds_per_sphere_step=4.0e-7, kind_seconds_per_sphere_step={"jenike": 8.0e-7, "blender": 6.0e-7})
+    measured = [timed("s1", "silo_flat", 5.0e-7), timed("s2", "silo_flat", 7.0e-7), timed("r1", "silo_recirculation", 9.0e-7),
+                timed("j1", "jenike", 1.2e-6)]
+    calibrated = calibrated_model(model, measured)
+    # the overall median of 5, 7, 9 and 12 (x 1e-7)
+    assert calibrated.seconds_per_sphere_step == pytest.approx(8.0e-7, rel=1e-12)
+    assert calibrated.seconds_for("silo_flat") == pytest.approx(6.0e-7, rel=1e-12)
+    assert calibrated.seconds_for("jenike") == pytest.approx(1.2e-6, rel=1e-12)
+    # the blender has not run: the overall median at the 1.5 the config gives it over the others
+    assert calibrated.seconds_for("blender") == pytest.approx(1.2e-6, rel=1e-12)
+    with pytest.raises(ValueError, match="unknown run kind 'silo'"):
+        CostModel(kind_seconds_per_sphere_step={"silo": 1.0e-6})
+
+
+def test_a_kind_s_own_cost_sets_its_estimates(estimates):
+    config = load_config(DEFAULT_CONFIG)
+    config["estimates"]["seconds_per_sphere_step_by_case"] = {"jenike": 2.0 * config["estimates"]["seconds_per_sphere_step"]}
+    doubled = {e.run_id: e for e in config_estimates(config)}
+    for estimate in estimates:
+        factor = 2.0 if estimate.kind == "jenike" else 1.0
+        assert doubled[estimate.run_id].wall_time_s == pytest.approx(factor * estimate.wall_time_s, rel=1e-12)
