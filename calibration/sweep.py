@@ -1,7 +1,7 @@
-"""The calibration sweep after its runs: which points make the charts, the diagnostics and the lid comparison.
+"""The calibration sweep after its runs: which rows of its table make the charts and the lid comparison.
 
-The sweep points themselves (the Jenike runs a configuration asks for) are designed by
-:func:`engines.cases.jenike_sweep.sweep_points`.
+The sweep points themselves (the Jenike runs a configuration asks for), their roles and which get diagnostics are
+designed by :mod:`engines.cases.jenike_sweep`.
 
 A sweep point is a plain dict (it keys the run and travels through Snakemake unchanged)::
 
@@ -12,13 +12,6 @@ A sweep point is a plain dict (it keys the run and travels through Snakemake unc
 from __future__ import annotations
 
 INTERNAL = "internal"
-
-def is_chart_point(point: dict, base_restitution: float) -> bool:
-    """Whether a point belongs on the calibration chart (base restitution, rotation free, configured lid and shear
-    velocity)."""
-    return (point["restitution"] == base_restitution and not point["rotation_blocked"] and "lid" not in point
-            and "shear_velocity" not in point)
-
 
 def chart_rows(rows, base_restitution: float, lid: str, shear_velocity: float) -> list[dict]:
     """Rows of the calibration table (as read from CSV) that belong on the chart.
@@ -76,17 +69,3 @@ def lid_comparison(rows, base_restitution: float, shear_velocity: float) -> list
                 }
             )
     return paired
-
-
-def diagnostic_points(points: list[dict], sweep: dict, lid: str) -> list[dict]:
-    """The chart points that get contact and rotation diagnostics (``jenike.sweep.diagnostics``).
-
-    Only rigid-lid runs record wall contacts, so a servo ``lid`` gives none.
-    """
-    if sweep["diagnostics"] == "none" or lid != "rigid":
-        return []
-    chart = [p for p in points if is_chart_point(p, sweep["restitution"])]
-    if sweep["diagnostics"] == "all":
-        return chart
-    middle = sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]
-    return [p for p in chart if p["sliding_friction"] == float(middle)]

@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from analysis.data.record import RunRecordError, read_run_record
-from engines.cases import CASE_BUILDERS, cases_of, reference_runs
+from engines.cases import CASE_BUILDERS, cases_of, run_roles
 from engines.config import load_config
 from engines.interface import engine_for
 from engines.estimates import (
@@ -281,7 +281,7 @@ def comparison_report(measured: list[tuple[RunEstimate, MeasuredWork]], steps: l
 
 def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[RunEstimate]]:
     """The runs each validation group makes, of a configuration's ``estimates`` (:func:`engines.validation_groups.assign`)."""
-    return assign(estimates, {kind: reference_runs(config, kind) for kind in CASE_BUILDERS})
+    return assign(estimates, {run: role for kind in CASE_BUILDERS for run, role in run_roles(config, kind).items()})
 
 
 def main(argv: list[str] | None = None) -> int:

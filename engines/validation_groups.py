@@ -13,12 +13,9 @@ import math
 from dataclasses import dataclass
 from typing import Iterable, Mapping, Sequence
 
+from engines.cases import REFERENCE, VARIANT
+from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.estimates import BLENDER, JENIKE, RECIRCULATION, SILO_FLAT, RunEstimate
-
-#: Which runs of its case kind a group makes: all of them, the reference configuration's (one per seed,
-#: :func:`engines.cases.reference_runs`) or the others.
-ALL, REFERENCE, VARIANTS = "all", "reference", "variants"
-
 
 @dataclass(frozen=True)
 class Group:
@@ -28,28 +25,32 @@ class Group:
     ----------
     kind : str
         The case kind whose runs it makes.
-    part : str
-        :data:`ALL`, :data:`REFERENCE` or :data:`VARIANTS` of that kind's runs.
+    roles : tuple of str, optional
+        The roles of that kind's runs it makes (:func:`engines.cases.run_roles`); None: all of them.
     reads : tuple of str
         Groups (earlier in :data:`GROUPS`) whose runs its rows compare against.
     """
 
     kind: str
-    part: str = ALL
+    roles: tuple[str, ...] | None = None
     reads: tuple[str, ...] = ()
 
-    def makes(self, kind: str, reference: bool) -> bool:
-        """Whether this group makes a run of ``kind``, a run of the reference configuration or not."""
-        return kind == self.kind and (self.part == ALL or (self.part == REFERENCE) == reference)
+    def makes(self, kind: str, role: str) -> bool:
+        """Whether this group makes a run of ``kind`` with ``role``."""
+        return kind == self.kind and (self.roles is None or role in self.roles)
 
 
-#: The groups in the order `make validate` runs them: a group is one stage of the study, so that its rows can be
-#: judged on its own runs. The flat-bottom silo is two: its base configuration over seeds (every figure of the silo)
-#: and the front-wall friction series that is compared against it, each inside the budget.
+#: The groups in the order `make validate` runs them, each one stage of the study within the budget, so that its
+#: rows can be judged on its own runs and those it reads: the calibration in three (the calibration shape's charts,
+#: the other shapes' charts, and the checks against the charts: rotation blocked, the other lid, restitution, shear
+#: speed, seeds), the flat-bottom silo in two (its base configuration over seeds, and the front-wall friction series
+#: compared against it).
 GROUPS: dict[str, Group] = {
-    "calibration": Group(JENIKE),
-    "silo": Group(SILO_FLAT, REFERENCE),
-    "silo_series": Group(SILO_FLAT, VARIANTS, reads=("silo",)),
+    "calibration": Group(JENIKE, (CALIBRATION_CHART,)),
+    "calibration_shapes": Group(JENIKE, (SHAPE_CHART,)),
+    "calibration_checks": Group(JENIKE, (CHECK,), reads=("calibration", "calibration_shapes")),
+    "silo": Group(SILO_FLAT, (REFERENCE,)),
+    "silo_series": Group(SILO_FLAT, (VARIANT,), reads=("silo",)),
     "blending": Group(RECIRCULATION),
     "blender": Group(BLENDER),
 }
@@ -61,28 +62,27 @@ GROUP_BUDGET_S = 2.5 * 3600.0
 COMPLETE, STALE, MISSING = "complete", "stale", "missing"
 
 
-def group_of(kind: str, reference: bool) -> str:
-    """The group that makes a run of case kind ``kind`` (of the reference configuration or not)."""
+def group_of(kind: str, role: str) -> str:
+    """The group that makes a run of case kind ``kind`` with ``role`` (:func:`engines.cases.run_roles`)."""
     for name, group in GROUPS.items():
-        if group.makes(kind, reference):
+        if group.makes(kind, role):
             return name
-    raise KeyError(f"no validation group makes runs of kind {kind!r}; the groups are {', '.join(GROUPS)}")
+    raise KeyError(f"no validation group makes {role!r} runs of kind {kind!r}; the groups are {', '.join(GROUPS)}")
 
 
-def assign(estimates: Sequence[RunEstimate], references: Mapping[str, Iterable[str]]) -> dict[str, list[RunEstimate]]:
+def assign(estimates: Sequence[RunEstimate], roles: Mapping[str, str]) -> dict[str, list[RunEstimate]]:
     """The runs each group makes: ``{group: [estimate]}`` in :data:`GROUPS` order.
 
     Parameters
     ----------
     estimates : sequence of RunEstimate
         A configuration's run estimates (:func:`engines.planning.config_estimates`).
-    references : mapping
-        ``{case kind: run ids of its reference configuration}`` (:func:`engines.cases.reference_runs`).
+    roles : mapping
+        ``{run id: role}`` of every run (:func:`engines.cases.run_roles`).
     """
-    reference = {kind: set(runs) for kind, runs in references.items()}
     made: dict[str, list[RunEstimate]] = {name: [] for name in GROUPS}
     for estimate in estimates:
-        made[group_of(estimate.kind, estimate.run_id in reference.get(estimate.kind, ()))].append(estimate)
+        made[group_of(estimate.kind, roles[estimate.run_id])].append(estimate)
     return made
 
 
@@ -198,7 +198,7 @@ def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
     lines = []
     for name, status in group_status(planned, recorded).items():
         held, runs = set(recorded.get(name, ())), set(planned[name])
-        line = f"{name:12s} {status:9s} {len(held & runs)} of {len(runs)} planned runs recorded"
+        line = f"{name:18s} {status:9s} {len(held & runs)} of {len(runs)} planned runs recorded"
         if status == STALE:
             gone, new = sorted(held - runs), sorted(runs - held)
             line += (f"; recorded but no longer planned: {', '.join(gone) or 'none'}; planned but not recorded: "
@@ -213,6 +213,6 @@ def cost_lines(costs: Sequence[GroupCost], cores: int) -> list[str]:
              f"{GROUP_BUDGET_S / 3600:g} h:"]
     for cost in costs:
         flag = "  OVER BUDGET: split it" if cost.over_budget else ""
-        lines.append(f"  {cost.name:12s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
+        lines.append(f"  {cost.name:18s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
                      f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
     return lines

@@ -10,10 +10,11 @@ import copy
 
 from engines.cases.blender import blender_cases
 from engines.cases.jenike import jenike_cases
+from engines.cases.jenike_sweep import point_role
 from engines.cases.silo_flat import silo_cases
 from engines.cases.silo_recirculation import recirculation_cases
 
-__all__ = ["CASE_BUILDERS", "case_for_run", "cases_of", "reference_runs"]
+__all__ = ["CASE_BUILDERS", "REFERENCE", "VARIANT", "case_for_run", "cases_of", "reference_runs", "run_roles"]
 
 #: Case kind -> function of a validated configuration returning its runs ``{run id: case}``.
 CASE_BUILDERS = {
@@ -72,6 +73,22 @@ def reference_runs(config: dict, case: str) -> list[str]:
     first = [next(iter(CASE_BUILDERS[case](config)), None)]
     first += [next(iter(_reseeded(config, case, offset))) for offset in range(1, _replicates(config, case)[1])]
     return [run for run in first if run is not None]
+
+
+#: The roles of the runs of a silo-type case kind (:func:`run_roles`): the reference configuration's or another's.
+REFERENCE, VARIANT = "reference", "variant"
+
+
+def run_roles(config: dict, case: str) -> dict[str, str]:
+    """``{run id: role}`` of the runs of case kind ``case``: a Jenike run's sweep role
+    (:data:`engines.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), any
+    other run :data:`REFERENCE` when it is one of :func:`reference_runs` and :data:`VARIANT` otherwise."""
+    runs = cases_of(config, case)
+    if case == "jenike":
+        return {run: point_role(job.sweep_point, config["jenike"]["sweep"]["restitution"],
+                                config["calibration"]["shape"]) for run, job in runs.items()}
+    reference = set(reference_runs(config, case))
+    return {run: REFERENCE if run in reference else VARIANT for run in runs}
 
 
 def case_for_run(config: dict, case: str, run: str):

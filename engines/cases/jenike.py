@@ -162,6 +162,9 @@ class JenikeCase(ChosenTimestep):
     domain: tuple[float, float, float, float, float, float]
     seeds: tuple[int, ...]
     defining_parameters: dict = field(repr=False)
+    #: The point as the sweep designed it (:func:`engines.cases.jenike_sweep.sweep_points`): ``point`` with ``lid``,
+    #: ``replicate`` and ``shear_velocity`` where the sweep set them.
+    sweep_point: dict = field(default_factory=dict, repr=False)
 
     @property
     def fill_height(self) -> float:
@@ -412,6 +415,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         Naming the offending key: unknown shape or material, a missing contact pair, values out of range,
         a cell too small for the clumps, or a plate too small for the shear travel.
     """
+    sweep_point = dict(point)
     lid = point.get("lid", config["jenike"]["lid"])
     if lid not in LID_KINDS:
         raise ValueError(f"jenike point: lid must be one of {', '.join(LID_KINDS)}, got {lid!r}")
@@ -534,6 +538,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         domain=(-half, half, -half, half, -margin, z_top),
         seeds=tuple(engine_seeds(jenike["seed"], 3)),
         defining_parameters=defining,
+        sweep_point=sweep_point,
     )
 
 

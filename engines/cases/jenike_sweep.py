@@ -13,6 +13,12 @@ from __future__ import annotations
 
 INTERNAL = "internal"
 
+#: The role of a sweep point (:func:`point_role`): a point of the calibration shape's charts, of another shape's
+#: charts, or of a check against a chart (rotation blocked, the other lid, another restitution or shear speed, another
+#: seed).
+CALIBRATION_CHART, SHAPE_CHART, CHECK = "calibration_chart", "shape_chart", "check"
+ROLES = (CALIBRATION_CHART, SHAPE_CHART, CHECK)
+
 
 def other_lid(lid: str) -> str:
     """The lid a comparison runs against: servo for rigid and rigid for servo."""
@@ -112,3 +118,32 @@ def reference_point(sweep: dict) -> dict | None:
             "sliding_friction": float(sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]),
             "rolling_friction": float(sweep["rolling_friction"][0]), "restitution": float(sweep["restitution"]),
             "rotation_blocked": False}
+
+
+def is_chart_point(point: dict, base_restitution: float) -> bool:
+    """Whether a sweep point belongs on a calibration chart: base restitution, rotation free, the configured lid and
+    shear velocity, the first seed."""
+    return (point["restitution"] == base_restitution and not point["rotation_blocked"]
+            and not {"lid", "shear_velocity", "replicate"} & set(point))
+
+
+def point_role(point: dict, base_restitution: float, calibration_shape: str) -> str:
+    """The role of a sweep point (:data:`ROLES`): a chart point of ``calibration_shape`` or of another shape, or a
+    check."""
+    if not is_chart_point(point, base_restitution):
+        return CHECK
+    return CALIBRATION_CHART if point["shape"] == calibration_shape else SHAPE_CHART
+
+
+def diagnostic_points(points: list[dict], sweep: dict, lid: str) -> list[dict]:
+    """The chart points that get contact and rotation diagnostics (``jenike.sweep.diagnostics``).
+
+    Only rigid-lid runs record wall contacts, so a servo ``lid`` gives none.
+    """
+    if sweep["diagnostics"] == "none" or lid != "rigid":
+        return []
+    chart = [p for p in points if is_chart_point(p, sweep["restitution"])]
+    if sweep["diagnostics"] == "all":
+        return chart
+    middle = sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]
+    return [p for p in chart if p["sliding_friction"] == float(middle)]

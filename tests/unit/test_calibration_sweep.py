@@ -2,8 +2,9 @@
 
 import pytest
 
-from calibration.sweep import chart_rows, diagnostic_points, is_chart_point, lid_comparison
-from engines.cases.jenike_sweep import sweep_points
+from calibration.sweep import chart_rows, lid_comparison
+from engines.cases.jenike_sweep import (CALIBRATION_CHART, CHECK, SHAPE_CHART, diagnostic_points, is_chart_point,
+                                        point_role, sweep_points)
 from engines.config import ConfigError, validate_config
 
 
@@ -123,3 +124,20 @@ def test_sweep_subsets_must_name_shapes_and_tests_of_the_sweep():
     config = {"jenike": {"sweep": {"tests": ["internal"], "sensitivity_tests": ["aluminium"]}}}
     with pytest.raises(ConfigError, match=r"jenike.sweep.sensitivity_tests\[0\]': 'aluminium' is not among jenike.sweep.tests"):
         validate_config(config)
+
+
+def test_each_sweep_point_has_one_role_and_only_chart_points_are_on_a_chart():
+    sweep = {**validate_config({})["jenike"]["sweep"], "shapes": ["sphere", "sphere2"], "sensitivity_shapes": ["sphere2"],
+             "reference_replicates": 2, "shear_velocity_sensitivity": [0.01]}
+    points = sweep_points(sweep, lid="rigid")
+    roles = [point_role(p, sweep["restitution"], "sphere2") for p in points]
+    charts = [p for p, role in zip(points, roles) if role != CHECK]
+    assert all(is_chart_point(p, sweep["restitution"]) for p in charts)
+    assert {p["shape"] for p, role in zip(points, roles) if role == CALIBRATION_CHART} == {"sphere2"}
+    assert {p["shape"] for p, role in zip(points, roles) if role == SHAPE_CHART} == {"sphere"}
+    checks = [p for p, role in zip(points, roles) if role == CHECK]
+    # the reference point's other seed and its slower shear are checks, as are the lid and sensitivity points
+    assert any(p.get("replicate") == 1 for p in checks) and any(p.get("shear_velocity") == 0.01 for p in checks)
+    assert all(p["shape"] == "sphere2" for p in checks)
+    # the diagnostics take chart points only: not the reference point's other seed
+    assert not any("replicate" in p for p in diagnostic_points(points, sweep, "rigid"))

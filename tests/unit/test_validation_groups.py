@@ -6,6 +6,8 @@ import pytest
 
 from engines.config import REPO_ROOT, load_config
 from engines.estimates import RunEstimate
+from engines.cases import REFERENCE, VARIANT
+from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
 from engines.planning import config_estimates, group_runs
 from engines.validation_groups import (
     COMPLETE,
@@ -37,21 +39,34 @@ def _estimate(run_id: str, kind: str, wall_time_s: float, mpi_ranks: int = 1) ->
 
 
 def test_every_run_of_the_study_is_made_by_exactly_one_group():
-    kinds = {"jenike", "silo_flat", "silo_recirculation", "blender"}
-    for kind in kinds:
-        makers = [name for name, group in GROUPS.items() for reference in (True, False) if group.makes(kind, reference)]
-        assert len(makers) == 2   # once for the reference configuration's runs, once for the others
-    assert group_of("silo_flat", True) == "silo" and group_of("silo_flat", False) == "silo_series"
-    assert group_of("jenike", True) == group_of("jenike", False) == "calibration"
-    # the series' rows compare against the base silo, which the silo group makes
+    roles = {"jenike": ROLES, "silo_flat": (REFERENCE, VARIANT), "silo_recirculation": (REFERENCE, VARIANT),
+             "blender": (REFERENCE, VARIANT)}
+    for kind, kind_roles in roles.items():
+        for role in kind_roles:
+            assert len([name for name, group in GROUPS.items() if group.makes(kind, role)]) == 1
+    assert group_of("silo_flat", REFERENCE) == "silo" and group_of("silo_flat", VARIANT) == "silo_series"
+    assert [group_of("jenike", role) for role in (CALIBRATION_CHART, SHAPE_CHART, CHECK)] == [
+        "calibration", "calibration_shapes", "calibration_checks"]
+    assert group_of("blender", REFERENCE) == group_of("blender", VARIANT) == "blender"
+    # the series' rows compare against the base silo, the checks against the charts
     assert GROUPS["silo_series"].reads == ("silo",)
+    assert GROUPS["calibration_checks"].reads == ("calibration", "calibration_shapes")
     with pytest.raises(KeyError, match="verification"):
-        group_of("verification", False)
+        group_of("verification", REFERENCE)
+
+
+def test_the_validation_config_s_runs_fall_into_their_groups():
+    config = load_config(REPO_ROOT / "config" / "validation.yaml")
+    made = group_runs(config, config_estimates(config))
+    counts = {name: len(runs) for name, runs in made.items()}
+    # 8 sphere2 internal + 8 aluminium; 8 sphere + 8 sphere4; 4 blocked + 4 servo + 1 restitution + 2 seeds + 1 slower
+    assert counts == {"calibration": 16, "calibration_shapes": 16, "calibration_checks": 12, "silo": 3,
+                      "silo_series": 4, "blending": 5, "blender": 7}
 
 
 def test_an_unknown_group_is_refused_with_the_groups_named():
     assert check_group("blender") == "blender"
-    with pytest.raises(ValueError, match="unknown validation group 'silos'; the groups are calibration, silo"):
+    with pytest.raises(ValueError, match="unknown validation group 'silos'; the groups are calibration, calibration_shapes, "):
         check_group("silos")
 
 
@@ -81,8 +96,9 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
                  _estimate("s1", "silo_flat", 1.0 * hour), _estimate("s2", "silo_flat", 1.0 * hour),
                  _estimate("s3", "silo_flat", 1.0 * hour),
                  _estimate("b1", "blender", 1.0 * hour, mpi_ranks=2)]
-    references = {"silo_flat": ["s1", "s2", "s3"]}
-    made = assign(estimates, references)
+    roles = {"j1": CALIBRATION_CHART, "j2": CALIBRATION_CHART, "j3": CALIBRATION_CHART, "s1": REFERENCE,
+             "s2": REFERENCE, "s3": REFERENCE, "b1": REFERENCE}
+    made = assign(estimates, roles)
     assert [e.run_id for e in made["silo"]] == ["s1", "s2", "s3"] and made["silo_series"] == []
     costs = {cost.name: cost for cost in group_costs(made, cores=2)}
     assert list(costs) == list(GROUPS)
@@ -97,17 +113,18 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
     assert one_core["silo"].wall_time_s > GROUP_BUDGET_S and one_core["silo"].over_budget
     lines = cost_lines(group_costs(made, cores=1), cores=1)
     assert lines[0].startswith("Validation groups (make validate GROUP=<name>) on 1 core(s), each at most 2.5 h")
-    assert lines[2].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
+    assert lines[4].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
                                 "split", "it"]
 
 
 def test_status_is_complete_stale_or_missing_against_the_plan():
     estimates = [_estimate("j1", "jenike", 1.0), _estimate("j2", "jenike", 1.0), _estimate("s1", "silo_flat", 1.0),
                  _estimate("r1", "silo_recirculation", 1.0), _estimate("b1", "blender", 1.0)]
-    planned = planned_runs(assign(estimates, {"silo_flat": ["s1"]}))
+    roles = {"j1": CALIBRATION_CHART, "j2": CALIBRATION_CHART, "s1": REFERENCE, "r1": REFERENCE, "b1": REFERENCE}
+    planned = planned_runs(assign(estimates, roles))
     # no front-wall series: no series group
     assert planned == {"calibration": {"j1", "j2"}, "silo": {"s1"}, "blending": {"r1"}, "blender": {"b1"}}
-    series = planned_runs(assign([*estimates, _estimate("v1", "silo_flat", 1.0)], {"silo_flat": ["s1"]}))
+    series = planned_runs(assign([*estimates, _estimate("v1", "silo_flat", 1.0)], {**roles, "v1": VARIANT}))
     # the series' rows draw on the base run too: its record holds both
     assert series["silo_series"] == {"v1", "s1"} and series["silo"] == {"s1"}
     recorded = {"calibration": {"j1", "j2"},   # as planned

@@ -247,3 +247,17 @@ def test_without_a_tube_the_interior_annulus_spans_both_plates_and_is_the_inner_
     assert rows["Interior annulus v_z / cross-section mean"]["value"] == pytest.approx(-2.0 / mean)
     inner = rows["Exterior annulus / interior annulus v_z (mass flow of the insert)"]
     assert inner["value"] == pytest.approx(0.5) and inner["scale_shows"] == YES
+
+
+def test_each_group_s_calibration_rows_are_its_sections():
+    rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01), _bulk("sphere2", 0.5, 0.56, 0.01),
+            _bulk("sphere2", 0.3, 0.60, 0.01, blocked=True)]
+    curves = calibration_rows(rows, None, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA, sections=("curves",))
+    assert [r["figure"] for r in curves] == ["Bulk friction at particle friction 0.5 (rigid lid)"]
+    checks = calibration_rows(rows, None, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA,
+                              sections=("comparisons",))
+    assert [r["figure"] for r in checks] == ["Bulk friction, rotation blocked - free"]
+    with pytest.raises(ValueError, match="need the calibration's parameters"):
+        calibration_rows(rows, None, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)
+    with pytest.raises(ValueError, match="unknown calibration row sections chart"):
+        calibration_rows(rows, None, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA, sections=("chart",))

@@ -1,6 +1,6 @@
 # Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
 
-from calibration.sweep import diagnostic_points
+from engines.cases.jenike_sweep import diagnostic_points, is_chart_point
 
 JENIKE_CASES = cases("jenike")
 CALIBRATION = f"{RESULTS}/calibration"
@@ -12,9 +12,40 @@ def jenike_point(run):
     return {**case.point, "lid": case.lid_kind, "shear_velocity": case.shear_velocity}
 
 
-def calibration_chart_names():
-    sweep = config["jenike"]["sweep"]
-    return [f"{shape}_{test}" for shape in sweep["shapes"] for test in sweep["tests"]]
+def _on_chart(case):
+    return is_chart_point(case.sweep_point, config["jenike"]["sweep"]["restitution"])
+
+
+def calibration_chart_names(runs=None):
+    """``<shape>_<test>`` of each calibration chart the sweep runs (of ``runs``' points only, run ids, when given)."""
+    chosen = JENIKE_CASES if runs is None else {run: JENIKE_CASES[run] for run in runs}
+    return list(dict.fromkeys(f"{case.point['shape']}_{case.point['test']}" for case in chosen.values()
+                              if _on_chart(case)))
+
+
+def chart_runs(chart):
+    """The runs of one calibration chart (``<shape>_<test>``): its chart points."""
+    return [run for run, case in JENIKE_CASES.items()
+            if _on_chart(case) and f"{case.point['shape']}_{case.point['test']}" == chart]
+
+
+def summaries_of(runs):
+    return [run_path("jenike", "metrics/bulk_friction.json", run) for run in runs]
+
+
+def lid_comparison_runs():
+    """The runs the lid comparison pairs: the internal tests at the base restitution, rotation free, with either lid
+    at the configured shear speed and first seed."""
+    base = config["jenike"]["sweep"]["restitution"]
+    return [run for run, case in JENIKE_CASES.items()
+            if case.point["test"] == "internal" and is_chart_point({k: v for k, v in case.sweep_point.items()
+                                                                    if k != "lid"}, base)]
+
+
+def calibration_shape_runs():
+    """The chart points of the calibration shape: what the calibrated parameters are read from."""
+    return [run for run, case in JENIKE_CASES.items() if _on_chart(case)
+            and case.point["shape"] == config["calibration"]["shape"]]
 
 
 def lid_comparison_targets():
@@ -24,19 +55,11 @@ def lid_comparison_targets():
     return [f"{CALIBRATION}/lid_comparison.csv", f"{CALIBRATION}/charts/lid_comparison.png"]
 
 
-def _sweep_point(run):
-    """The point as the sweep designed it (the lid and shear velocity only where they differ from the configured)."""
-    point = dict(JENIKE_CASES[run].point)
-    if JENIKE_CASES[run].lid_kind != config["jenike"]["lid"]:
-        point["lid"] = JENIKE_CASES[run].lid_kind
-    if JENIKE_CASES[run].shear_velocity != config["jenike"]["shear"]["velocity"]:
-        point["shear_velocity"] = JENIKE_CASES[run].shear_velocity
-    return point
-
-
-def diagnostic_targets():
-    points = diagnostic_points([_sweep_point(run) for run in JENIKE_CASES], config["jenike"]["sweep"], config["jenike"]["lid"])
-    chosen = [run for run in JENIKE_CASES if _sweep_point(run) in points]
+def diagnostic_targets(runs=None):
+    """The diagnostic plots of the runs (``runs``: run ids, all when None) whose points get diagnostics."""
+    points = diagnostic_points([case.sweep_point for case in JENIKE_CASES.values()], config["jenike"]["sweep"],
+                               config["jenike"]["lid"])
+    chosen = [run for run in (JENIKE_CASES if runs is None else runs) if JENIKE_CASES[run].sweep_point in points]
     return [run_path("jenike", f"plots/{name}.png", run) for run in chosen for name in ("mobilised_friction", "angular_velocity")]
 
 
@@ -108,29 +131,28 @@ rule calibration_table:
         "../scripts/calibration_table.py"
 
 
-rule calibration_charts:
+rule calibration_chart:
     input:
-        table=rules.calibration_table.output.table,
+        summaries=lambda wildcards: summaries_of(chart_runs(wildcards.chart)),
     output:
-        charts=[
-            report(f"{CALIBRATION}/charts/{name}.png", caption="../report/calibration_chart.rst",
-                   category="1 Calibration", subcategory="Charts", labels={"figure": name})
-            for name in calibration_chart_names()
-        ],
+        chart=report(f"{CALIBRATION}/charts/{{chart}}.png", caption="../report/calibration_chart.rst",
+                     category="1 Calibration", subcategory="Charts", labels={"figure": "{chart}"}),
+    wildcard_constraints:
+        chart="|".join(calibration_chart_names()) or "no chart",
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
         shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
     log:
-        f"{CALIBRATION}/logs/charts.log",
+        f"{CALIBRATION}/logs/chart_{{chart}}.log",
     script:
         "../scripts/calibration_charts.py"
 
 
 checkpoint calibration_parameters:
     input:
-        table=rules.calibration_table.output.table,
+        summaries=summaries_of(calibration_shape_runs()),
     output:
         parameters=f"{CALIBRATION}/parameters.yaml",
     params:
@@ -146,7 +168,7 @@ checkpoint calibration_parameters:
 
 rule lid_comparison:
     input:
-        table=rules.calibration_table.output.table,
+        summaries=summaries_of(lid_comparison_runs()),
     output:
         table=f"{CALIBRATION}/lid_comparison.csv",
         plot=report(f"{CALIBRATION}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),

@@ -2,9 +2,10 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
-from engines.cases import reference_runs
+from engines.cases import REFERENCE, VARIANT, reference_runs, run_roles
+from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.layout import VALIDATION_RECORD
-from engines.validation_groups import ALL, GROUPS
+from engines.validation_groups import GROUPS
 
 VALIDATION = f"{RESULTS}/summary"
 SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
@@ -18,13 +19,19 @@ def references(kind):
     return reference_runs(silo_config() if kind == "silo_flat" else config, kind)
 
 
+def roles(kind):
+    """``{run id: role}`` of case ``kind``'s runs (the flat-bottom silo's with calibrated parameters applied when asked
+    for)."""
+    return run_roles(silo_config() if kind == "silo_flat" else config, kind)
+
+
 def group_made(group):
     """Run ids a validation group makes."""
     spec = GROUPS[group]
-    if spec.part == ALL:
+    if spec.roles is None:
         return run_ids(spec.kind)
-    reference = set(references(spec.kind))
-    return [run for run in run_ids(spec.kind) if spec.makes(spec.kind, run in reference)]
+    role = roles(spec.kind)
+    return [run for run in run_ids(spec.kind) if spec.makes(spec.kind, role[run])]
 
 
 def group_runs(group):
@@ -49,7 +56,10 @@ def group_rows_inputs(group):
     def inputs(wildcards):
         kind = GROUPS[group].kind
         if kind == "jenike":
-            return {"bulk": f"{CALIBRATION}/bulk_friction.csv", "parameters": f"{CALIBRATION}/parameters.yaml"}
+            found = {"summaries": [run_path("jenike", "metrics/bulk_friction.json", run) for run in group_runs(group)]}
+            if CALIBRATION_CHART in GROUPS[group].roles:
+                found["parameters"] = f"{CALIBRATION}/parameters.yaml"
+            return found
         if kind == "silo_flat":
             labels = front_wall_labels()
             runs = [run for run in group_runs(group) if run in labels]
@@ -71,6 +81,10 @@ def group_rows_params(group):
     params = {"group": group, "kind": kind, "criteria": config["validation"]}
     if kind == "jenike":
         jenike = config["jenike"]
+        # the rows each role's group judges: the curves of its charts, the coefficients read from the calibration
+        # shape's, the checks against the charts
+        sections = {CALIBRATION_CHART: ("curves", "calibrated"), SHAPE_CHART: ("curves",), CHECK: ("comparisons",)}
+        params.update(sections=[section for role in GROUPS[group].roles for section in sections[role]])
         params.update(cell_diameter=jenike["cell"]["inner_diameter"],
                       shapes={shape: config["particle_models"][shape] for shape in jenike["sweep"]["shapes"]},
                       density=config["materials"][jenike["particle_material"]]["density"],
@@ -83,8 +97,8 @@ def group_rows_params(group):
 
 def makes_runs(spec):
     """Whether a group makes any run of this configuration."""
-    reference = set(reference_runs(config, spec.kind)) if spec.part != ALL else set()
-    return any(spec.makes(spec.kind, run in reference) for run in CASES[spec.kind])
+    role = run_roles(config, spec.kind)
+    return any(spec.makes(spec.kind, role[run]) for run in CASES[spec.kind])
 
 
 #: The groups whose rows this configuration makes: a group without runs (a study switched off, a silo without a
@@ -127,20 +141,24 @@ rule validation_table:
 # The validation tier in groups (engines.validation_groups): `make validate GROUP=<name>` asks for the products of the
 # runs one group makes.
 KIND_TARGETS = {
-    "jenike": calibration_targets,
     RECIRCULATION: recirculation_targets,
     "blender": blender_targets,
 }
 
 
 def group_targets(group):
-    """The products of the runs a group makes: the flat-bottom silo's per run (and its parametric studies' with the
-    series), every other kind's as a whole."""
-    spec = GROUPS[group]
+    """The products of the runs a group makes: the Jenike runs' and the flat-bottom silo's per run with the products
+    of their role (the charts, the calibrated parameters, the lid comparison; the parametric studies with the series),
+    every other kind's as a whole."""
+    spec, made = GROUPS[group], group_made(group)
+    if spec.kind == "jenike":
+        targets = [run_path("jenike", name, run) for run in made
+                   for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")]
+        parameters = [f"{CALIBRATION}/parameters.yaml"] if spec.makes(spec.kind, CALIBRATION_CHART) else []
+        return [*targets, *diagnostic_targets(made), *record_plots(group).values(), *parameters]
     if spec.kind != "silo_flat":
         return KIND_TARGETS[spec.kind]()
-    return [*silo_flat_targets(runs=group_made(group)), *(parametric_targets() if group_made(group) and
-                                                          spec.makes(spec.kind, False) else [])]
+    return [*silo_flat_targets(runs=made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
 
 
 for _group in GROUPS:
@@ -161,15 +179,16 @@ def record_plots(group):
     and gravity series."""
     kind = GROUPS[group].kind
     if kind == "jenike":
-        plots = {f"{name}.png": f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()}
-        plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
+        plots = {f"{name}.png": f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names(group_made(group))}
+        if GROUPS[group].makes(kind, CHECK):
+            plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
         return plots
     if kind == "silo_flat":
         plots = {}
-        if GROUPS[group].makes(kind, True):
+        if GROUPS[group].makes(kind, REFERENCE):
             base = run_ids("silo_flat")[0]
             plots.update({f"{name}.png": run_path("silo_flat", f"plots/{name}.png", base) for name in ("profiles", "janssen")})
-        if GROUPS[group].makes(kind, False):
+        if GROUPS[group].makes(kind, VARIANT):
             plots.update({f"{study}.png": f"{case_root('silo_flat')}/parametric/{study}.png" for study in parametric_studies()})
         return plots
     if kind == RECIRCULATION:

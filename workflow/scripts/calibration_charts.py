@@ -1,24 +1,22 @@
-"""Snakemake adapter: one calibration chart (bulk versus particle friction) per shape and test."""
+"""Snakemake adapter: one calibration chart (bulk versus particle friction) of one shape and test."""
 
-import csv
+import json
 from pathlib import Path
 
 from calibration.charts import plot_calibration_chart
 from calibration.inversion import curves_from_table
 from calibration.sweep import chart_rows
+from calibration.table import point_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
-    calibration = snakemake.params.calibration
-    with open(snakemake.input.table, newline="") as handle:
-        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid,
-                          snakemake.params.shear_velocity)
+    calibration, params = snakemake.params.calibration, snakemake.params
+    rows = chart_rows(point_table([json.loads(Path(path).read_text()) for path in snakemake.input.summaries]),
+                      params.base_restitution, params.lid, params.shear_velocity)
     curves = curves_from_table(rows)
-    for path in snakemake.output.charts:
-        shape, test = Path(path).stem.split("_", 1)
-        selected = [c for c in curves if c.shape == shape and c.test == ("internal" if test == "internal" else "wall")
-                    and (test == "internal" or c.wall_material == test)]
-        target = calibration["targets_deg"].get(test)
-        plot_calibration_chart(selected, path, title=f"{shape}, {'internal friction' if test == 'internal' else test + ' wall friction'}",
-                               target_angle_deg=target, tolerance_deg=calibration["tolerance_deg"] if target else None)
-        log.info("chart %s: %d curves", path, len(selected))
+    shape, test = snakemake.wildcards.chart.split("_", 1)
+    target = calibration["targets_deg"].get(test)
+    plot_calibration_chart(curves, snakemake.output.chart,
+                           title=f"{shape}, {'internal friction' if test == 'internal' else test + ' wall friction'}",
+                           target_angle_deg=target, tolerance_deg=calibration["tolerance_deg"] if target else None)
+    log.info("chart %s: %d curves", snakemake.output.chart, len(curves))

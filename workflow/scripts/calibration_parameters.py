@@ -1,18 +1,19 @@
 """Snakemake adapter: invert the calibration chart at the measured bulk friction angles."""
 
-import csv
+import json
+from pathlib import Path
 
 import yaml
 
 from calibration.inversion import curves_from_table, invert_calibration
 from calibration.sweep import chart_rows
+from calibration.table import point_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     calibration = snakemake.params.calibration
-    with open(snakemake.input.table, newline="") as handle:
-        rows = chart_rows(csv.DictReader(handle), snakemake.params.base_restitution, snakemake.params.lid,
-                          snakemake.params.shear_velocity)
+    rows = chart_rows(point_table([json.loads(Path(path).read_text()) for path in snakemake.input.summaries]),
+                      snakemake.params.base_restitution, snakemake.params.lid, snakemake.params.shear_velocity)
     curves = curves_from_table(rows)
     tested = {"internal" if c.test == "internal" else c.wall_material for c in curves}
     targets = {name: angle for name, angle in calibration["targets_deg"].items() if name in tested}

@@ -1,16 +1,17 @@
 """Snakemake adapter: compare bulk friction measured with the rigid and the servo lid on the same points."""
 
-import csv
+import json
+from pathlib import Path
 
 from analysis.io.tables import write_flow_table
 from calibration.charts import plot_lid_comparison
 from calibration.sweep import lid_comparison
+from calibration.table import point_table
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
-    with open(snakemake.input.table, newline="") as handle:
-        rows = lid_comparison(csv.DictReader(handle), snakemake.params.base_restitution,
-                              snakemake.params.shear_velocity)
+    rows = lid_comparison(point_table([json.loads(Path(path).read_text()) for path in snakemake.input.summaries]),
+                          snakemake.params.base_restitution, snakemake.params.shear_velocity)
     if not rows:
         raise ValueError("no sweep point was run with both lids; enable jenike.sweep.lid_comparison")
     write_flow_table(snakemake.output.table, rows)

@@ -15,6 +15,7 @@ from analysis.studies.validation.calibration import calibration_rows
 from analysis.studies.validation.rows import Criteria
 from analysis.numerics.reference_spread import combine_seeds, floor_errors, seed_note, table_spread
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
+from calibration.table import point_table
 from engines.cases.particles import particle_template
 from engines.logs import logged_to
 
@@ -78,11 +79,12 @@ def _blender(inputs, params, criteria):
 def _calibration(inputs, params, criteria):
     diameters = {shape: particle_template(shape, model, params.density).equivalent_diameter
                  for shape, model in params.shapes.items()}
-    points = read_table(inputs.bulk)
+    points = point_table([_json(path) for path in inputs.summaries])
     spread, replicated = table_spread(points, ("bulk_friction", "bulk_friction_angle_deg"))
     points = [point if point in replicated else floor_errors(point, spread) for point in points]
-    rows = calibration_rows(points, yaml.safe_load(Path(inputs.parameters).read_text()), params.cell_diameter,
-                            diameters, params.base_restitution, params.lid, params.shear_velocity, criteria)
+    parameters = yaml.safe_load(Path(inputs.parameters).read_text()) if "parameters" in inputs.keys() else None
+    rows = calibration_rows(points, parameters, params.cell_diameter, diameters, params.base_restitution, params.lid,
+                            params.shear_velocity, criteria, sections=params.sections)
     if spread.seeds >= 2:
         reference = "; ".join(f"{row['shape']} {row['test']}, particle friction {row['particle_friction']}, rolling "
                               f"{row['rolling_friction']}" for row in replicated)

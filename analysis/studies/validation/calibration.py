@@ -26,7 +26,7 @@ from analysis.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
 from analysis.studies.validation.rows import NO, Criteria, plus_minus, resolved, row, verdict
 
-__all__ = ["calibration_rows"]
+__all__ = ["SECTIONS", "calibration_rows"]
 
 GROUP = "Calibration (Jenike cell)"
 #: The study's chosen particle-scale friction of the two-sphere clump (SEED_DIGEST section 1).
@@ -142,9 +142,13 @@ def _paired_rows(figure: str, reference: dict, other: dict, cell_ok: bool, cell_
     return rows
 
 
-def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_diameter: float,
+#: The kinds of calibration rows (:func:`calibration_rows`' ``sections``).
+SECTIONS = ("curves", "comparisons", "calibrated")
+
+
+def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, cell_diameter: float,
                      particle_diameters: Mapping[str, float], base_restitution: float, lid: str,
-                     shear_velocity: float, criteria: Criteria) -> list[dict]:
+                     shear_velocity: float, criteria: Criteria, sections: Sequence[str] = SECTIONS) -> list[dict]:
     """The calibration's validation rows.
 
     Parameters
@@ -152,8 +156,9 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
     bulk_rows : sequence of mapping
         Rows of ``calibration/bulk_friction.csv``: shape, test, lid, rolling_friction, restitution,
         rotation_blocked, particle_friction, bulk_friction, bulk_friction_error (-).
-    parameters : mapping
-        The calibration's ``parameters.yaml`` (:func:`calibration.inversion` output) as read.
+    parameters : mapping or None
+        The calibration's ``parameters.yaml`` (:func:`calibration.inversion` output) as read; needed for the
+        ``calibrated`` rows only.
     cell_diameter : float
         Inner diameter of the Jenike cell (m).
     particle_diameters : mapping
@@ -165,7 +170,15 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
     shear_velocity : float
         The configured shear velocity (m/s); rows at another are the shear-speed study.
     criteria : Criteria
+    sections : sequence of str
+        Which rows (:data:`SECTIONS`): each chart's curve, the checks against the charts, the calibrated
+        coefficients.
     """
+    unknown = sorted(set(sections) - set(SECTIONS))
+    if unknown:
+        raise ValueError(f"unknown calibration row sections {', '.join(unknown)}; the sections are {', '.join(SECTIONS)}")
+    if "calibrated" in sections and parameters is None:
+        raise ValueError("the calibrated rows need the calibration's parameters")
     def base_speed(entry):
         return float(entry["shear_velocity"]) == shear_velocity
 
@@ -182,7 +195,7 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
     restitutions = sorted({float(e["restitution"]) for e in bulk_rows if base_speed(e)} - {base_restitution})
     speeds = sorted({float(e["shear_velocity"]) for e in bulk_rows} - {shear_velocity})
     rows = []
-    for key, entries in chart_entries.items():
+    for key, entries in chart_entries.items() if "curves" in sections else ():
         cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
         rows.append(_curve_row(f"{lid} lid", key, entries, cell_ok, cell_text, criteria))
     comparisons = [("Bulk friction, rotation blocked - free", blocked, "higher with rotation blocked", True),
@@ -198,13 +211,14 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping, cell_dia
                           and not _flag(e["rotation_blocked"]) and float(e["restitution"]) == base_restitution)
         comparisons.append((f"Bulk friction, shear velocity {speed:g} - {shear_velocity:g} m/s", slower,
                             "independent of the shear speed (quasi-static)", False))
-    for figure, others, study, expect in comparisons:
+    for figure, others, study, expect in comparisons if "comparisons" in sections else ():
         for key, entries in others.items():
             cell_ok, cell_text = _judged(_cell_text(cell_diameter, particle_diameters[key[0]], criteria),
                                          [*chart_entries.get(key, []), *entries])
             rows += _paired_rows(figure, curves, {key: [_point(entry) for entry in entries]}, cell_ok, cell_text,
                                  criteria, study, expect)
-    rows += _calibrated_rows(parameters, cell_diameter, particle_diameters, chart_entries, criteria)
+    if "calibrated" in sections:
+        rows += _calibrated_rows(parameters, cell_diameter, particle_diameters, chart_entries, criteria)
     return rows
 
 
