@@ -24,7 +24,8 @@ from collections.abc import Mapping, Sequence
 
 from analysis.numerics.replicates import ERROR_SUFFIX, SEED_STD_SUFFIX, replicate_error
 
-__all__ = ["SeedSpread", "combine_seeds", "relative_spread", "table_spread", "floor_errors", "seed_note"]
+__all__ = ["SeedSpread", "combine_seeds", "relative_spread", "table_spread", "floor_errors", "with_reference_spread",
+           "seed_note"]
 
 Path = tuple
 
@@ -228,6 +229,31 @@ def floor_errors(summary, spread: Mapping[Path, float]):
         if math.isfinite(floor) and not (error is not None and math.isfinite(error) and error >= floor):
             floored = _set(floored, error_path, floor)
     return floored
+
+
+def with_reference_spread(summaries: Sequence, run_ids: Sequence[str], reference: set[str]):
+    """The reference configuration's seeds combined and every other run's errors floored by their spread.
+
+    Parameters
+    ----------
+    summaries : sequence
+        The runs' summaries, in the order of ``run_ids``.
+    run_ids : sequence of str
+        Their run ids.
+    reference : set of str
+        The run ids of the reference configuration's seeds (at least one of ``run_ids``).
+
+    Returns
+    -------
+    combined : object
+        The reference's summary over its seeds (:func:`combine_seeds`).
+    others : list of (str, object)
+        ``(run id, summary)`` of every other run, errors floored (:func:`floor_errors`), in order.
+    spread : SeedSpread
+    """
+    combined, spread = combine_seeds([summary for run, summary in zip(run_ids, summaries) if run in reference])
+    others = [(run, floor_errors(summary, spread)) for run, summary in zip(run_ids, summaries) if run not in reference]
+    return combined, others, spread
 
 
 def seed_note(reference: str, spread: SeedSpread, reference_row: bool) -> str:

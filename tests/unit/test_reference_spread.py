@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from analysis.numerics.reference_spread import combine_seeds, floor_errors, relative_spread, seed_note, table_spread
+from analysis.numerics.reference_spread import (combine_seeds, floor_errors, relative_spread, seed_note, table_spread,
+                                               with_reference_spread)
 from calibration.friction import SECOND_HALF, STEADY, combined_window_method
 from engines.cases import cases_of, reference_runs
 from engines.cases.jenike import jenike_cases
@@ -121,3 +122,11 @@ def test_the_jenike_reference_point_runs_with_more_seeds_and_at_a_slower_shear(r
     fast = seeded[0]
     assert slow.shear_steps == pytest.approx(fast.shear_steps * configured / 0.01, rel=1e-3)
     assert slow.seeds == fast.seeds
+
+
+def test_the_reference_s_seeds_are_combined_and_the_others_floored_in_order():
+    runs = [_run(1.0, 0.8, [3.0, 9.0]), _run(2.0, 0.5, [4.0, 20.0]), _run(1.2, 0.6, [3.0, 11.0])]
+    combined, others, spread = with_reference_spread(runs, ["a", "b", "c"], {"a", "c"})
+    assert combined["flow"] == pytest.approx(1.1) and spread.seeds == 2
+    ((run, floored),) = others
+    assert run == "b" and floored["flow_error"] == pytest.approx(2.0 * math.sqrt(0.02) / 1.1)

@@ -13,7 +13,7 @@ from analysis.io.tables import read_table, write_flow_table
 from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows
 from analysis.studies.validation.calibration import calibration_rows
 from analysis.studies.validation.rows import Criteria
-from analysis.numerics.reference_spread import combine_seeds, floor_errors, seed_note, table_spread
+from analysis.numerics.reference_spread import floor_errors, seed_note, table_spread, with_reference_spread
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
 from calibration.table import point_table
 from engines.cases.particles import particle_template
@@ -22,15 +22,6 @@ from engines.logs import logged_to
 
 def _json(path):
     return json.loads(Path(path).read_text())
-
-
-def _with_spread(runs, run_ids, reference):
-    """``(reference summary, [(run id, summary)] of the others, spread)``: the reference's seeds combined, every
-    other run's errors floored by their spread. ``runs`` are the runs' summaries in the order of ``run_ids``."""
-    seeds = [summary for run, summary in zip(run_ids, runs) if run in reference]
-    combined, spread = combine_seeds(seeds)
-    others = [(run, floor_errors(summary, spread)) for run, summary in zip(run_ids, runs) if run not in reference]
-    return combined, others, spread
 
 
 def _noted(rows, reference_case, spread):
@@ -48,7 +39,7 @@ def _silo(inputs, params, criteria):
     for run, janssen, kinematic, boundary in zip(runs, inputs.janssen, inputs.kinematic, inputs.boundary):
         run.update(janssen=read_table(janssen), kinematic=read_table(kinematic), boundary=read_table(boundary))
     run_ids = [run["case"]["run_id"] for run in runs]
-    base, others, spread = _with_spread(runs, run_ids, set(params.reference))
+    base, others, spread = with_reference_spread(runs, run_ids, set(params.reference))
     silo = {key: SiloRun(**summary) for key, summary in [("base", base), *others]}
     if params.group == "silo":
         return _noted(silo_rows(silo["base"], criteria), base["case"]["run_id"], spread)
@@ -60,7 +51,7 @@ def _silo(inputs, params, criteria):
 def _blending(inputs, params, criteria):
     runs = [{"case": _json(case), "summary": _json(summary), "rtd": read_table(rtd)}
             for case, summary, rtd in zip(inputs.cases, inputs.summaries, inputs.rtds)]
-    reference, others, spread = _with_spread(runs, [run["case"]["run_id"] for run in runs], set(params.reference))
+    reference, others, spread = with_reference_spread(runs, [run["case"]["run_id"] for run in runs], set(params.reference))
     rows = []
     for run in [reference, *(summary for _, summary in others)]:
         rows += recirculation_rows(run["case"], run["summary"], run["rtd"], criteria)
@@ -69,7 +60,7 @@ def _blending(inputs, params, criteria):
 
 def _blender(inputs, params, criteria):
     runs = [{"case": _json(case), "summary": _json(summary)} for case, summary in zip(inputs.cases, inputs.summaries)]
-    reference, others, spread = _with_spread(runs, [run["case"]["run_id"] for run in runs], set(params.reference))
+    reference, others, spread = with_reference_spread(runs, [run["case"]["run_id"] for run in runs], set(params.reference))
     chosen = [reference, *(summary for _, summary in others)]
     summaries = [run["summary"] for run in chosen]
     rows = blender_rows(summaries, [run["case"] for run in chosen], criteria) + gravity_rows(summaries, criteria)
