@@ -208,10 +208,11 @@ def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
 
 
 def cost_lines(costs: Sequence[GroupCost], cores: int) -> list[str]:
-    """`make estimate`'s lines on the groups: each group's runs, core time and wall time on ``cores`` cores."""
+    """`make estimate`'s lines on the groups: each group's runs, core time and wall time on ``cores`` cores (the
+    groups that make no run of the configuration left out)."""
     lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s), each at most "
              f"{GROUP_BUDGET_S / 3600:g} h:"]
-    for cost in costs:
+    for cost in (cost for cost in costs if cost.runs):
         flag = "  OVER BUDGET: split it" if cost.over_budget else ""
         lines.append(f"  {cost.name:18s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
                      f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
