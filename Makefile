@@ -75,7 +75,7 @@ VALIDATION_RECORD_CLI = $(PYTHON) $(CURDIR)/workflow/scripts/validation_record_c
 GROUP             ?=
 
 validate: install
-	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)')
+	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD))
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \

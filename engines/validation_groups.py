@@ -93,6 +93,16 @@ def check_group(name: str) -> str:
     return name
 
 
+def check_reads(name: str, status: Mapping[str, str]) -> None:
+    """Refuse (ValueError) to run group ``name`` before the groups it reads are complete in the record (``status``
+    of :func:`group_status`): Snakemake would make their runs too, past the group's budget."""
+    waiting = [other for other in GROUPS[name].reads if status.get(other, COMPLETE) != COMPLETE]
+    if waiting:
+        raise ValueError(f"validation group {name!r} compares against the runs of {', '.join(waiting)}, whose record is "
+                         f"{' and '.join(status[other] for other in waiting)}: run "
+                         f"{' then '.join(f'make validate GROUP={other}' for other in waiting)} first")
+
+
 def makespan(core_seconds: Iterable[float], cores: int) -> float:
     """Wall time of independent single-core jobs on ``cores`` cores, the longest started first (s).
 

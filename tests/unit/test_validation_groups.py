@@ -17,6 +17,7 @@ from engines.validation_groups import (
     STALE,
     assign,
     check_group,
+    check_reads,
     cost_lines,
     group_costs,
     group_of,
@@ -173,3 +174,19 @@ def test_validate_checks_the_group_before_anything_runs(capsys):
     assert status_main(["check", "silos"]) == 2
     assert "unknown validation group 'silos'" in capsys.readouterr().err
     assert status_main(["status"]) == 2
+
+
+def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, capsys):
+    check_reads("silo", {"silo": MISSING})
+    check_reads("silo_series", {"silo": COMPLETE, "silo_series": MISSING})
+    with pytest.raises(ValueError, match="'silo_series' compares against the runs of silo, whose record is stale: run "
+                                         "make validate GROUP=silo first"):
+        check_reads("silo_series", {"silo": STALE})
+    with pytest.raises(ValueError, match="calibration, calibration_shapes, whose record is missing and missing: run "
+                                         "make validate GROUP=calibration then make validate GROUP=calibration_shapes"):
+        check_reads("calibration_checks", {"calibration": MISSING, "calibration_shapes": MISSING})
+    # through the command line, before anything runs: the validation config plans the checks, the empty record has none
+    config = str(REPO_ROOT / "config" / "validation.yaml")
+    assert status_main(["check", "calibration", config, str(tmp_path)]) == 0
+    assert status_main(["check", "calibration_checks", config, str(tmp_path)]) == 2
+    assert "run make validate GROUP=calibration then" in capsys.readouterr().err

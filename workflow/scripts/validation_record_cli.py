@@ -6,8 +6,8 @@ analysis): ``python workflow/scripts/validation_record_cli.py <command> ...``.
 complete, stale or missing against the runs ``CONFIG`` plans (:func:`engines.validation_groups.group_status`);
 ``publish WORKDIR RECORD_DIR [GROUP]`` copies the records a `make validate` wrote in ``WORKDIR`` into ``RECORD_DIR``;
 ``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
-(:func:`analysis.studies.validation.record.record_page`); ``check GROUP`` refuses an unknown group before anything
-runs.
+(:func:`analysis.studies.validation.record.record_page`); ``check GROUP [CONFIG RECORD_DIR]`` refuses an unknown group,
+or one whose rows compare against a group not yet complete in the record, before anything runs.
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from analysis.studies.validation.record import record_page
 from engines.config import load_config
 from engines.layout import VALIDATION_RECORD
 from engines.planning import config_estimates, group_runs
-from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, group_costs, group_status, makespan,
-                                       planned_runs, status_lines)
+from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, group_costs, group_status,
+                                       makespan, planned_runs, status_lines)
 
 #: The record's page, in its folder.
 RECORD_PAGE = "README.md"
@@ -64,11 +64,15 @@ def measured_wall_times(record: dict, cores: int) -> dict[str, float]:
             for name, group in record.items()}
 
 
+def _planned(config_path: str) -> dict[str, set[str]]:
+    config = load_config(config_path)
+    return planned_runs(group_runs(config, config_estimates(config)))
+
+
 def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: int = 2) -> str:
     """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
     group's measured wall time on ``cores`` cores and its cost at the scale of ``full_scale_path``."""
-    config = load_config(config_path)
-    planned = planned_runs(group_runs(config, config_estimates(config)))
+    planned = _planned(config_path)
     record = read_record(record_dir, GROUPS)
     status = group_status(planned, _run_ids(record))
     full = load_config(full_scale_path)
@@ -81,16 +85,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line; returns 0 when every group is complete (status) or the group exists (check), 1 when a group is
     stale or missing, 2 on a usage error."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    if len(argv) == 2 and argv[0] == "check":
+    if len(argv) in (2, 4) and argv[0] == "check":
         try:
             check_group(argv[1])
+            if len(argv) == 4:
+                check_reads(argv[1], group_status(_planned(argv[2]), recorded_runs(argv[3])))
         except ValueError as error:
             print(f"siloflow: {error}", file=sys.stderr)
             return 2
         return 0
     if len(argv) == 3 and argv[0] == "status":
-        config = load_config(argv[1])
-        planned = planned_runs(group_runs(config, config_estimates(config)))
+        planned = _planned(argv[1])
         recorded = recorded_runs(argv[2])
         print(f"The validation record in {argv[2]} against the runs {argv[1]} plans:")
         print("\n".join(status_lines(planned, recorded)))
@@ -109,7 +114,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"siloflow result: {path.resolve()}")
         return 0
     print("usage: validation_record_cli.py status CONFIG RECORD_DIR | publish WORKDIR RECORD_DIR [GROUP] | "
-          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP", file=sys.stderr)
+          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP [CONFIG RECORD_DIR]", file=sys.stderr)
     return 2
 
 
