@@ -109,16 +109,14 @@ def measured_cost_model(config: dict, estimates: list[RunEstimate], results: str
 
 def calibrated_model(model: CostModel, measured: list[tuple[RunEstimate, MeasuredWork]]) -> CostModel:
     """``model`` with the median over ``measured`` (at least one run) of each run's CPU seconds per sphere-step, and
-    for each case kind with a finished run the median over that kind's runs: a kind not measured yet takes the
-    overall median, scaled by the ratio the configuration gives it to the other kinds."""
+    for each case kind with a finished run the median over that kind's runs: a kind not measured yet keeps the cost
+    the configuration gives it, or takes the overall median when it gives none."""
     median = statistics.median(work.seconds_per_sphere_step for _, work in measured)
     by_kind = {kind: statistics.median(work.seconds_per_sphere_step for estimate, work in measured
                                        if estimate.kind == kind)
                for kind in dict.fromkeys(estimate.kind for estimate, _ in measured)}
-    unmeasured = {kind: median * value / model.seconds_per_sphere_step
-                  for kind, value in model.kind_seconds_per_sphere_step.items() if kind not in by_kind}
     return dataclasses.replace(model, seconds_per_sphere_step=median,
-                               kind_seconds_per_sphere_step={**unmeasured, **by_kind})
+                               kind_seconds_per_sphere_step={**model.kind_seconds_per_sphere_step, **by_kind})
 
 
 def pending(estimates: list[RunEstimate], results: str | Path) -> list[RunEstimate]:

@@ -180,7 +180,7 @@ def test_the_kind_with_the_longest_run_gets_the_highest_priority():
     assert run_priorities([]) == {}
 
 
-def test_each_measured_kind_takes_its_own_cost_and_an_unmeasured_one_keeps_its_ratio():
+def test_each_measured_kind_takes_its_own_cost_and_an_unmeasured_one_keeps_the_config_s():
     def timed(run_id, kind, seconds_per_sphere_step):
         estimate = RunEstimate(run_id=run_id, kind=kind, clumps=10, spheres=20, steps=100, sphere_steps=1.0e6,
                                simulated_time_s=0.01, wall_time_s=1.0, dump_frames=1, dump_bytes=1000, mpi_ranks=1)
@@ -194,8 +194,9 @@ def test_each_measured_kind_takes_its_own_cost_and_an_unmeasured_one_keeps_its_r
     assert calibrated.seconds_per_sphere_step == pytest.approx(8.0e-7, rel=1e-12)
     assert calibrated.seconds_for("silo_flat") == pytest.approx(6.0e-7, rel=1e-12)
     assert calibrated.seconds_for("jenike") == pytest.approx(1.2e-6, rel=1e-12)
-    # the blender has not run: the overall median at the 1.5 the config gives it over the others
-    assert calibrated.seconds_for("blender") == pytest.approx(1.2e-6, rel=1e-12)
+    # the blender has not run: the cost the config gives it; the recirculating silo its own measured one
+    assert calibrated.seconds_for("blender") == 6.0e-7
+    assert calibrated.seconds_for("silo_recirculation") == pytest.approx(9.0e-7, rel=1e-12)
     with pytest.raises(ValueError, match="unknown run kind 'silo'"):
         CostModel(kind_seconds_per_sphere_step={"silo": 1.0e-6})
 
