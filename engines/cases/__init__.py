@@ -53,26 +53,30 @@ def cases_of(config: dict, case: str) -> dict:
     reference configuration (:func:`reference_runs`) is there ``max(N, M)`` times, so that a comparison of
     configurations knows the spread between seeds at the cost of M - N runs.
     """
+    return _runs_and_reference(config, case)[0]
+
+
+def _runs_and_reference(config: dict, case: str) -> tuple[dict, list[str]]:
+    """The runs of :func:`cases_of` and the run ids of :func:`reference_runs`, from one build of each seed."""
     if case not in CASE_BUILDERS:
         raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_BUILDERS)}")
     runs = CASE_BUILDERS[case](config)
-    replicates, reference = _replicates(config, case)
-    for offset in range(1, reference):
+    # the builders list the reference configuration first
+    reference = list(runs)[:1]
+    replicates, seeds = _replicates(config, case)
+    for offset in range(1, seeds):
         others = _reseeded(config, case, offset)
-        # the builders list the reference configuration first
-        runs.update(others if offset < replicates else dict([next(iter(others.items()))]))
-    return runs
+        first = next(iter(others))
+        reference.append(first)
+        runs.update(others if offset < replicates else {first: others[first]})
+    return runs, reference
 
 
 def reference_runs(config: dict, case: str) -> list[str]:
     """Run ids of the reference configuration of case kind ``case``, one per seed: the first run its builder
     defines (the base flat-bottom silo, the first flow pattern, the first blender configuration at the lowest
     gravity factor, the first Jenike sweep point), then its reseeded replicates (:func:`cases_of`)."""
-    if case not in CASE_BUILDERS:
-        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_BUILDERS)}")
-    first = [next(iter(CASE_BUILDERS[case](config)), None)]
-    first += [next(iter(_reseeded(config, case, offset))) for offset in range(1, _replicates(config, case)[1])]
-    return [run for run in first if run is not None]
+    return _runs_and_reference(config, case)[1]
 
 
 #: The roles of the runs of a silo-type case kind (:func:`run_roles`): the reference configuration's or another's.
@@ -83,11 +87,10 @@ def run_roles(config: dict, case: str) -> dict[str, str]:
     """``{run id: role}`` of the runs of case kind ``case``: a Jenike run's sweep role
     (:data:`engines.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), any
     other run :data:`REFERENCE` when it is one of :func:`reference_runs` and :data:`VARIANT` otherwise."""
-    runs = cases_of(config, case)
+    runs, reference = _runs_and_reference(config, case)
     if case == "jenike":
         return {run: point_role(job.sweep_point, config["jenike"]["sweep"]["restitution"],
                                 config["calibration"]["shape"]) for run, job in runs.items()}
-    reference = set(reference_runs(config, case))
     return {run: REFERENCE if run in reference else VARIANT for run in runs}
 
 

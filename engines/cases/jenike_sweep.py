@@ -20,6 +20,12 @@ CALIBRATION_CHART, SHAPE_CHART, CHECK = "calibration_chart", "shape_chart", "che
 ROLES = (CALIBRATION_CHART, SHAPE_CHART, CHECK)
 
 
+def middle_sliding_friction(sweep: dict) -> float:
+    """The middle of the sweep's sliding frictions (the upper middle of an even count): the point of the restitution
+    study, the reference point and the diagnostics."""
+    return float(sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2])
+
+
 def other_lid(lid: str) -> str:
     """The lid a comparison runs against: servo for rigid and rigid for servo."""
     return "servo" if lid == "rigid" else "rigid"
@@ -80,7 +86,7 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
                     add(shape, test, mu, mu_r, base_restitution)
             if shape not in sensitivity_shapes or test not in sensitivity_tests:
                 continue
-            middle = sorted(sliding)[len(sliding) // 2]
+            middle = middle_sliding_friction(sweep)
             for restitution in sweep["restitution_sensitivity"]:
                 add(shape, test, middle, rolling[0], restitution)
             if sweep["rotation_blocked"]:
@@ -115,7 +121,7 @@ def reference_point(sweep: dict) -> dict | None:
     if not shapes or not tests:
         return None
     return {"shape": shapes[0], "test": tests[0],
-            "sliding_friction": float(sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]),
+            "sliding_friction": middle_sliding_friction(sweep),
             "rolling_friction": float(sweep["rolling_friction"][0]), "restitution": float(sweep["restitution"]),
             "rotation_blocked": False}
 
@@ -145,5 +151,4 @@ def diagnostic_points(points: list[dict], sweep: dict, lid: str) -> list[dict]:
     chart = [p for p in points if is_chart_point(p, sweep["restitution"])]
     if sweep["diagnostics"] == "all":
         return chart
-    middle = sorted(sweep["sliding_friction"])[len(sweep["sliding_friction"]) // 2]
-    return [p for p in chart if p["sliding_friction"] == float(middle)]
+    return [p for p in chart if p["sliding_friction"] == middle_sliding_friction(sweep)]

@@ -2,7 +2,7 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
-from engines.cases import REFERENCE, VARIANT, reference_runs, run_roles
+from engines.cases import REFERENCE, VARIANT, run_roles
 from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.layout import VALIDATION_RECORD
 from engines.validation_groups import GROUPS
@@ -13,16 +13,15 @@ SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metr
               "kinematic": "metrics/kinematic.csv", "boundary": "metrics/flow_channel_boundary.csv"}
 
 
-def references(kind):
-    """Run ids of the reference configuration of case ``kind``, one per seed (the flat-bottom silo's with calibrated
-    parameters applied when asked for)."""
-    return reference_runs(silo_config() if kind == "silo_flat" else config, kind)
-
-
 def roles(kind):
     """``{run id: role}`` of case ``kind``'s runs (the flat-bottom silo's with calibrated parameters applied when asked
     for)."""
     return run_roles(silo_config() if kind == "silo_flat" else config, kind)
+
+
+def references(kind):
+    """Run ids of the reference configuration of a silo-type case ``kind``, one per seed, in seed order."""
+    return [run for run, role in roles(kind).items() if role == REFERENCE]
 
 
 def group_made(group):
@@ -117,7 +116,8 @@ for _group in ROW_GROUPS:
             rows=f"{VALIDATION}/rows/{_group}.csv",
         params:
             **group_rows_params(_group),
-            reference=lambda wildcards, kind=GROUPS[_group].kind: references(kind),
+            # the Jenike rows take the reference point's seeds from the calibration table
+            reference=lambda wildcards, kind=GROUPS[_group].kind: [] if kind == "jenike" else references(kind),
             labels=lambda wildcards, group=_group: front_wall_labels() if GROUPS[group].kind == "silo_flat" else {},
         log:
             f"{VALIDATION}/rows/{_group}.log",
