@@ -179,21 +179,20 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, c
         raise ValueError(f"unknown calibration row sections {', '.join(unknown)}; the sections are {', '.join(SECTIONS)}")
     if "calibrated" in sections and parameters is None:
         raise ValueError("the calibrated rows need the calibration's parameters")
-    def base_speed(entry):
-        return float(entry["shear_velocity"]) == shear_velocity
+    configured = {"rotation": lambda e: not _flag(e["rotation_blocked"]), "lid": lambda e: e["lid"] == lid,
+                  "restitution": lambda e: float(e["restitution"]) == base_restitution,
+                  "speed": lambda e: float(e["shear_velocity"]) == shear_velocity}
 
-    def chart(entry):
-        return (float(entry["restitution"]) == base_restitution and not _flag(entry["rotation_blocked"])
-                and entry["lid"] == lid and base_speed(entry))
+    def chart(entry, varied=()):
+        """Whether an entry is on the chart in every dimension but the ``varied`` ones (a check varies one)."""
+        return all(test(entry) for name, test in configured.items() if name not in varied)
 
     curves = _curves(bulk_rows, chart)
     chart_entries = _entries(bulk_rows, chart)
-    blocked = _entries(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and e["lid"] == lid
-                       and float(e["restitution"]) == base_restitution and base_speed(e))
-    other_lid = _entries(bulk_rows, lambda e: e["lid"] != lid and not _flag(e["rotation_blocked"])
-                         and float(e["restitution"]) == base_restitution and base_speed(e))
-    restitutions = sorted({float(e["restitution"]) for e in bulk_rows if base_speed(e)} - {base_restitution})
-    speeds = sorted({float(e["shear_velocity"]) for e in bulk_rows} - {shear_velocity})
+    blocked = _entries(bulk_rows, lambda e: _flag(e["rotation_blocked"]) and chart(e, ("rotation",)))
+    other_lid = _entries(bulk_rows, lambda e: e["lid"] != lid and chart(e, ("lid",)))
+    restitutions = sorted({float(e["restitution"]) for e in bulk_rows if chart(e, ("restitution",))} - {base_restitution})
+    speeds = sorted({float(e["shear_velocity"]) for e in bulk_rows if chart(e, ("speed",))} - {shear_velocity})
     rows = []
     for key, entries in chart_entries.items() if "curves" in sections else ():
         cell_ok, cell_text = _cell_text(cell_diameter, particle_diameters[key[0]], criteria)
@@ -202,13 +201,11 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, c
                    (f"Bulk friction, {'servo' if lid == 'rigid' else 'rigid'} lid - {lid} lid", other_lid,
                     "a servo lid that cannot tilt overestimates", True)]
     for restitution in restitutions:
-        extra = _entries(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and e["lid"] == lid
-                         and not _flag(e["rotation_blocked"]) and base_speed(e))
+        extra = _entries(bulk_rows, lambda e, r=restitution: float(e["restitution"]) == r and chart(e, ("restitution",)))
         comparisons.append((f"Bulk friction, restitution {restitution:g} - {base_restitution:g}", extra,
                             "insensitive to restitution", False))
     for speed in speeds:
-        slower = _entries(bulk_rows, lambda e, v=speed: float(e["shear_velocity"]) == v and e["lid"] == lid
-                          and not _flag(e["rotation_blocked"]) and float(e["restitution"]) == base_restitution)
+        slower = _entries(bulk_rows, lambda e, v=speed: float(e["shear_velocity"]) == v and chart(e, ("speed",)))
         comparisons.append((f"Bulk friction, shear velocity {speed:g} - {shear_velocity:g} m/s", slower,
                             "independent of the shear speed (quasi-static)", False))
     for figure, others, study, expect in comparisons if "comparisons" in sections else ():
