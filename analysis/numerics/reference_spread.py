@@ -24,8 +24,8 @@ from collections.abc import Mapping, Sequence
 
 from analysis.numerics.replicates import ERROR_SUFFIX, SEED_STD_SUFFIX, replicate_error
 
-__all__ = ["SeedSpread", "combine_seeds", "relative_spread", "table_spread", "floor_errors", "with_reference_spread",
-           "seed_note"]
+__all__ = ["SeedSpread", "combine_seeds", "relative_spread", "table_spread", "floor_table", "floor_errors",
+           "with_reference_spread", "seed_note"]
 
 Path = tuple
 
@@ -212,6 +212,13 @@ def table_spread(rows: Sequence[Mapping], figures: Sequence[str] | None = None) 
             spread[(figure,)] = max(ratios)
     seeds = max((int(_number(row["replicates"])) for row in replicated), default=1)
     return SeedSpread(spread, seeds), replicated
+
+
+def floor_table(rows: Sequence[Mapping], figures: Sequence[str] | None = None) -> tuple[list, SeedSpread, list]:
+    """A combined table's rows with the rows run once floored by the replicated rows' spread (:func:`table_spread`,
+    :func:`floor_errors`): ``(rows, spread, replicated rows)``, the rows in their order."""
+    spread, replicated = table_spread(rows, figures)
+    return [row if row in replicated else floor_errors(row, spread) for row in rows], spread, replicated
 
 
 def floor_errors(summary, spread: Mapping[Path, float]):

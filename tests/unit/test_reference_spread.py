@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from analysis.numerics.reference_spread import (combine_seeds, floor_errors, relative_spread, seed_note, table_spread,
+from analysis.numerics.reference_spread import (combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
                                                with_reference_spread)
 from calibration.friction import SECOND_HALF, STEADY, combined_window_method
 from engines.cases import cases_of, reference_runs
@@ -130,3 +130,11 @@ def test_the_reference_s_seeds_are_combined_and_the_others_floored_in_order():
     assert combined["flow"] == pytest.approx(1.1) and spread.seeds == 2
     ((run, floored),) = others
     assert run == "b" and floored["flow_error"] == pytest.approx(2.0 * math.sqrt(0.02) / 1.1)
+
+
+def test_a_table_s_rows_run_once_are_floored_by_the_replicated_rows():
+    rows = [{"flow": 2.0, "flow_error": 0.01, "replicates": 1},
+            {"flow": 1.0, "flow_error": 0.05, "flow_seed_std": 0.1, "replicates": 3}]
+    floored, spread, replicated = floor_table(rows)
+    assert replicated == [rows[1]] and spread.seeds == 3
+    assert floored == [{"flow": 2.0, "flow_error": pytest.approx(0.2), "replicates": 1}, rows[1]]

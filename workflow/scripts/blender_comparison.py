@@ -15,7 +15,7 @@ from analysis.studies.blender.plots import plot_configuration_comparison, plot_r
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
 from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs
 from analysis.io.tables import write_flow_table, write_text
-from analysis.numerics.reference_spread import floor_errors, table_spread
+from analysis.numerics.reference_spread import floor_table
 from analysis.numerics.replicates import combine_replicates
 from engines.logs import logged_to
 
@@ -26,8 +26,7 @@ with logged_to(snakemake.log[0]) as log:
     # replicates (the same configuration with other seeds) become one row: their mean and its error
     rows = combine_replicates(comparison_table(metrics), ["configuration"])
     # an insert run once takes the relative spread of the one run with several seeds (reference_replicates)
-    spread, replicated = table_spread(rows)
-    rows = [row if row in replicated else floor_errors(row, spread) for row in rows]
+    rows = floor_table(rows)[0]
     best = best_blender(metrics)
     significance = significance_rows(rows)
     write_flow_table(snakemake.output.table, rows)

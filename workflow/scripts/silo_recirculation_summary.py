@@ -4,7 +4,7 @@ import json
 from pathlib import Path
 
 from analysis.io.tables import write_flow_table
-from analysis.numerics.reference_spread import floor_errors, table_spread
+from analysis.numerics.reference_spread import floor_table
 from analysis.numerics.replicates import combine_replicates
 from analysis.studies.silo_recirculation.plots import plot_vrr_versus_recirculations
 from analysis.studies.silo_recirculation.tables import summary_rows
@@ -15,8 +15,7 @@ with logged_to(snakemake.log[0]) as log:
     # replicates (the same flow pattern with other seeds) become one row per layout: their mean and its error
     rows = combine_replicates(rows, ["flow_pattern", "layout"])
     # a flow pattern run once takes the relative spread of the one run with several seeds (reference_replicates)
-    spread, replicated = table_spread(rows)
-    rows = [row if row in replicated else floor_errors(row, spread) for row in rows]
+    rows = floor_table(rows)[0]
     write_flow_table(snakemake.output.table, rows)
     plot_vrr_versus_recirculations(curves, snakemake.output.vrr_plot, "VRR per recirculation: flow patterns and layouts")
     log.info("%d flow pattern x layout rows", len(rows))

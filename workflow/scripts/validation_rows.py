@@ -13,7 +13,7 @@ from analysis.io.tables import read_table, write_flow_table
 from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows
 from analysis.studies.validation.calibration import calibration_rows
 from analysis.studies.validation.rows import Criteria
-from analysis.numerics.reference_spread import floor_errors, seed_note, table_spread, with_reference_spread
+from analysis.numerics.reference_spread import floor_table, seed_note, with_reference_spread
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
 from calibration.table import point_table
 from engines.cases.particles import particle_template
@@ -70,9 +70,8 @@ def _blender(inputs, params, criteria):
 def _calibration(inputs, params, criteria):
     diameters = {shape: particle_template(shape, model, params.density).equivalent_diameter
                  for shape, model in params.shapes.items()}
-    points = point_table([_json(path) for path in inputs.summaries])
-    spread, replicated = table_spread(points, ("bulk_friction", "bulk_friction_angle_deg"))
-    points = [point if point in replicated else floor_errors(point, spread) for point in points]
+    points, spread, replicated = floor_table(point_table([_json(path) for path in inputs.summaries]),
+                                             ("bulk_friction", "bulk_friction_angle_deg"))
     parameters = yaml.safe_load(Path(inputs.parameters).read_text()) if "parameters" in inputs.keys() else None
     rows = calibration_rows(points, parameters, params.cell_diameter, diameters, params.base_restitution, params.lid,
                             params.shear_velocity, criteria, sections=params.sections)
