@@ -40,8 +40,8 @@ class Group:
         return kind == self.kind and (self.roles is None or role in self.roles)
 
 
-#: The groups in the order `make validate` runs them, each one stage of the study within the budget, so that its
-#: rows can be judged on its own runs and those it reads: the calibration in three (the calibration shape's charts,
+#: The groups in the order `make validate` runs them, each one stage of the study, so that its rows can be judged on
+#: its own runs and those it reads (`make estimate` flags a group over :data:`GROUP_BUDGET_S`): the calibration in three (the calibration shape's charts,
 #: the other shapes' charts, and the checks against the charts: rotation blocked, the other lid, restitution, shear
 #: speed, seeds), the flat-bottom silo in two (its base configuration over seeds, and the front-wall friction series
 #: compared against it).
@@ -132,6 +132,12 @@ def makespan(core_seconds: Iterable[float], cores: int) -> float:
     return max(ends)
 
 
+def runs_wall_time(runs: Iterable[tuple[float, int]], cores: int) -> float:
+    """Wall time of runs ``(wall time s, MPI ranks)`` on ``cores`` cores (:func:`makespan`): a run on r ranks holds r
+    cores for its wall time, as r jobs of that length."""
+    return makespan([wall for wall, ranks in runs for _ in range(min(ranks, cores))], cores)
+
+
 @dataclass(frozen=True)
 class GroupCost:
     """What one group costs.
@@ -162,9 +168,7 @@ def group_costs(made: Mapping[str, Sequence[RunEstimate]], cores: int) -> list[G
     takes that many cores for its wall time."""
     costs = []
     for name, members in made.items():
-        # a run on r ranks holds r cores for its wall time: as r jobs of that length
-        jobs = [e.wall_time_s for e in members for _ in range(min(e.mpi_ranks, cores))]
-        wall = makespan(jobs, cores)
+        wall = runs_wall_time(((e.wall_time_s, e.mpi_ranks) for e in members), cores)
         costs.append(GroupCost(name, len(members), math.fsum(e.core_seconds for e in members), wall,
                                wall > GROUP_BUDGET_S))
     return costs

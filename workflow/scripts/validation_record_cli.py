@@ -24,7 +24,7 @@ from engines.config import load_config
 from engines.layout import VALIDATION_RECORD
 from engines.planning import config_estimates, group_runs
 from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, group_costs, group_status,
-                                       makespan, planned_runs, status_lines)
+                                       planned_runs, runs_wall_time, status_lines)
 
 #: The record's page, in its folder.
 RECORD_PAGE = "README.md"
@@ -58,9 +58,9 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
 
 def measured_wall_times(record: dict, cores: int) -> dict[str, float]:
     """``{group: s}``: the wall time of the runs each recorded group makes, from their measured times, on ``cores``
-    cores (:func:`engines.validation_groups.makespan`; a run on r ranks holds r cores)."""
-    return {name: makespan([float(run["wall_time_s"]) for run in group.runs if run.get("group", name) == name
-                            for _ in range(min(int(run["cores"]), cores))], cores)
+    cores (:func:`engines.validation_groups.runs_wall_time`)."""
+    return {name: runs_wall_time(((float(run["wall_time_s"]), int(run["cores"])) for run in group.runs
+                                  if run.get("group", name) == name), cores)
             for name, group in record.items()}
 
 
