@@ -62,28 +62,33 @@ verify: install
 		--report $(abspath $(RUN_DIR))/results/report.html
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
-# (make estimate CONFIG=config/validation.yaml prints its cost, per group). It works in results/validation/ (its own
-# results/ and report there, so that it never overwrites the default run's), prints the estimate of every run first
-# and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group (engines.validation_groups:
-# calibration, silo, blending, blender); `make validate-status` says which groups of the record in docs/validation/
-# are complete, stale or missing.
+# (make estimate CONFIG=config/validation.yaml prints its cost, per group and part). It works in results/validation/
+# (its own results/ and reports there, so that it never overwrites the default run's), prints the estimate of every run
+# first and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group
+# (engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series, blending,
+# blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record is written
+# and copied into docs/validation/ once all its runs have finished, whichever part finished them.
+# `make validate-status` says which groups of the record in docs/validation/ are complete, stale or missing.
 VALIDATION_CONFIG ?= config/validation.yaml
 VALIDATION_DIR    ?= results/validation
 VALIDATION_RECORD ?= docs/validation
 FULL_SCALE_CONFIG ?= config/thesis.yaml
 VALIDATION_RECORD_CLI = $(PYTHON) $(CURDIR)/workflow/scripts/validation_record_cli.py
+VALIDATION_SNAKEMAKE  = $(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG))
 GROUP             ?=
 
 validate: install
 	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD))
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
-	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
-		--configfile $(abspath $(VALIDATION_CONFIG)) \
-		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input --keep-going
-	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --directory $(abspath $(VALIDATION_DIR)) \
-		--configfile $(abspath $(VALIDATION_CONFIG)) --report $(abspath $(VALIDATION_DIR))/report$(if $(GROUP),-$(GROUP)).html
-	$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $(if $(GROUP),'$(GROUP)')
+	$(VALIDATION_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --cores $(CORES) \
+		--rerun-incomplete --rerun-triggers mtime params input --keep-going
+	@groups="$$($(VALIDATION_RECORD_CLI) finished $(VALIDATION_CONFIG) $(VALIDATION_DIR) $(if $(GROUP),'$(GROUP)'))" || exit 1; \
+	for group in $$groups; do \
+		$(VALIDATION_SNAKEMAKE) validate_$$group --cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input && \
+		$(VALIDATION_SNAKEMAKE) validate_$$group --report $(abspath $(VALIDATION_DIR))/report-$$group.html && \
+		$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $$group || exit 1; \
+	done
 	$(VALIDATION_RECORD_CLI) page $(VALIDATION_CONFIG) $(FULL_SCALE_CONFIG) $(VALIDATION_RECORD)
 
 validate-status: install-python

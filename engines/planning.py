@@ -31,7 +31,7 @@ from engines.estimates import (
     total_dump_bytes,
 )
 from engines.layout import RUN_RECORD, run_dir
-from engines.validation_groups import assign, cost_lines, group_costs
+from engines.validation_groups import assign, cost_lines, group_costs, part_costs, split_groups
 
 
 def cost_model(config: dict) -> CostModel:
@@ -314,7 +314,9 @@ def main(argv: list[str] | None = None) -> int:
     print(estimate_table(config_estimates(config, model) if measured else estimates))
     print()
     made = group_runs(config, config_estimates(config, model) if measured else estimates)
-    print("\n".join(cost_lines(group_costs(made, cores), cores)))
+    # the parts come from the config's own cost model, so that measuring a run never moves a run to another part
+    parts = split_groups(group_runs(config, estimates))
+    print("\n".join(cost_lines(group_costs(made, cores), cores, part_costs(parts, made, cores))))
     waiting = pending(estimates, results)
     print(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
           f"{format_bytes(total_dump_bytes(waiting))}; {format_bytes(free_bytes(results))} free for {results}/")

@@ -1,9 +1,12 @@
-"""The validation tier in groups: which runs each group makes, what it costs on the cores at hand, and whether the
-record in the repository still matches what the configuration plans.
+"""The validation tier in groups: which runs each group makes, how a group too long for one working session is split
+into parts, what each costs, and whether the record in the repository still matches what the configuration plans.
 
-`make validate GROUP=<name>` runs one group (`make validate` all of them); `make estimate` prints each group's cost;
-`make validate-status` says which groups of the record are complete, stale or missing. Pure computation: callers
-pass estimates and run ids; the record's files are read at the edge (:mod:`analysis.studies.validation.record`).
+A group is one stage of the study with its own rows in the record. `make validate GROUP=<name>` runs one group, or one
+part of a group that takes longer than :data:`GROUP_BUDGET_S` on :data:`PART_CORES` cores (`silo_1`, `silo_2`, ...;
+the part that makes the group's last run writes its record); `make validate` runs them all. `make estimate` prints
+each group's and each part's cost; `make validate-status` says which groups of the record are complete, stale or
+missing. Pure computation: callers pass estimates and run ids; the record's files are read at the edge
+(:mod:`analysis.studies.validation.record`).
 """
 
 from __future__ import annotations
@@ -55,8 +58,12 @@ GROUPS: dict[str, Group] = {
     "blender": Group(BLENDER),
 }
 
-#: The longest a group may take on the cores of one machine (s): a working session.
+#: The longest a group (or a part of one) may take on :data:`PART_CORES` cores (s): a working session.
 GROUP_BUDGET_S = 2.5 * 3600.0
+
+#: The cores the budget is for, a laptop's: the parts of a group are the same whatever the cores of the machine at
+#: hand, so that a group begun on one machine can be finished on another.
+PART_CORES = 2
 
 #: A group's status against the record (:func:`group_status`).
 COMPLETE, STALE, MISSING = "complete", "stale", "missing"
@@ -139,6 +146,114 @@ def runs_wall_time(runs: Iterable[tuple[float, int]], cores: int) -> float:
 
 
 @dataclass(frozen=True)
+class Part:
+    """A part of a validation group: the runs one `make validate GROUP=<name>` makes.
+
+    Attributes
+    ----------
+    name : str
+        What `make validate GROUP=` takes: the group's name when the group is one part, else ``<group>_<k>``.
+    group : str
+        The group it belongs to.
+    positions : tuple of int
+        Its runs, as positions in the group's runs (:func:`assign`'s order, which is the configuration's): positions,
+        not run ids, so that a part still names its runs when a silo's run ids are known only after the calibration.
+    """
+
+    name: str
+    group: str
+    positions: tuple[int, ...]
+
+    def runs(self, members: Sequence):
+        """The part's runs among ``members``, the group's runs in :func:`assign`'s order (estimates or run ids)."""
+        return [members[i] for i in self.positions]
+
+
+def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
+          budget_s: float = GROUP_BUDGET_S) -> list[Part]:
+    """A group's runs in parts that each take at most ``budget_s`` on ``cores`` cores.
+
+    First-fit decreasing: the runs, the longest first, each go into the first part whose wall time
+    (:func:`runs_wall_time`) stays within the budget with it, else into a new part. The parts depend only on the
+    estimates, so the same configuration always gives the same parts. A run longer than the budget on its own is a
+    part by itself (over budget: :func:`part_costs` flags it).
+
+    Parameters
+    ----------
+    group : str
+        The group's name (the parts are ``<group>_1``, ``<group>_2``, ...; a group in one part keeps its name).
+    members : sequence of RunEstimate
+        The group's runs (:func:`assign`).
+    cores : int
+        The cores of the budget.
+    budget_s : float
+        The longest a part may take (s).
+
+    Returns
+    -------
+    list of Part
+        In order of their longest run; none for a group without runs.
+    """
+    order = sorted(range(len(members)), key=lambda i: (-members[i].wall_time_s * members[i].mpi_ranks,
+                                                       members[i].run_id))
+    bins: list[list[int]] = []
+    for i in order:
+        fits = (b for b in bins
+                if runs_wall_time(((members[j].wall_time_s, members[j].mpi_ranks) for j in (*b, i)), cores) <= budget_s)
+        target = next(fits, None)
+        if target is None:
+            bins.append([i])
+        else:
+            target.append(i)
+    if len(bins) == 1:
+        return [Part(group, group, tuple(sorted(bins[0])))]
+    return [Part(f"{group}_{k}", group, tuple(sorted(b))) for k, b in enumerate(bins, start=1)]
+
+
+def split_groups(made: Mapping[str, Sequence[RunEstimate]], cores: int = PART_CORES) -> dict[str, list[Part]]:
+    """``{group: [Part]}`` of every group that makes a run (:func:`split` of each group of :func:`assign`)."""
+    return {name: split(name, members, cores) for name, members in made.items() if members}
+
+
+def find_part(name: str, parts: Mapping[str, Sequence[Part]]) -> Part:
+    """The part `make validate GROUP=<name>` names; a ValueError that says what to run instead for an unknown name or
+    a group that is split into parts."""
+    for group_parts in parts.values():
+        for part in group_parts:
+            if part.name == name:
+                return part
+    if name in parts:
+        names = [part.name for part in parts[name]]
+        raise ValueError(f"validation group {name!r} takes longer than {GROUP_BUDGET_S / 3600:g} h on {PART_CORES} "
+                         f"cores, so it runs in {len(names)} parts: {' then '.join(f'make validate GROUP={n}' for n in names)} "
+                         f"(the part that makes its last run writes its record)")
+    known = [part.name for group_parts in parts.values() for part in group_parts]
+    raise ValueError(f"unknown validation group {name!r}; this configuration's groups and parts are {', '.join(known)}")
+
+
+def part_of_runs(parts: Mapping[str, Sequence[Part]], runs: Mapping[str, Sequence[str]]) -> dict[str, str]:
+    """``{run id: part name}`` from the parts and each group's run ids in :func:`assign`'s order (``runs``)."""
+    return {run: part.name for name, group_parts in parts.items() for part in group_parts
+            for run in part.runs(runs[name])}
+
+
+def group_of_part(name: str) -> str:
+    """The group a part name (or a group name) belongs to."""
+    if name in GROUPS:
+        return name
+    group, _, k = name.rpartition("_")
+    if group in GROUPS and k.isdigit():
+        return group
+    raise ValueError(f"{name!r} names no validation group or part of one; the groups are {', '.join(GROUPS)}")
+
+
+def finished_groups(planned: Mapping[str, set[str]], done: set[str]) -> list[str]:
+    """The groups whose every run behind their rows (:func:`planned_runs`) is in ``done`` (the runs that have finished
+    in the working directory), in :data:`GROUPS` order: the groups whose record can be written."""
+    return [name for name in GROUPS if name in planned and planned[name] <= done]
+
+
+@dataclass(frozen=True)
 class GroupCost:
     """What one group costs.
 
@@ -163,15 +278,23 @@ class GroupCost:
     over_budget: bool
 
 
+def _cost(name: str, members: Sequence[RunEstimate], cores: int) -> GroupCost:
+    wall = runs_wall_time(((e.wall_time_s, e.mpi_ranks) for e in members), cores)
+    return GroupCost(name, len(members), math.fsum(e.core_seconds for e in members), wall, wall > GROUP_BUDGET_S)
+
+
 def group_costs(made: Mapping[str, Sequence[RunEstimate]], cores: int) -> list[GroupCost]:
     """The cost of each group of the runs it makes (:func:`assign`) on ``cores`` cores; a run on several MPI ranks
     takes that many cores for its wall time."""
-    costs = []
-    for name, members in made.items():
-        wall = runs_wall_time(((e.wall_time_s, e.mpi_ranks) for e in members), cores)
-        costs.append(GroupCost(name, len(members), math.fsum(e.core_seconds for e in members), wall,
-                               wall > GROUP_BUDGET_S))
-    return costs
+    return [_cost(name, members, cores) for name, members in made.items()]
+
+
+def part_costs(parts: Mapping[str, Sequence[Part]], made: Mapping[str, Sequence[RunEstimate]],
+               cores: int) -> dict[str, list[GroupCost]]:
+    """``{group: [cost of each part]}`` on ``cores`` cores of the groups split into several parts (``parts`` from
+    :func:`split_groups`, ``made`` the groups' runs in the same order, possibly estimated with another cost model)."""
+    return {name: [_cost(part.name, part.runs(made[name]), cores) for part in group_parts]
+            for name, group_parts in parts.items() if len(group_parts) > 1}
 
 
 def planned_runs(made: Mapping[str, Sequence[RunEstimate]]) -> dict[str, set[str]]:
@@ -221,13 +344,21 @@ def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
     return lines
 
 
-def cost_lines(costs: Sequence[GroupCost], cores: int) -> list[str]:
+def cost_lines(costs: Sequence[GroupCost], cores: int, parts: Mapping[str, Sequence[GroupCost]] | None = None) -> list[str]:
     """`make estimate`'s lines on the groups: each group's runs, core time and wall time on ``cores`` cores (the
-    groups that make no run of the configuration left out)."""
-    lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s), each at most "
-             f"{GROUP_BUDGET_S / 3600:g} h:"]
+    groups that make no run of the configuration left out), and under a group split into parts (``parts`` from
+    :func:`part_costs`) each part, the name `make validate GROUP=` takes."""
+    parts = parts or {}
+    lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s); a group over "
+             f"{GROUP_BUDGET_S / 3600:g} h on {PART_CORES} cores runs in parts:"]
     for cost in (cost for cost in costs if cost.runs):
-        flag = "  OVER BUDGET: split it" if cost.over_budget else ""
+        split_into = parts.get(cost.name, ())
+        flag = (f"  in {len(split_into)} parts" if split_into else
+                "  OVER BUDGET: split it" if cost.over_budget else "")
         lines.append(f"  {cost.name:18s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
                      f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
+        for part in split_into:
+            over = "  OVER BUDGET: a run alone is longer; give it more MPI ranks" if part.over_budget else ""
+            lines.append(f"    {part.name:16s} {part.runs:3d} runs  {part.core_seconds / 3600:6.2f} core-h  "
+                         f"{part.wall_time_s / 3600:5.2f} h wall{over}")
     return lines

@@ -18,12 +18,21 @@ from engines.validation_groups import (
     assign,
     check_group,
     check_reads,
+    PART_CORES,
+    Part,
     cost_lines,
+    find_part,
+    finished_groups,
     group_costs,
     group_of,
+    group_of_part,
     group_status,
     makespan,
+    part_costs,
+    part_of_runs,
     planned_runs,
+    split,
+    split_groups,
     status_lines,
 )
 from analysis.io.validation_record import RUNS as RECORD_RUNS
@@ -113,7 +122,8 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
     assert one_core["silo"].wall_time_s == pytest.approx(3.0 * hour)
     assert one_core["silo"].wall_time_s > GROUP_BUDGET_S and one_core["silo"].over_budget
     lines = cost_lines(group_costs(made, cores=1), cores=1)
-    assert lines[0].startswith("Validation groups (make validate GROUP=<name>) on 1 core(s), each at most 2.5 h")
+    assert lines[0] == ("Validation groups (make validate GROUP=<name>) on 1 core(s); a group over 2.5 h on 2 cores "
+                        "runs in parts:")
     # the groups without runs (the other calibration groups, the series, the recirculating silos) are left out
     assert [line.split()[0] for line in lines[1:]] == ["calibration", "silo", "blender"]
     assert lines[2].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
@@ -169,11 +179,94 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
         recorded_runs(tmp_path)
 
 
-def test_validate_checks_the_group_before_anything_runs(capsys):
-    assert status_main(["check", "blending"]) == 0
-    assert status_main(["check", "silos"]) == 2
-    assert "unknown validation group 'silos'" in capsys.readouterr().err
+def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
+    config = str(REPO_ROOT / "config" / "validation.yaml")
+    assert status_main(["check", "blending_1", config, str(tmp_path)]) == 0
+    assert status_main(["check", "silos", config, str(tmp_path)]) == 2
+    assert "unknown validation group 'silos'; this configuration's groups and parts are calibration," in (
+        capsys.readouterr().err)
+    # a group longer than a session is run by its parts
+    assert status_main(["check", "blending", config, str(tmp_path)]) == 2
+    assert ("runs in 2 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2" in
+            capsys.readouterr().err)
     assert status_main(["status"]) == 2
+
+
+def test_a_group_longer_than_a_session_is_split_first_fit_decreasing():
+    hour = 3600.0
+    # three 2.2 h silo runs: two fit side by side on two cores, the third needs a second part
+    silo = [_estimate(f"s{i}", "silo_flat", 2.2 * hour) for i in range(3)]
+    assert split("silo", silo) == [Part("silo_1", "silo", (0, 1)), Part("silo_2", "silo", (2,))]
+    # longest first, each into the first part it fits: e 2.4 h and b 2.0 h side by side; c 1.5 h after b would end
+    # at 3.5 h, so it opens a second part; d 1.0 h after b would end at 3.0 h, so it joins c; a 0.5 h after b ends at
+    # exactly the budget, 2.5 h, so it joins the first part
+    mixed = [_estimate("a", "blender", 0.5 * hour), _estimate("b", "blender", 2.0 * hour),
+             _estimate("c", "blender", 1.5 * hour), _estimate("d", "blender", 1.0 * hour),
+             _estimate("e", "blender", 2.4 * hour)]
+    assert split("blender", mixed) == [Part("blender_1", "blender", (0, 1, 4)),
+                                      Part("blender_2", "blender", (2, 3))]
+    # a group that fits keeps its name; a run longer than the budget alone is a part by itself
+    assert split("blending", mixed[:2]) == [Part("blending", "blending", (0, 1))]
+    long = [_estimate("x", "blender", 3.0 * hour), _estimate("y", "blender", 0.1 * hour)]
+    assert split("blender", long) == [Part("blender_1", "blender", (0,)), Part("blender_2", "blender", (1,))]
+    # on one core, two 1.5 h runs take 3 h: two parts
+    pair = [_estimate("p", "blender", 1.5 * hour), _estimate("q", "blender", 1.5 * hour)]
+    assert split("blender", pair) == [Part("blender", "blender", (0, 1))]
+    assert split("blender", pair, cores=1) == [Part("blender_1", "blender", (0,)), Part("blender_2", "blender", (1,))]
+    assert split("silo", []) == []
+    assert split_groups({"silo": []}) == {}
+    assert PART_CORES == 2
+
+
+def test_parts_name_their_runs_cost_and_what_to_run():
+    hour = 3600.0
+    made = {"silo": [_estimate(f"s{i}", "silo_flat", 2.2 * hour) for i in range(3)],
+            "blending": [_estimate("r1", "silo_recirculation", 1.0 * hour)], "blender": []}
+    parts = split_groups(made)
+    assert list(parts) == ["silo", "blending"]
+    assert find_part("silo_2", parts) == Part("silo_2", "silo", (2,))
+    assert find_part("blending", parts) == Part("blending", "blending", (0,))
+    with pytest.raises(ValueError, match="'silo' takes longer than 2.5 h on 2 cores, so it runs in 2 parts: make "
+                                         "validate GROUP=silo_1 then make validate GROUP=silo_2"):
+        find_part("silo", parts)
+    with pytest.raises(ValueError, match="unknown validation group 'silo_3'; this configuration's groups and parts "
+                                         "are silo_1, silo_2, blending"):
+        find_part("silo_3", parts)
+    assert part_of_runs(parts, {"silo": ["s0", "s1", "s2"], "blending": ["r1"]}) == {
+        "s0": "silo_1", "s1": "silo_1", "s2": "silo_2", "r1": "blending"}
+    # the parts keep their runs when the runs are estimated with another cost model
+    slower = {"silo": [_estimate(f"s{i}", "silo_flat", 3.0 * hour) for i in range(3)], "blending": made["blending"]}
+    costs = part_costs(parts, slower, cores=2)
+    assert list(costs) == ["silo"]
+    assert [(c.name, c.runs, c.wall_time_s / hour, c.over_budget) for c in costs["silo"]] == [
+        ("silo_1", 2, pytest.approx(3.0), True), ("silo_2", 1, pytest.approx(3.0), True)]
+    lines = cost_lines(group_costs(made, cores=2), 2, part_costs(parts, made, 2))
+    assert lines[1].split() == ["silo", "3", "runs", "6.60", "core-h", "4.40", "h", "wall", "in", "2", "parts"]
+    assert lines[2].split() == ["silo_1", "2", "runs", "4.40", "core-h", "2.20", "h", "wall"]
+    assert lines[3].split() == ["silo_2", "1", "runs", "2.20", "core-h", "2.20", "h", "wall"]
+    assert lines[4].split()[:2] == ["blending", "1"] and len(lines) == 5
+    assert [group_of_part(name) for name in ("silo_2", "silo_series_1", "silo_series", "blender")] == [
+        "silo", "silo_series", "silo_series", "blender"]
+    with pytest.raises(ValueError, match="'silos_1' names no validation group or part of one"):
+        group_of_part("silos_1")
+
+
+def test_a_group_s_record_waits_for_every_run_behind_its_rows():
+    planned = {"silo": {"s1", "s2"}, "silo_series": {"v1", "s1", "s2"}, "blender": {"b1"}}
+    assert finished_groups(planned, set()) == []
+    assert finished_groups(planned, {"s1", "b1"}) == ["blender"]
+    assert finished_groups(planned, {"s1", "s2", "b1"}) == ["silo", "blender"]
+    assert finished_groups(planned, {"s1", "s2", "v1", "b1"}) == ["silo", "silo_series", "blender"]
+
+
+def test_validate_writes_a_record_only_once_the_group_s_runs_have_finished(tmp_path, capsys):
+    config = str(REPO_ROOT / "config" / "validation.yaml")
+    assert status_main(["finished", config, str(tmp_path), "silo_2"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.strip() == ""
+    assert captured.err.strip() == ("siloflow: silo: 3 of 3 runs behind its rows still to make; its record is written "
+                                    "by the `make validate GROUP=` that makes the last")
+    assert status_main(["finished", config, str(tmp_path), "silos"]) == 2
 
 
 def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, capsys):

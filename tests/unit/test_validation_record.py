@@ -71,8 +71,10 @@ def test_a_table_without_the_validation_columns_is_refused(tmp_path):
 
 
 def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
-    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
-            provenance_row(_record("sphere2-def"), "silo", "3.8", [2], "c0ffee", 1800.0, "2026-11-29")]
+    # the silo group ran in two parts: silo_1 made two runs side by side, silo_2 one
+    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
+            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, "2026-11-29"),
+            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, "2026-11-29")]
     # the series' record also lists the base run it compares against, made by the silo group
     series = [provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, "2026-11-29"),
               runs[0]]
@@ -80,17 +82,17 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
               "silo_series": GroupRecord(rows=_rows()[:1], runs=series)}
     status = {"calibration": "missing", "silo": "stale", "silo_series": "complete"}
     wall = CLI.measured_wall_times(groups, cores=2)
-    assert wall == {"silo": 5400.0, "silo_series": 3600.0}
+    assert wall == {"silo": {"silo_1": 5400.0, "silo_2": 900.0}, "silo_series": {"silo_series": 3600.0}}
     text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, wall, 2,
                        "config/validation.yaml", "config/thesis.yaml")
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
     assert "| calibration | missing | 0 | - | - | 0 | 0 |" in lines
-    assert "| silo | stale | 2 | 2.00 h | 1.50 h | 2 | 1 |" in lines
+    assert "| silo | stale | 3 | 2.25 h | silo_1 1.50 h, silo_2 0.25 h | 2 | 1 |" in lines
     assert "| silo_series | complete | 1 | 1.00 h | 1.00 h | 1 | 1 |" in lines
     assert "Not recorded yet: `make validate GROUP=calibration`." in lines
     assert any(line.startswith("**Stale**") for line in lines)
-    assert ("2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
+    assert ("3 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
             "[`silo/runs.csv`](silo/runs.csv).") in lines
     assert ("| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | 667 | yes | "
             "depth 40 mm = 12.0 particle diameters (>= 10) |") in lines

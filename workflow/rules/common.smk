@@ -164,25 +164,29 @@ def shortcut_measured():
     return blending["recirculations"] > blending["tracer"]["start_recirculations"] + blending["shortcut"]["residence_times"]
 
 
-def recirculation_targets(wildcards=None):
-    runs = recirculation_runs()
+def recirculation_targets(wildcards=None, runs=None):
+    """The products of the recirculating silo's runs (``runs``: those of these run ids, without the summary across
+    runs; all with the summary when None)."""
+    chosen = (lambda found: found) if runs is None else (lambda found: [run for run in found if run in runs])
+    blending = chosen(recirculation_runs())
     targets = [
         run_path(RECIRCULATION, name, run)
-        for run in runs
+        for run in blending
         for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png",
                      "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
                      "plots/snapshots")
     ]
     if shortcut_measured():
-        targets += [run_path(RECIRCULATION, name, run) for run in runs for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
-    if runs:
+        targets += [run_path(RECIRCULATION, name, run) for run in blending for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
+    if runs is None and blending:
         targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
+    verification = chosen(recirculation_runs("verification"))
     targets += [
         run_path(RECIRCULATION, f"verification/{name}", run)
-        for run in recirculation_runs("verification")
+        for run in verification
         for name in ("verification.json", "paths.png", "residence_times.png")
     ]
-    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in recirculation_runs("verification")]
+    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in verification]
     return targets
 
 
@@ -191,16 +195,20 @@ def blender_runs():
     return run_ids("blender")
 
 
-def blender_targets(wildcards=None):
-    runs = blender_runs()
+def blender_targets(wildcards=None, runs=None):
+    """The products of the blender's runs (``runs``: those of these run ids, without the comparisons across runs;
+    all with the comparisons when None)."""
+    chosen = blender_runs() if runs is None else [run for run in blender_runs() if run in runs]
     targets = [
         run_path("blender", name, run)
-        for run in runs
+        for run in chosen
         for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png",
                      "plots/insert_velocities.png", "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png",
                      "plots/discontinuous.png", "plots/vrr_period.png")
     ]
-    if runs:
+    if runs is not None:
+        return targets
+    if chosen:
         targets += [f"{case_root('blender')}/comparison/{name}"
                     for name in ("configurations.csv", "significance.csv", "configurations.md", "configurations.png", "rtd.png")]
     if len(config["blender"]["gravity_factors"]) > 1:

@@ -5,7 +5,8 @@
 from engines.cases import REFERENCE, VARIANT, run_roles
 from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.layout import VALIDATION_RECORD
-from engines.validation_groups import GROUPS
+from engines.planning import group_runs as planned_group_runs
+from engines.validation_groups import GROUPS, part_of_runs, split_groups
 
 VALIDATION = f"{RESULTS}/summary"
 SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
@@ -139,26 +140,51 @@ rule validation_table:
 
 
 # The validation tier in groups (engines.validation_groups): `make validate GROUP=<name>` asks for the products of the
-# runs one group makes.
+# runs one group makes, with its record; a group too long for one session runs in parts, each asking for the products
+# of its runs only (the Makefile then writes the group's record once its last run has finished).
+def run_targets(kind, runs):
+    """The products of each of ``runs`` of case ``kind`` on its own (the products across runs come with the record)."""
+    if kind == "jenike":
+        return [*(run_path("jenike", name, run) for run in runs
+                  for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")), *diagnostic_targets(runs)]
+    if kind == "silo_flat":
+        return silo_flat_targets(runs=runs)
+    if kind == RECIRCULATION:
+        return recirculation_targets(runs=runs)
+    return blender_targets(runs=runs)
+
+
+def group_targets(group):
+    """The products of the runs a group makes and of the analyses across them: the Jenike runs' with the charts, the
+    calibrated parameters and the lid comparison; the flat-bottom silo's with the parametric studies of the series;
+    every other kind's as a whole."""
+    spec, made = GROUPS[group], group_made(group)
+    if spec.kind == "jenike":
+        parameters = [f"{CALIBRATION}/parameters.yaml"] if spec.makes(spec.kind, CALIBRATION_CHART) else []
+        return [*run_targets("jenike", made), *record_plots(group).values(), *parameters]
+    if spec.kind == "silo_flat":
+        return [*run_targets("silo_flat", made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
+    return KIND_TARGETS[spec.kind]()
+
+
 KIND_TARGETS = {
     RECIRCULATION: recirculation_targets,
     "blender": blender_targets,
 }
 
+#: Each group's parts, from the configuration's own cost estimates (engines.validation_groups.split).
+PARTS = split_groups(planned_group_runs(config, ESTIMATES))
 
-def group_targets(group):
-    """The products of the runs a group makes: the Jenike runs' and the flat-bottom silo's per run with the products
-    of their role (the charts, the calibrated parameters, the lid comparison; the parametric studies with the series),
-    every other kind's as a whole."""
-    spec, made = GROUPS[group], group_made(group)
-    if spec.kind == "jenike":
-        targets = [run_path("jenike", name, run) for run in made
-                   for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")]
-        parameters = [f"{CALIBRATION}/parameters.yaml"] if spec.makes(spec.kind, CALIBRATION_CHART) else []
-        return [*targets, *diagnostic_targets(made), *record_plots(group).values(), *parameters]
-    if spec.kind != "silo_flat":
-        return KIND_TARGETS[spec.kind]()
-    return [*silo_flat_targets(runs=made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
+
+def part_runs(part):
+    """Run ids a part of a group makes."""
+    return part.runs(group_made(part.group))
+
+
+def made_by(group):
+    """``{run id: the group or part that makes it}`` of the runs behind a group's rows."""
+    names = (group, *GROUPS[group].reads)
+    return part_of_runs({name: PARTS[name] for name in names if name in PARTS}, {name: group_made(name) for name in names})
 
 
 for _group in GROUPS:
@@ -171,6 +197,15 @@ for _group in GROUPS:
             # calibrated parameters
             lambda wildcards, group=_group: group_targets(group),
             [f"{VALIDATION_RECORD}/{_group}/{name}" for name in ("runs.csv", "table.csv")] if _group in ROW_GROUPS else [],
+
+
+for _part in (part for group_parts in PARTS.values() if len(group_parts) > 1 for part in group_parts):
+
+    rule:
+        name:
+            f"validate_{_part.name}"
+        input:
+            lambda wildcards, part=_part: run_targets(GROUPS[part.group].kind, part_runs(part)),
 
 
 def record_plots(group):
@@ -220,8 +255,7 @@ for _group in ROW_GROUPS:
             plot_names=lambda wildcards, group=_group: list(record_plots(group)),
             seeds=lambda wildcards, group=_group: {run: list(case.seeds) for run, case in
                                                    cases(GROUPS[group].kind).items()},
-            made_by=lambda wildcards, group=_group: {run: name for name in (group, *GROUPS[group].reads)
-                                                     for run in group_made(name)},
+            made_by=lambda wildcards, group=_group: made_by(group),
         log:
             f"{VALIDATION_RECORD}/{_group}.log",
         script:

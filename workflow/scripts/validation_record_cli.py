@@ -6,8 +6,10 @@ analysis): ``python workflow/scripts/validation_record_cli.py <command> ...``.
 complete, stale or missing against the runs ``CONFIG`` plans (:func:`engines.validation_groups.group_status`);
 ``publish WORKDIR RECORD_DIR [GROUP]`` copies the records a `make validate` wrote in ``WORKDIR`` into ``RECORD_DIR``;
 ``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
-(:func:`analysis.studies.validation.record.record_page`); ``check GROUP [CONFIG RECORD_DIR]`` refuses an unknown group,
-or one whose rows compare against a group not yet complete in the record, before anything runs.
+(:func:`analysis.studies.validation.record.record_page`); ``check GROUP CONFIG RECORD_DIR`` refuses, before anything
+runs, an unknown group or part, a group that runs in parts (naming them), or one whose rows compare against a group
+not yet complete in the record; ``finished CONFIG WORKDIR [GROUP]`` prints the groups (of GROUP's only) whose every
+run has finished in WORKDIR, whose record `make validate` then writes.
 """
 
 from __future__ import annotations
@@ -21,10 +23,11 @@ from analysis.io.tables import write_text
 from analysis.io.validation_record import read_group_record, read_record, write_group_record
 from analysis.studies.validation.record import record_page
 from engines.config import load_config
-from engines.layout import VALIDATION_RECORD
-from engines.planning import config_estimates, group_runs
-from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, group_costs, group_status,
-                                       planned_runs, runs_wall_time, status_lines)
+from engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
+from engines.planning import config_estimates, group_runs, run_directory
+from engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, find_part, finished_groups,
+                                       group_costs, group_of_part, group_status, planned_runs, runs_wall_time,
+                                       split_groups, status_lines)
 
 #: The record's page, in its folder.
 RECORD_PAGE = "README.md"
@@ -56,17 +59,65 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
     return copied
 
 
-def measured_wall_times(record: dict, cores: int) -> dict[str, float]:
-    """``{group: s}``: the wall time of the runs each recorded group makes, from their measured times, on ``cores``
-    cores (:func:`engines.validation_groups.runs_wall_time`)."""
-    return {name: runs_wall_time(((float(run["wall_time_s"]), int(run["cores"])) for run in group.runs
-                                  if run.get("group", name) == name), cores)
-            for name, group in record.items()}
+def measured_wall_times(record: dict, cores: int) -> dict[str, dict[str, float]]:
+    """``{group: {part: s}}``: the wall time of the runs each part of each recorded group makes (the ``group`` column
+    of its runs names the part), from their measured times, on ``cores`` cores
+    (:func:`engines.validation_groups.runs_wall_time`); the runs a group reads from another group are not its own."""
+    walls = {}
+    for name, group in record.items():
+        made: dict[str, list] = {}
+        for run in group.runs:
+            if group_of_part(run["group"]) == name:
+                made.setdefault(run["group"], []).append((float(run["wall_time_s"]), int(run["cores"])))
+        walls[name] = {part: runs_wall_time(runs, cores) for part, runs in sorted(made.items())}
+    return walls
 
 
 def _planned(config_path: str) -> dict[str, set[str]]:
     config = load_config(config_path)
     return planned_runs(group_runs(config, config_estimates(config)))
+
+
+def check(name: str, config_path: str, record_dir: str | Path) -> None:
+    """`make validate GROUP=<name>`'s check before anything runs: ``name`` is a group or a part of one that
+    ``config_path`` plans, and the groups its rows compare against are complete in the record (ValueError)."""
+    config = load_config(config_path)
+    made = group_runs(config, config_estimates(config))
+    part = find_part(name, split_groups(made))
+    check_reads(part.group, group_status(planned_runs(made), recorded_runs(record_dir)))
+
+
+def finished(config_path: str, workdir: str | Path, name: str | None = None) -> tuple[list[str], list[str]]:
+    """The groups whose record can be written now, and what the others still wait for.
+
+    Parameters
+    ----------
+    config_path : str
+        The configuration.
+    workdir : path
+        The working directory of `make validate` (its ``results/`` holds the runs).
+    name : str, optional
+        A group or part (`make validate GROUP=<name>`): only its group is considered.
+
+    Returns
+    -------
+    groups : list of str
+        The groups every run behind whose rows has finished in ``workdir`` (its run record written).
+    waiting : list of str
+        For each other group considered, a line saying how many of its runs are still to make.
+    """
+    config = load_config(config_path)
+    estimates = config_estimates(config)
+    planned = planned_runs(group_runs(config, estimates))
+    results = Path(workdir) / RESULTS
+    done = {e.run_id for e in estimates if (run_directory(results, e) / RUN_RECORD).is_file()}
+    if name is not None:
+        planned = {group: runs for group, runs in planned.items() if group == group_of_part(name)}
+    ready = finished_groups(planned, done)
+    waiting = [f"{group}: {len(planned[group] - done)} of {len(planned[group])} runs behind its rows still to make; "
+               f"its record is written by the `make validate GROUP=` that makes the last"
+               for group in planned if group not in ready]
+    return ready, waiting
 
 
 def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: int = 2) -> str:
@@ -85,14 +136,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line; returns 0 when every group is complete (status) or the group exists (check), 1 when a group is
     stale or missing, 2 on a usage error."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    if len(argv) in (2, 4) and argv[0] == "check":
+    if len(argv) == 4 and argv[0] == "check":
         try:
-            check_group(argv[1])
-            if len(argv) == 4:
-                check_reads(argv[1], group_status(_planned(argv[2]), recorded_runs(argv[3])))
+            check(argv[1], argv[2], argv[3])
         except ValueError as error:
             print(f"siloflow: {error}", file=sys.stderr)
             return 2
+        return 0
+    if len(argv) in (3, 4) and argv[0] == "finished":
+        try:
+            ready, waiting = finished(argv[1], argv[2], argv[3] if len(argv) == 4 else None)
+        except ValueError as error:
+            print(f"siloflow: {error}", file=sys.stderr)
+            return 2
+        for line in waiting:
+            print(f"siloflow: {line}", file=sys.stderr)
+        print(" ".join(ready))
         return 0
     if len(argv) == 3 and argv[0] == "status":
         planned = _planned(argv[1])
@@ -114,7 +173,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"siloflow result: {path.resolve()}")
         return 0
     print("usage: validation_record_cli.py status CONFIG RECORD_DIR | publish WORKDIR RECORD_DIR [GROUP] | "
-          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP [CONFIG RECORD_DIR]", file=sys.stderr)
+          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP CONFIG RECORD_DIR | finished CONFIG WORKDIR [GROUP]",
+          file=sys.stderr)
     return 2
 
 

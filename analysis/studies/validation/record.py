@@ -59,7 +59,8 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
     record : RunRecord
         The run's record (run id, case kind, engine, MPI ranks, stages).
     group : str
-        The validation group that makes the run (a group's rows may also draw on the runs of a group it reads).
+        The validation group that makes the run, or its part as `make validate GROUP=` names it when the group runs
+        in parts (a group's rows may also draw on the runs of a group it reads).
     engine_version : str
         The engine's installed version.
     seeds : sequence of int
@@ -108,7 +109,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     full_scale_core_s : mapping
         ``{group: CPU s}`` of each group at the study's full scale (the estimate of ``full_scale_config``).
     wall_s : mapping
-        ``{group: s}``: the wall time of the runs each group makes on ``cores`` cores, from their measured times.
+        ``{group: {part: s}}``: the wall time on ``cores`` cores of the runs each part of each group makes (a group in
+        one part: its own name), from their measured times; a run of the record belongs to the group whose parts
+        name it.
     cores : int
         The cores ``wall_s`` is for.
     config_name, full_scale_config : str
@@ -126,16 +129,17 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
         "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
         "",
-        f"| group | status | runs it makes | core time | wall time on {cores} cores | rows | shown at this scale |",
+        f"| group | status | runs it makes | core time | wall time on {cores} cores (per part) | rows | shown at this scale |",
         "|---|---|---|---|---|---|---|",
     ]
     for name, state in status.items():
-        record = groups.get(name, GroupRecord())
-        made = [run for run in record.runs if run.get("group", name) == name]
+        record, parts = groups.get(name, GroupRecord()), wall_s.get(name, {})
+        made = [run for run in record.runs if run["group"] in parts]
         core = math.fsum(float(run["wall_time_s"]) * int(run["cores"]) for run in made)
         shown = sum(row["scale_shows"] == YES for row in record.rows)
+        wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in parts.items())
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | "
-                     f"{_hours(wall_s[name]) if made and name in wall_s else '-'} | {len(record.rows)} | {shown} |")
+                     f"{wall if made else '-'} | {len(record.rows)} | {shown} |")
     for name, state in status.items():
         record = groups.get(name)
         lines += ["", f"## {name}", ""]
