@@ -100,14 +100,16 @@ def check_group(name: str) -> str:
     return name
 
 
-def check_reads(name: str, status: Mapping[str, str]) -> None:
+def check_reads(name: str, status: Mapping[str, str], parts: Mapping[str, Sequence["Part"]] | None = None) -> None:
     """Refuse (ValueError) to run group ``name`` before the groups it reads are complete in the record (``status``
-    of :func:`group_status`): Snakemake would make their runs too, past the group's budget."""
+    of :func:`group_status`): Snakemake would make their runs too, past the group's budget. The message names what
+    to run first, part by part for a group in parts (``parts`` from :func:`split_groups`)."""
     waiting = [other for other in GROUPS[name].reads if status.get(other, COMPLETE) != COMPLETE]
     if waiting:
+        names = [part.name for other in waiting for part in (parts or {}).get(other, ())] or waiting
         raise ValueError(f"validation group {name!r} compares against the runs of {', '.join(waiting)}, whose record is "
                          f"{' and '.join(status[other] for other in waiting)}: run "
-                         f"{' then '.join(f'make validate GROUP={other}' for other in waiting)} first")
+                         f"{' then '.join(f'make validate GROUP={other}' for other in names)} first")
 
 
 def makespan(core_seconds: Iterable[float], cores: int) -> float:

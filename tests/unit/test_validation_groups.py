@@ -283,3 +283,7 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
     assert status_main(["check", "calibration", config, str(tmp_path)]) == 0
     assert status_main(["check", "calibration_checks", config, str(tmp_path)]) == 2
     assert "run make validate GROUP=calibration then" in capsys.readouterr().err
+    # a group read in parts is named part by part
+    assert status_main(["check", "silo_series_1", config, str(tmp_path)]) == 2
+    assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
+            "validate GROUP=silo_2 first") in capsys.readouterr().err

@@ -83,8 +83,8 @@ def check(name: str, config_path: str, record_dir: str | Path) -> None:
     ``config_path`` plans, and the groups its rows compare against are complete in the record (ValueError)."""
     config = load_config(config_path)
     made = group_runs(config, config_estimates(config))
-    part = find_part(name, split_groups(made))
-    check_reads(part.group, group_status(planned_runs(made), recorded_runs(record_dir)))
+    parts = split_groups(made)
+    check_reads(find_part(name, parts).group, group_status(planned_runs(made), recorded_runs(record_dir)), parts)
 
 
 def finished(config_path: str, workdir: str | Path, name: str | None = None) -> tuple[list[str], list[str]]:
