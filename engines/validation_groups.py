@@ -61,6 +61,10 @@ GROUPS: dict[str, Group] = {
 #: The longest a group (or a part of one) may take on :data:`PART_CORES` cores (s): a working session.
 GROUP_BUDGET_S = 2.5 * 3600.0
 
+#: The share of the budget a part is filled to by its estimated wall time: a run's estimate is within about a tenth of
+#: its measured time (`make estimate`'s comparison), and the budget holds for the measured times.
+PART_FILL = 0.9
+
 #: The cores the budget is for, a laptop's: the parts of a group are the same whatever the cores of the machine at
 #: hand, so that a group begun on one machine can be finished on another.
 PART_CORES = 2
@@ -172,8 +176,9 @@ class Part:
 
 
 def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
-          budget_s: float = GROUP_BUDGET_S) -> list[Part]:
-    """A group's runs in parts that each take at most ``budget_s`` on ``cores`` cores.
+          budget_s: float = PART_FILL * GROUP_BUDGET_S) -> list[Part]:
+    """A group's runs in parts that each take at most ``budget_s`` on ``cores`` cores (by default
+    :data:`PART_FILL` of :data:`GROUP_BUDGET_S`, so that the measured times stay within the budget).
 
     First-fit decreasing: the runs, the longest first, each go into the first part whose wall time
     (:func:`runs_wall_time`) stays within the budget with it, else into a new part. The parts depend only on the
@@ -189,7 +194,7 @@ def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
     cores : int
         The cores of the budget.
     budget_s : float
-        The longest a part may take (s).
+        The longest a part may take by its estimate (s).
 
     Returns
     -------
@@ -351,16 +356,17 @@ def cost_lines(costs: Sequence[GroupCost], cores: int, parts: Mapping[str, Seque
     groups that make no run of the configuration left out), and under a group split into parts (``parts`` from
     :func:`part_costs`) each part, the name `make validate GROUP=` takes."""
     parts = parts or {}
-    lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s); a group over "
-             f"{GROUP_BUDGET_S / 3600:g} h on {PART_CORES} cores runs in parts:"]
+    lines = [f"Validation groups (make validate GROUP=<name>) on {cores} core(s); a group whose estimate exceeds "
+             f"{PART_FILL * GROUP_BUDGET_S / 3600:g} h on {PART_CORES} cores ({PART_FILL:.0%} of the "
+             f"{GROUP_BUDGET_S / 3600:g} h budget) runs in parts:"]
     for cost in (cost for cost in costs if cost.runs):
         split_into = parts.get(cost.name, ())
         flag = (f"  in {len(split_into)} parts" if split_into else
                 "  OVER BUDGET: split it" if cost.over_budget else "")
-        lines.append(f"  {cost.name:18s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
+        lines.append(f"  {cost.name:22s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
                      f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
         for part in split_into:
             over = "  OVER BUDGET: a run alone is longer; give it more MPI ranks" if part.over_budget else ""
-            lines.append(f"    {part.name:16s} {part.runs:3d} runs  {part.core_seconds / 3600:6.2f} core-h  "
+            lines.append(f"    {part.name:20s} {part.runs:3d} runs  {part.core_seconds / 3600:6.2f} core-h  "
                          f"{part.wall_time_s / 3600:5.2f} h wall{over}")
     return lines

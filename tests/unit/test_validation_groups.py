@@ -19,6 +19,7 @@ from engines.validation_groups import (
     check_group,
     check_reads,
     PART_CORES,
+    PART_FILL,
     Part,
     cost_lines,
     find_part,
@@ -122,8 +123,8 @@ def test_group_costs_add_core_time_and_schedule_wall_time_per_group():
     assert one_core["silo"].wall_time_s == pytest.approx(3.0 * hour)
     assert one_core["silo"].wall_time_s > GROUP_BUDGET_S and one_core["silo"].over_budget
     lines = cost_lines(group_costs(made, cores=1), cores=1)
-    assert lines[0] == ("Validation groups (make validate GROUP=<name>) on 1 core(s); a group over 2.5 h on 2 cores "
-                        "runs in parts:")
+    assert lines[0] == ("Validation groups (make validate GROUP=<name>) on 1 core(s); a group whose estimate exceeds "
+                        "2.25 h on 2 cores (90% of the 2.5 h budget) runs in parts:")
     # the groups without runs (the other calibration groups, the series, the recirculating silos) are left out
     assert [line.split()[0] for line in lines[1:]] == ["calibration", "silo", "blender"]
     assert lines[2].split() == ["silo", "3", "runs", "3.00", "core-h", "3.00", "h", "wall", "OVER", "BUDGET:",
@@ -203,8 +204,13 @@ def test_a_group_longer_than_a_session_is_split_first_fit_decreasing():
     mixed = [_estimate("a", "blender", 0.5 * hour), _estimate("b", "blender", 2.0 * hour),
              _estimate("c", "blender", 1.5 * hour), _estimate("d", "blender", 1.0 * hour),
              _estimate("e", "blender", 2.4 * hour)]
-    assert split("blender", mixed) == [Part("blender_1", "blender", (0, 1, 4)),
-                                      Part("blender_2", "blender", (2, 3))]
+    assert split("blender", mixed, budget_s=GROUP_BUDGET_S) == [Part("blender_1", "blender", (0, 1, 4)),
+                                                               Part("blender_2", "blender", (2, 3))]
+    # by default a part is filled to 90 % of the budget, 2.25 h: e 2.4 h is a part alone; b 2.0 h and c 1.5 h side
+    # by side; d 1.0 h after c would end at 2.5 h, so it opens a third part; a 0.5 h after c ends at 2.0 h
+    assert PART_FILL == 0.9
+    assert split("blender", mixed) == [Part("blender_1", "blender", (4,)), Part("blender_2", "blender", (0, 1, 2)),
+                                      Part("blender_3", "blender", (3,))]
     # a group that fits keeps its name; a run longer than the budget alone is a part by itself
     assert split("blending", mixed[:2]) == [Part("blending", "blending", (0, 1))]
     long = [_estimate("x", "blender", 3.0 * hour), _estimate("y", "blender", 0.1 * hour)]
