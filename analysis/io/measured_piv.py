@@ -1,5 +1,6 @@
 """The edge where a measured PIV sequence comes in: the configured files (glob patterns expanded in sorted order) read
-frame by frame with their format's reader, then made into timed, filtered silo fields
+frame by frame with their format's reader and the section's reading options (:func:`analysis.io.piv.read_options`),
+then made into timed, filtered silo fields under the section's validity policy
 (:func:`analysis.piv.measured.measured_fields`). Used before any simulation starts, to stop on a bad file, and by
 the comparison rule."""
 
@@ -8,7 +9,7 @@ from __future__ import annotations
 import glob
 from pathlib import Path
 
-from analysis.io.piv import read_piv_file
+from analysis.io.piv import read_options, read_piv_file
 from analysis.piv.field import PlanarField
 from analysis.piv.measured import MeasuredPiv, measured_fields
 
@@ -44,8 +45,9 @@ def load_measured_piv(measured: dict, settings: MeasuredPiv, paths) -> list[Plan
         Naming the file and the problem (:class:`analysis.io.piv.PivFormatError` is one).
     """
     frames, sources = [], []
+    options = read_options(measured)
     for path in paths:
-        for rows in read_piv_file(path, measured["format"], measured["y_down"]):
+        for rows in read_piv_file(path, measured["format"], options):
             frames.append(rows)
             sources.append(str(path))
     return measured_fields(frames, settings, sources)

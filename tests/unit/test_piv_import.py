@@ -1,5 +1,6 @@
-"""Measured PIV fields in: the readers of OpenPIV, PIVlab and siloflow CSV files, the image scale from wall markers,
-the neutral field and the Hampel filter, each against exact answers on hand-made fields and files."""
+"""Measured PIV fields in: the readers of OpenPIV, PIVlab and siloflow CSV files on hand-made files, the image scale
+from wall markers, the neutral field and the Hampel filter, each against exact answers. The readers on files in every
+layout the programs wrote are in test_piv_formats.py."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import scipy.io
 
 from analysis.io.piv import (
     PivFormatError,
+    PivReadOptions,
     read_openpiv,
     read_piv_csv,
     read_piv_file,
@@ -18,9 +20,11 @@ from analysis.io.piv import (
     read_pivlab_txt,
     write_piv_csv,
 )
+from analysis.io.piv_base import axis_steps
 from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
-from analysis.piv.field import PlanarField, field_from_rows, time_average
+from analysis.piv.field import NODE_KINDS, PivRows, PlanarField, field_from_rows, time_average
 from analysis.piv.hampel import hampel_filter, hampel_outliers
+from analysis.piv.measured import MeasuredPiv
 
 # ---------------------------------------------------------------------------------------------- the scale
 
@@ -78,7 +82,10 @@ def test_the_openpiv_reader_reads_what_openpiv_wrote_with_flags_and_mask(tmp_pat
     rows = read_openpiv(path, y_down=True)
     assert rows.x.tolist() == x.ravel().tolist() and rows.y.tolist() == y.ravel().tolist()
     assert rows.u.tolist() == u.ravel().tolist() and rows.v.tolist() == v.ravel().tolist()
+    assert [NODE_KINDS[k] for k in rows.kind] == ["measured", "invalid", "measured", "interpolated", "measured",
+                                                  "masked"]
     assert rows.valid.tolist() == [True, False, True, False, True, False]  # flags 1 and 2, and mask 1, are out
+    assert rows.y_down and rows.pixels is None
 
 
 def test_the_pivlab_reader_takes_its_information_lines_delimiters_and_types(tmp_path):
@@ -89,8 +96,9 @@ def test_the_pivlab_reader_takes_its_information_lines_delimiters_and_types(tmp_
     path = tmp_path / "PIVlab_0001.txt"
     path.write_bytes(text.encode())
     rows = read_pivlab_txt(path)
-    assert rows.y_down and rows.x.tolist() == [16, 48, 16, 48]
+    assert rows.y_down and rows.pixels and rows.x.tolist() == [16, 48, 16, 48]
     assert rows.u[0] == 1.25 and rows.v[3] == 1.0
+    assert [NODE_KINDS[k] for k in rows.kind] == ["measured", "masked", "interpolated", "measured"]
     assert rows.valid.tolist() == [True, False, False, True]
 
 
@@ -124,8 +132,11 @@ def test_a_bad_openpiv_or_pivlab_file_is_refused_naming_it(tmp_path):
     path.write_text("# x y u v flags mask\n1 2 3 4 0\n")
     with pytest.raises(PivFormatError, match="short.txt: 5 columns, expected 6"):
         read_openpiv(path, y_down=True)
+    path.write_text("x [px],y [px],u [px/frame]\n1,2,3,4\n")
+    with pytest.raises(PivFormatError, match="short.txt: the header names x, y, u over 4 columns"):
+        read_pivlab_txt(path)
     path.write_text("x,y,u,v\n1,2,3,4\n")
-    with pytest.raises(PivFormatError, match="short.txt: line 2 has 4 columns"):
+    with pytest.raises(PivFormatError, match="short.txt: line 1 is neither PIVlab's information lines, its header"):
         read_pivlab_txt(path)
 
 
@@ -185,52 +196,24 @@ def test_time_average_is_the_mean_over_the_window_of_the_valid_values():
 # ---------------------------------------------------------------------------------------------- PIVlab .mat, DaVis
 
 
-def _pivlab_frames():
-    """Two frames of 2 x 3 vectors in PIVlab's layout: image axes, types 1 measured, 0 masked, 2 interpolated."""
-    x, y = np.meshgrid([16.0, 48.0, 80.0], [16.0, 48.0])
-    frames = {}
-    for n, shift in ((1, 0.0), (2, 1.0)):
-        u = np.array([[1.0, 2.0, np.nan], [3.0, 4.0, 5.0]]) + shift
-        frames.update({f"x_{n}": x, f"y_{n}": y, f"u_{n}": u, f"v_{n}": -u, f"typevector_{n}": np.array([[1, 1, 0], [2, 1, 1]])})
-    return frames
-
-
-def _check_pivlab_frames(frames):
-    assert len(frames) == 2
-    for frame, shift in zip(frames, (0.0, 1.0)):
-        assert frame.y_down and frame.pixels is None
-        assert sorted(zip(frame.x.tolist(), frame.y.tolist())) == sorted(
-            (a, b) for a in (16.0, 48.0, 80.0) for b in (16.0, 48.0))
-        lookup = {(a, b): (c, d, e) for a, b, c, d, e in zip(frame.x, frame.y, frame.u, frame.v, frame.valid)}
-        assert lookup[(48.0, 48.0)] == (4.0 + shift, -4.0 - shift, True)
-        assert not lookup[(80.0, 16.0)][2] and not lookup[(16.0, 48.0)][2]  # masked, and interpolated
-
-
-def test_a_pivlab_mat_file_of_matlab_5_is_read_frame_by_frame(tmp_path):
+def test_a_mat_file_of_per_frame_arrays_x_1_u_1_is_refused_naming_pivlabs_layouts(tmp_path):
+    # no PIVlab release writes x_<n>, u_<n>: its GUI export, command-line workspace and session are the layouts
     path = tmp_path / "PIVlab.mat"
-    scipy.io.savemat(path, _pivlab_frames())
-    _check_pivlab_frames(read_pivlab_mat(path))
-
-
-def test_a_pivlab_mat_file_of_matlab_7_3_hdf5_is_read_frame_by_frame(tmp_path):
-    path = tmp_path / "PIVlab_v73.mat"
-    with h5py.File(path, "w", userblock_size=512) as handle:
-        for key, array in _pivlab_frames().items():
-            handle[key] = np.asarray(array, dtype=float).T  # MATLAB stores column-major: h5py sees the transpose
-    with open(path, "r+b") as handle:  # MATLAB's text header in the user block
-        handle.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Fri Nov 27 2026 HDF5 schema 1.00 .")
-    _check_pivlab_frames(read_pivlab_mat(path))
-
-
-def test_a_pivlab_mat_file_without_its_arrays_is_refused_naming_it(tmp_path):
-    path = tmp_path / "partial.mat"
-    frames = _pivlab_frames()
-    del frames["typevector_2"]
-    scipy.io.savemat(path, frames)
-    with pytest.raises(PivFormatError, match="partial.mat: frame 2 has no typevector_2"):
+    grid = np.ones((2, 3))
+    scipy.io.savemat(path, {"x_1": grid, "y_1": grid, "u_1": grid, "v_1": grid, "typevector_1": grid})
+    with pytest.raises(PivFormatError, match="PIVlab.mat: none of PIVlab's layouts: the GUI export has x, y, "
+                                             "u_original"):
         read_pivlab_mat(path)
     path.write_text("not matlab")
-    with pytest.raises(PivFormatError, match="partial.mat: not a MATLAB file"):
+    with pytest.raises(PivFormatError, match="PIVlab.mat: not a MATLAB file"):
+        read_pivlab_mat(path)
+
+
+def test_an_hdf5_file_that_is_not_pivlabs_is_refused_naming_it(tmp_path):
+    path = tmp_path / "other.mat"
+    with h5py.File(path, "w") as handle:
+        handle["velocity"] = np.zeros((2, 2))
+    with pytest.raises(PivFormatError, match="other.mat: none of PIVlab's layouts"):
         read_pivlab_mat(path)
 
 
@@ -258,6 +241,7 @@ def test_davis_vectors_come_in_metres_with_y_up_and_davis_masks(tmp_path):
     assert frame.y[[0, 3]] == pytest.approx(1e-3 * (np.array([0.5, 1.5]) * 16 * -0.1 + 20.0))
     assert frame.u.tolist()[:5] == [0.0, 2.0, 4.0, 6.0, 8.0] and frame.v[0] == 2.0  # -1 along a y that points up
     assert frame.valid.tolist() == [True] * 5 + [False]
+    assert NODE_KINDS[frame.kind[5]] in ("masked", "invalid")
 
 
 def test_read_piv_file_names_an_unknown_format_or_a_missing_file(tmp_path):
@@ -273,3 +257,28 @@ def test_a_csv_through_read_piv_file_is_one_frame_in_metres(tmp_path):
     (frame,) = read_piv_file(write_piv_csv(tmp_path / "f.csv", field), "csv")
     assert (frame.pixels, frame.y_down) == (False, False)
     assert frame.x.tolist() == [-0.01, 0.01] and frame.y.tolist() == [0.02, 0.02] and frame.valid.tolist() == [True, False]
+    assert [NODE_KINDS[k] for k in frame.kind] == ["measured", "invalid"]
+
+
+def test_the_grid_order_says_which_way_each_axis_points():
+    # OpenPIV's order (x fastest) of a 2 x 2 grid with y up, and PIVlab's (y fastest) with x to the left
+    assert axis_steps(np.array([16.0, 48.0, 16.0, 48.0]), np.array([80.0, 80.0, 48.0, 48.0]), True) == (32.0, -32.0)
+    assert axis_steps(np.array([48.0, 48.0, 16.0, 16.0]), np.array([16.0, 48.0, 16.0, 48.0]), False) == (-32.0, 32.0)
+    assert axis_steps(np.array([16.0, 48.0]), np.array([16.0, 16.0]), True) == (32.0, None)  # one grid row
+
+
+def test_reading_options_a_format_does_not_have_are_refused():
+    with pytest.raises(ValueError, match="pivlab_field must be one of original, filtered, got 'smoothed'"):
+        PivReadOptions(pivlab_field="smoothed")
+    with pytest.raises(ValueError, match="valid kinds .'masked'.: give one or more of measured, second_peak"):
+        MeasuredPiv(False, None, 100.0, valid_kinds=("masked",))
+
+
+def test_rows_made_by_hand_take_true_as_measured_and_refuse_unknown_codes():
+    rows = PivRows([0.0, 1.0], [0.0, 0.0], [1.0, 2.0], [3.0, np.nan], np.array([True, True]), True)
+    assert [NODE_KINDS[k] for k in rows.kind] == ["measured", "measured"]
+    assert rows.valid.tolist() == [True, False]  # a measured vector without a finite velocity does not count
+    with pytest.raises(ValueError, match="kind holds codes other than 0 to 5"):
+        PivRows([0.0], [0.0], [1.0], [1.0], np.array([7]), True)
+    with pytest.raises(ValueError, match="PIV rows of different lengths"):
+        PivRows([0.0, 1.0], [0.0], [1.0], [1.0], np.array([0]), True)
