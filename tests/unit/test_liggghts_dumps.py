@@ -93,7 +93,8 @@ def test_empty_liggghts_dump_gives_empty_frame(tmp_path):
 # --------------------------------------------------------------------------- layouts LIGGGHTS does not write
 
 
-def test_layouts_no_deck_writes_are_rejected_naming_file_and_finding(tmp_path):
+def test_layouts_liggghts_does_not_write_are_rejected_naming_file_and_finding(tmp_path):
+    # (ASCII and version 4.2, which LIGGGHTS does write, are read: tests/unit/test_dumps_formats.py)
     points, fields = liggghts_like_fields(2)
     source = "results/x/dumps/silo_4000.vtk"
 
@@ -102,10 +103,6 @@ def test_layouts_no_deck_writes_are_rejected_naming_file_and_finding(tmp_path):
             parse_legacy_vtk_polydata(content, source)
         assert str(error.value).startswith(f"{source}: ")
         return str(error.value)
-
-    ascii_path = tmp_path / "ascii_1.vtk"
-    dump_mesh(points, fields).save(ascii_path, binary=False)
-    assert "file format 'ASCII'" in rejection(ascii_path.read_bytes())
 
     # pyvista leaves the first array as the active scalars unless told otherwise: a SCALARS section
     scalars_path = tmp_path / "scalars_1.vtk"
@@ -121,8 +118,8 @@ def test_layouts_no_deck_writes_are_rejected_naming_file_and_finding(tmp_path):
     assert "unknown or unsupported section 'CELL_DATA'" in rejection(cell_path.read_bytes())
 
     content = liggghts_dump_bytes(points, fields, tmp_path)
-    old_version = content.replace(b"Version 5.1", b"Version 4.2", 1)
-    assert "'# vtk DataFile Version 4.2': LIGGGHTS writes" in rejection(old_version)
+    old_version = content.replace(b"Version 5.1", b"Version 3.0", 1)
+    assert "'# vtk DataFile Version 3.0': siloflow reads legacy VTK versions 4.2 and 5.1" in rejection(old_version)
 
     double_points = liggghts_dump_bytes(points.astype(np.float64), fields, tmp_path)
     assert "POINTS have type 'double'" in rejection(double_points)
