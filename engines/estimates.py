@@ -633,10 +633,10 @@ def estimate_blender_case(case: BlenderCase, mpi_ranks: int = 1, model: CostMode
 
 
 def jenike_run_steps(case: JenikeCase) -> int:
-    """Steps of a Jenike deck: fill + one deletion step + relaxation + load ramp + hold + preshear + shear."""
+    """Steps of a Jenike deck: fill + one deletion step + relaxation + load ramp + hold + shear."""
     return (
         case.fill.steps + JENIKE_LEVEL_DELETION_STEPS + case.fill.relax_steps
-        + case.consolidation_steps + case.shear_steps
+        + case.ramp_steps + case.hold_steps + case.shear_steps
     )
 
 
@@ -663,15 +663,14 @@ def jenike_stage_work(case: JenikeCase) -> tuple[StageWork, ...]:
     - fill: all clumps created at once, held for the fall and settling;
     - settle: the deletion step still at that count (the engine removes the spheres of the deleted clumps in
       it), then the relaxation at the levelled count (:func:`jenike_levelled_clumps`);
-    - consolidate (load ramp, hold and preshear passes) and shear: the levelled clumps plus the lid's atoms, placed
-      after levelling.
+    - consolidate (load ramp and hold) and shear: the levelled clumps plus the lid's atoms, placed after levelling.
     """
     spheres = case.particle.n_spheres
     created = spheres * case.fill.n_clumps
     levelled = spheres * jenike_levelled_clumps(case)
     loaded = levelled + jenike_lid_atoms(case)
     relax = case.fill.relax_steps
-    consolidation = case.consolidation_steps
+    consolidation = case.ramp_steps + case.hold_steps
     return (
         StageWork("fill", case.fill.steps, float(created * case.fill.steps)),
         StageWork("settle", JENIKE_LEVEL_DELETION_STEPS + relax,
@@ -686,10 +685,10 @@ def estimate_jenike_case(case: JenikeCase, mpi_ranks: int = 1, model: CostModel 
 
     Disk (upper bounds): every dump counts the clumps created (``fill.n_clumps``) and the lid's atoms
     (:func:`jenike_lid_atoms`), although levelling deletes the overfill first; particle dumps over consolidation
-    and shear (:func:`dump_frames` of ramp + hold + preshear + shear at ``dump_every``), and as many pair-and-wall
-    contact dumps (the deck writes one fewer); the calibration analysis keeps no parsed-frame cache.
+    and shear (:func:`dump_frames` of ramp + hold + shear at ``dump_every``), and as many pair-and-wall contact
+    dumps (the deck writes one fewer); the calibration analysis keeps no parsed-frame cache.
     """
-    dumped_steps = case.consolidation_steps + case.shear_steps
+    dumped_steps = case.ramp_steps + case.hold_steps + case.shear_steps
     frames = dump_frames(dumped_steps, case.dump_every)
     stages = jenike_stage_work(case)
     return estimate_run(

@@ -157,9 +157,6 @@ class JenikeCase(ChosenTimestep):
     hold_steps: int
     shear_velocity: float
     shear_steps: int
-    #: Forward-and-back preshear passes under the consolidation load before the measured shear (each
-    #: ``2 * shear_steps``), part of the consolidation as in Jenike's procedure.
-    preshear_passes: int
     output_every: int
     dump_every: int
     domain: tuple[float, float, float, float, float, float]
@@ -194,26 +191,15 @@ class JenikeCase(ChosenTimestep):
         """``<shape>-<test>-<hash of every defining parameter>``."""
         return run_id(f"{self.particle.name}-{self.test}", self.defining_parameters)
 
-    @property
-    def preshear_steps(self) -> int:
-        """Steps of the preshear passes, forward and back (0 without preshear)."""
-        return 2 * self.preshear_passes * self.shear_steps
-
-    @property
-    def consolidation_steps(self) -> int:
-        """Steps from the lid's placing to the measured shear: the load ramp, the hold and the preshear passes."""
-        return self.ramp_steps + self.hold_steps + self.preshear_steps
-
     def stages(self) -> tuple[Stage, ...]:
-        """Pour into the cell, level it and let it settle, consolidate under the lid (and preshear), shear; the wall
-        forces (lid, shear ring, base) throughout, frames and contacts during consolidation and shear."""
+        """Pour into the cell, level it and let it settle, consolidate under the lid, shear; the wall forces
+        (lid, shear ring, base) throughout, frames and contacts during consolidation and shear."""
         dt = self.timestep
         return (
             Stage("fill", {"n_clumps": self.fill.n_clumps, "duration_s": self.fill.steps * dt}),
             Stage("settle", {"level_z_m": self.fill.level_z, "duration_s": self.fill.relax_steps * dt}),
             Stage("consolidate", {"normal_force_N": self.normal_force, "lid": self.lid_kind,
-                                  "preshear_passes": self.preshear_passes,
-                                  "duration_s": self.consolidation_steps * dt},
+                                  "duration_s": (self.ramp_steps + self.hold_steps) * dt},
                   ("frames", "wall_forces")),
             Stage("shear", {"velocity_m_s": self.shear_velocity, "duration_s": self.shear_steps * dt},
                   ("frames", "wall_forces", "contacts") + (("wall_contacts",) if self.lid_kind == "rigid" else ())),
@@ -250,8 +236,7 @@ class JenikeCase(ChosenTimestep):
             "fill": asdict(self.fill),
             "normal_force_N": self.normal_force,
             "lid": lid,
-            "consolidation_time_s": self.consolidation_steps * self.timestep,
-            "preshear_passes": self.preshear_passes,
+            "consolidation_time_s": (self.ramp_steps + self.hold_steps) * self.timestep,
             "shear_velocity_m_s": self.shear_velocity,
             "shear_time_s": self.shear_steps * self.timestep,
             "output_interval_s": self.output_every * self.timestep,
@@ -528,8 +513,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
         "test_contacts": asdict(test_contacts),
         "fill_contacts": asdict(fill_contacts),
-        "jenike": without_fill_checks({key: value for key, value in jenike.items() if key not in ("sweep",)}
-                                      | {"shear": _defining_shear(jenike["shear"])}),
+        "jenike": without_fill_checks({key: value for key, value in jenike.items() if key not in ("sweep",)}),
     }
     return JenikeCase(
         particle=particle,
@@ -549,7 +533,6 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         hold_steps=max(1, consolidation_steps - ramp_steps),
         shear_velocity=shear_velocity,
         shear_steps=shear_steps,
-        preshear_passes=int(jenike["shear"]["preshear_passes"]),
         output_every=steps_for(jenike["output_interval"], timestep),
         dump_every=max(1, shear_steps // SHEAR_DUMPS),
         domain=(-half, half, -half, half, -margin, z_top),
@@ -557,12 +540,6 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         defining_parameters=defining,
         sweep_point=sweep_point,
     )
-
-
-def _defining_shear(shear: dict) -> dict:
-    """The shear section as it defines a run: without ``preshear_passes`` when it is 0, so that the runs of a
-    configuration without preshear keep their ids."""
-    return {key: value for key, value in shear.items() if not (key == "preshear_passes" and value == 0)}
 
 
 def jenike_cases(config: dict) -> dict[str, JenikeCase]:

@@ -114,8 +114,7 @@ def jenike_script_context(case: JenikeCase) -> dict:
         "lid": lid_context,
         "normal_force": case.normal_force,
         "consolidation": {"ramp_steps": case.ramp_steps, "hold_steps": case.hold_steps},
-        "shear": {"velocity": case.shear_velocity, "steps": case.shear_steps,
-                      "preshear_passes": case.preshear_passes},
+        "shear": {"velocity": case.shear_velocity, "steps": case.shear_steps},
         "output_every": case.output_every,
         "force_sample_every": case.force_sample_every,
         "dump_every": case.dump_every,
@@ -141,7 +140,8 @@ def write_jenike_inputs(case: JenikeCase, deck_dir: str | Path) -> Path:
 def run_jenike(case: JenikeCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
     """Run a rendered Jenike script, check it and write ``run.json``; returns the record."""
     run_dir = Path(run_dir)
-    duration = (case.fill.steps + case.fill.relax_steps + case.consolidation_steps + case.shear_steps) * case.timestep
+    duration = (case.fill.steps + case.fill.relax_steps + case.ramp_steps + case.hold_steps
+                + case.shear_steps) * case.timestep
     return run_script_checked(
         run_dir, options, duration,
         lambda markers, dumps: {**check_jenike_run(case, markers, run_dir, run_dir / FORCES_NAME),

@@ -542,22 +542,14 @@ run_steps(RAMP_STEPS)
 load(NORMAL_FORCE)
 SCHEDULE[0] = (FORCE_SAMPLE_EVERY, history.sample)
 run_steps(HOLD_STEPS)
-
-
-def move_cell(velocity):
-    """The shear ring, the mould on it and the lid move along x at ``velocity`` [m/s] (the lid keeps its vertical
-    velocity)."""
-    for name in ("shear_ring", "mould"):
-        for i in WALLS[name]:
-            O.bodies[i].state.vel = Vector3(velocity, 0.0, 0.0)
-    lid_velocity = O.bodies[LID_ID].state.vel
-    O.bodies[LID_ID].state.vel = Vector3(velocity, 0.0, lid_velocity[2])
-
-
 say_stage("consolidated", lid_x=O.bodies[LID_ID].state.pos[0], lid_z=O.bodies[LID_ID].state.pos[2], lid_fz=history.values()[3], mass_above=mass_above())
 
 # --- shear: the shear ring, the mould on it and the lid move along +x ---
-move_cell(SHEAR_VELOCITY)
+for name in ("shear_ring", "mould"):
+    for i in WALLS[name]:
+        O.bodies[i].state.vel = Vector3(SHEAR_VELOCITY, 0.0, 0.0)
+lid_velocity = O.bodies[LID_ID].state.vel
+O.bodies[LID_ID].state.vel = Vector3(SHEAR_VELOCITY, 0.0, lid_velocity[2])
 SCHEDULE[2] = (OUTPUT_EVERY * 10, lambda: (check_sane(inside), progress("shear")))
 run_steps(SHEAR_STEPS)
 say_stage("sheared", lid_x=O.bodies[LID_ID].state.pos[0], lid_z=O.bodies[LID_ID].state.pos[2], lid_fz=history.values()[3], mass_above=mass_above())

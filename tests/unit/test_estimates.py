@@ -480,7 +480,7 @@ def test_hand_made_jenike_case_exact_numbers():
     case = SimpleNamespace(
         run_id="jenike-test", particle=SimpleNamespace(n_spheres=2, volume=1.45e-8), timestep=1.0e-5,
         fill=SimpleNamespace(n_clumps=453, steps=16900, relax_steps=1734),
-        ramp_steps=1083, hold_steps=3250, shear_steps=17331, dump_every=1733, consolidation_steps=1083 + 3250,
+        ramp_steps=1083, hold_steps=3250, shear_steps=17331, dump_every=1733,
         rigid_lid=SimpleNamespace(n_spheres=280), servo_lid=None,
         geometry=SimpleNamespace(area=1.0e-3, sample_height=0.01),
     )
@@ -503,12 +503,6 @@ def test_hand_made_jenike_case_exact_numbers():
     assert estimate.dump_bytes == 14 * (1024 + 1186 * 128) + 14 * (1024 + 1186 * 200)
     assert estimate.simulated_time_s == pytest.approx(0.40299, rel=1e-12)
     assert estimate.kind == "jenike"
-    # one preshear pass (the shear's 17331 steps forward and as many back) belongs to the consolidation
-    presheared = estimate_jenike_case(SimpleNamespace(**{**vars(case), "consolidation_steps": 1083 + 3250 + 2 * 17331}))
-    assert presheared.stages[2] == StageWork("consolidate", 1083 + 3250 + 34662, 1080.0 * (1083 + 3250 + 34662))
-    assert presheared.steps == 40299 + 34662
-    # (4333 + 34662 + 17331) / 1733 = 32.5 intervals: 33 dumps after the first
-    assert presheared.dump_frames == 34
 
 
 def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
@@ -517,7 +511,6 @@ def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
         estimate = estimate_jenike_case(case)
         assert estimate.steps == (case.fill.steps + 1 + case.fill.relax_steps + case.ramp_steps + case.hold_steps
                                   + case.shear_steps)
-        assert case.preshear_passes == 0 and case.consolidation_steps == case.ramp_steps + case.hold_steps
         lid_atoms = case.rigid_lid.n_spheres if lid == "rigid" else 2
         assert estimate.spheres == case.fill.n_clumps * case.particle.n_spheres + lid_atoms
         # the pour was sized for 1 + overfill times the sample: levelling keeps about 1 / (1 + overfill) of it

@@ -491,26 +491,3 @@ def test_the_liggghts_force_history_averages_the_samples_of_one_output_interval(
     deck = render_jenike_deck(case)
     assert (f"fix force_history all ave/time {every} {case.output_every // every} {case.output_every} "
             "v_time_now") in deck
-
-
-def test_preshear_passes_move_the_cell_forward_and_back_before_the_measured_shear():
-    plain, presheared = _case(), _case(shear={"velocity": 0.03, "displacement": 0.004, "preshear_passes": 2})
-    # without preshear the run keeps the id it had before the key existed; with it, the run is another
-    assert "preshear_passes" not in plain.defining_parameters["jenike"]["shear"]
-    assert presheared.run_id != plain.run_id
-    assert presheared.preshear_passes == 2 and presheared.preshear_steps == 4 * presheared.shear_steps
-    assert presheared.consolidation_steps == presheared.ramp_steps + presheared.hold_steps + 4 * presheared.shear_steps
-    consolidate = presheared.stages()[2]
-    assert consolidate.controls["preshear_passes"] == 2
-    assert consolidate.controls["duration_s"] == pytest.approx(presheared.consolidation_steps * presheared.timestep)
-    deck = render_jenike_deck(presheared)
-    assert "preshear" not in render_jenike_deck(plain)
-    # two passes, each forward then back at the shear velocity, then the lid stops before the measured shear
-    moves = re.findall(r"^fix ring_preshear all move/mesh mesh shear_ring linear (\S+) 0.0 0.0$", deck, re.M)
-    assert [float(v) for v in moves] == [0.03, -0.03, 0.03, -0.03]
-    assert deck.count("unfix ring_preshear") == 4 and deck.count("unfix mould_preshear") == 4
-    lid = re.findall(r"^velocity lid set (\S+) 0.0 NULL units box$", deck, re.M)
-    assert [float(v) for v in lid] == [0.03, -0.03, 0.03, -0.03, 0.0, 0.03]
-    assert deck.index("ring_preshear") < deck.index("SILOFLOW consolidated") < deck.index("fix ring_shear")
-    servo = render_jenike_deck(_case(lid="servo", shear={"velocity": 0.03, "displacement": 0.004, "preshear_passes": 1}))
-    assert re.findall(r"^variable lid_vx equal (\S+)$", servo, re.M)[1:] == ["0.03", "-0.03", "0.0", "0.03"]

@@ -120,14 +120,3 @@ def test_written_inputs_hold_the_cells_meshes_as_triangle_corners(tmp_path):
     with np.load(tmp_path / "rigid" / "deck" / "geometry.npz") as arrays:
         assert np.array_equal(arrays["lid_sphere_positions"], rigid.rigid_lid.positions)
     assert (tmp_path / "deck" / "case.json").exists() and (tmp_path / "deck" / "run.py").exists()
-
-
-def test_preshear_passes_run_forward_and_back_before_the_consolidated_marker():
-    config = validate_config({"jenike": {"engine": "yade", "shear": {"preshear_passes": 2}}})
-    case = build_jenike_case(config, POINT)
-    script = render_jenike_script(case)
-    ast.parse(script)
-    assert "preshear" not in render_jenike_script(_case())
-    loop = script[script.index("# preshear under the consolidation load"):script.index('say_stage("consolidated"')]
-    assert "for _ in range(2):" in loop and "for velocity in (SHEAR_VELOCITY, -SHEAR_VELOCITY):" in loop
-    assert "run_steps(SHEAR_STEPS)" in loop and loop.rstrip().endswith("move_cell(0.0)")
