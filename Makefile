@@ -74,19 +74,21 @@ VALIDATION_DIR    ?= results/validation
 VALIDATION_RECORD ?= docs/validation
 FULL_SCALE_CONFIG ?= config/thesis.yaml
 VALIDATION_RECORD_CLI = $(PYTHON) $(CURDIR)/workflow/scripts/validation_record_cli.py
-VALIDATION_SNAKEMAKE  = $(RUN_SNAKEMAKE) --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG))
+# the target goes before these options: --configfile takes every word after it
+VALIDATION_OPTIONS = --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG))
 GROUP             ?=
 
 validate: install
 	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD))
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
-	$(VALIDATION_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) --cores $(CORES) \
+	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) $(VALIDATION_OPTIONS) --cores $(CORES) \
 		--rerun-incomplete --rerun-triggers mtime params input --keep-going
 	@groups="$$($(VALIDATION_RECORD_CLI) finished $(VALIDATION_CONFIG) $(VALIDATION_DIR) $(if $(GROUP),'$(GROUP)'))" || exit 1; \
 	for group in $$groups; do \
-		$(VALIDATION_SNAKEMAKE) validate_$$group --cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input && \
-		$(VALIDATION_SNAKEMAKE) validate_$$group --report $(abspath $(VALIDATION_DIR))/report-$$group.html && \
+		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --cores $(CORES) --rerun-incomplete \
+			--rerun-triggers mtime params input && \
+		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --report $(abspath $(VALIDATION_DIR))/report-$$group.html && \
 		$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $$group || exit 1; \
 	done
 	$(VALIDATION_RECORD_CLI) page $(VALIDATION_CONFIG) $(FULL_SCALE_CONFIG) $(VALIDATION_RECORD)
