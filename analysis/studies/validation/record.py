@@ -95,7 +95,8 @@ def _hours(seconds: float) -> str:
 
 
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
-                wall_s: Mapping[str, float], cores: int, config_name: str, full_scale_config: str) -> str:
+                wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
+                parts: Mapping[str, Sequence[str]] | None = None) -> str:
     """The record's page (Markdown): per group its freshness, runs and rows, and for each row the scale does not
     show, what scale would show it and what that scale costs.
 
@@ -116,6 +117,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         The cores ``wall_s`` is for.
     config_name, full_scale_config : str
         The configuration the record comes from and the full-scale one, as the page names them.
+    parts : mapping, optional
+        ``{group: [part]}``: what `make validate GROUP=` takes for each group the configuration runs in parts (a
+        group absent runs whole).
 
     Returns
     -------
@@ -133,22 +137,23 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         "|---|---|---|---|---|---|---|",
     ]
     for name, state in status.items():
-        record, parts = groups.get(name, GroupRecord()), wall_s.get(name, {})
-        made = [run for run in record.runs if run["group"] in parts]
+        record, part_walls = groups.get(name, GroupRecord()), wall_s.get(name, {})
+        made = [run for run in record.runs if run["group"] in part_walls]
         core = math.fsum(float(run["wall_time_s"]) * int(run["cores"]) for run in made)
         shown = sum(row["scale_shows"] == YES for row in record.rows)
-        wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in parts.items())
+        wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | "
                      f"{wall if made else '-'} | {len(record.rows)} | {shown} |")
     for name, state in status.items():
         record = groups.get(name)
+        command = ", then ".join(f"`make validate GROUP={part}`" for part in (parts or {}).get(name, [name]))
         lines += ["", f"## {name}", ""]
         if record is None:
-            lines.append(f"Not recorded yet: `make validate GROUP={name}`.")
+            lines.append(f"Not recorded yet: {command}.")
             continue
         if state != "complete":
-            lines += [f"**Stale**: the runs below are not those `{config_name}` now plans; `make validate "
-                      f"GROUP={name}` brings the record up to date.", ""]
+            lines += [f"**Stale**: the runs below are not those `{config_name}` now plans; {command} brings the "
+                      "record up to date.", ""]
         engines = sorted({f"{run['engine']} {run['engine_version']}" for run in record.runs})
         commits = sorted({str(run["commit"]) for run in record.runs})
         dates = sorted(str(run["date"]) for run in record.runs)
