@@ -231,9 +231,10 @@ def find_part(name: str, parts: Mapping[str, Sequence[Part]]) -> Part:
                 return part
     if name in parts:
         names = [part.name for part in parts[name]]
-        raise ValueError(f"validation group {name!r} takes longer than {GROUP_BUDGET_S / 3600:g} h on {PART_CORES} "
-                         f"cores, so it runs in {len(names)} parts: {' then '.join(f'make validate GROUP={n}' for n in names)} "
-                         f"(the part that makes its last run writes its record)")
+        raise ValueError(f"validation group {name!r} takes longer than {PART_FILL * GROUP_BUDGET_S / 3600:g} h on "
+                         f"{PART_CORES} cores by its estimate, so it runs in {len(names)} parts: "
+                         f"{' then '.join(f'make validate GROUP={n}' for n in names)} (the part that makes its last run "
+                         f"writes its record)")
     known = [part.name for group_parts in parts.values() for part in group_parts]
     raise ValueError(f"unknown validation group {name!r}; this configuration's groups and parts are {', '.join(known)}")
 

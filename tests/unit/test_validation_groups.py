@@ -232,8 +232,8 @@ def test_parts_name_their_runs_cost_and_what_to_run():
     assert list(parts) == ["silo", "blending"]
     assert find_part("silo_2", parts) == Part("silo_2", "silo", (2,))
     assert find_part("blending", parts) == Part("blending", "blending", (0,))
-    with pytest.raises(ValueError, match="'silo' takes longer than 2.5 h on 2 cores, so it runs in 2 parts: make "
-                                         "validate GROUP=silo_1 then make validate GROUP=silo_2"):
+    with pytest.raises(ValueError, match="'silo' takes longer than 2.25 h on 2 cores by its estimate, so it runs in 2 "
+                                         "parts: make validate GROUP=silo_1 then make validate GROUP=silo_2"):
         find_part("silo", parts)
     with pytest.raises(ValueError, match="unknown validation group 'silo_3'; this configuration's groups and parts "
                                          "are silo_1, silo_2, blending"):

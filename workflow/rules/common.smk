@@ -164,11 +164,15 @@ def shortcut_measured():
     return blending["recirculations"] > blending["tracer"]["start_recirculations"] + blending["shortcut"]["residence_times"]
 
 
+def among(found, runs):
+    """The run ids of ``found`` that are in ``runs`` (all of them when ``runs`` is None), in ``found``'s order."""
+    return list(found) if runs is None else [run for run in found if run in runs]
+
+
 def recirculation_targets(wildcards=None, runs=None):
     """The products of the recirculating silo's runs (``runs``: those of these run ids, without the summary across
     runs; all with the summary when None)."""
-    chosen = (lambda found: found) if runs is None else (lambda found: [run for run in found if run in runs])
-    blending = chosen(recirculation_runs())
+    blending = among(recirculation_runs(), runs)
     targets = [
         run_path(RECIRCULATION, name, run)
         for run in blending
@@ -180,7 +184,7 @@ def recirculation_targets(wildcards=None, runs=None):
         targets += [run_path(RECIRCULATION, name, run) for run in blending for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
     if runs is None and blending:
         targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
-    verification = chosen(recirculation_runs("verification"))
+    verification = among(recirculation_runs("verification"), runs)
     targets += [
         run_path(RECIRCULATION, f"verification/{name}", run)
         for run in verification
@@ -198,7 +202,7 @@ def blender_runs():
 def blender_targets(wildcards=None, runs=None):
     """The products of the blender's runs (``runs``: those of these run ids, without the comparisons across runs;
     all with the comparisons when None)."""
-    chosen = blender_runs() if runs is None else [run for run in blender_runs() if run in runs]
+    chosen = among(blender_runs(), runs)
     targets = [
         run_path("blender", name, run)
         for run in chosen

@@ -164,13 +164,7 @@ def group_targets(group):
         return [*run_targets("jenike", made), *record_plots(group).values(), *parameters]
     if spec.kind == "silo_flat":
         return [*run_targets("silo_flat", made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
-    return KIND_TARGETS[spec.kind]()
-
-
-KIND_TARGETS = {
-    RECIRCULATION: recirculation_targets,
-    "blender": blender_targets,
-}
+    return recirculation_targets() if spec.kind == RECIRCULATION else blender_targets()
 
 #: Each group's parts, from the configuration's own cost estimates (engines.validation_groups.split).
 PARTS = split_groups(planned_group_runs(config, ESTIMATES))

@@ -73,16 +73,21 @@ def measured_wall_times(record: dict, cores: int) -> dict[str, dict[str, float]]
     return walls
 
 
-def _planned(config_path: str) -> dict[str, set[str]]:
+def _plan(config_path: str) -> tuple[list, dict[str, list]]:
+    """A configuration's run estimates and the runs each group makes of them (:func:`engines.planning.group_runs`)."""
     config = load_config(config_path)
-    return planned_runs(group_runs(config, config_estimates(config)))
+    estimates = config_estimates(config)
+    return estimates, group_runs(config, estimates)
+
+
+def _planned(config_path: str) -> dict[str, set[str]]:
+    return planned_runs(_plan(config_path)[1])
 
 
 def check(name: str, config_path: str, record_dir: str | Path) -> None:
     """`make validate GROUP=<name>`'s check before anything runs: ``name`` is a group or a part of one that
     ``config_path`` plans, and the groups its rows compare against are complete in the record (ValueError)."""
-    config = load_config(config_path)
-    made = group_runs(config, config_estimates(config))
+    made = _plan(config_path)[1]
     parts = split_groups(made)
     check_reads(find_part(name, parts).group, group_status(planned_runs(made), recorded_runs(record_dir)), parts)
 
@@ -106,9 +111,8 @@ def finished(config_path: str, workdir: str | Path, name: str | None = None) -> 
     waiting : list of str
         For each other group considered, a line saying how many of its runs are still to make.
     """
-    config = load_config(config_path)
-    estimates = config_estimates(config)
-    planned = planned_runs(group_runs(config, estimates))
+    estimates, made = _plan(config_path)
+    planned = planned_runs(made)
     results = Path(workdir) / RESULTS
     done = {e.run_id for e in estimates if (run_directory(results, e) / RUN_RECORD).is_file()}
     if name is not None:
@@ -123,13 +127,11 @@ def finished(config_path: str, workdir: str | Path, name: str | None = None) -> 
 def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: int = 2) -> str:
     """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
     group's measured wall time on ``cores`` cores, its parts and its cost at the scale of ``full_scale_path``."""
-    config = load_config(config_path)
-    made = group_runs(config, config_estimates(config))
+    made = _plan(config_path)[1]
     record = read_record(record_dir, GROUPS)
     status = group_status(planned_runs(made), _run_ids(record))
     parts = {name: [part.name for part in group_parts] for name, group_parts in split_groups(made).items()}
-    full = load_config(full_scale_path)
-    full_scale = {cost.name: cost.core_seconds for cost in group_costs(group_runs(full, config_estimates(full)), cores=1)}
+    full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts)
 
