@@ -162,58 +162,60 @@ def _fraction(name: str, value: float, allow_one: bool = True) -> float:
 # --------------------------------------------------------------------------- steady window
 
 
-def _default_averaging_samples(n: int) -> int:
-    """About 5 % of ``n`` samples, odd, at least 5."""
-    samples = max(5, int(round(0.05 * n)))
-    return samples if samples % 2 == 1 else samples + 1
+def _batch_means(values: np.ndarray, cumulative: np.ndarray, start: int, n_batches: int) -> np.ndarray:
+    """Means of ``n_batches`` consecutive batches that together cover ``values[start:]``, from prefix sums
+    ``cumulative`` (``cumulative[i] = sum(values[:i])``); as :func:`numpy.array_split` cuts them, the first batches
+    one sample longer where the samples do not divide evenly."""
+    size, longer = divmod(values.size - start, n_batches)
+    batches = np.arange(n_batches + 1)
+    edges = start + batches * size + np.minimum(batches, longer)
+    return np.diff(cumulative[edges]) / np.diff(edges)
 
 
-def _centred_running_mean(values: np.ndarray, samples: int) -> np.ndarray:
-    """Centred running mean over ``samples`` (odd) samples, windows clipped at both ends."""
-    half = samples // 2
-    padded = np.concatenate([np.full(half, np.nan), values, np.full(half, np.nan)])
-    windows = np.lib.stride_tricks.sliding_window_view(padded, samples)
-    return np.nanmean(windows, axis=1)
+def _drift(time: np.ndarray, signal: np.ndarray, cumulative_time: np.ndarray, cumulative_signal: np.ndarray,
+           start: int, n_batches: int) -> tuple[float, float]:
+    """Level and relative drift of the window ``start:`` (see :func:`detect_steady_window`)."""
+    centres = _batch_means(time, cumulative_time, start, n_batches)
+    means = _batch_means(signal, cumulative_signal, start, n_batches)
+    level = float(np.mean(means))
+    centred = centres - np.mean(centres)
+    slope = float(np.dot(centred, means - level) / np.dot(centred, centred))
+    if level == 0.0:
+        return level, math.inf
+    return level, abs(slope) * (time[-1] - time[start]) / abs(level)
 
 
 def detect_steady_window(
     time,
     signal,
     start_after: float = 0.0,
-    rel_tolerance: float = 0.05,
+    max_drift: float = 0.05,
     min_fraction: float = 0.25,
-    averaging_samples: int | None = None,
+    n_batches: int = 10,
 ) -> SteadyWindow:
-    """Find the steady (plateau) part of a ramp-then-plateau force history.
+    """Find the steady part of a ramp-then-plateau force history: the longest final window without a trend.
 
-    The shear force of a Jenike test rises while the sample is mobilised and
-    then fluctuates (possibly with stick-slip) about a steady level. Only the
-    samples with ``time >= start_after`` are analysed; among them:
+    The shear force of a Jenike test rises while the sample is mobilised and then fluctuates about a steady
+    level, often with stick-slip whose excursions exceed any useful band about the level; or it never levels
+    off (a sample that keeps dilating, a shear too short). Only the samples with ``time >= start_after`` are
+    analysed. A candidate window runs from a sample to the last one; it is cut into ``n_batches`` equal
+    consecutive batches covering it (their sizes differ by one sample at most), and a least-squares line is fitted to the batch means against the batch
+    mean times. The window's *drift* is the line's rise or fall over the window's duration, relative to its
+    level (the mean of the batch means):
 
-    1. the plateau ``P`` is the median of the last half of the samples (robust
-       to the fluctuations and to the ramp, which lies in the first half);
-    2. the signal is smoothed with a *centred* running mean of
-       ``averaging_samples`` samples (``w = 2 h + 1``; near both ends of the
-       analysed record the window is clipped to the samples that exist);
-    3. the window starts at the first sample after which the running mean stays
-       within the band ``|mean - P| <= rel_tolerance * |P|`` up to the last
-       sample, and ends at the last sample.
+        ``drift = |slope| (t_end - t_start) / |level|``
 
-    Precision on a noise-free ramp. Because the running mean is centred it does
-    not lag: on a linear ramp it equals the signal, except at the ``h`` samples
-    either side of the corner at ``t0 = time[k]`` (end of the ramp), where it
-    lies below the plateau by the relative amount ``(h - d)(h - d + 1) / (2 r w)``
-    at sample ``k + d`` (``|d| < h``; ``r`` = ramp length in samples). Hence:
+    The steady window is the earliest (longest) candidate of at least ``min_fraction`` of the analysed
+    samples whose drift is at most ``max_drift``. Averaging over batches makes the test blind to fluctuations
+    shorter than a batch (stick-slip), and the fit makes it see a trend that a band about the final level
+    would accept over a short window.
 
-    * if the ramp enters the band at a sample ``j <= k - h`` (a slow ramp), the
-      window starts exactly at ``j``, the first sample of the ramp within
-      ``rel_tolerance`` of the plateau;
-    * otherwise it starts between ``j`` and ``k + h``. For a steep ramp that
-      enters the band less than one sample before ``t0`` (``rel_tolerance * r < 1``)
-      and with ``h (h - 1) / (2 r w) <= rel_tolerance`` (with the defaults
-      ``h = 2, w = 5``: ``r >= 4``), "within one sample of ``t0``" holds in
-      the precise sense ``t0 <= t_start <= t0 + dt``: the window starts at
-      ``time[k]`` or ``time[k + 1]``.
+    Precision. On a linear signal ``a + b t`` the batch means lie on the same line, so the drift is exactly
+    ``|b| (t_end - t_start) / |a + b t_mean|`` (``t_mean``: the mean of the batches' mean times). A window that
+    takes in the end of a ramp is accepted only while the ramp's samples keep the drift within ``max_drift``:
+    with a step of relative height ``d`` in the first of ten batches the drift is about ``0.55 d``, so the
+    window's mean is then biased by about ``max_drift / 5`` at most (1 % with the defaults; a linear ramp's tail
+    comes to the same).
 
     Parameters
     ----------
@@ -223,80 +225,62 @@ def detect_steady_window(
         Force history, e.g. ``F_lid + F_ring`` [N].
     start_after : float, optional
         Ignore samples before this time [s] (default 0).
-    rel_tolerance : float, optional
-        Half-width of the band about the plateau, relative to ``|P|``
-        (default 0.05, i.e. 5 %).
+    max_drift : float, optional
+        Largest accepted drift of a window, relative to its level (default 0.05, i.e. 5 %).
     min_fraction : float, optional
-        Smallest accepted window, as a fraction of the analysed samples
-        (default 0.25).
-    averaging_samples : int, optional
-        Odd number of samples ``w`` of the running mean (>= 1; 1 means no
-        smoothing). Default: about 5 % of the analysed samples, odd, at least
-        5 (5 for up to 109 samples; 21 for 400 samples). Raise it for signals
-        with strong stick-slip so that a window spans a few slip events.
+        Smallest accepted window, as a fraction of the analysed samples (default 0.25).
+    n_batches : int, optional
+        Number of batches the line is fitted to (>= 3, default 10). A window holds at least two samples per
+        batch.
 
     Returns
     -------
     SteadyWindow
-        Window times [s], slice bounds and plateau level.
+        Window times [s], slice bounds and level (``plateau``, the mean of the batch means).
 
     Raises
     ------
     ValueError
-        On malformed input; if the plateau is 0; or (naming ``signal``) if the
-        running mean never settles in the band for at least ``min_fraction``
-        of the analysed samples, e.g. a force that keeps growing.
+        On malformed input; or (naming ``signal``) if no window of at least ``min_fraction`` of the analysed
+        samples drifts by at most ``max_drift``, e.g. a force that keeps growing; the message gives the
+        least drift found.
     """
     time = _times(time)
     signal = _history("signal", signal, time.size)
     start_after = float(start_after)
     if not math.isfinite(start_after):
         raise ValueError(f"start_after must be a finite time, got {start_after!r}")
-    rel_tolerance = float(rel_tolerance)
-    if not (math.isfinite(rel_tolerance) and rel_tolerance > 0.0):
-        raise ValueError(f"rel_tolerance must be a finite number > 0, got {rel_tolerance!r}")
+    max_drift = float(max_drift)
+    if not (math.isfinite(max_drift) and max_drift > 0.0):
+        raise ValueError(f"max_drift must be a finite number > 0, got {max_drift!r}")
     min_fraction = _fraction("min_fraction", min_fraction)
+    if isinstance(n_batches, bool) or int(n_batches) != n_batches or n_batches < 3:
+        raise ValueError(f"n_batches must be an integer >= 3, got {n_batches!r}")
+    n_batches = int(n_batches)
 
     first = int(np.searchsorted(time, start_after, side="left"))
-    analysed = signal[first:]
+    analysed_time, analysed = time[first:], signal[first:]
     n_analysed = analysed.size
-    if n_analysed < 4:
+    shortest = max(math.ceil(min_fraction * n_analysed), 2 * n_batches)
+    if shortest > n_analysed:
         raise ValueError(
-            f"start_after = {start_after:.6g} s leaves {n_analysed} samples of signal; at least 4 are needed"
+            f"start_after = {start_after:.6g} s leaves {n_analysed} samples of signal; at least "
+            f"{shortest} are needed ({2 * n_batches} for {n_batches} batches of two)"
         )
-    if averaging_samples is None:
-        averaging_samples = _default_averaging_samples(n_analysed)
-    if (
-        isinstance(averaging_samples, bool)
-        or int(averaging_samples) != averaging_samples
-        or averaging_samples < 1
-        or averaging_samples % 2 == 0
-    ):
-        raise ValueError(f"averaging_samples must be an odd integer >= 1, got {averaging_samples!r}")
-    averaging_samples = int(averaging_samples)
-
-    plateau = float(np.median(analysed[n_analysed // 2 :]))
-    if plateau == 0.0:
-        raise ValueError("signal: the final level (median of the last half) is 0; there is no shear force")
-    running_mean = _centred_running_mean(analysed, averaging_samples)
-    inside = np.abs(running_mean - plateau) <= rel_tolerance * abs(plateau)
-
-    outside = np.flatnonzero(~inside)
-    start = 0 if outside.size == 0 else int(outside[-1]) + 1
-    length = n_analysed - start
-    if length < 2 or length < min_fraction * n_analysed:
-        raise ValueError(
-            f"signal: no steady shear: the force never settles within {100.0 * rel_tolerance:g} % of its "
-            f"final level ({plateau:.6g}) for at least {100.0 * min_fraction:g} % of the samples after "
-            f"start_after = {start_after:.6g} s (settled part: {length} of {n_analysed} samples)"
-        )
-    i_start = first + start
-    return SteadyWindow(
-        t_start=float(time[i_start]),
-        t_end=float(time[-1]),
-        i_start=i_start,
-        i_end=int(time.size),
-        plateau=plateau,
+    cumulative_time = np.concatenate([[0.0], np.cumsum(analysed_time)])
+    cumulative_signal = np.concatenate([[0.0], np.cumsum(analysed)])
+    least = (math.inf, n_analysed)
+    for start in range(n_analysed - shortest + 1):
+        level, drift = _drift(analysed_time, analysed, cumulative_time, cumulative_signal, start, n_batches)
+        if drift <= max_drift:
+            i_start = first + start
+            return SteadyWindow(t_start=float(time[i_start]), t_end=float(time[-1]), i_start=i_start,
+                                i_end=int(time.size), plateau=level)
+        least = min(least, (drift, n_analysed - start))
+    raise ValueError(
+        f"signal: no steady shear: every window of at least {100.0 * min_fraction:g} % of the {n_analysed} "
+        f"samples after start_after = {start_after:.6g} s drifts by more than {100.0 * max_drift:g} % of its level "
+        f"(least: {100.0 * least[0]:.3g} % over the last {least[1]} samples)"
     )
 
 
