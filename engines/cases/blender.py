@@ -27,7 +27,7 @@ from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, IN
 from engines.cases.blender_passages import clear_widths, geometry_summary
 from engines.cases.blender_meshes import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
-from engines.cases.particles import particle_template
+from engines.cases.particles import model_parameters, particle_template
 from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from analysis.data.constants import GRAVITY
 from engines.cases.common import (
@@ -240,7 +240,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
     timestep_choice = stable_timestep(
         particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
         largest_impact_velocity(fill_config, fill_height, domain_top, gravity, reentry_velocity),
-        blender["timestep_fraction"], blender["timestep_hertz_fraction"],
+        blender["timestep_fraction"], blender["timestep_hertz_fraction"], particle.timestep_scale,
     )
     timestep = timestep_choice.timestep
     fill = plan_fill(particle, blender["width"], blender["depth"], fill_height, fill_config, timestep, gravity, n_clumps)
@@ -273,7 +273,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         "insert": insert_spec(config, configuration),
         "gravity_factor": float(gravity_factor),
         "materials": {name: config["materials"][name] for name in table.names},
-        "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
+        "particle_model": model_parameters(particle.name, config["particle_models"][particle.name]),
         "contacts": sorted(
             ({**c, "materials": sorted(c["materials"])} for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
             key=lambda c: c["materials"],

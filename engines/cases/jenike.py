@@ -34,7 +34,7 @@ import numpy as np
 from analysis.data.constants import GRAVITY
 from engines.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
 from engines.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
-from engines.cases.particles import ParticleTemplate, particle_template
+from engines.cases.particles import ParticleTemplate, model_parameters, particle_template
 from engines.cases.physics import (
     ChosenTimestep, TimestepChoice, engine_seeds, free_fall_velocity, stable_timestep, steps_for,
 )
@@ -470,6 +470,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     timestep_choice = stable_timestep(
         particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
         free_fall_velocity(0.0, column_top, GRAVITY), jenike["timestep_fraction"], jenike["timestep_hertz_fraction"],
+        particle.timestep_scale,
     )
     timestep = timestep_choice.timestep
     fill = plan_fill(geometry, particle, overfill, jenike["fill"]["settle_time"], timestep)
@@ -510,7 +511,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         "point": point,
         "lid": jenike["lid"],
         "materials": {name: materials[name] for name in sorted(set(table.names))},
-        "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
+        "particle_model": model_parameters(particle.name, config["particle_models"][particle.name]),
         "test_contacts": asdict(test_contacts),
         "fill_contacts": asdict(fill_contacts),
         "jenike": without_fill_checks({key: value for key, value in jenike.items() if key not in ("sweep",)}),

@@ -11,7 +11,8 @@ import numpy as np
 
 from analysis.checks import finite_array
 
-
+#: A particle model's ``timestep_scale`` when it gives none.
+DEFAULT_TIMESTEP_SCALE = 1.0
 
 @dataclass(frozen=True)
 class ParticleTemplate:
@@ -29,6 +30,10 @@ class ParticleTemplate:
         Solid density (kg/m^3).
     volume : float
         Volume of the union of the spheres (m^3).
+    timestep_scale : float
+        Factor on the time step of runs with this clump (-), in (0, 1]: the time step limits (Rayleigh, Hertz) are
+        those of one sphere, and a clump whose spheres overlap heavily touches another with many sphere pairs at
+        once, a stiffer contact.
     """
 
     name: str
@@ -36,6 +41,7 @@ class ParticleTemplate:
     sphere_radii: np.ndarray
     density: float
     volume: float
+    timestep_scale: float = 1.0
 
     @property
     def n_spheres(self) -> int:
@@ -73,7 +79,17 @@ def particle_template(name: str, model: dict, density: float) -> ParticleTemplat
     radii = np.array([sphere["radius"] for sphere in model["spheres"]], dtype=float)
     positions = positions - positions.mean(axis=0)
     volume = _template_volume(tuple(map(tuple, positions.tolist())), tuple(radii.tolist()))
-    return ParticleTemplate(name, positions, radii, float(density), volume)
+    return ParticleTemplate(name, positions, radii, float(density), volume,
+                            float(model.get("timestep_scale", DEFAULT_TIMESTEP_SCALE)))
+
+
+def model_parameters(name: str, model: dict) -> dict:
+    """A ``particle_models`` entry as a run's defining parameters: its name and keys, the time step scale only where
+    it is not the default (1), so that the runs of a model at the default keep their run ids."""
+    parameters = {"name": name, **model}
+    if parameters.get("timestep_scale", DEFAULT_TIMESTEP_SCALE) == DEFAULT_TIMESTEP_SCALE:
+        parameters.pop("timestep_scale", None)
+    return parameters
 
 
 @lru_cache(maxsize=64)

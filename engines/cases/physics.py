@@ -91,6 +91,8 @@ class TimestepChoice:
         The largest relative velocity the case expects at an impact (m/s).
     limited_by : str
         ``"rayleigh"`` or ``"hertz"``: the criterion that set the time step.
+    scale : float
+        The particle model's factor on the smaller limit (-).
     """
 
     timestep: float
@@ -98,6 +100,7 @@ class TimestepChoice:
     hertz_time: float
     impact_velocity: float
     limited_by: str
+    scale: float = 1.0
 
 
 class ChosenTimestep:
@@ -120,7 +123,7 @@ class ChosenTimestep:
         choice = self.timestep_choice
         return {"rayleigh_time_s": choice.rayleigh_time, "hertz_time_s": choice.hertz_time,
                 "impact_velocity_m_s": choice.impact_velocity, "timestep_limited_by": choice.limited_by,
-                "timestep_s": choice.timestep}
+                "timestep_scale": choice.scale, "timestep_s": choice.timestep}
 
 
 def stable_timestep(
@@ -131,13 +134,16 @@ def stable_timestep(
     impact_velocity: float,
     rayleigh_fraction: float,
     hertz_fraction: float,
+    scale: float = 1.0,
 ) -> TimestepChoice:
     """The time step of a run from two explicit stability criteria.
 
-    dt = min(f_R t_R, f_H t_H(v_max)): a fraction of the Rayleigh time (a surface wave must not cross a sphere
+    dt = s min(f_R t_R, f_H t_H(v_max)): a fraction of the Rayleigh time (a surface wave must not cross a sphere
     within one step) and a fraction of the Hertz contact duration at the largest impact velocity the case
     expects (an impact must span enough steps to integrate its force). These are the two limits LIGGGHTS'
-    ``fix check/timestep/gran`` checks.
+    ``fix check/timestep/gran`` checks, both for one pair of spheres. The particle model's scale ``s`` accounts
+    for a clump whose spheres overlap so much that two clumps touch with many sphere pairs at once: their contact
+    is that many times stiffer than one pair's.
 
     Parameters
     ----------
@@ -147,23 +153,27 @@ def stable_timestep(
         Largest expected relative impact velocity v_max (m/s).
     rayleigh_fraction, hertz_fraction : float
         f_R and f_H (-), each in (0, 1].
+    scale : float, optional
+        s (-), in (0, 1] (default 1).
 
     Returns
     -------
     TimestepChoice
     """
-    for name, value in (("rayleigh_fraction", rayleigh_fraction), ("hertz_fraction", hertz_fraction)):
+    for name, value in (("rayleigh_fraction", rayleigh_fraction), ("hertz_fraction", hertz_fraction),
+                        ("scale", scale)):
         if not (math.isfinite(value) and 0 < value <= 1):
             raise ValueError(f"{name} must lie in (0, 1], got {value!r}")
     t_rayleigh = rayleigh_time(radius, density, youngs_modulus, poisson_ratio)
     t_hertz = hertz_contact_time(radius, density, youngs_modulus, poisson_ratio, impact_velocity)
     by_rayleigh, by_hertz = rayleigh_fraction * t_rayleigh, hertz_fraction * t_hertz
     return TimestepChoice(
-        timestep=min(by_rayleigh, by_hertz),
+        timestep=scale * min(by_rayleigh, by_hertz),
         rayleigh_time=t_rayleigh,
         hertz_time=t_hertz,
         impact_velocity=impact_velocity,
         limited_by="rayleigh" if by_rayleigh <= by_hertz else "hertz",
+        scale=scale,
     )
 
 

@@ -22,16 +22,17 @@ from engines.cases.common import (
     material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
 )
 from engines.cases.geometry import horizontal_rectangle
-from engines.cases.particles import ParticleTemplate, particle_template
+from engines.cases.particles import ParticleTemplate, model_parameters, particle_template
 from engines.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
 from engines.cases.stages import Stage
 
 CASE_NAME = "silo_flat"
 
 #: Keys of ``silo_flat`` that only steer the analysis; they do not define (or rerun) the simulation.
-#: Keys that do not define a run: analysis settings, and the replicate count (each replicate is its own run, defined
-#: by its seed).
-ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates", "reference_replicates", "piv")
+#: Keys that do not define a run: analysis settings, the replicate count (each replicate is its own run, defined
+#: by its seed), and the runs siloflow did not make, which it only analyses.
+ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates", "reference_replicates", "piv",
+                      "existing_runs")
 
 
 @dataclass(frozen=True)
@@ -169,7 +170,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
     timestep_choice = stable_timestep(
         particle.smallest_radius, material["density"], material["youngs_modulus"], material["poisson_ratio"],
         largest_impact_velocity(silo["fill"], silo["fill_height"], domain_top, GRAVITY, reentry_velocity),
-        silo["timestep_fraction"], silo["timestep_hertz_fraction"],
+        silo["timestep_fraction"], silo["timestep_hertz_fraction"], particle.timestep_scale,
     )
     timestep = timestep_choice.timestep
     fill = plan_fill(particle, silo["width"], silo["depth"], silo["fill_height"], silo["fill"], timestep, GRAVITY)
@@ -187,7 +188,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
         "case": CASE_NAME,
         "engine": engine_kind(config, section),
         "materials": {name: config["materials"][name] for name in table.names},
-        "particle_model": {"name": particle.name, **config["particle_models"][particle.name]},
+        "particle_model": model_parameters(particle.name, config["particle_models"][particle.name]),
         "contacts": sorted(
             (c for c in config["contacts"] if set(c["materials"]) <= set(table.names)),
             key=lambda c: sorted(c["materials"]),

@@ -4,6 +4,7 @@ import math
 
 import pytest
 
+from engines.cases.particles import model_parameters, particle_template
 from engines.cases.physics import (
     engine_seeds, free_fall_time, free_fall_velocity, hertz_contact_time, is_prime, rayleigh_time, stable_timestep, steps_for,
 )
@@ -71,6 +72,25 @@ def test_stable_timestep_takes_the_smaller_limit_and_names_it():
     fast = stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 10.0, 0.2, 0.1)
     assert fast.limited_by == "hertz"
     assert fast.timestep == pytest.approx(0.1 * t_h / 10.0**0.2, rel=1e-12)
+
+
+def test_stable_timestep_scales_the_smaller_limit_by_the_particle_models_factor():
+    t_r = rayleigh_time(1.5e-3, 950.0, 5e6, 0.4)
+    halved = stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 1.0, 0.1, 0.1, scale=0.5)
+    assert (halved.timestep, halved.limited_by, halved.scale) == (0.5 * 0.1 * t_r, "rayleigh", 0.5)
+    with pytest.raises(ValueError, match=r"scale must lie in \(0, 1\], got 1.5"):
+        stable_timestep(1.5e-3, 950.0, 5e6, 0.4, 1.0, 0.1, 0.1, scale=1.5)
+
+
+def test_a_particle_models_time_step_scale_enters_its_defining_parameters_only_when_not_1():
+    spheres = [{"position": [0.0, 0.0, 0.0], "radius": 0.0019}]
+    assert model_parameters("sphere", {"spheres": spheres, "timestep_scale": 1.0}) == {"name": "sphere",
+                                                                                     "spheres": spheres}
+    assert model_parameters("sphere", {"spheres": spheres}) == {"name": "sphere", "spheres": spheres}
+    assert model_parameters("sphere", {"spheres": spheres, "timestep_scale": 0.5}) == {
+        "name": "sphere", "spheres": spheres, "timestep_scale": 0.5}
+    assert particle_template("sphere", {"spheres": spheres, "timestep_scale": 0.5}, 950.0).timestep_scale == 0.5
+    assert particle_template("sphere", {"spheres": spheres}, 950.0).timestep_scale == 1.0
 
 
 @pytest.mark.parametrize("fractions", [(0.0, 0.1), (0.1, -0.1), (1.5, 0.1), (0.1, math.nan)])
