@@ -15,6 +15,7 @@ report: "workflow/report/workflow.rst"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/calibration.smk"
 include: "workflow/rules/silo.smk"
+include: "workflow/rules/existing_runs.smk"
 include: "workflow/rules/silo_recirculation.smk"
 include: "workflow/rules/blender.smk"
 include: "workflow/rules/fill_balance.smk"
@@ -28,6 +29,7 @@ rule all:
     input:
         calibration_targets(),
         silo_flat_targets,
+        existing_runs_targets,
         parametric_targets,
         recirculation_targets,
         blender_targets,

@@ -23,6 +23,7 @@ from typing import Any, Iterable, Mapping
 import jsonschema
 import yaml
 
+from analysis.data.existing_run import ExistingRunError, ExistingSiloRun
 from engines.cases.blender_geometry import INSERT_PRESETS
 from engines.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
 
@@ -254,7 +255,38 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
     _check_engine_settings(config, filled)
     _check_settle_criteria(config, given)
     _settle_criteria_in_use(filled)
+    existing_silo_runs(filled)
     return filled
+
+
+#: Where the flat-bottom silo runs siloflow did not make are configured.
+EXISTING_RUNS_KEY = "silo_flat.existing_runs"
+
+
+def existing_silo_runs(config: Mapping) -> dict[str, ExistingSiloRun]:
+    """The flat-bottom silo runs siloflow did not make (``silo_flat.existing_runs``) of a validated configuration.
+
+    Only the description is checked here (required keys given, the opening given once, the outlet narrower than the
+    silo); :func:`engines.existing_runs.check_existing_runs` checks the folders and their dumps.
+
+    Returns
+    -------
+    dict of str to ExistingSiloRun
+        By name, in the configuration's order.
+
+    Raises
+    ------
+    ConfigError
+        Naming the key, e.g. ``config key 'silo_flat.existing_runs.mine.width': required: ...``.
+    """
+    runs = {}
+    for name, section in config["silo_flat"]["existing_runs"].items():
+        try:
+            runs[name] = ExistingSiloRun.from_config(name, section)
+        except ExistingRunError as error:
+            key = f"{EXISTING_RUNS_KEY}.{name}" + ("" if error.key == "name" else f".{error.key}")
+            raise ConfigError(f"config key '{key}': {error.reason}") from None
+    return runs
 
 
 def _check_settle_criteria(raw: Mapping, given: Mapping) -> None:

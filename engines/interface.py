@@ -10,6 +10,10 @@ Each engine is a subclass of :class:`Engine` in the package ``engines.<name>`` t
 :data:`ENGINE_KINDS`, as the configuration schema's ``engine.kind`` enumerates them). As in signac-flow, each engine
 class names its own base template, and its case templates extend it with blocks.
 
+A run siloflow did not make (a user's own input, ``silo_flat.existing_runs``) is known only from its particle dumps:
+an engine that reads those implements :meth:`Engine.dump_files` and :meth:`Engine.read_dump_files`; one that does not
+refuses, naming itself.
+
 Adding an engine: create ``engines/<name>/`` with an :class:`Engine` subclass, its templates under
 ``templates/<name>/``, add the name to :data:`ENGINE_KINDS` and to the schema's ``engine.kind`` enum.
 """
@@ -37,6 +41,7 @@ if TYPE_CHECKING:  # the neutral types appear in signatures only
 __all__ = [
     "ENGINE_KINDS",
     "CaseNotSupported",
+    "DumpFile",
     "Engine",
     "EngineError",
     "EngineNotFound",
@@ -91,6 +96,22 @@ class EngineOptions:
         section = config["engine"]
         return cls(mpi_ranks=int(section["mpi_ranks"]), mpirun=str(section["mpirun"]),
                    settings=dict(section.get(kind, {})))
+
+
+@dataclass(frozen=True)
+class DumpFile:
+    """One particle dump file of a run siloflow did not make (:meth:`Engine.dump_files`).
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The file.
+    step : int or None
+        The step its name gives; None for a file that holds its own steps (several snapshots).
+    """
+
+    path: Path
+    step: int | None
 
 
 class Engine(ABC):
@@ -174,6 +195,45 @@ class Engine(ABC):
         CaseNotSupported
             When the engine saves no settled fill for this case.
         """
+
+    # Runs siloflow did not make (a user's own input): the engine reads their particle dumps and nothing else. Not
+    # abstract: an engine that cannot refuses, naming itself.
+
+    def dump_files(self, folder: str | Path, pattern: str) -> list[DumpFile]:
+        """The particle dump files a run of the engine's own input left in ``folder``, in step order.
+
+        Parameters
+        ----------
+        folder : str or path-like
+            The run's folder.
+        pattern : str
+            The dump file names, relative to ``folder``, as the engine's dump command names them.
+
+        Raises
+        ------
+        analysis.data.existing_run.ExistingRunError
+            Naming ``folder`` (missing) or ``dumps`` (a pattern the engine does not write, or no file).
+        CaseNotSupported
+            When the engine reads no dumps of runs siloflow did not make.
+        """
+        raise CaseNotSupported(f"siloflow reads no {self.name} dumps of runs it did not make")
+
+    def read_dump_files(self, files, timestep: float, *, density: float | None = None,
+                        on_damaged: str = "error") -> list[ParticleFrame]:
+        """The particle frames of :meth:`dump_files`' files, in their order.
+
+        Parameters
+        ----------
+        files : sequence of DumpFile
+            The files.
+        timestep : float
+            The run's time step (s): a frame's time is its step times it.
+        density : float, optional
+            Particle density (kg/m^3), for dumps without a mass.
+        on_damaged : {"error", "skip"}
+            What a damaged dump does.
+        """
+        raise CaseNotSupported(f"siloflow reads no {self.name} dumps of runs it did not make")
 
 
 _REGISTERED: dict[str, type[Engine]] = {}

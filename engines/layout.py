@@ -10,6 +10,10 @@ The workflow's rules, the run planning (estimates, disk checks) and the tests al
         failed_attempts/ output of unfinished earlier attempts, moved aside, never deleted
 
 The engine's own files (dumps, logs, restart files) also live in the run directory, under names only the engine knows.
+
+Runs siloflow did not make (a user's own engine input, configured by name in ``<case>.existing_runs``) stay in their
+own folders, which siloflow only reads; their analysis products go to ``results/existing_runs/<case root>/<name>/``
+(``metrics/ fields/ plots/ logs/``, as a run directory's).
 """
 
 from __future__ import annotations
@@ -17,7 +21,9 @@ from __future__ import annotations
 import os
 from pathlib import Path, PurePosixPath
 
-__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "RUN_BENCHMARK", "RUN_RECORD", "VALIDATION_RECORD", "case_root", "run_dir", "run_path", "write_text_atomic"]
+__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
+           "RUN_RECORD", "VALIDATION_RECORD", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
+           "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
 RESULTS = "results"
@@ -44,6 +50,11 @@ VALIDATION_RECORD = f"{RESULTS}/summary/record"
 #: The wildcard rules use for a run id.
 RUN_WILDCARD = "{run}"
 
+#: Folder, under :data:`RESULTS`, of the analyses of runs siloflow did not make.
+EXISTING_RUNS = "existing_runs"
+#: The wildcard rules use for the name of a run siloflow did not make.
+EXISTING_RUN_WILDCARD = "{existing}"
+
 
 def case_root(case: str, results: str = RESULTS) -> str:
     """``results/<case root>``: the folder that holds every run of case kind ``case``."""
@@ -62,6 +73,23 @@ def run_path(case: str, relative: str, run: str = RUN_WILDCARD, results: str = R
     if relative.startswith("/") or ".." in PurePosixPath(relative).parts:
         raise ValueError(f"run paths are relative and stay inside the run directory, got {relative!r}")
     return f"{run_dir(case, run, results)}/{relative}"
+
+
+def existing_run_dir(case: str, name: str = EXISTING_RUN_WILDCARD, results: str = RESULTS) -> str:
+    """The folder of the analysis of run ``name`` siloflow did not make, of case ``case``:
+    ``results/existing_runs/<case root>/<name>`` (with the default ``{existing}``: the rules' wildcard pattern)."""
+    if case not in CASE_ROOTS:
+        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_ROOTS)}")
+    return str(PurePosixPath(results) / EXISTING_RUNS / CASE_ROOTS[case] / name)
+
+
+def existing_run_path(case: str, relative: str, name: str = EXISTING_RUN_WILDCARD, results: str = RESULTS) -> str:
+    """A product of the analysis of a run siloflow did not make: ``existing_run_path("silo_flat", "metrics/flow.csv")``
+    is ``results/existing_runs/silo_flat/{existing}/metrics/flow.csv``."""
+    if relative.startswith("/") or ".." in PurePosixPath(relative).parts:
+        raise ValueError(f"paths of an existing run's analysis are relative and stay inside its folder, "
+                         f"got {relative!r}")
+    return f"{existing_run_dir(case, name, results)}/{relative}"
 
 
 def write_text_atomic(path: Path, text: str) -> None:

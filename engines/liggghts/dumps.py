@@ -35,6 +35,7 @@ All quantities are SI: metres, seconds, kilograms, newtons, radians.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import os
 import re
@@ -59,6 +60,7 @@ __all__ = [
     "read_custom_dump",
     "frame_from_arrays",
     "clumps_from_frame",
+    "dump_format",
     "dump_step",
     "list_dumps",
     "read_file_frames",
@@ -265,6 +267,30 @@ def dump_step(path: str | os.PathLike) -> int:
     return int(digits)
 
 
+def dump_format(path: str | os.PathLike) -> str:
+    """Which kind of LIGGGHTS particle dump a file is, from its first line (as :func:`read_file_frames` tells them
+    apart).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    str
+        ``"vtk"`` (legacy VTK: its step is in its name), ``"text"`` (``dump custom``: its steps are in it) or
+        ``"other"`` (neither; :func:`read_file_frames` says why it refuses it).
+    """
+    with open(path, "rb") as handle:
+        head = handle.read(64)
+    if head.startswith(_VTK_MAGIC):
+        return "vtk"
+    if head.startswith(FIRST_LINE.encode()):
+        return "text"
+    return "other"
+
+
 def list_dumps(dump_dir: str | os.PathLike, prefix: str, suffix: str = ".vtk") -> list[Path]:
     """Dump files ``<prefix>_<digits><suffix>`` in a folder, sorted by step (particle dumps ``.vtk``, contact
     dumps ``.txt``).
@@ -407,7 +433,7 @@ DAMAGED_DUMP_POLICIES = ("error", "skip")
 
 def readable_frames(
     paths: Iterable[str | os.PathLike], timestep: float, *, on_damaged: str = "error",
-    density: PerType | None = None, sphere_mass: PerType | None = None,
+    density: PerType | None = None, sphere_mass: PerType | None = None, steps: Iterable[int | None] | None = None,
 ) -> Iterator[ParticleFrame]:
     """Read dumps one after another, lazily.
 
@@ -423,17 +449,30 @@ def readable_frames(
         logger) that names the file and the problem (``"skip"``).
     density, sphere_mass : float or mapping of int to float, optional
         For dumps without a mass field (:func:`frame_from_arrays`).
+    steps : iterable of int or None, optional
+        One per path, in their order: the time step number [-] of a legacy VTK dump whose name does not end in
+        ``_<step>``, or None (a VTK dump's step from its name; a text dump, which holds its own)
+        (:func:`read_file_frames`). Taken one at a time, just before its dump is read. By default None for every
+        dump.
 
     Yields
     ------
     ParticleFrame
         The frames of every readable dump.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``on_damaged``, ``steps`` not as many as ``paths``, or from :func:`read_file_frames`.
+    DumpFormatError
+        A damaged dump under ``on_damaged="error"``.
     """
     if on_damaged not in DAMAGED_DUMP_POLICIES:
         raise ValueError(f"on_damaged must be one of {DAMAGED_DUMP_POLICIES}, got {on_damaged!r}")
-    for path in paths:
+    paired = zip(paths, itertools.repeat(None)) if steps is None else zip(paths, steps, strict=True)
+    for path, step in paired:
         try:
-            frames = read_file_frames(path, timestep, density=density, sphere_mass=sphere_mass)
+            frames = read_file_frames(path, timestep, density=density, sphere_mass=sphere_mass, step=step)
         except DumpFormatError as error:
             if on_damaged == "error":
                 raise

@@ -22,11 +22,12 @@ from engines.cases.silo_flat import SiloCase
 from engines.cases.silo_recirculation import RecirculationCase
 from engines.cases.verification import VerificationCase
 from engines.estimates import MeasuredWork
-from engines.interface import CaseNotSupported, Engine, EngineOptions, register
+from engines.interface import CaseNotSupported, DumpFile, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from engines.cases.blender import GATE
 from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
+from engines.liggghts.dump_files import match_dump_files, read_dump_files
 from engines.liggghts.dumps import list_dumps, read_frames
 from engines.liggghts.forces import read_jenike_forces, read_wall_forces
 from engines.liggghts.inputs import ENGINE_NAME
@@ -179,3 +180,10 @@ class LiggghtsEngine(Engine):
         if record.case not in FLOOR_WALLS:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
         return read_settled_fill(dumps, record.timestep_s, FLOOR_WALLS[record.case])
+
+    def dump_files(self, folder: str | Path, pattern: str) -> list[DumpFile]:
+        return match_dump_files(folder, pattern)
+
+    def read_dump_files(self, files, timestep: float, *, density: float | None = None,
+                        on_damaged: str = "error") -> list[ParticleFrame]:
+        return read_dump_files(files, timestep, density=density, on_damaged=on_damaged)

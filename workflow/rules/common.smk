@@ -221,8 +221,8 @@ def blender_targets(wildcards=None, runs=None):
 
 
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets(), *parametric_targets(), *recirculation_targets(),
-                 *blender_targets()]:
+    for path in [*calibration_targets(), *silo_flat_targets(), *existing_runs_targets(), *parametric_targets(),
+                 *recirculation_targets(), *blender_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")
 
 

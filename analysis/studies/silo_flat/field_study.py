@@ -1,8 +1,9 @@
 """The continuum study of one flat-bottom silo run, from the frames after opening to the rows of its tables.
 
-:func:`analyse_silo_fields` takes the clump frames since the outlet opened, the contacts of the settled fill,
-the silo's dimensions (:class:`SiloDimensions`, from the case summary) and the ``silo_flat.fields`` settings
-(:class:`SiloFieldOptions`) and returns a :class:`SiloFieldStudy`: the coarse-grained fields and their time
+:func:`analyse_silo_fields` takes the clump frames since the outlet opened, the contacts of the settled fill
+(None for a run that saved none: what needs them is then left out), the silo's dimensions
+(:class:`SiloDimensions`, from the case summary) and the ``silo_flat.fields`` settings (:class:`SiloFieldOptions`)
+and returns a :class:`SiloFieldStudy`: the coarse-grained fields and their time
 average, the velocity profiles, flow channel boundaries and kinematic constant, the centreline velocity, the
 profile flow rates, the Janssen comparison and the force-chain segments, with the standard errors of B(z), of
 the flow channel boundary (batch means over :data:`FIELD_BATCHES` time windows,
@@ -280,16 +281,17 @@ class SiloFieldStudy:
         Mass flow rate through the lowest profile height from the momentum density (kg/s).
     bulk_rate : float
         The same from ``rho_b T integral(v_z dx)`` at the filling bulk density (kg/s).
-    stress : numpy.ndarray
-        Contact stress of the settled fill on the grid (Pa, compression positive).
-    janssen : JanssenComparison
-        Mean vertical contact stress against Janssen's formula and hydrostatic, with its error.
+    stress : numpy.ndarray or None
+        Contact stress of the settled fill on the grid (Pa, compression positive); None without contacts.
+    janssen : JanssenComparison or None
+        Mean vertical contact stress against Janssen's formula and hydrostatic, with its error; None without
+        contacts.
     uncertainty : ProfileUncertainty
         Standard errors of the depth-averaged B(z) and flow channel boundary.
-    segments : ForceChainSegments
-        Force chains in the mid-depth slice.
-    n_contacts : int
-        Contacts of the settled fill (-).
+    segments : ForceChainSegments or None
+        Force chains in the mid-depth slice; None without contacts.
+    n_contacts : int or None
+        Contacts of the settled fill (-); None when none were given (a run that saved none).
     """
 
     settings: FieldSettings
@@ -309,16 +311,16 @@ class SiloFieldStudy:
     centreline: np.ndarray
     profile_rate: float
     bulk_rate: float
-    stress: np.ndarray
-    janssen: JanssenComparison
-    segments: ForceChainSegments
-    n_contacts: int
+    stress: np.ndarray | None
+    janssen: JanssenComparison | None
+    segments: ForceChainSegments | None
+    n_contacts: int | None
     uncertainty: ProfileUncertainty
 
 
 def analyse_silo_fields(
     frames: Sequence[ClumpFrame],
-    contacts: ContactFrame,
+    contacts: ContactFrame | None,
     silo: SiloDimensions,
     options: SiloFieldOptions,
     steady_window: tuple[float, float],
@@ -331,8 +333,9 @@ def analyse_silo_fields(
     ----------
     frames : sequence of ClumpFrame
         The clumps of each frame from the opening of the outlet on; the first is the settled fill.
-    contacts : ContactFrame
-        Contacts of the settled fill.
+    contacts : ContactFrame or None
+        Contacts of the settled fill; None for a run that saved none (its contact stress, Janssen comparison and
+        force chains are then None, never made up).
     silo : SiloDimensions
         The silo's dimensions and particle.
     options : SiloFieldOptions
@@ -379,6 +382,21 @@ def analyse_silo_fields(
     profile_rate = profile_mass_flow_rate(averaged_depth, heights[0], silo.depth)
     bulk_rate = profile_flow_rate(profiles.x, profiles.v_z[0], bulk_density, silo.depth)
 
+    stress, janssen, segments = (None, None, None) if contacts is None else _contact_analyses(
+        contacts, grid, settings, surface, bulk_density, bulk_density_error, silo, options)
+    return SiloFieldStudy(
+        settings=settings, grid=grid, steps=tuple(frame.step for frame in frames), times=times, fields=fields,
+        window=window, averaged=averaged, averaged_depth=averaged_depth, surface=surface, top=top, heights=heights,
+        profiles=profiles, front=front, depth_series=depth_series, centreline=centre, profile_rate=profile_rate,
+        bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments,
+        n_contacts=None if contacts is None else len(contacts), uncertainty=uncertainty,
+    )
+
+
+def _contact_analyses(contacts: ContactFrame, grid: Grid, settings: FieldSettings, surface: np.ndarray,
+                      bulk_density: float, bulk_density_error: float | None, silo: SiloDimensions,
+                      options: SiloFieldOptions) -> tuple[np.ndarray, JanssenComparison, ForceChainSegments]:
+    """The settled fill's contact stress on the grid (Pa), its Janssen comparison and its force chains."""
     # Janssen: mean vertical contact stress of the settled fill against the formula, below the lowest point of
     # the surface.
     stress = contact_stress_field(contacts, grid, settings)
@@ -391,13 +409,7 @@ def analyse_silo_fields(
         bulk_density_error=number_or_nan(bulk_density_error))
     segments = force_chain_segments(contacts, 0.5 * silo.depth, options.force_chain_slice,
                                     cap=force_chain_cap(silo.clump_mass))
-    return SiloFieldStudy(
-        settings=settings, grid=grid, steps=tuple(frame.step for frame in frames), times=times, fields=fields,
-        window=window, averaged=averaged, averaged_depth=averaged_depth, surface=surface, top=top, heights=heights,
-        profiles=profiles, front=front, depth_series=depth_series, centreline=centre, profile_rate=profile_rate,
-        bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments, n_contacts=len(contacts),
-        uncertainty=uncertainty,
-    )
+    return stress, janssen, segments
 
 
 # --------------------------------------------------------------------------- table rows
@@ -473,7 +485,8 @@ def janssen_rows(comparison: JanssenComparison) -> list[dict]:
 def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
     """The contents of ``fields.json``: grid, kernel, window, heights, the profile flow rates against the
     measured outflow ``outflow_rate`` (kg/s), B and the flow-pattern index (wall over centreline v_z) per height with
-    their errors, surface height and number of contacts."""
+    their errors, surface height and number of contacts (the Janssen bins and the contacts null for a study made
+    without contacts)."""
     return {
         "grid_shape": list(study.grid.shape),
         "grid_spacing_m": list(study.grid.spacing),
@@ -493,7 +506,7 @@ def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
         "flow_pattern_index_error": {f"{z:g}": float(e) for z, e in
                                      zip(study.profiles.heights, _index_errors(study))},
         "error_batches": study.uncertainty.n_batches,
-        "janssen_error_bin_pairs": study.janssen.bin_pairs,
+        "janssen_error_bin_pairs": None if study.janssen is None else study.janssen.bin_pairs,
         "surface_height_m": study.top,
         "contacts": study.n_contacts,
     }
