@@ -35,10 +35,13 @@ GUI export (``mat_file_save``, every PIVlab release)
     exported, plain arrays for the current frame only. A frame that PIVlab never validated has empty filtered
     cells.
 Command-line workspace (``PIVlab_commandline.m``, in ``Example_scripts/`` from 3.04, ``PIVlab_process_commandline.m``
-from 3.14; saved by the user, or by the script's own ``save`` from November 2020 to April 2021)
+from 3.14; saved by the user, or by ``PIVlab_commandline.m``'s own ``save`` from November 2020 until its rework of April
+2026, MATLAB's default format 7 (MATLAB 5, compressed), as ``<first image>_<last image>_<images>_frames_result_.mat``)
     ``x``, ``y``, ``u``, ``v``, ``typevector``, ``u_filt``, ``v_filt``, ``typevector_filt``: cell arrays of one
-    cell per image pair, and since the script's rework of April 2026 (3.14) three-dimensional arrays (rows,
-    columns, pairs). Pixels and displacements per frame: the script does not calibrate.
+    cell per image pair (single precision in PIVlab's own sample of 3.10, September 2025), and since the script's
+    rework of April 2026 (3.14) three-dimensional arrays (rows, columns, pairs). Pixels and displacements per
+    frame: the script does not calibrate (its factors ``r{1,2}`` and ``r{2,2}`` only scale the velocity limits of
+    the validation).
 Session (``save_session_function``, always MATLAB 7.3)
     ``resultslist``, a cell array of one column per frame: rows 1 to 5 ``x``, ``y``, ``u``, ``v``, ``typevector``
     of the correlation, rows 7 to 9 the validated ``u``, ``v`` and ``typevector``; uncalibrated (pixels and

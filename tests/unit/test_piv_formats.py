@@ -279,6 +279,55 @@ def test_the_command_line_workspace_of_three_dimensional_arrays_matlab_7_3():
         _check_frame(rows, *(arrays[k][:, :, n] for k in ("x", "y", "u_filt", "v_filt", "typevector_filt")))
 
 
+PIVLAB_JET = FIXTURES / "pivlab_example_jet_commandline_v5.mat"
+
+
+def test_pivlabs_own_jet_result_keeps_the_command_line_workspace_as_matlab_saved_it():
+    """The copy of PIVlab's sample is what the reader must face: MATLAB 5, cells of single-precision arrays."""
+    assert PIVLAB_JET.read_bytes()[:10] == b"MATLAB 5.0"
+    classes = {name: (shape, matlab_class) for name, shape, matlab_class in scipy.io.whosmat(PIVLAB_JET)}
+    for name in ("x", "y", "u", "v", "typevector", "u_filt", "v_filt", "typevector_filt", "correlation_map"):
+        assert classes[name] == ((3, 1), "cell")  # one cell per image pair
+    assert "units" not in classes and "u_original" not in classes  # no GUI export: nothing says the units
+    raw = scipy.io.loadmat(PIVLAB_JET, mat_dtype=True)
+    assert {raw[k][0, 0].dtype for k in ("x", "y", "u", "v", "u_filt", "typevector_filt")} == {np.dtype(np.float32)}
+    assert raw["amount"][0, 0] == 20 and raw["pairwise"][0, 0] == 1  # 20 images as pairs A+B, C+D, ...
+
+
+@pytest.mark.parametrize("field, names", [("original", ("u", "v", "typevector")),
+                                          ("filtered", ("u_filt", "v_filt", "typevector_filt"))])
+def test_pivlabs_own_jet_result_read_against_its_variables(field, names):
+    raw = scipy.io.loadmat(PIVLAB_JET)
+    frames = read_pivlab_mat(PIVLAB_JET, field)
+    assert len(frames) == 3
+    for n, rows in enumerate(frames):  # in pair order, each against its own cells
+        x, y, u, v, types = (_cells(raw[k])[n] for k in ("x", "y") + names)
+        _check_frame(rows, x, y, u, v, types)  # positions, velocities, pixels, y down, kinds
+        assert y[1, 0] > y[0, 0] and x[0, 1] > x[0, 0]  # image axes: y grows down the grid column, x to the right
+        assert rows.x.dtype == float and rows.u.tolist() == u.astype(float).ravel(order="F").tolist()
+    # the script does not calibrate: its calibration factors r{1,2} and r{2,2} only scale the velocity limits
+    calibration = raw["r"]
+    assert calibration[0, 1][0, 0] == 1 and calibration[1, 1][0, 0] == 1
+    if field == "original":  # the correlation's own types: no mask, so every vector measured
+        assert {k for rows in frames for k in kinds(rows)} == {"measured"}
+    else:  # validation rejected some and PIVlab_commandline.m filled them in (inpaint_nans): type 2, finite
+        assert [kinds(rows).count("interpolated") for rows in frames] == [2, 4, 4]
+        assert all(np.isfinite(rows.u).all() for rows in frames)
+
+
+def test_pivlabs_own_jet_result_replaced_what_its_validation_rejected():
+    """The two fields differ exactly where the filtered types say PIVlab interpolated: the reader picks the right
+    variables for each."""
+    raw = scipy.io.loadmat(PIVLAB_JET)
+    for original, filtered, u, u_filt in zip(read_pivlab_mat(PIVLAB_JET, "original"),
+                                             read_pivlab_mat(PIVLAB_JET, "filtered"), _cells(raw["u"]),
+                                             _cells(raw["u_filt"])):
+        interpolated = np.array(kinds(filtered)) == "interpolated"
+        assert original.x.tolist() == filtered.x.tolist() and original.y.tolist() == filtered.y.tolist()
+        assert (original.u != filtered.u).tolist() == interpolated.tolist()
+        assert ((u != u_filt).ravel(order="F")).tolist() == interpolated.tolist()
+
+
 @pytest.mark.parametrize("field, first", [("original", 2), ("filtered", 6)])
 def test_a_session_is_read_from_its_resultslist(field, first):
     path = FIXTURES / "pivlab_3.14_session_v73.mat"
