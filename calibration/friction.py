@@ -172,17 +172,20 @@ def _batch_means(values: np.ndarray, cumulative: np.ndarray, start: int, n_batch
     return np.diff(cumulative[edges]) / np.diff(edges)
 
 
-def _drift(time: np.ndarray, signal: np.ndarray, cumulative_time: np.ndarray, cumulative_signal: np.ndarray,
-           start: int, n_batches: int) -> tuple[float, float]:
-    """Level and relative drift of the window ``start:`` (see :func:`detect_steady_window`)."""
+def _unsteadiness(time: np.ndarray, signal: np.ndarray, cumulative_time: np.ndarray, cumulative_signal: np.ndarray,
+                  start: int, n_batches: int) -> tuple[float, float]:
+    """Level and unsteadiness of the window ``start:``: the larger of its drift and its batch means' largest
+    distance from their line, relative to the level (see :func:`detect_steady_window`)."""
     centres = _batch_means(time, cumulative_time, start, n_batches)
     means = _batch_means(signal, cumulative_signal, start, n_batches)
     level = float(np.mean(means))
-    centred = centres - np.mean(centres)
-    slope = float(np.dot(centred, means - level) / np.dot(centred, centred))
     if level == 0.0:
         return level, math.inf
-    return level, abs(slope) * (time[-1] - time[start]) / abs(level)
+    centred = centres - np.mean(centres)
+    slope = float(np.dot(centred, means - level) / np.dot(centred, centred))
+    drift = abs(slope) * (time[-1] - time[start])
+    scatter = float(np.max(np.abs(means - level - slope * centred)))
+    return level, max(drift, scatter) / abs(level)
 
 
 def detect_steady_window(
@@ -197,25 +200,28 @@ def detect_steady_window(
 
     The shear force of a Jenike test rises while the sample is mobilised and then fluctuates about a steady
     level, often with stick-slip whose excursions exceed any useful band about the level; or it never levels
-    off (a sample that keeps dilating, a shear too short). Only the samples with ``time >= start_after`` are
-    analysed. A candidate window runs from a sample to the last one; it is cut into ``n_batches`` equal
-    consecutive batches covering it (their sizes differ by one sample at most), and a least-squares line is fitted to the batch means against the batch
-    mean times. The window's *drift* is the line's rise or fall over the window's duration, relative to its
-    level (the mean of the batch means):
+    off (a sample that keeps dilating, a shear too short); or it passes a peak and softens (a dense sample).
+    Only the samples with ``time >= start_after`` are analysed. A candidate window runs from a sample to the
+    last one; it is cut into ``n_batches`` consecutive batches covering it (as :func:`numpy.array_split` cuts
+    them), and a least-squares line is fitted to the batch means against the batch mean times. Relative to the
+    window's level (the mean of the batch means), its *drift* is the line's rise or fall over the window's
+    duration and its *scatter* the largest distance of a batch mean from the line:
 
-        ``drift = |slope| (t_end - t_start) / |level|``
+        ``drift = |slope| (t_end - t_start) / |level|``,
+        ``scatter = max_j |mean_j - line(t_j)| / |level|``
 
     The steady window is the earliest (longest) candidate of at least ``min_fraction`` of the analysed
-    samples whose drift is at most ``max_drift``. Averaging over batches makes the test blind to fluctuations
-    shorter than a batch (stick-slip), and the fit makes it see a trend that a band about the final level
-    would accept over a short window.
+    samples whose drift and scatter are both at most ``max_drift``. Averaging over batches makes the test blind
+    to fluctuations shorter than a batch (stick-slip); the drift sees a trend that a band about the final level
+    would accept over a short window; the scatter sees a curve the line cannot follow, such as a rise and a
+    fall whose line is level.
 
-    Precision. On a linear signal ``a + b t`` the batch means lie on the same line, so the drift is exactly
-    ``|b| (t_end - t_start) / |a + b t_mean|`` (``t_mean``: the mean of the batches' mean times). A window that
-    takes in the end of a ramp is accepted only while the ramp's samples keep the drift within ``max_drift``:
-    with a step of relative height ``d`` in the first of ten batches the drift is about ``0.55 d``, so the
-    window's mean is then biased by about ``max_drift / 5`` at most (1 % with the defaults; a linear ramp's tail
-    comes to the same).
+    Precision. On a linear signal ``a + b t`` the batch means lie on the same line (scatter 0), so the drift is
+    exactly ``|b| (t_end - t_start) / |a + b t_mean|`` (``t_mean``: the mean of the batches' mean times). A
+    window that takes in the end of a ramp is accepted only while the ramp's samples keep the first batch mean
+    within ``max_drift`` of the line and the line within ``max_drift`` of level, so the window's mean is then
+    biased by about ``max_drift / 5`` at most (1 % with the defaults), and by up to about ``max_drift / 4`` where
+    a softening after a peak spreads over several batches.
 
     Parameters
     ----------
@@ -226,7 +232,7 @@ def detect_steady_window(
     start_after : float, optional
         Ignore samples before this time [s] (default 0).
     max_drift : float, optional
-        Largest accepted drift of a window, relative to its level (default 0.05, i.e. 5 %).
+        Largest accepted drift and scatter of a window, relative to its level (default 0.05, i.e. 5 %).
     min_fraction : float, optional
         Smallest accepted window, as a fraction of the analysed samples (default 0.25).
     n_batches : int, optional
@@ -242,8 +248,8 @@ def detect_steady_window(
     ------
     ValueError
         On malformed input; or (naming ``signal``) if no window of at least ``min_fraction`` of the analysed
-        samples drifts by at most ``max_drift``, e.g. a force that keeps growing; the message gives the
-        least drift found.
+        samples has a drift and a scatter of at most ``max_drift``, e.g. a force that keeps growing; the message
+        gives the least unsteadiness found (the larger of the two).
     """
     time = _times(time)
     signal = _history("signal", signal, time.size)
@@ -271,7 +277,7 @@ def detect_steady_window(
     cumulative_signal = np.concatenate([[0.0], np.cumsum(analysed)])
     least = (math.inf, n_analysed)
     for start in range(n_analysed - shortest + 1):
-        level, drift = _drift(analysed_time, analysed, cumulative_time, cumulative_signal, start, n_batches)
+        level, drift = _unsteadiness(analysed_time, analysed, cumulative_time, cumulative_signal, start, n_batches)
         if drift <= max_drift:
             i_start = first + start
             return SteadyWindow(t_start=float(time[i_start]), t_end=float(time[-1]), i_start=i_start,
@@ -279,8 +285,8 @@ def detect_steady_window(
         least = min(least, (drift, n_analysed - start))
     raise ValueError(
         f"signal: no steady shear: every window of at least {100.0 * min_fraction:g} % of the {n_analysed} "
-        f"samples after start_after = {start_after:.6g} s drifts by more than {100.0 * max_drift:g} % of its level "
-        f"(least: {100.0 * least[0]:.3g} % over the last {least[1]} samples)"
+        f"samples after start_after = {start_after:.6g} s drifts or scatters by more than {100.0 * max_drift:g} % "
+        f"of its level (least: {100.0 * least[0]:.3g} % over the last {least[1]} samples)"
     )
 
 
