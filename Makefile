@@ -46,6 +46,7 @@ RUN_SNAKEMAKE = $(PYTHON) -m engines.workflow_lock --snakefile $(CURDIR)/Snakefi
 RUN_DIR ?= .
 
 run: install
+	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES) \
 		--rerun-incomplete --rerun-triggers mtime params input
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
@@ -56,6 +57,7 @@ run: install
 CHECKS_CONFIG := $(CURDIR)/config/checks.yaml
 
 verify: install
+	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG)) $(CHECKS_CONFIG)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
 		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \

@@ -26,6 +26,7 @@ import yaml
 from analysis.data.existing_run import ExistingRunError, ExistingSiloRun
 from engines.cases.blender_geometry import INSERT_PRESETS
 from engines.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
+from engines.config_yaml import ConfigFileError, read_config_file
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -150,14 +151,18 @@ def load_schema(path: Path = SCHEMA_PATH) -> dict:
 
 
 def load_config_file(path: str | Path) -> dict:
-    """Read a YAML configuration file into a dict (no validation)."""
-    with open(path, encoding="utf-8") as handle:
-        loaded = yaml.load(handle, Loader=SAFE_LOADER)
-    if loaded is None:
-        return {}
-    if not isinstance(loaded, dict):
-        raise ConfigError(f"{path}: the top level of a config file must be a mapping, got {type(loaded).__name__}")
-    return loaded
+    """Read a YAML configuration file into a dict as plain data (:func:`engines.config_yaml.read_config_file`; no
+    validation against the schema).
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the key or line, for what :func:`engines.config_yaml.read_config_file` refuses.
+    """
+    try:
+        return read_config_file(path)
+    except ConfigFileError as error:
+        raise ConfigError(str(error)) from None
 
 
 def _with_defaults(validator_class, definitions: Mapping):
@@ -529,7 +534,8 @@ def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None
 
 def load_config(path: str | Path) -> dict:
     """Read and validate a configuration file (defaults filled)."""
+    data = load_config_file(path)  # its errors name the file already
     try:
-        return validate_config(load_config_file(path))
+        return validate_config(data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None

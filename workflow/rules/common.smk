@@ -13,12 +13,22 @@ from engines.cases import CASE_BUILDERS, cases_of
 from engines.cases.silo_flat import build_silo_case, parametric_variants
 from engines.cases.silo_recirculation import SECTION as RECIRCULATION
 from engines.config import ConfigError, validate_config
+from engines.config_yaml import ConfigFileError, read_config_file
 from engines.estimates import InsufficientDiskSpace, format_bytes
 from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from engines.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from engines.layout import CASE_SUMMARY, RESULTS, RUN_BENCHMARK, RUN_RECORD, case_root, run_dir, run_path
 from engines.planning import config_estimates, ensure_disk_space, run_priorities
+
+# Snakemake has read the config files already, through YTE when a file asks for it (Snakemake has no switch to refuse
+# that); siloflow reads them again as plain data, so that such a file, a repeated key or a YAML 1.1 boolean word stops
+# the workflow here, before anything runs.
+for configfile_path in workflow.configfiles:
+    try:
+        read_config_file(configfile_path)
+    except (ConfigFileError, OSError) as error:
+        raise WorkflowError(f"Invalid configuration: {error}") from None
 
 try:
     # In place, so that scripts see the defaults through snakemake.config too.
