@@ -217,9 +217,27 @@ def _describe(error: jsonschema.ValidationError) -> str:
     return f"config key '{key}': {message}{suffix}"
 
 
-def _error_depth_key(error: jsonschema.ValidationError):
-    # The deepest error is the most specific one, e.g. the friction value rather than its parent object.
-    return (-len(error.absolute_path), str(list(error.absolute_path)))
+def _is_given(raw: Any, path: Iterable[Any]) -> bool:
+    """Whether the configuration as the user gave it holds the key at ``path`` (not only inherited or filled)."""
+    node = raw
+    for element in path:
+        if isinstance(node, Mapping) and element in node:
+            node = node[element]
+        elif isinstance(node, list) and isinstance(element, int) and 0 <= element < len(node):
+            node = node[element]
+        else:
+            return False
+    return True
+
+
+def _error_rank(raw: Mapping):
+    """Sort key of schema errors, the one to report first: the deepest (the most specific, e.g. the friction value
+    rather than its parent object), and among those one at a key the user gave: a bad ``defaults.seed`` is reported
+    there, not at the ``blender.seed`` that inherited it."""
+    def rank(error: jsonschema.ValidationError):
+        path = list(error.absolute_path)
+        return (-len(path), not _is_given(raw, path), str(path))
+    return rank
 
 
 def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> dict:
@@ -248,7 +266,7 @@ def validate_config(config: Mapping[str, Any], schema: dict | None = None) -> di
     # What the user set, before the schema fills its defaults (a filled default is no choice of theirs).
     given = copy.deepcopy(filled)
     validator = _with_defaults(jsonschema.Draft7Validator, schema.get("definitions", {}))(schema)
-    errors = sorted(validator.iter_errors(filled), key=_error_depth_key)
+    errors = sorted(validator.iter_errors(filled), key=_error_rank(config))
     if errors:
         best = errors[0]
         # oneOf/anyOf wrap the real reason; report the most relevant inner error.

@@ -20,8 +20,10 @@ from typing import Any
 import jinja2
 
 TEMPLATE_ROOT = Path(__file__).resolve().parent.parent / "templates"
-_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
-_PATH = re.compile(r"^[A-Za-z0-9_.-]+(/[A-Za-z0-9_.*-]+)*$")
+# Applied with fullmatch, to the whole string: a pattern ending in ``$`` also matches before a final newline, and a
+# name "twin\n" would end its deck line and start another.
+_NAME = re.compile(r"[A-Za-z0-9_.-]+")
+_PATH = re.compile(r"[A-Za-z0-9_.-]+(/[A-Za-z0-9_.*-]+)*")
 
 
 class UnsafeDeckValue(ValueError):
@@ -59,7 +61,7 @@ def deck_integer(value: Any) -> str:
 def deck_name(value: Any) -> str:
     """Render a name: letters, digits, ``_ . -`` only."""
     value = _defined(value)
-    if not isinstance(value, str) or not _NAME.match(value):
+    if not isinstance(value, str) or not _NAME.fullmatch(value):
         raise UnsafeDeckValue(f"expected a name of letters, digits, '_', '.', '-', got {value!r}")
     return value
 
@@ -68,7 +70,7 @@ def deck_path(value: Any) -> str:
     """Render a relative path made by the orchestrator (no '..', no absolute paths, no spaces)."""
     value = _defined(value)
     text = str(value)
-    if not _PATH.match(text) or ".." in text.split("/"):
+    if not _PATH.fullmatch(text) or ".." in text.split("/"):
         raise UnsafeDeckValue(f"expected a relative path of safe characters, got {value!r}")
     return text
 
@@ -99,7 +101,7 @@ def check_context(node: Any, where: str = "context") -> None:
         if not math.isfinite(float(node)):
             raise UnsafeDeckValue(f"{where}: {node!r} is not a finite number")
     elif isinstance(node, str):
-        if not _PATH.match(node) or ".." in node.split("/"):
+        if not _PATH.fullmatch(node) or ".." in node.split("/"):
             raise UnsafeDeckValue(f"{where}: {node!r} is not a safe name or relative path")
     else:
         raise UnsafeDeckValue(f"{where}: values of type {type(node).__name__} cannot be rendered into a deck")

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 
 from engines.cases.particles import ParticleTemplate
-from engines.cases.physics import free_fall_time, free_fall_velocity, steps_for
+from engines.cases.physics import check_steps, free_fall_time, free_fall_velocity, steps_for
 
 
 @dataclass(frozen=True)
@@ -292,8 +292,9 @@ def plan_fill(
     clumps_per_insertion = max(1, min(clumps_per_insertion, int(gentle_rate * insert_every * timestep)))
     particle_rate = clumps_per_insertion / (insert_every * timestep)
     insertions = math.ceil(n_clumps / clumps_per_insertion)
-    # Worst-case fall of the last batch from the top of the zone to the floor.
+    # Worst-case fall of the last batch from the top of the zone to the floor. The pour is one engine run command.
     fill_steps = insertions * insert_every + steps_for(free_fall_time(velocity, z_max, gravity), timestep)
+    check_steps(fill_steps, f"the pour of {n_clumps} clumps")
     return FillPlan(
         n_clumps=n_clumps,
         zone=(x_min, x_max, y_min, y_max, z_min, z_max),

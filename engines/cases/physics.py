@@ -223,8 +223,38 @@ def engine_seeds(seed: int, count: int) -> list[int]:
     return primes
 
 
+#: The most time steps one stage may take: 2^31 - 1, the largest N of LIGGGHTS' ``run N`` (a 32-bit int; a larger
+#: one fails only when the deck reaches it, hours into the run), and on any engine half a year of one core for the
+#: default config's silo (10,000 spheres at 0.7 microseconds a sphere-step).
+MAX_STEPS = 2**31 - 1
+
+
+def check_steps(steps: float, what: str = "a stage") -> float:
+    """``steps`` if it is at most :data:`MAX_STEPS`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``what`` and the count, when the plan would take more steps than one engine run command (or an
+        infinite or NaN count).
+    """
+    if not steps <= MAX_STEPS:
+        raise ValueError(f"{what} would take {steps:.3g} time steps, more than the {MAX_STEPS} (2^31 - 1) one engine "
+                         "run command takes: raise the time step fractions or shorten the stage")
+    return steps
+
+
 def steps_for(duration: float, timestep: float) -> int:
-    """Whole number of time steps (at least one) that covers ``duration`` (s) at ``timestep`` (s)."""
+    """Whole number of time steps (at least one) that covers ``duration`` (s) at ``timestep`` (s).
+
+    Raises
+    ------
+    ValueError
+        For a duration or time step that is not positive, or a count beyond :data:`MAX_STEPS` (also one too large
+        for a float, which ``int`` would refuse with an OverflowError the workflow does not report as a
+        configuration error).
+    """
     if duration <= 0 or timestep <= 0:
         raise ValueError(f"duration and timestep must be positive, got {duration!r}, {timestep!r}")
-    return max(1, int(math.ceil(duration / timestep - 1e-9)))
+    ratio = check_steps(duration / timestep, f"{duration!r} s at a time step of {timestep!r} s")
+    return max(1, int(math.ceil(ratio - 1e-9)))
