@@ -69,7 +69,10 @@ verify: install
 # first and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group
 # (engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series, blending,
 # blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record is written
-# and copied into docs/validation/ once all its runs have finished, whichever part finished them.
+# and copied into docs/validation/ once all its runs have finished, whichever part finished them. A group that compares
+# against another group's runs (calibration_checks, silo_series) starts from the products of those runs that the
+# other group's record keeps (docs/validation/<group>/products/), restored into results/validation/ where missing,
+# so that it runs on a machine other than the one that made them.
 # `make validate-status` says which groups of the record in docs/validation/ are complete, stale or missing.
 VALIDATION_CONFIG ?= config/validation.yaml
 VALIDATION_DIR    ?= results/validation
@@ -81,8 +84,8 @@ VALIDATION_OPTIONS = --directory $(abspath $(VALIDATION_DIR)) --configfile $(abs
 GROUP             ?=
 
 validate: install
-	$(if $(GROUP),$(VALIDATION_RECORD_CLI) check '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD))
 	@mkdir -p $(VALIDATION_DIR)/results
+	$(if $(GROUP),$(VALIDATION_RECORD_CLI) restore '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD) $(VALIDATION_DIR))
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) $(VALIDATION_OPTIONS) --cores $(CORES) \
 		--rerun-incomplete --rerun-triggers mtime params input --keep-going

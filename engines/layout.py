@@ -22,7 +22,7 @@ import os
 from pathlib import Path, PurePosixPath
 
 __all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
-           "RUN_RECORD", "VALIDATION_RECORD", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
+           "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "VALIDATION_RECORD", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
@@ -46,6 +46,19 @@ RUN_BENCHMARK = "logs/run_benchmark.tsv"
 #: Each validation group's record as the pipeline writes it (``<group>/``), before `make validate` copies it into
 #: the repository's ``docs/validation/``.
 VALIDATION_RECORD = f"{RESULTS}/summary/record"
+
+#: The products of a flat-bottom silo run its validation rows are read from, by the name the rows call them.
+SILO_ROW_PRODUCTS = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
+                     "balance": "metrics/fill_balance.json", "janssen": "metrics/janssen.csv",
+                     "kinematic": "metrics/kinematic.csv", "boundary": "metrics/flow_channel_boundary.csv"}
+
+#: The products of a run that another validation group reads (its rows, its record, the analyses across runs behind
+#: them), by case kind: the record of a group that others read keeps them, so that a later `make validate GROUP=`
+#: on another machine restores them instead of making those runs again.
+READ_PRODUCTS = {
+    "jenike": ("metrics/bulk_friction.json", RUN_RECORD, RUN_BENCHMARK),
+    "silo_flat": (*SILO_ROW_PRODUCTS.values(), "fields/averaged.npz", RUN_RECORD, RUN_BENCHMARK),
+}
 
 #: The wildcard rules use for a run id.
 RUN_WILDCARD = "{run}"

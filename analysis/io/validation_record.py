@@ -1,5 +1,5 @@
-"""Reader and writer of the validation record's files (``docs/validation/<group>/``): ``table.csv``, ``runs.csv`` and
-the group's plots. The record itself (its columns, its page) is :mod:`analysis.studies.validation.record`."""
+"""Reader and writer of the validation record's files (``docs/validation/<group>/``): ``table.csv``, ``runs.csv``, the
+group's plots and, for a group whose runs another group reads, those runs' products (``products/``). The record itself (its columns, its page) is :mod:`analysis.studies.validation.record`."""
 
 from __future__ import annotations
 
@@ -14,19 +14,35 @@ from analysis.io.tables import write_flow_table
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from analysis.studies.validation.rows import COLUMNS
 
-__all__ = ["TABLE", "RUNS", "benchmark_wall_time", "read_validation_rows", "write_group_record", "read_group_record", "read_record"]
+__all__ = ["TABLE", "RUNS", "PRODUCTS", "benchmark_wall_time", "read_validation_rows", "write_group_record",
+           "read_group_record", "read_record", "restore_products"]
 
 #: A group's table rows and its runs' provenance, in its folder.
 TABLE, RUNS = "table.csv", "runs.csv"
+#: The folder of a group's record that keeps the products of its runs another group reads, each under its path in the
+#: workflow's working directory (``products/results/...``).
+PRODUCTS = "products"
+
+
+def _product_path(name: str) -> Path:
+    """``name`` as a path relative to the working directory, refused (ValueError) if it could leave it."""
+    path = Path(name)
+    if path.is_absolute() or ".." in path.parts or not path.parts:
+        raise ValueError(f"a record product is a path inside the working directory, got {name!r}")
+    return path
 
 
 def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], runs: Sequence[Mapping],
-                       plots: Mapping[str, str | os.PathLike]) -> Path:
-    """Write one group's record into ``directory``: its rows, its runs and its plots (``{name: source file}``),
-    replacing the group's previous record there (a plot no longer made is removed). Returns the folder."""
+                       plots: Mapping[str, str | os.PathLike],
+                       products: Mapping[str, str | os.PathLike] | None = None) -> Path:
+    """Write one group's record into ``directory``: its rows, its runs, its plots (``{name: source file}``) and the
+    products of its runs another group reads (``{path in the working directory: source file}``, under
+    :data:`PRODUCTS`), replacing the group's previous record there (a plot or product no longer made is removed).
+    Returns the folder."""
     directory = Path(directory)
     if not rows or not runs:
         raise ValueError(f"a group's record needs rows and runs; got {len(rows)} rows and {len(runs)} runs")
+    products = {_product_path(name): Path(source) for name, source in (products or {}).items()}
     directory.mkdir(parents=True, exist_ok=True)
     write_flow_table(directory / TABLE, [{column: row[column] for column in COLUMNS} for row in rows])
     write_flow_table(directory / RUNS, [{column: run[column] for column in RUN_COLUMNS} for run in runs])
@@ -37,6 +53,14 @@ def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], ru
         if Path(name).name != name or not name.endswith(".png"):
             raise ValueError(f"a record plot is a PNG file name without a folder, got {name!r}")
         shutil.copyfile(source, directory / name)
+    kept = directory / PRODUCTS
+    # read whole before the folder is replaced: the sources may be the previous record's own products
+    contents = {name: source.read_bytes() for name, source in products.items()}
+    if kept.is_dir():
+        shutil.rmtree(kept)
+    for name, content in contents.items():
+        (kept / name).parent.mkdir(parents=True, exist_ok=True)
+        (kept / name).write_bytes(content)
     return directory
 
 
@@ -79,10 +103,28 @@ def read_group_record(directory: str | os.PathLike) -> GroupRecord:
     """One group's record from its folder (written by :func:`write_group_record`)."""
     directory = Path(directory)
     rows = read_validation_rows(directory / TABLE) if (directory / TABLE).is_file() else []
-    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=sorted(p.name for p in directory.glob("*.png")))
+    kept = directory / PRODUCTS
+    products = sorted(path.relative_to(kept).as_posix() for path in kept.rglob("*") if path.is_file())
+    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=sorted(p.name for p in directory.glob("*.png")),
+                       products=products)
 
 
 def read_record(record_dir: str | os.PathLike, groups: Iterable[str]) -> dict[str, GroupRecord]:
     """``{group: GroupRecord}`` of the groups with a record (a ``runs.csv``) under ``record_dir``."""
     return {name: read_group_record(Path(record_dir) / name) for name in groups
             if (Path(record_dir) / name / RUNS).is_file()}
+
+
+def restore_products(directory: str | os.PathLike, workdir: str | os.PathLike) -> list[Path]:
+    """Copy the products a group's record keeps (its folder ``directory``) into the working directory ``workdir``
+    where they are missing, so that the workflow reads them instead of making their runs again; a file already
+    there is left as it is. Returns the files copied."""
+    directory, workdir = Path(directory), Path(workdir)
+    copied = []
+    for name in read_group_record(directory).products:
+        target = workdir / _product_path(name)
+        if not target.exists():
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(directory / PRODUCTS / name, target)
+            copied.append(target)
+    return copied

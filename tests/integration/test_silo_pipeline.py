@@ -28,6 +28,7 @@ from engines.cases import cases_of
 from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_named
+from engines.layout import READ_PRODUCTS
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
@@ -150,6 +151,14 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
     text = cli.page(str(config_path), str(config_path), record_dir)
     assert "| silo | complete | 1 |" in text and "| silo_series | complete | 1 |" in text
     assert "| calibration | missing | 0 |" in text
+    # another machine: the series starts from the base run's products the silo record keeps, and makes only its own
+    fresh = tmp_path / "fresh"
+    assert cli.restore("silo_series", str(config_path), record_dir, fresh) == {"silo": len(READ_PRODUCTS["silo_flat"])}
+    assert (fresh / "results" / "silo_flat" / run_dir.name / "run.json").read_bytes() == (run_dir / "run.json").read_bytes()
+    planned_jobs = run_snakemake(fresh, "-n", "--cores", "1", "--configfile", str(config_path),
+                                 targets=["validate_silo_series"])
+    assert planned_jobs.returncode == 0, planned_jobs.stdout[-3000:] + planned_jobs.stderr[-3000:]
+    assert "rule silo_run:" in planned_jobs.stdout and f"run={run_dir.name}" not in planned_jobs.stdout
 
 
 def test_make_estimate_takes_its_cost_model_from_the_finished_runs(tiny_pipeline):

@@ -289,6 +289,12 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
     assert status_main(["check", "calibration", config, str(tmp_path)]) == 0
     assert status_main(["check", "calibration_checks", config, str(tmp_path)]) == 2
     assert "run make validate GROUP=calibration then" in capsys.readouterr().err
+    # restoring the runs a group reads checks first: nothing is copied for a group that cannot run yet
+    workdir = tmp_path / "work"
+    assert status_main(["restore", "calibration_checks", config, str(tmp_path), str(workdir)]) == 2
+    assert "run make validate GROUP=calibration then" in capsys.readouterr().err and not workdir.exists()
+    assert status_main(["restore", "calibration", config, str(tmp_path), str(workdir)]) == 0
+    assert capsys.readouterr().out == "" and not workdir.exists()
     # a group read in parts is named part by part
     assert status_main(["check", "silo_series_1", config, str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "

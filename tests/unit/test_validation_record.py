@@ -7,8 +7,8 @@ import math
 import pytest
 
 from analysis.data.record import RunRecord
-from analysis.io.validation_record import (RUNS, TABLE, benchmark_wall_time, read_group_record, read_record, read_validation_rows,
-                                           write_group_record)
+from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
+                                           read_validation_rows, restore_products, write_group_record)
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time
 from analysis.studies.validation.rows import COLUMNS, row
 from engines.config import REPO_ROOT
@@ -116,6 +116,37 @@ def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_p
     assert publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
     assert (record_dir / "silo" / "janssen.png").read_bytes() == PNG and (record_dir / "silo" / RUNS).is_file()
     assert (record_dir / "blender" / RUNS).is_file()
+
+
+def test_a_record_keeps_the_products_other_groups_read_and_restores_only_what_is_missing(tmp_path):
+    """A group another group reads keeps its runs' products under their working-directory paths; a later session
+    restores the missing ones and leaves what it already has."""
+    workdir, record_dir = tmp_path / "work", tmp_path / "docs"
+    summary = "results/calibration/runs/sphere2-abc/metrics/bulk_friction.json"
+    run = "results/calibration/runs/sphere2-abc/run.json"
+    for name, text in ((summary, '{"bulk_friction": 0.5}'), (run, '{"run_id": "sphere2-abc"}')):
+        (workdir / name).parent.mkdir(parents=True, exist_ok=True)
+        (workdir / name).write_text(text)
+    runs = [provenance_row(_record(), "calibration", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    source = workdir / "results" / "summary" / "record" / "calibration"
+    write_group_record(source, _rows(), runs, {}, {summary: workdir / summary, run: workdir / run})
+    assert read_group_record(source).products == [summary, run]
+    assert publish(workdir, record_dir, ["calibration"]) == ["calibration"]
+    kept = record_dir / "calibration"
+    assert (kept / PRODUCTS / summary).read_text() == '{"bulk_friction": 0.5}'
+    # republished with fewer products, the record drops the one no longer made
+    write_group_record(kept, _rows(), runs, {}, {summary: kept / PRODUCTS / summary})
+    assert read_group_record(kept).products == [summary]
+    write_group_record(kept, _rows(), runs, {}, {summary: workdir / summary, run: workdir / run})
+    # a fresh machine: one product is already there (a user's), the other is restored
+    fresh = tmp_path / "fresh"
+    (fresh / run).parent.mkdir(parents=True)
+    (fresh / run).write_text("mine")
+    assert restore_products(kept, fresh) == [fresh / summary]
+    assert (fresh / summary).read_text() == '{"bulk_friction": 0.5}' and (fresh / run).read_text() == "mine"
+    assert restore_products(kept, fresh) == []
+    with pytest.raises(ValueError, match="a path inside the working directory"):
+        write_group_record(kept, _rows(), runs, {}, {"../outside.json": workdir / run})
 
 
 def test_the_committed_page_is_rebuilt_from_the_committed_record(monkeypatch):

@@ -4,14 +4,11 @@
 
 from engines.cases import REFERENCE, VARIANT, run_roles
 from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
-from engines.layout import VALIDATION_RECORD
+from engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, VALIDATION_RECORD
 from engines.planning import group_runs as planned_group_runs
 from engines.validation_groups import GROUPS, part_of_runs, split_groups
 
 VALIDATION = f"{RESULTS}/summary"
-SILO_FILES = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",
-              "balance": "metrics/fill_balance.json", "janssen": "metrics/janssen.csv",
-              "kinematic": "metrics/kinematic.csv", "boundary": "metrics/flow_channel_boundary.csv"}
 
 
 def roles(kind):
@@ -63,7 +60,7 @@ def group_rows_inputs(group):
         if kind == "silo_flat":
             labels = front_wall_labels()
             runs = [run for run in group_runs(group) if run in labels]
-            return {key: [run_path("silo_flat", name, run) for run in runs] for key, name in SILO_FILES.items()}
+            return {key: [run_path("silo_flat", name, run) for run in runs] for key, name in SILO_ROW_PRODUCTS.items()}
         if kind == RECIRCULATION:
             runs = recirculation_runs()
             return {"cases": [run_path(RECIRCULATION, CASE_SUMMARY, run) for run in runs],
@@ -229,6 +226,19 @@ def record_plots(group):
     return plots
 
 
+#: The groups whose runs another group's rows read.
+READ_GROUPS = {other for spec in GROUPS.values() for other in spec.reads}
+
+
+def read_products(group):
+    """The products of the runs a group makes that another group reads (engines.layout.READ_PRODUCTS), which its
+    record keeps; none when no group reads it."""
+    if group not in READ_GROUPS:
+        return []
+    kind = GROUPS[group].kind
+    return [run_path(kind, name, run) for run in group_made(group) for name in READ_PRODUCTS[kind]]
+
+
 for _group in ROW_GROUPS:
 
     rule:
@@ -242,6 +252,7 @@ for _group in ROW_GROUPS:
             benchmarks=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_BENCHMARK, run)
                                                         for run in group_runs(group)],
             plots=lambda wildcards, group=_group: list(record_plots(group).values()),
+            products=lambda wildcards, group=_group: read_products(group),
         output:
             runs=f"{VALIDATION_RECORD}/{_group}/runs.csv",
             table=f"{VALIDATION_RECORD}/{_group}/table.csv",

@@ -34,5 +34,7 @@ with logged_to(snakemake.log[0]) as log:
         runs.append(provenance_row(record, params.made_by[record.run_id], versions[record.engine],
                                    params.seeds[record.run_id], commit, benchmark_wall_time(benchmark), finished))
     directory = write_group_record(Path(snakemake.output.runs).parent, read_validation_rows(inputs.rows), runs,
-                                   dict(zip(params.plot_names, inputs.plots)))
-    log.info("record of %d runs in %s (code %s)", len(runs), directory, commit)
+                                   dict(zip(params.plot_names, inputs.plots)),
+                                   {path: path for path in inputs.products})
+    log.info("record of %d runs in %s (code %s), with %d products other groups read", len(runs), directory, commit,
+             len(inputs.products))

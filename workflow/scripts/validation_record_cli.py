@@ -8,7 +8,9 @@ complete, stale or missing against the runs ``CONFIG`` plans (:func:`engines.val
 ``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
 (:func:`analysis.studies.validation.record.record_page`); ``check GROUP CONFIG RECORD_DIR`` refuses, before anything
 runs, an unknown group or part, a group that runs in parts (naming them), or one whose rows compare against a group
-not yet complete in the record; ``finished CONFIG WORKDIR [GROUP]`` prints the groups (of GROUP's only) whose every
+not yet complete in the record; ``restore GROUP CONFIG RECORD_DIR WORKDIR`` checks as ``check`` does, then copies
+into WORKDIR the products of the runs of the groups GROUP reads that their records keep and WORKDIR lacks (so that
+a group reads the runs another session made instead of making them again); ``finished CONFIG WORKDIR [GROUP]`` prints the groups (of GROUP's only) whose every
 run has finished in WORKDIR, whose record `make validate` then writes.
 """
 
@@ -20,7 +22,7 @@ from pathlib import Path
 from typing import Sequence
 
 from analysis.io.tables import write_text
-from analysis.io.validation_record import read_group_record, read_record, write_group_record
+from analysis.io.validation_record import PRODUCTS, read_group_record, read_record, restore_products, write_group_record
 from analysis.studies.validation.record import record_page
 from engines.config import load_config
 from engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
@@ -54,7 +56,8 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
         if (source / "runs.csv").is_file():
             record = read_group_record(source)
             write_group_record(Path(record_dir) / name, record.rows, record.runs,
-                               {plot: source / plot for plot in record.plots})
+                               {plot: source / plot for plot in record.plots},
+                               {product: source / PRODUCTS / product for product in record.products})
             copied.append(name)
     return copied
 
@@ -90,6 +93,26 @@ def check(name: str, config_path: str, record_dir: str | Path) -> None:
     made = _plan(config_path)[1]
     parts = split_groups(made)
     check_reads(find_part(name, parts).group, group_status(planned_runs(made), recorded_runs(record_dir)), parts)
+
+
+def restore(name: str, config_path: str, record_dir: str | Path, workdir: str | Path) -> dict[str, int]:
+    """:func:`check` group or part ``name``, then copy into ``workdir`` the products of the runs of the groups it
+    reads that their records in ``record_dir`` keep and ``workdir`` lacks
+    (:func:`analysis.io.validation_record.restore_products`). Returns ``{group read: files copied}``."""
+    check(name, config_path, record_dir)
+    made = _plan(config_path)[1]
+    reads = GROUPS[group_of_part(name)].reads
+    restored = {other: len(restore_products(Path(record_dir) / other, workdir)) for other in reads}
+    results = Path(workdir) / RESULTS
+    absent = [e.run_id for other in reads for e in made[other] if not (run_directory(results, e) / RUN_RECORD).is_file()]
+    if absent:
+        parts = split_groups(made)
+        again = [part.name for other in reads for part in parts.get(other, ())]
+        raise ValueError(f"{len(absent)} runs of {', '.join(reads)} that {name!r} compares against are neither in "
+                         f"{results} nor kept by their record in {record_dir} (a record written before records kept "
+                         f"the products of their runs): run {' then '.join(f'make validate GROUP={p}' for p in again)} "
+                         f"on this machine first")
+    return restored
 
 
 def finished(config_path: str, workdir: str | Path, name: str | None = None) -> tuple[list[str], list[str]]:
@@ -147,6 +170,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"siloflow: {error}", file=sys.stderr)
             return 2
         return 0
+    if len(argv) == 5 and argv[0] == "restore":
+        try:
+            restored = restore(*argv[1:])
+        except ValueError as error:
+            print(f"siloflow: {error}", file=sys.stderr)
+            return 2
+        for other, count in restored.items():
+            print(f"siloflow: {count} products of the runs of {other} restored from {argv[3]}/{other} into {argv[4]}")
+        return 0
     if len(argv) in (3, 4) and argv[0] == "finished":
         try:
             ready, waiting = finished(argv[1], argv[2], argv[3] if len(argv) == 4 else None)
@@ -177,7 +209,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"siloflow result: {path.resolve()}")
         return 0
     print("usage: validation_record_cli.py status CONFIG RECORD_DIR | publish WORKDIR RECORD_DIR [GROUP] | "
-          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP CONFIG RECORD_DIR | finished CONFIG WORKDIR [GROUP]",
+          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP CONFIG RECORD_DIR | "
+          "restore GROUP CONFIG RECORD_DIR WORKDIR | finished CONFIG WORKDIR [GROUP]",
           file=sys.stderr)
     return 2
 

@@ -37,11 +37,15 @@ class GroupRecord:
         Its provenance rows (:data:`RUN_COLUMNS`).
     plots : list of str
         Its plot file names, relative to the group's folder.
+    products : list of str
+        The products of its runs that other groups read, by their paths in the workflow's working directory
+        (:data:`engines.layout.READ_PRODUCTS`).
     """
 
     rows: list = field(default_factory=list)
     runs: list = field(default_factory=list)
     plots: list = field(default_factory=list)
+    products: list = field(default_factory=list)
 
 
 def simulated_time(record: RunRecord) -> float:
