@@ -15,6 +15,7 @@ Errors are reported as one :class:`ConfigError` naming the offending key, before
 from __future__ import annotations
 
 import copy
+import difflib
 import functools
 import math
 from pathlib import Path
@@ -200,8 +201,8 @@ def _describe(error: jsonschema.ValidationError) -> str:
     key = _key_path(error.absolute_path)
     value = error.instance
     message = error.message
-    if error.validator == "additionalProperties":
-        return f"config key '{key}': {message} (check the spelling against the schema)"
+    if error.validator == "additionalProperties" and isinstance(value, Mapping):
+        return _unknown_key(error.absolute_path, value, error.schema)
     if error.validator == "type" and isinstance(value, str):
         try:
             float(value)
@@ -215,6 +216,19 @@ def _describe(error: jsonschema.ValidationError) -> str:
         description = parent.schema.get("description") if parent is not None else None
     suffix = f" [{description.strip()}]" if description else ""
     return f"config key '{key}': {message}{suffix}"
+
+
+def _unknown_key(path: Iterable[Any], given: Mapping, schema: Mapping) -> str:
+    """The message of a key the schema does not declare in the mapping at ``path``: the key in full, the declared
+    key nearest in spelling (difflib's ratio of at least 0.6, a transposition or a letter or two away) and the keys
+    that mapping takes."""
+    known = sorted(schema.get("properties", {}))
+    unknown = sorted(str(name) for name in given if name not in known)[0]
+    key = _key_path([*path, unknown])
+    nearest = difflib.get_close_matches(unknown, known, n=1, cutoff=0.6)
+    hint = f"did you mean '{_key_path([*path, nearest[0]])}'? " if nearest else ""
+    keys = ", ".join(known) if len(known) <= 20 else f"{', '.join(known[:20])}, ... ({len(known)} in all)"
+    return f"config key '{key}' is not a siloflow setting: {hint}the keys here are {keys or 'none'}"
 
 
 def _is_given(raw: Any, path: Iterable[Any]) -> bool:

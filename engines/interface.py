@@ -134,6 +134,16 @@ class Engine(ABC):
         return found.stdout.strip() if found.returncode == 0 and found.stdout.strip() else "unknown"
 
     @abstractmethod
+    def check_installed(self, options: EngineOptions) -> None:
+        """Refuse, before anything runs, an engine whose programs (as ``options`` name them) are not installed.
+
+        Raises
+        ------
+        EngineNotFound
+            Naming the config key that names the missing program and how to install it.
+        """
+
+    @abstractmethod
     def check_case(self, case) -> None:
         """Refuse a case the engine cannot run as configured, before anything runs.
 

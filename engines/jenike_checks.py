@@ -16,6 +16,7 @@ import numpy as np
 from analysis.data.forces import WallForceHistory
 from analysis.data.record import RunRecord
 from engines.cases.jenike import JenikeCase
+from analysis.data.file_messages import first_not_read
 from engines.interface import EngineRunError
 from engines.markers import Marker
 
@@ -86,10 +87,10 @@ def read_jenike_force_history(path: str | Path) -> dict[str, np.ndarray]:
             )
         try:
             values = [float(field) for field in fields]
-        except ValueError:
-            raise ValueError(f"{path}: line {number} is not numeric: {text[:80]!r}") from None
+        except ValueError:  # its message quotes the field, and the file may be any file: the place is given
+            raise ValueError(f"{path}: line {number}, column {first_not_read(fields)} is not a number") from None
         if not all(np.isfinite(values)):
-            raise ValueError(f"{path}: line {number} holds a non-finite value: {text[:80]!r}")
+            raise ValueError(f"{path}: line {number}, column {int(np.argmin(np.isfinite(values))) + 1} is not finite")
         rows.append(values)
     if not rows:
         raise ValueError(f"{path}: the force history holds no data rows")

@@ -71,9 +71,9 @@ RUN_RECORD_SCHEMA = {
                  "resumed_attempts", "output_bytes", "stages"],
     "properties": {
         "schema_version": {"const": SCHEMA_VERSION},
-        "engine": {"type": "string", "pattern": "^[a-z][a-z0-9_]*$"},
+        "engine": {"type": "string", "pattern": "^[a-z][a-z0-9_]*$(?!\\n)"},
         "case": {"enum": ["jenike", "silo_flat", "silo_recirculation", "blender", "verification"]},
-        "run_id": {"type": "string", "pattern": "^[A-Za-z0-9_.=,+-]+$"},
+        "run_id": {"type": "string", "pattern": "^[A-Za-z0-9_.=,+-]+$(?!\\n)"},
         "timestep_s": {"type": "number", "exclusiveMinimum": 0},
         "n_clumps": {"type": "integer", "minimum": 0},
         "n_frames": {"type": "integer", "minimum": 0},

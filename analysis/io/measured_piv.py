@@ -23,7 +23,8 @@ def measured_piv_paths(patterns, base: str | Path = ".", where: str = "silo_flat
     Raises
     ------
     ValueError
-        Naming ``where`` and the pattern that matches no file.
+        Naming ``where`` and the pattern that matches no file, or that matches a folder (a DaVis set is named by its
+        ``.set`` file), with the folder.
     """
     paths = []
     for pattern in patterns:
@@ -31,6 +32,11 @@ def measured_piv_paths(patterns, base: str | Path = ".", where: str = "silo_flat
         matches = sorted(glob.glob(str(full))) if glob.has_magic(pattern) else ([str(full)] if full.exists() else [])
         if not matches:
             raise ValueError(f"{where}: {pattern!r} matches no file (looked in {Path(base).resolve()})")
+        folders = [m for m in matches if Path(m).is_dir()]
+        if folders:
+            more = f" (and {len(folders) - 1} more folder(s))" if len(folders) > 1 else ""
+            which = f": {folders[0]}{more}" if glob.has_magic(pattern) else ""
+            raise ValueError(f"{where}: {pattern!r} matches a folder, not a file{which}")
         paths.extend(Path(m) for m in matches)
     return paths
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.io.piv_base import PivFormatError, finite_positions
+from analysis.io.piv_base import PivFormatError, finite_positions, header_names, numeric_table, text_lines
 from analysis.io.piv_davis import DAVIS_CHOICES, DAVIS_OUT_OF_PLANE, read_davis
 from analysis.io.piv_openpiv import OPENPIV_FIFTH_COLUMNS, read_openpiv
 from analysis.io.piv_pivlab import PIVLAB_FIELDS, read_pivlab_mat, read_pivlab_txt
@@ -43,6 +43,7 @@ __all__ = ["PIV_FORMATS", "PivFormatError", "PivReadOptions", "PivRows", "read_d
 PIV_FORMATS = ("openpiv", "pivlab_txt", "pivlab_mat", "davis", "csv")
 
 CSV_HEADER = "x_m,z_m,u_m_s,w_m_s,valid"
+_CSV_NAMES = CSV_HEADER.split(",")
 
 
 @dataclass(frozen=True)
@@ -92,36 +93,28 @@ def read_options(measured: dict) -> PivReadOptions:
         davis.get("out_of_plane", default.davis_out_of_plane))
 
 
-def _table(path: Path, columns: int, delimiter: str, skip: int) -> np.ndarray:
-    try:
-        table = np.loadtxt(path, delimiter=delimiter, skiprows=skip, ndmin=2)
-    except ValueError as error:
-        raise PivFormatError(f"{path}: not a numeric table ({error})") from None
-    if table.size == 0:
-        raise PivFormatError(f"{path}: no vectors")
-    if table.shape[1] != columns:
-        raise PivFormatError(f"{path}: {table.shape[1]} columns, expected {columns}")
-    return table
-
-
 def read_piv_csv(path: str | Path, time: float = 0.0) -> PlanarField:
     """A siloflow PIV CSV (module docstring) as a field at ``time`` [s].
 
     Raises
     ------
     PivFormatError
-        Naming the file: another header, not five numeric columns, a position that is not finite, or nodes that do
-        not fill a regular grid.
+        Naming the file: a folder or a file that cannot be read, another header, a line and column that is not a
+        number, not five columns, a position that is not finite, or nodes that do not fill a regular grid.
     """
     path = Path(path)
-    with open(path, encoding="utf-8") as handle:
-        header = handle.readline().strip()
-    if header != CSV_HEADER:
-        raise PivFormatError(f"{path}: the header is {header[:60]!r}, expected {CSV_HEADER!r}")
-    table = _table(path, 5, ",", skip=1)
+    lines = text_lines(path)
+    names = lines[0].strip().split(",") if lines[0].strip() else []
+    if names != _CSV_NAMES:
+        raise PivFormatError(f"{path}: the header on line 1 {header_names(names, _CSV_NAMES, 'siloflow')}; siloflow's "
+                             f"is {CSV_HEADER}")
+    table, numbers = numeric_table(path, lines, start=1)
+    if table.shape[1] != 5:
+        raise PivFormatError(f"{path}: {table.shape[1]} columns, expected 5")
     x, z, u, w, valid = table.T
-    finite_positions(path, x, z)
+    finite_positions(path, x, z, numbers)
     try:
+        # field_from_rows says what the nodes lack (counts and shapes), not their values
         return field_from_rows(x, z, u, w, (valid == 1) & np.isfinite(u) & np.isfinite(w), time)
     except ValueError as error:
         raise PivFormatError(f"{path}: {error}") from None
@@ -143,7 +136,8 @@ def read_piv_file(path: str | Path, file_format: str, options: PivReadOptions = 
     Raises
     ------
     PivFormatError
-        Naming the file: an unknown format, a missing file, or what the format's reader refuses.
+        Naming the file: an unknown format, a missing file, or what the format's reader refuses (a folder, except a
+        DaVis set's, or a file that cannot be read among them).
     """
     path = Path(path)
     if file_format not in PIV_FORMATS:

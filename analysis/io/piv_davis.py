@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.io.piv_base import PivFormatError
+from analysis.io.piv_base import PivFormatError, first_at, readable_file
 from analysis.piv.field import INTERPOLATED, INVALID, MASKED, MEASURED, SECOND_PEAK, PivRows
 
 try:
@@ -58,15 +58,18 @@ def _units(frame, path: Path) -> tuple[float, float, bool]:
         return 1.0, 1.0, True
     if length in _DAVIS_LENGTHS and speed in _DAVIS_VELOCITIES:
         return _DAVIS_LENGTHS[length], _DAVIS_VELOCITIES[speed], False
-    raise PivFormatError(f"{path}: units {frame.scales.x.unit!r} and {frame.scales.i.unit!r}; expected pixel, or mm "
-                         "or m with m/s or mm/s")
+    # the units are the file's text: quoted only when they are units this reader knows
+    units = (f"units {length} and {speed}" if {length, speed} <= {"pixel", *_DAVIS_LENGTHS, *_DAVIS_VELOCITIES}
+             else "a length or velocity unit this reader does not know")
+    raise PivFormatError(f"{path}: {units}; expected pixel, or mm or m with m/s or mm/s")
 
 
 def _kinds(frame, path: Path, choice: str) -> np.ndarray:
     active = np.asarray(frame.active_choice[0])
-    if np.any((active < 0) | (active > 5)):
-        raise PivFormatError(f"{path}: active choice {int(active[(active < 0) | (active > 5)][0])}; DaVis writes 0 to "
-                             "3 (a correlation peak), 4 or 5 (filled in or smoothed)")
+    odd = (active < 0) | (active > 5)
+    if np.any(odd):
+        raise PivFormatError(f"{path}: {first_at(odd.ravel())} (row by row) has an active choice DaVis does not "
+                             "write; DaVis writes 0 to 3 (a correlation peak), 4 or 5 (filled in or smoothed)")
     kind = np.full(active.shape, INVALID, dtype=np.int8)
     kind[active == 0] = MEASURED
     if choice == "active":
@@ -130,9 +133,10 @@ def read_davis(path: str | Path, choice: str = "active", out_of_plane: str = "re
     Raises
     ------
     PivFormatError
-        Naming the file: ``lvpyio`` not installed, an image instead of vectors, a volume, a stereo field with
-        ``out_of_plane`` "refuse", an active choice DaVis does not write, or units other than pixels, or mm or m
-        with m/s or mm/s.
+        Naming the file: ``lvpyio`` not installed, a file that cannot be read or that lvpyio cannot read, an image
+        instead of vectors, a volume, a stereo field with ``out_of_plane`` "refuse", an active choice DaVis does not
+        write (and the first vector that has one), or units other than pixels, or mm or m with m/s or mm/s. No
+        message quotes the file's contents.
     """
     path = Path(path)
     if choice not in DAVIS_CHOICES or out_of_plane not in DAVIS_OUT_OF_PLANE:
@@ -140,8 +144,15 @@ def read_davis(path: str | Path, choice: str = "active", out_of_plane: str = "re
                          f"{', '.join(DAVIS_OUT_OF_PLANE)}, got {choice!r} and {out_of_plane!r}")
     if lvpyio is None:
         raise PivFormatError(f"{path}: reading DaVis files needs LaVision's lvpyio: pip install 'siloflow[davis]'")
-    buffers = [lvpyio.read_buffer(str(path))] if path.suffix.lower() in (".vc7", ".im7") \
-        else list(lvpyio.read_set(str(path)))
+    if not path.is_dir():  # a set may be named by its folder
+        readable_file(path)
+    try:
+        buffers = [lvpyio.read_buffer(str(path))] if path.suffix.lower() in (".vc7", ".im7") \
+            else list(lvpyio.read_set(str(path)))
+    except (RuntimeError, ValueError, OSError):
+        # lvpyio's messages may quote what it found in the file's header, so they are not passed on
+        raise PivFormatError(f"{path}: not a DaVis buffer or set that lvpyio can read (a set is a .set file next to "
+                             "its folder of the same name)") from None
     frames = [_davis_rows(frame, path, choice, out_of_plane) for buffer in buffers for frame in buffer]
     if not frames:
         raise PivFormatError(f"{path}: no vector frame")

@@ -41,7 +41,15 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.io.piv_base import PivFormatError, axis_steps, finite_positions
+from analysis.io.piv_base import (
+    PivFormatError,
+    axis_steps,
+    finite_positions,
+    first_at,
+    header_names,
+    numeric_table,
+    text_lines,
+)
 from analysis.piv.field import INTERPOLATED, INVALID, MASKED, MEASURED, UNFLAGGED, PivRows
 
 __all__ = ["OPENPIV_FIFTH_COLUMNS", "OPENPIV_HEADERS", "read_openpiv"]
@@ -56,51 +64,48 @@ OPENPIV_HEADERS = {
 OPENPIV_FIFTH_COLUMNS = ("mask", "sig2noise")
 
 _NAMES = re.compile(r"[\s,;]+")
+#: The column names of OpenPIV's headers: a message quotes a header only when it holds these alone.
+_KNOWN_NAMES = {name for names in OPENPIV_HEADERS for name in names}
+#: What a message says OpenPIV writes in each column of flags or masks.
+_FLAGS = "OpenPIV writes 0 (valid), 1 (invalid) or 2 (interpolated) there"
+_IMAGE_MASK = "OpenPIV writes 0 or 1 (inside the image mask) there"
+_VALIDATION_MASK = "OpenPIV writes 0 (valid) or the count of validations a vector failed there"
+_MASK_OR_SIG2NOISE = ("if the column holds the signal-to-noise ratio, set silo_flat.piv.measured.openpiv.fifth_column: "
+                      "sig2noise")
 
 
-def _header_and_rows(path: Path) -> tuple[tuple[str, ...] | None, list[str]]:
-    try:
-        lines = [line for line in path.read_text(encoding="utf-8", errors="replace").splitlines() if line.strip()]
-    except OSError as error:
-        raise PivFormatError(f"{path}: cannot be read ({error})") from None
-    if not lines:
-        raise PivFormatError(f"{path}: no vectors")
-    names = None
-    if lines[0].lstrip().startswith("#"):
-        names = tuple(n.lower() for n in _NAMES.split(lines[0].lstrip()[1:].strip()) if n)
-        if names not in OPENPIV_HEADERS:
-            raise PivFormatError(
-                f"{path}: the header {lines[0].strip()[:60]!r} is none of OpenPIV's: "
-                + "; ".join(f"'# {' '.join(k)}' ({v})" for k, v in OPENPIV_HEADERS.items()))
-        lines = lines[1:]
-    return names, lines
+def _header(path: Path, lines: list[str]) -> tuple[str, ...] | None:
+    """The column names of the header, None without one: OpenPIV's header is a first line that begins with ``#``."""
+    first = next((number for number, line in enumerate(lines) if line.strip()), None)
+    if first is None or not lines[first].lstrip().startswith("#"):
+        return None
+    names = tuple(n.lower() for n in _NAMES.split(lines[first].lstrip()[1:].strip()) if n)
+    if names not in OPENPIV_HEADERS:
+        raise PivFormatError(
+            f"{path}: the header on line {first + 1} {header_names(names, _KNOWN_NAMES, 'OpenPIV')}, none of OpenPIV's: "
+            + "; ".join(f"'# {' '.join(k)}' ({v})" for k, v in OPENPIV_HEADERS.items()))
+    return names
 
 
-def _table(path: Path, lines: list[str], names: tuple[str, ...] | None) -> np.ndarray:
-    if not lines:
-        raise PivFormatError(f"{path}: no vectors")
-    # OpenPIV writes with the caller's delimiter (a tab by default); numpy reads a comma only when told
-    delimiter = "," if "," in lines[0] else None
-    try:
-        table = np.loadtxt(lines, delimiter=delimiter, comments="#", ndmin=2)
-    except ValueError as error:
-        raise PivFormatError(f"{path}: not a numeric table ({error})") from None
+def _table(path: Path, lines: list[str], names: tuple[str, ...] | None) -> tuple[np.ndarray, np.ndarray]:
+    # OpenPIV writes with the caller's delimiter (a tab by default); the header, a '#' line, is left out with comments
+    table, numbers = numeric_table(path, lines, delimiters=(",", None))
     expected = len(names) if names else 5
     if table.shape[1] != expected:
         said = (f"its header names {' '.join(names)}" if names else
                 "OpenPIV wrote five columns (x y u v mask) without a header, and six only with one")
         raise PivFormatError(f"{path}: {table.shape[1]} columns, expected {expected} ({said})")
-    return table
+    return table, numbers
 
 
-def _whole(path: Path, values: np.ndarray, column: str) -> np.ndarray:
-    """The flags or mask column as integers; refused when it holds anything else."""
-    finite = np.isfinite(values)
-    if not np.all(finite) or np.any(values != np.round(values)) or np.any(values < 0):
-        odd = values[~finite | (values != np.round(values)) | (values < 0)]
-        raise PivFormatError(f"{path}: the {column} column holds {odd[0]:g}, not a whole number >= 0; "
-                             + ("if it is the signal-to-noise ratio, set silo_flat.piv.measured.openpiv.fifth_column"
-                                ": sig2noise" if column == "fifth (mask)" else "OpenPIV writes 0 or 1 there"))
+def _whole(path: Path, table: np.ndarray, numbers: np.ndarray, column: int, name: str, hint: str) -> np.ndarray:
+    """The flags or mask column (``column``, from 0) as integers; refused, with ``hint``, when it holds anything
+    else."""
+    values = table[:, column]
+    odd = ~np.isfinite(values) | (values != np.round(values)) | (values < 0)
+    if odd.any():
+        raise PivFormatError(f"{path}: {first_at(odd, numbers)}, column {column + 1} ({name}) is not a whole number "
+                             f">= 0; {hint}")
     return values.astype(int)
 
 
@@ -128,44 +133,46 @@ def read_openpiv(path: str | Path, y_down: bool | None = None, fifth_column: str
     Raises
     ------
     PivFormatError
-        Naming the file: a header that is none of OpenPIV's, a column count its layout does not have, text that is
-        not numbers, flags other than 0, 1 or 2, a mask that is not whole numbers, a position that is not finite, x
-        decreasing along a grid row, or a single grid row with ``y_down`` None.
+        Naming the file and, for its values, the line and column: a folder or a file that cannot be read, a header
+        that is none of OpenPIV's, a column count its layout does not have, a value that is not a number, flags
+        other than 0, 1 or 2, a mask that is not whole numbers, a position that is not finite, x decreasing along a
+        grid row, or a single grid row with ``y_down`` None. No message quotes the file's text.
     """
     path = Path(path)
     if fifth_column not in OPENPIV_FIFTH_COLUMNS:
         raise ValueError(f"fifth_column must be one of {', '.join(OPENPIV_FIFTH_COLUMNS)}, got {fifth_column!r}")
-    names, lines = _header_and_rows(path)
-    table = _table(path, lines, names)
+    lines = text_lines(path)
+    names = _header(path, lines)
+    table, numbers = _table(path, lines, names)
     x, y, u, v = table[:, :4].T
-    finite_positions(path, x, y)
-    columns = dict(zip(names, table.T)) if names else {}
+    finite_positions(path, x, y, numbers)
+    columns = {name: index for index, name in enumerate(names)} if names else {}
     kind = np.full(x.size, MEASURED, dtype=np.int8)
     sig2noise = None
     if names is None and fifth_column == "sig2noise":
         sig2noise = table[:, 4]
         kind[:] = UNFLAGGED
     elif names is None:
-        kind[_whole(path, table[:, 4], "fifth (mask)") != 0] = INVALID
+        kind[_whole(path, table, numbers, 4, "mask", _MASK_OR_SIG2NOISE) != 0] = INVALID
     elif "flags" in columns:
-        flags = _whole(path, columns["flags"], "flags")
+        flags = _whole(path, table, numbers, columns["flags"], "flags", _FLAGS)
         if np.any(flags > 2):
-            raise PivFormatError(f"{path}: flag {flags.max()} in the flags column; OpenPIV writes 0 (valid), "
-                                 "1 (invalid) or 2 (interpolated)")
+            raise PivFormatError(f"{path}: {first_at(flags > 2, numbers)}, column {columns['flags'] + 1} (flags) "
+                                 f"holds a flag OpenPIV does not write; {_FLAGS}")
         kind[flags == 1] = INVALID
         kind[flags == 2] = INTERPOLATED
     else:
-        kind[_whole(path, columns["mask"], "mask") != 0] = INVALID
-        sig2noise = columns.get("s2n")
+        kind[_whole(path, table, numbers, columns["mask"], "mask", _VALIDATION_MASK) != 0] = INVALID
+        sig2noise = table[:, columns["s2n"]] if "s2n" in columns else None
     if sig2noise is not None and sig2noise_threshold is not None:
         kind[(kind == UNFLAGGED) | (kind == MEASURED)] = MEASURED
         kind[~(sig2noise >= sig2noise_threshold)] = INVALID
     kind[~(np.isfinite(u) & np.isfinite(v))] = INVALID
     if "flags" in columns:
-        mask = _whole(path, columns["mask"], "mask")
+        mask = _whole(path, table, numbers, columns["mask"], "mask", _IMAGE_MASK)
         if np.any(mask > 1):
-            raise PivFormatError(f"{path}: {mask.max()} in the mask column; OpenPIV writes 0 or 1 (inside the image "
-                                 "mask)")
+            raise PivFormatError(f"{path}: {first_at(mask > 1, numbers)}, column {columns['mask'] + 1} (mask) is "
+                                 f"neither 0 nor 1; {_IMAGE_MASK}")
         kind[mask == 1] = MASKED
     dx, dy = axis_steps(x, y, x_fastest=True)
     if dx is not None and dx < 0:

@@ -65,13 +65,23 @@ points right).
 from __future__ import annotations
 
 import re
+import zlib
 from pathlib import Path
 
 import h5py
 import numpy as np
 import scipy.io
 
-from analysis.io.piv_base import PivFormatError, axis_steps, finite_positions
+from analysis.io.piv_base import (
+    PivFormatError,
+    axis_steps,
+    finite_positions,
+    first_at,
+    header_names,
+    numeric_table,
+    readable_file,
+    text_lines,
+)
 from analysis.piv.field import INTERPOLATED, INVALID, MASKED, MEASURED, SECOND_PEAK, UNFLAGGED, PivRows
 
 __all__ = ["PIVLAB_FIELDS", "PIVLAB_TEXT_LAYOUTS", "read_pivlab_mat", "read_pivlab_txt"]
@@ -95,17 +105,27 @@ _HEADER = re.compile(r"([^\[\]]*?)\s*\[([^\]]*)\]")
 _FACTORS = re.compile(r"conversion factor xy \(px -> m\):\s*([^,]+?)\s*,\s*conversion factor uv "
                       r"\(px/frame -> m/s\):\s*(\S+)")
 _TYPES = {0: "masked", 1: "measured", 2: "interpolated", 3: "second peak"}
+#: The column names (lower case) and units of PIVlab's text headers: a message quotes a header's names or units only
+#: when each is one of these (anything else is the file's text).
+_HEADER_NAMES = {"x", "y", "u", "v", "vector type", "vorticity", "magnitude", "divergence", "dcev", "simple shear",
+                 "simple strain", "vector direction", "correlation coefficient", "q criterion",
+                 "shear rate (magnitude of the rate-of-strain tensor)", "uncertainty"}
+_HEADER_UNITS = {"px", "m", "px/frame", "m/s", "m/frame"}
+#: The units variable of PIVlab's GUI export, and whether it means pixels.
+_MAT_UNITS = {"[px] respectively [px/frame]": True, "[m] respectively [m/s]": False}
 
 
-def _kinds(path: Path, where: str, types: np.ndarray | None, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The node kinds of PIVlab's vector types (module docstring), or of NaN alone without types."""
+def _kinds(path: Path, where: str, types: np.ndarray | None, u: np.ndarray, v: np.ndarray,
+           lines: np.ndarray | None = None) -> np.ndarray:
+    """The node kinds of PIVlab's vector types (module docstring), or of NaN alone without types; ``lines``, each
+    vector's line in a text file, for messages."""
     finite = np.isfinite(u) & np.isfinite(v)
     if types is None:
         return np.where(finite, UNFLAGGED, MASKED).astype(np.int8)
     unknown = ~np.isin(types, list(_TYPES))
     if unknown.any():
-        raise PivFormatError(f"{path}: {where}vector type {types[unknown][0]:g}; PIVlab's types are "
-                             + ", ".join(f"{k} ({v})" for k, v in _TYPES.items()))
+        raise PivFormatError(f"{path}: {where}{first_at(unknown, lines)} has a vector type PIVlab does not write; "
+                             "PIVlab's types are " + ", ".join(f"{k} ({v})" for k, v in _TYPES.items()))
     kind = np.full(types.shape, INVALID, dtype=np.int8)
     kind[(types == 1) & finite] = MEASURED
     kind[(types == 3) & finite] = SECOND_PEAK
@@ -114,9 +134,11 @@ def _kinds(path: Path, where: str, types: np.ndarray | None, u: np.ndarray, v: n
     return kind
 
 
-def _oriented(path: Path, x, y, u, v, kind, pixels: bool | None, where: str = "") -> PivRows:
-    """Rows in PIVlab's column-major order, with the file's y direction read off the grid."""
-    finite_positions(path, x, y)
+def _oriented(path: Path, x, y, u, v, kind, pixels: bool | None, where: str = "",
+              lines: np.ndarray | None = None) -> PivRows:
+    """Rows in PIVlab's column-major order, with the file's y direction read off the grid; ``lines``, each vector's
+    line in a text file, for messages."""
+    finite_positions(path, x, y, lines)
     dx, dy = axis_steps(x, y, x_fastest=False)
     if dx is not None and dx < 0:
         raise PivFormatError(f"{path}: {where}x increases to the left (PIVlab's calibration setting \"x axis "
@@ -127,8 +149,10 @@ def _oriented(path: Path, x, y, u, v, kind, pixels: bool | None, where: str = ""
     return PivRows(x, y, u, v, kind, True if dy is None else dy > 0, pixels)
 
 
-def _text_units(path: Path, header: list[tuple[str, str]] | None, factors: tuple[str, str] | None) -> bool | None:
-    """True for pixels, False for metres, None when the file does not say."""
+def _text_units(path: Path, header: list[tuple[str, str]] | None, factors: tuple[str, str] | None,
+                lines: tuple[int, int]) -> bool | None:
+    """True for pixels, False for metres, None when the file does not say; ``lines``, the header's and the factors'
+    line numbers, for messages."""
     said = []
     if header:
         position, velocity = header[0][1].strip(), header[2][1].strip()
@@ -137,19 +161,21 @@ def _text_units(path: Path, header: list[tuple[str, str]] | None, factors: tuple
                                  "of 0): give the calibration's time step, or export uncalibrated (px) and give the "
                                  "markers and the frame rate")
         if (position, velocity) not in (("px", "px/frame"), ("m", "m/s")):
-            raise PivFormatError(f"{path}: units x [{position}], u [{velocity}]; PIVlab writes px with px/frame or m "
-                                 "with m/s")
+            units = (f"units x [{position}], u [{velocity}]" if {position, velocity} <= _HEADER_UNITS else
+                     "units of x and u that are not PIVlab's")
+            raise PivFormatError(f"{path}: the header on line {lines[0]} gives {units}; PIVlab writes px with "
+                                 "px/frame or m with m/s")
         said.append(position == "px")
     if factors:
         try:
             xy, uv = float(factors[0]), float(factors[1])
         except ValueError:
-            raise PivFormatError(f"{path}: conversion factors {factors[0]!r} and {factors[1]!r} are not numbers") \
+            raise PivFormatError(f"{path}: line {lines[1]}: the conversion factors xy and uv are not both numbers") \
                 from None
         pixels = xy == 1 and abs(uv) == 1
         if not pixels and factors[0] == factors[1].lstrip("-"):
             raise PivFormatError(
-                f"{path}: the conversion factors xy and uv are equal ({factors[0]}): PIVlab's displacement-only "
+                f"{path}: line {lines[1]}: the conversion factors xy and uv are equal: PIVlab's displacement-only "
                 "calibration (time step 0, PIVlab 3.07 and later) writes displacements per frame under an m/s header, "
                 "and a time step of exactly 1 s gives the same factors; the file cannot say which. Export "
                 "uncalibrated (px) and give the markers and the frame rate")
@@ -172,17 +198,17 @@ def read_pivlab_txt(path: str | Path) -> PivRows:
     Raises
     ------
     PivFormatError
-        Naming the file: a line that is neither PIVlab's information lines, its header nor numbers; rows of unequal
-        length; a column count or header of no PIVlab layout, or 12 columns without a header; units PIVlab does not
-        write, velocities per frame in metres, or header and factors that disagree; a vector type PIVlab does not
-        write; a position that is not finite; x increasing to the left; or, in metres, a single grid row.
+        Naming the file and, where it can, the line (and column): a folder or a file that cannot be read; a line
+        that is neither PIVlab's information lines, its header nor numbers; a value that is not a number; rows of
+        unequal length; a column count or header of no PIVlab layout, or 12 columns without a header; units PIVlab
+        does not write, velocities per frame in metres, or header and factors that disagree; a vector type PIVlab
+        does not write; a position that is not finite; x increasing to the left; or, in metres, a single grid row.
+        No message quotes the file's text (a header's names and units only when they are PIVlab's).
     """
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as error:
-        raise PivFormatError(f"{path}: cannot be read ({error})") from None
+    lines = text_lines(path)
     header, factors, start = None, None, None
+    header_line = factors_line = 0
     for number, line in enumerate(lines):
         text = line.strip()
         if not text:
@@ -195,28 +221,26 @@ def read_pivlab_txt(path: str | Path) -> PivRows:
             if text.startswith("FRAME:"):
                 match = _FACTORS.search(text)
                 factors = (match.group(1), match.group(2)) if match else None
+                factors_line = number + 1
                 continue
             if text.startswith("x ["):
                 header = [(name.strip(" ,\t"), unit) for name, unit in _HEADER.findall(text)]
+                header_line = number + 1
                 continue
             raise PivFormatError(f"{path}: line {number + 1} is neither PIVlab's information lines, its header nor "
-                                 f"numbers: {text[:60]!r}") from None
+                                 "numbers") from None
         start = number
         break
     if start is None:
         raise PivFormatError(f"{path}: no vectors")
-    data = [line for line in lines[start:] if line.strip()]
-    delimiter = "," if "," in data[0] else "\t" if "\t" in data[0] else None
-    try:
-        table = np.loadtxt(data, delimiter=delimiter, ndmin=2)
-    except ValueError as error:
-        raise PivFormatError(f"{path}: not a numeric table after line {start} ({error})") from None
+    table, numbers = numeric_table(path, lines, start, delimiters=(",", "\t", None))
     columns = table.shape[1]
     if header is not None:
         names = [name.lower() for name, _ in header]
         if len(names) != columns or names[:4] != ["x", "y", "u", "v"]:
-            raise PivFormatError(f"{path}: the header names {', '.join(names) or 'nothing'} over {columns} columns; "
-                                 "PIVlab's begin x, y, u, v (then the vector type since 2.44)")
+            raise PivFormatError(f"{path}: the header on line {header_line} "
+                                 f"{header_names(names, _HEADER_NAMES, 'PIVlab')} over {columns} columns; PIVlab's "
+                                 "begin x, y, u, v (then the vector type since 2.44)")
         typed = len(names) > 4 and names[4] == "vector type"
     elif columns == 12:
         raise PivFormatError(f"{path}: 12 columns without a header: PIVlab 2.37 to 2.43 wrote x y u v and eight "
@@ -228,10 +252,10 @@ def read_pivlab_txt(path: str | Path) -> PivRows:
         raise PivFormatError(f"{path}: {columns} columns{' with' if typed else ' without'} a vector type; PIVlab "
                              "writes " + "; ".join(f"{c} columns{' with' if t else ' without'} a type ({d})"
                                                    for (c, t), d in PIVLAB_TEXT_LAYOUTS.items()))
-    pixels = _text_units(path, header, factors)
+    pixels = _text_units(path, header, factors, (header_line, factors_line))
     x, y, u, v = table[:, :4].T
-    kind = _kinds(path, "", table[:, 4] if typed else None, u, v)
-    return _oriented(path, x, y, u, v, kind, pixels)
+    kind = _kinds(path, "", table[:, 4] if typed else None, u, v, numbers)
+    return _oriented(path, x, y, u, v, kind, pixels, lines=numbers)
 
 
 # ---------------------------------------------------------------------------------------------- MATLAB files
@@ -243,6 +267,8 @@ _COMMAND_LINE = (("x", "y"), {"original": ("u", "v", "typevector"),
                               "filtered": ("u_filt", "v_filt", "typevector_filt")})
 #: Rows (from 0) of a session's resultslist.
 _SESSION_ROWS = {"original": (2, 3, 4), "filtered": (6, 7, 8)}
+#: What scipy.io and h5py raise on a file that is not MATLAB 5 to 7.3 (zlib's on a damaged compressed variable).
+_MATLAB_ERRORS = (scipy.io.matlab.MatReadError, ValueError, TypeError, KeyError, OSError, zlib.error)
 
 
 def _h5_value(handle: h5py.File, node):
@@ -251,7 +277,7 @@ def _h5_value(handle: h5py.File, node):
         return None  # a struct or an object: no PIVlab variable this reader uses is one
     attributes = node.attrs
     matlab_class = attributes.get("MATLAB_class", b"")
-    matlab_class = matlab_class.decode() if isinstance(matlab_class, bytes) else str(matlab_class)
+    matlab_class = matlab_class.decode(errors="replace") if isinstance(matlab_class, bytes) else str(matlab_class)
     if int(attributes.get("MATLAB_empty", 0)):
         return np.zeros((0, 0))
     # MATLAB writes its column-major arrays as HDF5's row-major ones with the axes reversed
@@ -266,21 +292,47 @@ def _h5_value(handle: h5py.File, node):
     return values
 
 
+def _not_matlab(path: Path) -> PivFormatError:
+    # scipy's and h5py's messages may quote the file's bytes (scipy's "version 61, 97" is two of them), so they are
+    # not passed on
+    return PivFormatError(f"{path}: not a MATLAB file (5 to 7.3) that scipy.io or h5py can read")
+
+
+def _present(path: Path) -> set[str]:
+    """The names of the variables of a MATLAB file."""
+    try:
+        if h5py.is_hdf5(path):  # MATLAB 7.3
+            with h5py.File(path, "r") as handle:
+                return set(handle.keys())
+        return {name for name, _, _ in scipy.io.whosmat(path)}
+    except _MATLAB_ERRORS:
+        raise _not_matlab(path) from None
+
+
 def _variables(path: Path, wanted: set[str]) -> dict:
     """The variables named in ``wanted`` that the file holds, in MATLAB's axis order."""
-    if h5py.is_hdf5(path):  # MATLAB 7.3
-        with h5py.File(path, "r") as handle:
-            return {name: _h5_value(handle, handle[name]) for name in wanted if name in handle}
+    names = wanted & _present(path)
     try:
-        names = {name for name, _, _ in scipy.io.whosmat(path)}
-        arrays = scipy.io.loadmat(path, variable_names=sorted(wanted & names))
-    except (scipy.io.matlab.MatReadError, ValueError, TypeError, OSError) as error:
-        raise PivFormatError(f"{path}: not a MATLAB file ({error})") from None
+        if h5py.is_hdf5(path):  # MATLAB 7.3
+            with h5py.File(path, "r") as handle:
+                return {name: _h5_value(handle, handle[name]) for name in names}
+        arrays = scipy.io.loadmat(path, variable_names=sorted(names))
+    except _MATLAB_ERRORS:
+        raise _not_matlab(path) from None
     values = {}
-    for name in wanted & names:
+    for name in names:
         value = arrays[name]
         values[name] = str(value[0]) if value.dtype.kind == "U" and value.size else value
     return values
+
+
+def _numeric(value, path: Path, name: str) -> np.ndarray:
+    """``value`` as an array of floats; refused when it holds anything but numbers (numpy's conversion of text would
+    quote the text)."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        raise PivFormatError(f"{path}: {name} is not numeric")
+    return array.astype(float)
 
 
 def _frames(value, path: Path, name: str) -> list[np.ndarray]:
@@ -291,8 +343,8 @@ def _frames(value, path: Path, name: str) -> list[np.ndarray]:
         if min(value.shape) > 1:
             raise PivFormatError(f"{path}: {name} is a {' x '.join(map(str, value.shape))} cell array; PIVlab writes "
                                  "one cell per frame")
-        return [np.asarray(cell, dtype=float) for cell in value.ravel()]
-    value = np.asarray(value, dtype=float)
+        return [_numeric(cell, path, f"{name}{{{n}}}") for n, cell in enumerate(value.ravel(), start=1)]
+    value = _numeric(value, path, name)
     if value.ndim == 3:
         return [value[:, :, n] for n in range(value.shape[2])]
     return [value]
@@ -304,15 +356,13 @@ def _mat_units(path: Path, variables: dict) -> bool:
         raise PivFormatError(f"{path}: no units variable; PIVlab's export writes units ('[px] respectively "
                              "[px/frame]' or '[m] respectively [m/s]')")
     units = " ".join(str(units).split())
-    if units == "[px] respectively [px/frame]":
-        return True
-    if units == "[m] respectively [m/s]":
-        return False
+    if units in _MAT_UNITS:
+        return _MAT_UNITS[units]
     if units == "[m] respectively [m/frame]":
         raise PivFormatError(f"{path}: velocities in m/frame (PIVlab's displacement-only calibration, a time step of "
                              "0): give the calibration's time step, or export uncalibrated (px) and give the markers "
                              "and the frame rate")
-    raise PivFormatError(f"{path}: units {units!r}; PIVlab writes '[px] respectively [px/frame]' or '[m] "
+    raise PivFormatError(f"{path}: the units variable is none of PIVlab's: '[px] respectively [px/frame]' or '[m] "
                          "respectively [m/s]'")
 
 
@@ -360,21 +410,17 @@ def read_pivlab_mat(path: str | Path, field: str = "filtered") -> list[PivRows]:
     Raises
     ------
     PivFormatError
-        Naming the file (and the frame): not a MATLAB file, none of PIVlab's layouts, units PIVlab does not write or
-        per frame in metres, an empty field, arrays or frame counts that differ, a vector type PIVlab does not
-        write, a position that is not finite, x increasing to the left, or, in metres, a single grid row.
+        Naming the file (and the frame, variable or vector): a folder or a file that cannot be read, not a MATLAB
+        file, none of PIVlab's layouts, a variable that is not numbers, units PIVlab does not write or per frame in
+        metres, an empty field, arrays or frame counts that differ, a vector type PIVlab does not write, a position
+        that is not finite, x increasing to the left, or, in metres, a single grid row. No message quotes the
+        file's contents.
     """
     path = Path(path)
     if field not in PIVLAB_FIELDS:
         raise ValueError(f"field must be one of {', '.join(PIVLAB_FIELDS)}, got {field!r}")
-    if not h5py.is_hdf5(path):
-        try:
-            present = {name for name, _, _ in scipy.io.whosmat(path)}
-        except (scipy.io.matlab.MatReadError, ValueError, TypeError, OSError) as error:
-            raise PivFormatError(f"{path}: not a MATLAB file ({error})") from None
-    else:
-        with h5py.File(path, "r") as handle:
-            present = set(handle.keys())
+    readable_file(path)
+    present = _present(path)
     for (positions, fields), pixels in ((_GUI, None), (_COMMAND_LINE, True)):
         names = positions + fields[field]
         if set(positions + fields["original"]) <= present:
@@ -394,7 +440,8 @@ def read_pivlab_mat(path: str | Path, field: str = "filtered") -> list[PivRows]:
         if results.shape[0] <= max(rows):
             raise PivFormatError(f"{path}: resultslist has no filtered field (rows 7 to 9) for any frame "
                                  "(silo_flat.piv.measured.pivlab.field: filtered)")
-        frames = [[np.asarray(cell, dtype=float) for cell in results[r]] for r in rows]
+        frames = [[_numeric(cell, path, f"resultslist{{{r + 1},{n}}}") for n, cell in enumerate(results[r], start=1)]
+                  for r in rows]
         names = tuple(f"resultslist{{{r + 1},:}}" for r in rows)
         return _rows_of_frames(path, field, *frames, True, names)
     raise PivFormatError(f"{path}: none of PIVlab's layouts: the GUI export has x, y, u_original, v_original, "

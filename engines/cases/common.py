@@ -224,13 +224,17 @@ def fill_zone(
     """The central insertion zone (x_min, x_max, y_min, y_max, z_min, z_max) (m) of :func:`plan_fill`.
 
     Centred, spanning the whole depth, its floor above the highest heap the pile can form,
-    H + (W/2) tan(heap angle), plus two clump diameters.
+    H + (W/2) tan(heap angle), plus two clump diameters. LIGGGHTS inserts a clump only with its bounding sphere
+    inside the zone (``all_in``), so the zone must be wider, deeper and taller than one clump.
     """
     clearance = particle.bounding_radius
     zone_half_width = 0.5 * fill_config["zone_width_fraction"] * width
     x_min, x_max = -zone_half_width + clearance, zone_half_width - clearance
     if x_max - x_min <= 2.0 * clearance or depth <= 2.0 * clearance:
         raise ValueError("insertion zone thinner than one clump: increase silo depth or zone_width_fraction")
+    if fill_config["zone_height"] <= 2.0 * clearance:
+        raise ValueError(f"insertion zone lower than one clump: fill.zone_height ({fill_config['zone_height']} m) must "
+                         f"exceed the clump's bounding diameter ({2.0 * clearance:.4g} m)")
     heap_rise = 0.5 * width * math.tan(math.radians(fill_config["heap_angle"]))
     z_min = fill_height + heap_rise + 4.0 * particle.bounding_radius
     return (x_min, x_max, 0.0, depth, z_min, z_min + fill_config["zone_height"])

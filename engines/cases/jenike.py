@@ -341,6 +341,16 @@ def _material_table(config: dict, point: dict, test: ContactSet) -> MaterialTabl
     )
 
 
+def check_cell_fits(inner_radius: float, particle: ParticleTemplate) -> None:
+    """Refuse a cell whose inner radius R leaves no room for the pour's column, R - r_b > r_b (r_b the clump's
+    bounding radius), naming ``jenike.cell.inner_diameter``."""
+    if inner_radius - particle.bounding_radius <= particle.bounding_radius:
+        raise ValueError(
+            f"jenike.cell.inner_diameter ({2 * inner_radius} m) is too small for clumps of "
+            f"bounding diameter {2 * particle.bounding_radius:.4g} m"
+        )
+
+
 def fill_column(
     geometry: CellGeometry, particle: ParticleTemplate, overfill: float
 ) -> tuple[int, tuple[float, ...], float, float, float]:
@@ -353,12 +363,8 @@ def fill_column(
     to the height that holds n clumps at INSERT_SOLID_FRACTION.
     """
     r_b = particle.bounding_radius
+    check_cell_fits(geometry.inner_radius, particle)
     radius = geometry.inner_radius - r_b
-    if radius <= r_b:
-        raise ValueError(
-            f"jenike.cell.inner_diameter ({2 * geometry.inner_radius} m) is too small for clumps of "
-            f"bounding diameter {2 * r_b:.4g} m"
-        )
     if geometry.wall_test:
         centres: tuple[float, ...] = (geometry.ring_centre[0],)
         area = math.pi * radius**2
@@ -370,7 +376,7 @@ def fill_column(
     sample_volume = geometry.area * geometry.sample_height
     n_clumps = int(round(FILL_SOLID_FRACTION * (1.0 + overfill) * sample_volume / particle.volume))
     if n_clumps < 1:
-        raise ValueError("jenike cell too small: less than one clump fits")
+        raise ValueError("jenike.cell.inner_diameter: the cell is too small, less than one clump fits in its sample")
     column = n_clumps * particle.volume / (INSERT_SOLID_FRACTION * area)
     z_min = r_b
     return n_clumps, centres, radius, z_min, z_min + max(column, 2.0 * r_b)
@@ -441,6 +447,12 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     table = _material_table(config, point, test_contacts)
 
     radius = 0.5 * cell["inner_diameter"]
+    check_cell_fits(radius, particle)  # before the rings' polygons, which need a cell wider than the chord error
+    try:
+        segments = segments_for_chord(radius, CHORD_TOLERANCE * particle.smallest_radius)
+    except ValueError as error:
+        raise ValueError(f"jenike.cell.inner_diameter ({cell['inner_diameter']} m) for spheres of radius "
+                         f"{particle.smallest_radius:.4g} m: {error}") from None
     displacement = jenike["shear"]["displacement"]
     overfill = jenike["fill"]["overfill"]
     sample_height = cell["shear_ring_height"] + (0.0 if wall_test else cell["bottom_ring_height"])
@@ -454,7 +466,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         shear_displacement=displacement,
         plate_size=cell["plate_size"] if wall_test else 0.0,
         mould_height=2.0 * overfill * sample_height + 4.0 * particle.bounding_radius,
-        segments=segments_for_chord(radius, CHORD_TOLERANCE * particle.smallest_radius),
+        segments=segments,
         lid_clearance=LID_CLEARANCE * particle.smallest_radius,
     )
     if wall_test:
@@ -478,9 +490,13 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     normal_force = jenike["consolidation"]["normal_stress"] * geometry.area
     lid_radius = radius - geometry.lid_clearance
     sphere_radius = particle.smallest_radius
+    try:
+        lid_spheres = lid_sphere_layout(lid_radius - sphere_radius, LID_SPHERE_SPACING * sphere_radius)
+    except ValueError as error:
+        raise ValueError(f"jenike.cell.inner_diameter ({cell['inner_diameter']} m) for spheres of radius "
+                         f"{sphere_radius:.4g} m: {error}") from None
     rigid_lid = RigidLid(
-        positions=lid_sphere_layout(lid_radius - sphere_radius, LID_SPHERE_SPACING * sphere_radius)
-        + np.array(geometry.ring_centre),
+        positions=lid_spheres + np.array(geometry.ring_centre),
         sphere_radius=sphere_radius,
         density=float(material["density"]),
         height_above_sample=float(particle.sphere_radii.max()) + (1.0 + LID_PLACEMENT_GAP) * sphere_radius,

@@ -33,6 +33,10 @@ from engines.cases.geometry import TriangleMesh, horizontal_rectangle
 
 # ---------------------------------------------------------------------------------------------- meshes
 
+#: The most sides a circle's polygon may have: above the 1.6e5 the schema's bounds allow at worst (a 100 m cell
+#: meshed for spheres of 1 micrometre), and below a mesh of millions of triangles per wall.
+MAX_SEGMENTS = 1_000_000
+
 
 def segments_for_chord(radius: float, max_sagitta: float) -> int:
     """Fewest polygon sides n whose chords deviate from a circle by at most ``max_sagitta``.
@@ -50,11 +54,22 @@ def segments_for_chord(radius: float, max_sagitta: float) -> int:
     -------
     int
         n >= 8.
+
+    Raises
+    ------
+    ValueError
+        Unless 0 < max_sagitta < radius, or when n would exceed :data:`MAX_SEGMENTS`.
     """
     if not (radius > 0 and 0 < max_sagitta < radius):
         raise ValueError(f"need 0 < max_sagitta < radius, got radius={radius!r}, max_sagitta={max_sagitta!r}")
-    n = math.ceil(math.pi / math.acos(1.0 - max_sagitta / radius) - 1e-9)
-    return max(8, n)
+    # The half angle pi / n of a chord with sagitta s: 1 - cos(a) = 2 sin(a / 2)^2 = s / R. Written with the sine, it
+    # stays accurate where 1 - s / R rounds to 1 (acos of that is 0, and pi / 0 divides by zero).
+    half_angle = 2.0 * math.asin(math.sqrt(0.5 * max_sagitta / radius))
+    sides = math.pi / half_angle - 1e-9 if half_angle > 0 else math.inf
+    if not sides <= MAX_SEGMENTS:
+        raise ValueError(f"a circle of radius {radius!r} m within {max_sagitta!r} m needs {sides:.3g} polygon sides, "
+                         f"more than the {MAX_SEGMENTS} a mesh is given")
+    return max(8, math.ceil(sides))
 
 
 def _circle(radius: float, segments: int, centre: tuple[float, float]) -> np.ndarray:

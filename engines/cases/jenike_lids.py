@@ -24,6 +24,11 @@ import numpy as np
 from analysis.data.constants import GRAVITY
 
 
+#: The most spheres a rigid lid may have: far above a 1 m cell's lid of the study's 3 mm spheres (some 2e5), and a
+#: few tens of megabytes of centres; a cell thousands of sphere diameters across would need billions.
+MAX_LID_SPHERES = 1_000_000
+
+
 def lid_sphere_layout(outer_radius: float, spacing: float) -> np.ndarray:
     """Centres (x, y) of the lid spheres relative to the lid axis: a centre sphere and concentric rings.
 
@@ -42,9 +47,21 @@ def lid_sphere_layout(outer_radius: float, spacing: float) -> np.ndarray:
     -------
     numpy.ndarray
         (k, 2) centres (m).
+
+    Raises
+    ------
+    ValueError
+        For a radius or spacing that is not positive, or a lid of more than :data:`MAX_LID_SPHERES` spheres.
     """
     if not (outer_radius > 0 and spacing > 0):
         raise ValueError(f"need positive outer_radius and spacing, got {outer_radius!r}, {spacing!r}")
+    # K <= R / s + 1 rings, ring k at most 2 pi k + 1 spheres: at most 1 + K + pi K (K + 1), counted before laying
+    # them out (in floats, which reach inf rather than overflow)
+    most_rings = outer_radius / spacing + 1.0
+    most = 1.0 + most_rings + math.pi * most_rings * (most_rings + 1.0)
+    if not most <= MAX_LID_SPHERES:
+        raise ValueError(f"a lid of radius {outer_radius:.4g} m with spheres {spacing:.4g} m apart would hold up to "
+                         f"{most:.3g} spheres, more than the {MAX_LID_SPHERES} a lid is given")
     rings = math.ceil(outer_radius / spacing - 1e-9)
     step = outer_radius / rings
     points = [np.zeros((1, 2))]

@@ -184,11 +184,15 @@ def free_fall_velocity(start_velocity: float, height: float, gravity: float) -> 
 
 def free_fall_time(start_velocity: float, height: float, gravity: float) -> float:
     """Time (s) of a free fall of ``height`` (m) that starts downwards at ``start_velocity`` (m/s):
-    the root of v t + g t^2 / 2 = h."""
+    the root of v t + g t^2 / 2 = h, as 2 h / (v + sqrt(v^2 + 2 g h)). The textbook (sqrt(v^2 + 2 g h) - v) / g
+    subtracts two nearly equal numbers when the start is fast or the fall short, down to 0 for a fall that takes
+    time (1e-15 m at 100 m/s)."""
     if not (height >= 0 and gravity > 0 and start_velocity >= 0):
         raise ValueError(f"need height >= 0, gravity > 0 and start_velocity >= 0, got {height!r}, {gravity!r}, "
                          f"{start_velocity!r}")
-    return (-start_velocity + math.sqrt(start_velocity**2 + 2.0 * gravity * height)) / gravity
+    if height == 0:
+        return 0.0
+    return 2.0 * height / (start_velocity + math.sqrt(start_velocity**2 + 2.0 * gravity * height))
 
 
 def is_prime(number: int) -> bool:

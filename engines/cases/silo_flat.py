@@ -162,6 +162,9 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
         raise ValueError(
             f"{section}.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"
         )
+    if silo["outlet_width"] < 2.0 * particle.bounding_radius:
+        raise ValueError(f"{section}.outlet_width ({silo['outlet_width']} m) is narrower than one clump "
+                         f"({2 * particle.bounding_radius:.4g} m): no clump would pass")
     walls = silo["wall_materials"]
     used_walls = [walls["side"], walls["bottom"]] + ([walls["front_back"]] if silo["front_back_walls"] else [])
     table = material_table(config, material_name, used_walls)

@@ -12,7 +12,8 @@ The silo deck writes ``compute pair/gran/local pos id force`` through ``dump loc
     x_i y_i z_i x_j y_j z_j id_i id_j periodic f_x f_y f_z
 
 ``f`` is the force on particle i by particle j (N). Parsing is pure (text in, arrays out); reading a file
-is a thin wrapper.
+is a thin wrapper. A message names the file, the line and column and what was expected there, never what the file
+holds (:mod:`analysis.data.file_messages`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.data.contacts import ContactFrame
+from analysis.data.file_messages import first_not_read
 
 N_COLUMNS = 12
 
@@ -39,8 +41,8 @@ def parse_local_table(
     Raises
     ------
     ContactDumpError
-        Naming ``source`` when a header item is missing, the entry count disagrees with the lines, a row
-        has another number of columns, or a value is not a finite number.
+        Naming ``source`` (and the line) when a header item is missing, the entry count disagrees with the lines,
+        a row has another number of columns, or a value is not a finite number; never what the file holds there.
     """
     lines = text.splitlines()
 
@@ -50,22 +52,31 @@ def parse_local_table(
                 return index
         raise ContactDumpError(f"{source}: no 'ITEM: {name}' header (not a complete LIGGGHTS local dump?)")
 
+    stepped, counted = item("TIMESTEP") + 1, item(count_item) + 1
     try:
-        step = int(lines[item("TIMESTEP") + 1])
-        count = int(lines[item(count_item) + 1])
+        step = int(lines[stepped])
+        count = int(lines[counted])
     except (IndexError, ValueError):
         raise ContactDumpError(f"{source}: malformed TIMESTEP or {count_item}") from None
-    rows = [line.split() for line in lines[item(table_item) + 1 :] if line.strip()]
-    if len(rows) != count:
-        raise ContactDumpError(f"{source}: header announces {count} contacts but the file holds {len(rows)}")
-    if any(len(row) != n_columns for row in rows):
-        raise ContactDumpError(f"{source}: every contact line must hold {n_columns} columns")
+    table = item(table_item) + 1
+    numbered = [(number, line.split()) for number, line in enumerate(lines[table:], start=table + 1) if line.strip()]
+    if len(numbered) != count:  # the count is the file's: the message gives the line that declares it
+        found = f"{len(numbered)} line{'' if len(numbered) == 1 else 's'}"
+        raise ContactDumpError(f"{source}: the {count_item} of line {counted + 1} differs from the {found} after "
+                               f"'ITEM: {table_item}' (line {table})")
+    for number, row in numbered:
+        if len(row) != n_columns:
+            raise ContactDumpError(f"{source}: line {number} holds {len(row)} values, expected {n_columns}")
     try:
-        values = np.array(rows, dtype=float).reshape(count, n_columns)
-    except ValueError as error:
-        raise ContactDumpError(f"{source}: a contact line is not numeric ({error})") from None
+        values = np.array([row for _, row in numbered], dtype=float).reshape(count, n_columns)
+    except ValueError:
+        # numpy's message quotes the value: the place is found again, row by row
+        found = next((f"line {number}, column {place}" for number, row in numbered if (place := first_not_read(row))),
+                     "a value")
+        raise ContactDumpError(f"{source}: {found} is not a number") from None
     if not np.all(np.isfinite(values)):
-        raise ContactDumpError(f"{source}: non-finite values in the contacts")
+        row, column = (int(index[0]) for index in np.nonzero(~np.isfinite(values)))
+        raise ContactDumpError(f"{source}: line {numbered[row][0]}, column {column + 1} is not finite")
     return step, values
 
 

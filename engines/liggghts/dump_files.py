@@ -12,7 +12,9 @@ run's folder) and reads what it made: the files ``<head><step><tail>`` in step o
 LIGGGHTS writes beside VTK dumps, ``siloboundingBox_<step>.vtk`` for ``silo*.vtk``, never match, as their names hold
 more than digits where the ``*`` is), or the one file. Each file is read by :func:`engines.liggghts.dumps.read_file_frames` (legacy VTK 4.2 or 5.1, ASCII or
 binary, or text ``dump custom``, told apart by its first line); a VTK file's step is the number its name gives.
-A pattern with ``%`` (one file per processor) is refused: siloflow reads whole frames.
+A pattern with ``%`` (one file per processor) is refused: siloflow reads whole frames. So is a pattern that names or
+matches anything but a regular file (a folder, or a link to a device or a pipe: ``/dev/zero`` never ends), when the
+files are listed, before any is opened.
 
 All quantities are SI: metres, seconds, kilograms.
 """
@@ -26,6 +28,7 @@ from pathlib import Path, PurePosixPath
 
 from analysis.data.existing_run import ExistingRunError
 from analysis.data.frames import ParticleFrame
+from analysis.data.file_messages import not_regular
 from engines.interface import DumpFile
 from engines.liggghts.dumps import PerType, dump_format, readable_frames
 
@@ -63,6 +66,15 @@ def check_dump_pattern(pattern: str) -> None:
         raise ExistingRunError("dumps", f"{pattern!r}: the '*' (the step) belongs in the file name, not a folder")
 
 
+def _regular(pattern: str, folder: Path, entry: Path, relative: PurePosixPath) -> None:
+    """Refuse an ``entry`` of the pattern that is no regular file (:func:`analysis.data.file_messages.not_regular`), naming
+    it by ``relative``, its path in ``folder``."""
+    refused = not_regular(entry)
+    if refused is not None:
+        matches = f"{pattern!r} matches " if "*" in pattern else ""
+        raise ExistingRunError("dumps", f"{matches}{str(relative)!r} in {str(folder)!r}: {refused}")
+
+
 def match_dump_files(folder: str | os.PathLike, pattern: str) -> list[DumpFile]:
     """The dump files a LIGGGHTS dump file name made in a run's folder, in step order.
 
@@ -82,8 +94,8 @@ def match_dump_files(folder: str | os.PathLike, pattern: str) -> list[DumpFile]:
     Raises
     ------
     ExistingRunError
-        Key ``folder`` when the folder does not exist or is no folder; key ``dumps`` when the pattern is refused or
-        matches no file.
+        Key ``folder`` when the folder does not exist or is no folder; key ``dumps`` when the pattern is refused,
+        matches no file, or names or matches something that is no regular file (a folder, a device, a pipe).
     """
     check_dump_pattern(pattern)
     folder = Path(folder)
@@ -95,15 +107,18 @@ def match_dump_files(folder: str | os.PathLike, pattern: str) -> list[DumpFile]:
     name = relative.name
     if "*" not in name:
         path = where / name
-        if not path.is_file():
+        if not os.path.lexists(path):
             raise ExistingRunError("dumps", f"no file {pattern!r} in {str(folder)!r}")
+        _regular(pattern, folder, path, relative)
         return [DumpFile(path, None)]
     head, _, tail = name.partition("*")
     step_name = re.compile(re.escape(head) + r"([0-9]+)" + re.escape(tail))
     found = []
     if where.is_dir():
         found = [(int(match.group(1)), entry) for entry in where.iterdir()
-                 if (match := step_name.fullmatch(entry.name)) and entry.is_file()]
+                 if (match := step_name.fullmatch(entry.name))]
+    for _, entry in sorted(found):  # in step order, so that the first refused is the same on every system
+        _regular(pattern, folder, entry, relative.parent / entry.name)
     if not found:
         raise ExistingRunError("dumps", f"no file matches {pattern!r} in {str(folder)!r} ('*' stands for the step, "
                                         "as in the dump command)")

@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from analysis.data.file_messages import refuse_irregular, unreadable
 from engines.liggghts.dump_text import FIRST_LINE, CustomDumpSnapshot, parse_custom_dump, read_custom_dump
 from engines.liggghts.vtk_legacy import DumpFormatError, parse_legacy_vtk_polydata, parse_legacy_vtk_views
 
@@ -281,9 +282,19 @@ def dump_format(path: str | os.PathLike) -> str:
     str
         ``"vtk"`` (legacy VTK: its step is in its name), ``"text"`` (``dump custom``: its steps are in it) or
         ``"other"`` (neither; :func:`read_file_frames` says why it refuses it).
+
+    Raises
+    ------
+    DumpFormatError
+        Naming the file: no regular file (a folder, a device, a pipe), or one that cannot be read.
     """
-    with open(path, "rb") as handle:
-        head = handle.read(64)
+    # a folder cannot be read, a device (/dev/zero) never ends and a named pipe may never begin
+    refuse_irregular(path, DumpFormatError)
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(64)
+    except OSError as error:
+        raise DumpFormatError(f"{path}: {unreadable(error)}") from None
     if head.startswith(_VTK_MAGIC):
         return "vtk"
     if head.startswith(FIRST_LINE.encode()):
@@ -354,15 +365,20 @@ def read_file_frames(
     Raises
     ------
     DumpFormatError
-        When the dump is malformed or in neither format (the message names the file).
+        When the file is no regular file (refused before it is opened) or cannot be read, or the dump is malformed
+        or in neither format (the message names the file and the place, never what the file holds there).
     ValueError
         When ``timestep`` is not a finite positive number, a VTK file's name has no step and none is given, or
         the mass arguments are wrong (:func:`frame_from_arrays`).
     """
     path = Path(path)
     timestep = _check_timestep(timestep)
+    refuse_irregular(path, DumpFormatError)
     # The file's bytes: the VTK parser's arrays are views into them, and the frame's arrays the one copy.
-    content = np.fromfile(path, dtype=np.uint8)
+    try:
+        content = np.fromfile(path, dtype=np.uint8)
+    except OSError as error:
+        raise DumpFormatError(f"{path}: {unreadable(error)}") from None
     head = bytes(content[:64])
     masses = {"density": density, "sphere_mass": sphere_mass}
     if head.startswith(_VTK_MAGIC):
@@ -377,18 +393,18 @@ def read_file_frames(
     if head.startswith(FIRST_LINE.encode()):
         if step is not None:
             raise ValueError(f"{path}: a text dump holds its own steps; do not pass step")
+        # a snapshot is named by its place in the file: its step is a number the file holds
         return [
-            frame_from_arrays(snapshot.arrays, snapshot.step, snapshot.step * timestep, source=f"{path} (step "
-                              f"{snapshot.step})", **masses)
-            for snapshot in parse_custom_dump(content.tobytes(), str(path))
+            frame_from_arrays(snapshot.arrays, snapshot.step, snapshot.step * timestep,
+                              source=f"{path} (snapshot {number})", **masses)
+            for number, snapshot in enumerate(parse_custom_dump(content.tobytes(), str(path)), start=1)
         ]
     if head.lstrip().startswith(_XML_MAGIC):
         raise DumpFormatError(f"{path}: an XML VTK file; siloflow reads legacy VTK (dump custom/vtk to a .vtk file) "
                               "and text dump custom")
     if not head:
         raise DumpFormatError(f"{path}: the file is empty")
-    first = head.split(b"\n", 1)[0][:40]
-    raise DumpFormatError(f"{path}: not a LIGGGHTS particle dump: the first line {first!r} starts neither legacy VTK "
+    raise DumpFormatError(f"{path}: not a LIGGGHTS particle dump: its first line starts neither legacy VTK "
                           f"({_VTK_MAGIC.decode()!r}) nor a text dump custom ({FIRST_LINE!r})")
 
 
@@ -423,8 +439,7 @@ def read_frame(
     """
     frames = read_file_frames(path, timestep, density=density, sphere_mass=sphere_mass, step=step)
     if len(frames) != 1:
-        raise DumpFormatError(f"{path}: holds {len(frames)} snapshots (steps {frames[0].step} to {frames[-1].step}); "
-                              "read them with read_file_frames")
+        raise DumpFormatError(f"{path}: holds {len(frames)} snapshots; read them with read_file_frames")
     return frames[0]
 
 

@@ -42,7 +42,7 @@ from engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from engines.liggghts.cost import measured_work as work_from_logs
-from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs
+from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs, check_programs
 from engines.liggghts.settled import read_settled_fill
 from engines.cases.silo_flat import FLOOR_MESHES
 from engines.liggghts.silo_flat import run_silo, write_silo_inputs
@@ -137,6 +137,10 @@ class LiggghtsEngine(Engine):
                     f"which requires {MIN_RESTITUTION} < e <= 1 ({adapter.kind} run {case.run_id}); raise it (the study "
                     "found bulk behaviour insensitive to restitution) or run this case on another engine"
                 )
+
+    def check_installed(self, options: EngineOptions) -> None:
+        check_programs(str(dict(options.settings or {}).get("executable", "liggghts")), options.mpi_ranks,
+                       options.mpirun)
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
         self.check_case(case)

@@ -17,7 +17,8 @@ Silo-type runs (flat-bottom silo, recirculating silo, blender)
     replaces the rows after its restart step (the trajectory the run went on with) and the rows before it come
     from the earlier files; a file's sample at its own restart step is dropped. A killed attempt may have cut
     its last line: in a file that a later one supersedes, an unreadable last line is ignored; anything else
-    that is not well formed is an error naming the file and line.
+    that is not well formed is an error naming the file, the line (and column) and what was expected there, never
+    what the file holds (:mod:`analysis.data.file_messages`).
 
 Jenike shear cell
     The deck writes ``<run>/forces.txt`` in the engines' one Jenike format (:mod:`engines.jenike_checks`, read
@@ -38,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.data.forces import WallForceHistory
+from analysis.data.file_messages import first_not_read
 from engines.jenike_checks import jenike_wall_forces, read_jenike_force_history
 from engines.liggghts.jenike import FORCES_NAME
 from engines.liggghts.run import WALL_FORCES_NAME
@@ -73,11 +75,15 @@ def _header_walls(path: Path, number: int, line: str) -> tuple[str, ...]:
         group = columns[start:start + len(QUANTITIES)]
         matches = [_WALL_COLUMN.match(column) for column in group]
         wall = matches[0].group(1) if matches[0] else None
+        # columns are named by their place (TimeStep is column 1): their names are the file's text
+        place = f"columns {start + 2} to {start + 1 + len(QUANTITIES)}"
         if any(m is None or m.group(1) != wall or m.group(2) != q for m, q in zip(matches, QUANTITIES)):
-            raise ValueError(f"{path}: line {number}: columns {' '.join(group)} are not v_<wall>_"
+            raise ValueError(f"{path}: line {number}: {place} are not v_<wall>_"
                              f"{', v_<wall>_'.join(QUANTITIES)} of one wall")
         if wall in walls:
-            raise ValueError(f"{path}: line {number} names wall {wall!r} twice")
+            earlier = 2 + len(QUANTITIES) * walls.index(wall)
+            raise ValueError(f"{path}: line {number}: {place} name the wall of columns {earlier} to "
+                             f"{earlier + len(QUANTITIES) - 1} again")
         walls.append(wall)
     return tuple(walls)
 
@@ -127,14 +133,14 @@ def read_wall_force_file(path: str | Path, cut_last_line_allowed: bool = False,
         timestep = math.nan
     if not (timestep > 0 and math.isfinite(timestep)):
         raise ValueError(f"{path}: line {title_number} is not the title 'siloflow wall forces, time step <dt> s' "
-                         f"with a positive time step: {title[:80]!r}")
+                         "with a positive time step")
     if not header.startswith("#") or header[1:].split()[:1] != ["TimeStep"]:
-        raise ValueError(f"{path}: line {header_number} is not the column header '# TimeStep v_<wall>_fx ...': "
-                         f"{header[:80]!r}")
+        raise ValueError(f"{path}: line {header_number} is not the column header '# TimeStep v_<wall>_fx ...'")
     walls = _header_walls(path, header_number, header)
     width = len(QUANTITIES) * len(walls)
     steps, rows = [], []
     last = numbered[-1][0]
+    previous = header_number  # the line of the last sample read
     for number, text in numbered[2:]:
         try:
             step, values = _data_row(path, number, text, 1 + width)
@@ -143,9 +149,10 @@ def read_wall_force_file(path: str | Path, cut_last_line_allowed: bool = False,
                 break
             raise
         if steps and step <= steps[-1]:
-            raise ValueError(f"{path}: line {number}: step {step} does not follow step {steps[-1]}")
+            raise ValueError(f"{path}: line {number}: the step does not follow the step of line {previous}")
         steps.append(step)
         rows.append(values)
+        previous = number
     return timestep, walls, np.array(steps, dtype=np.int64), np.array(rows, dtype=float).reshape(-1, width)
 
 
@@ -157,10 +164,12 @@ def _data_row(path: Path, number: int, text: str, expected: int) -> tuple[int, l
     try:
         step = int(fields[0])
         values = [float(field) for field in fields[1:]]
-    except ValueError:
-        raise ValueError(f"{path}: line {number} is not numeric: {text[:80]!r}") from None
+    except ValueError:  # its message quotes the field: the message gives the field's place
+        if first_not_read(fields[:1], int) is not None:
+            raise ValueError(f"{path}: line {number}, column 1 is not a step (an integer)") from None
+        raise ValueError(f"{path}: line {number}, column {first_not_read(fields[1:]) + 1} is not a number") from None
     if not all(np.isfinite(values)):
-        raise ValueError(f"{path}: line {number} holds a non-finite value: {text[:80]!r}")
+        raise ValueError(f"{path}: line {number}, column {int(np.argmin(np.isfinite(values))) + 2} is not finite")
     return step, values
 
 
@@ -205,8 +214,8 @@ def read_silo_wall_forces(run_dir: str | Path) -> WallForceHistory:
         if first is None:
             first = (timestep, walls)
         elif (timestep, walls) != first:
-            raise ValueError(f"{path}: time step {timestep!r} s and walls {list(walls)} differ from those of "
-                             f"{WALL_FORCES_NAME}: {first[0]!r} s, {list(first[1])}")
+            raise ValueError(f"{path}: its time step or walls (title and column header) differ from those of "
+                             f"{WALL_FORCES_NAME}")
         keep = np.ones(steps.shape, dtype=bool)
         if start is not None:
             keep &= steps > start

@@ -81,18 +81,25 @@ def restart_every(stage_steps: int) -> int:
 # ---------------------------------------------------------------------------------------------- running
 
 
+def check_programs(executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun") -> None:
+    """Refuse (EngineNotFound, naming the config key) a LIGGGHTS executable, or an MPI launcher when ``mpi_ranks``
+    > 1, that is not an executable file on PATH or at the path given."""
+    if shutil.which(executable) is None:
+        raise EngineNotFound(
+            f"config key 'engine.liggghts.executable': LIGGGHTS executable '{executable}' is not an executable on "
+            "PATH or at that path; install it with `make install` (Debian package liggghts) or give its path"
+        )
+    if mpi_ranks > 1 and shutil.which(mpirun) is None:
+        raise EngineNotFound(f"config key 'engine.mpirun': MPI launcher '{mpirun}' (engine.mpi_ranks is {mpi_ranks}) is "
+                             "not an executable on PATH or at that path; install openmpi-bin or give its path")
+
+
 def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
                    log_name: str = LOG_NAME) -> list[str]:
     """Command line of one engine run, serial or under MPI (no shell involved)."""
-    if shutil.which(executable) is None:
-        raise EngineNotFound(
-            f"LIGGGHTS executable '{executable}' not found on PATH; install it with `make install` "
-            "(Debian package liggghts) or set engine.executable in the config"
-        )
+    check_programs(executable, mpi_ranks, mpirun)
     command = [executable, "-in", deck, "-log", log_name]
     if mpi_ranks > 1:
-        if shutil.which(mpirun) is None:
-            raise EngineNotFound(f"MPI launcher '{mpirun}' not found; install openmpi-bin or set engine.mpirun")
         command = [mpirun, "-np", str(mpi_ranks), "--oversubscribe", *command]
     return command
 

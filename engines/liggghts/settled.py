@@ -60,8 +60,8 @@ def read_settled_spheres(path: str | Path, timestep: float) -> tuple[ParticleFra
     path = Path(path)
     text = path.read_text(encoding="utf-8", errors="replace")
     header = next((line.split()[2:] for line in text.splitlines() if line.startswith("ITEM: ATOMS")), None)
-    if header is None or tuple(header) != SETTLED_COLUMNS:
-        raise ContactDumpError(f"{path}: columns {header} are not the settled fill's {list(SETTLED_COLUMNS)}")
+    if header is None or tuple(header) != SETTLED_COLUMNS:  # the file's columns are not quoted: any text may be there
+        raise ContactDumpError(f"{path}: no 'ITEM: ATOMS' line of the settled fill's columns {list(SETTLED_COLUMNS)}")
     step, table = parse_local_table(text, len(SETTLED_COLUMNS), str(path), "NUMBER OF ATOMS", "ATOMS")
     column = {name: table[:, index] for index, name in enumerate(SETTLED_COLUMNS)}
     # the arrays of a particle dump, so that the one reader rule (free spheres, clump ids) applies

@@ -41,9 +41,11 @@ dump. ASCII files put empty lines between some sections; they are skipped.
 
 :func:`parse_legacy_vtk_polydata` reads that layout and nothing else: another VTK version, another dataset,
 SCALARS/VECTORS attributes, CELL_DATA, METADATA or any other section raises :class:`DumpFormatError` naming the
-file and what was found. Its one latitude: 5.1's CONNECTIVITY may also be ``vtkIdType`` (4 bytes), as newer VTK
-releases (9.7, the one pyvista ships) write it; the vertex cells are checked for their counts and skipped, since a
-sphere is its point.
+file, the place (line or byte) and what was expected there. A message never quotes what the file holds there (a
+configuration may point the reader at any file, :mod:`analysis.data.file_messages`): no line, no word, no value, no count
+it declares; a section, a dataset, a field or a data type is named only when it is one VTK or LIGGGHTS names. Its one
+latitude: 5.1's CONNECTIVITY may also be ``vtkIdType`` (4 bytes), as newer VTK releases (9.7, the one pyvista ships)
+write it; the vertex cells are checked for their counts and skipped, since a sphere is its point.
 
 Why a hand-written parser, and not ``pyvista.read``
 ---------------------------------------------------
@@ -54,8 +56,8 @@ Why a hand-written parser, and not ``pyvista.read``
   files and from the ASCII 4.2 one, and 40 points with no array from the ASCII 5.1 one; cut in half, 4 of the 7
   arrays (``v`` partly made up) from both binary files and no array from both ASCII ones: always with a log
   message and no exception. A run killed while dumping leaves exactly such a file. This parser raises
-  :class:`DumpFormatError` naming the file, the field and the counts (``silo_4000.vtk: POINTS declares 1600 points
-  but the file ends after 812``).
+  :class:`DumpFormatError` naming the file, the field and how much of it there is (``silo_4000.vtk: POINTS
+  declares more points than the file holds: it ends after 812``).
 - Speed is neither the reason nor a cost for the binary 5.1 files siloflow's own decks write: ``make bench``
   (``tests/bench/bench_dumps.py``, 500,000 spheres) timed parsing alone at 0.88-1.15 times ``pyvista.read``'s time,
   and the binary 4.2 path is the same code. On a 500,000-sphere ASCII 5.1 dump of the silo decks' fields (61 MB;
@@ -69,6 +71,8 @@ All quantities are SI: metres, seconds, kilograms, newtons, radians.
 from __future__ import annotations
 
 import numpy as np
+
+from analysis.data.file_messages import first_not_read
 
 __all__ = ["DumpFormatError", "SUPPORTED_VERSIONS", "parse_legacy_vtk_polydata", "parse_legacy_vtk_views"]
 
@@ -95,6 +99,26 @@ _LEGACY_CELL_DTYPE = np.dtype(">i4")
 _NEWLINE = ord("\n")
 _CUT = " (and a last line without its newline, cut short)"
 _LINE_WINDOW = 256  # bytes searched at a time for the end of a keyword line
+#: Names a message may give, as the reader knows them (any other word is the file's text): the legacy format's
+#: sections and datasets, its data types, and the point-data arrays LIGGGHTS writes.
+_SECTIONS = frozenset(("POINTS", "VERTICES", "LINES", "POLYGONS", "TRIANGLE_STRIPS", "OFFSETS", "CONNECTIVITY",
+                       "POINT_DATA", "CELL_DATA", "FIELD", "SCALARS", "COLOR_SCALARS", "LOOKUP_TABLE", "VECTORS",
+                       "NORMALS", "TEXTURE_COORDINATES", "TENSORS", "METADATA", "INFORMATION", "DATASET"))
+_DATASETS = frozenset(("STRUCTURED_POINTS", "STRUCTURED_GRID", "RECTILINEAR_GRID", "UNSTRUCTURED_GRID", "POLYDATA",
+                       "FIELD"))
+_DATA_TYPES = frozenset(("bit", "unsigned_char", "char", "unsigned_short", "short", "unsigned_int", "int",
+                         "unsigned_long", "long", "float", "double", "vtkIdType", "vtktypeint64", "vtktypeuint64",
+                         "string"))
+_FIELDS = frozenset(("id", "type", "id_multisphere", "mass", "v", "f", "omega", "radius", "density"))
+
+
+def _known(word: str, names: frozenset) -> str | None:
+    """``word`` when ``names`` holds it (then a message may give it), else None."""
+    return word if word in names else None
+
+
+def _words(count: int) -> str:
+    return f"{count} word{'' if count == 1 else 's'}"
 
 
 class _Reader:
@@ -105,6 +129,7 @@ class _Reader:
         self.size = self.data.size
         self.source = source
         self.pos = 0
+        self.place = "byte 0"  # where the last line read starts, for messages
 
     def error(self, message: str) -> DumpFormatError:
         return DumpFormatError(f"{self.source}: {message}")
@@ -128,8 +153,9 @@ class _Reader:
         return bytes(self.data[start:end])
 
     def line(self, expected: str) -> list[str]:
-        """Tokens of the next line; ``expected`` describes it in error messages."""
+        """Tokens of the next line; ``expected`` describes it in error messages, :attr:`place` says where it was."""
         start = self.pos
+        self.place = f"byte {start}"
         if start >= self.size:
             raise self.error(f"the file ends where {expected} was expected")
         try:
@@ -151,10 +177,8 @@ class _Reader:
         nbytes = count * dtype.itemsize
         available = max(self.size - self.pos, 0)
         if available < nbytes:
-            raise self.error(
-                f"{what} declares {count // unit} {unit_name} but the file ends after "
-                f"{available // dtype.itemsize // unit}"
-            )
+            raise self.error(f"{what} declares more {unit_name} than the file holds: it ends after "
+                             f"{available // dtype.itemsize // unit}")
         values = np.frombuffer(self.data, dtype=dtype, count=count, offset=self.pos)
         self.pos += nbytes
         # The writer ends every array with a newline; anything else means the declared count is wrong.
@@ -165,8 +189,7 @@ class _Reader:
         return values
 
     def unexpected_content(self) -> DumpFormatError:
-        found = bytes(self.data[self.pos : self.pos + 40])
-        return self.error(f"unexpected content at byte {self.pos} after the last section: {found!r}")
+        return self.error(f"unexpected content at byte {self.pos} after the last section")
 
 
 class _AsciiReader:
@@ -181,6 +204,7 @@ class _AsciiReader:
         self.first_line = bytes(reader.data[: reader.pos]).count(b"\n") + 1  # for line numbers in messages
         self.lines = bytes(reader.data[reader.pos :]).split(b"\n")
         self.index = 0
+        self.place = f"line {self.first_line}"  # the last line read, for messages
         # VTK ends every line with a newline: a last line without one is a cut file's, whose last value may be a
         # number cut short, and is not read
         self.cut = self.lines.pop() != b""
@@ -203,6 +227,7 @@ class _AsciiReader:
         if self.at_end():
             raise self.error(f"the file ends where {expected} was expected{_CUT if self.cut else ''}")
         number = self.line_number()
+        self.place = f"line {number}"
         try:
             tokens = self.lines[self.index].decode("ascii").split()
         except UnicodeDecodeError:
@@ -230,32 +255,28 @@ class _AsciiReader:
         tokens = []
         while len(tokens) < count:
             if self.at_end():
-                raise self.error(f"{what} declares {count // unit} {unit_name} but the file ends after "
+                raise self.error(f"{what} declares more {unit_name} than the file holds: it ends after "
                                  f"{len(tokens) // unit}{_CUT if self.cut else ''}")
             words = self.lines[self.index].split()
             if not _is_number(words[0]):
-                raise self.error(f"{what} declares {count // unit} {unit_name} but holds {len(tokens) // unit} "
-                                 f"before line {self.line_number()} ({self.lines[self.index][:40]!r})")
+                raise self.error(f"{what} declares more {unit_name} than it holds: {len(tokens) // unit} before line "
+                                 f"{self.line_number()}, which does not start with a number")
             if len(tokens) + len(words) > count:
-                raise self.error(f"{what}: line {self.line_number()} holds values beyond the declared "
-                                 f"{count // unit} {unit_name}")
+                raise self.error(f"{what}: line {self.line_number()} holds values beyond the {unit_name} it "
+                                 "declares")
             tokens.extend(words)
             self.index += 1
         try:
             return _convert(tokens, dtype)
         except (ValueError, OverflowError):
             kind = "an integer" if dtype.kind in "iu" else "a number"
-            for position, token in enumerate(tokens):
-                try:
-                    _convert([token], dtype)
-                except (ValueError, OverflowError):
-                    raise self.error(f"{what}: value {position} ({token.decode('ascii', 'replace')!r}) is not "
-                                     f"{kind} of type {dtype.name}") from None
-            raise
+            position = first_not_read(tokens, int if dtype.kind in "iu" else float)
+            if position is not None:  # counted from 0, as the points and tuples are
+                raise self.error(f"{what}: value {position - 1} is not {kind} of type {dtype.name}") from None
+            raise self.error(f"{what}: a value is not {kind} of type {dtype.name}") from None
 
     def unexpected_content(self) -> DumpFormatError:
-        line = self.lines[self.index][:40]
-        return self.error(f"unexpected content at line {self.line_number()} after the last section: {line!r}")
+        return self.error(f"unexpected content at line {self.line_number()} after the last section")
 
 
 def _is_number(token: bytes) -> bool:
@@ -272,77 +293,80 @@ def _convert(tokens: list[bytes], dtype: np.dtype) -> np.ndarray:
     return np.fromiter(map(convert, tokens), dtype=dtype, count=len(tokens))
 
 
-def _count(token: str, what: str, reader) -> int:
+def _count(token: str, what: str, reader, which: str = "its count") -> int:
+    """The count ``token`` of the line of ``what``; ``which`` names it in messages (the token is the file's)."""
     try:
         value = int(token)
     except ValueError:
-        raise reader.error(f"{what}: {token!r} is not an integer") from None
+        raise reader.error(f"{what} ({reader.place}): {which} is not an integer") from None
     if value < 0:
-        raise reader.error(f"{what}: negative count {value}")
+        raise reader.error(f"{what} ({reader.place}): {which} is negative")
     return value
 
 
 def _expect(tokens: list[str], keyword: str, form: str, reader) -> None:
     """Check that a line is ``form`` (its first word ``keyword``, as many words as ``form``)."""
     if tokens[0] != keyword and _is_number(tokens[0].encode()):
-        raise reader.error(f"more values ({' '.join(tokens)[:40]!r}) where {form!r} was expected: the data hold more "
-                           "than the count declared before them")
+        raise reader.error(f"more values ({reader.place}) where '{form}' was expected: the data hold more than the "
+                           "count declared before them")
     if tokens[0] != keyword:
-        raise reader.error(f"unknown or unsupported section {tokens[0]!r} where {form!r} was expected")
+        section = _known(tokens[0], _SECTIONS)
+        found = f"unsupported section {section}" if section else "unknown section"
+        raise reader.error(f"{found} ({reader.place}) where '{form}' was expected")
     if len(tokens) != len(form.split()):
-        raise reader.error(f"malformed line {' '.join(tokens)!r}, expected {form!r}")
+        raise reader.error(f"malformed line ({reader.place}): {_words(len(tokens))}, expected '{form}'")
 
 
 def _check_finite(values: np.ndarray, what: str, reader, per: int) -> None:
     finite = np.isfinite(values)
     if not finite.all():
         first = int(np.argmin(finite))
-        raise reader.error(f"{what} contains a non-finite value ({float(values[first])!r}) at point {first // per}")
+        raise reader.error(f"{what} contains a non-finite value at point {first // per}")
 
 
 def _read_header(reader: _Reader) -> tuple[str, bool]:
-    """The version (``"4.2"`` or ``"5.1"``) and whether the file is ASCII."""
+    """The version (``"4.2"`` or ``"5.1"``) and whether the file is ASCII; the header is lines 1 to 4."""
     version_line = reader.raw_line().rstrip(b"\r")
     if not version_line.startswith(_VERSION_PREFIX):
-        raise reader.error(f"not a legacy VTK file (first line {version_line[:40]!r})")
+        raise reader.error(f"not a legacy VTK file (line 1 does not start with {_VERSION_PREFIX.decode()!r})")
     version = version_line[len(_VERSION_PREFIX) :].decode("ascii", "replace").strip()
     if version not in SUPPORTED_VERSIONS:
         raise reader.error(
-            f"{version_line.decode('ascii', 'replace')!r}: siloflow reads legacy VTK versions "
+            f"line 1: a legacy VTK version siloflow does not read; it reads versions "
             f"{' and '.join(SUPPORTED_VERSIONS)} (what LIGGGHTS writes when built against VTK 8 or VTK 9)"
         )
     reader.raw_line()  # the free title line
     file_format = reader.line("BINARY or ASCII")
     if file_format not in (["BINARY"], ["ASCII"]):
-        raise reader.error(f"file format {' '.join(file_format)!r}, expected BINARY or ASCII")
+        raise reader.error("line 3: the file format is neither BINARY nor ASCII")
     dataset = reader.line("'DATASET POLYDATA'")
     if dataset[0] != "DATASET" or len(dataset) != 2:
-        raise reader.error(f"expected 'DATASET POLYDATA', found {' '.join(dataset)!r}")
+        raise reader.error("line 4: expected 'DATASET POLYDATA'")
     if dataset[1] != "POLYDATA":
-        raise reader.error(f"dataset is {dataset[1]}, not POLYDATA (a bounding-box file?)")
+        named = _known(dataset[1], _DATASETS)
+        raise reader.error(f"line 4: the dataset is {named or 'an unknown one'}, not POLYDATA (a bounding-box file?)")
     return version, file_format == ["ASCII"]
 
 
 def _skip_vertices(n_points: int, version: str, reader) -> None:
     """Check the one-vertex-per-point cell section; its arrays are skipped (a sphere is its point)."""
     tokens = reader.line("a VERTICES line")
+    # the counts are the file's: the messages say how they should relate, not what they are
     if version == "4.2":
         _expect(tokens, "VERTICES", "VERTICES n_cells size", reader)
         if tokens[1:] != [str(n_points), str(2 * n_points)]:
-            raise reader.error(
-                f"{' '.join(tokens)!r}: expected 'VERTICES {n_points} {2 * n_points}' (one vertex per point)"
-            )
+            raise reader.error(f"VERTICES ({reader.place}): expected 'VERTICES n 2n' for the n points of POINTS (one "
+                               "vertex per point)")
         cells = reader.array(2 * n_points, _LEGACY_CELL_DTYPE, "VERTICES", unit=2, unit_name="cells")
         sizes = cells[0::2]
         if np.any(sizes != 1):
             first = int(np.argmax(sizes != 1))
-            raise reader.error(f"VERTICES: cell {first} has {sizes[first]} points, expected one vertex per point")
+            raise reader.error(f"VERTICES: cell {first} is not a single vertex, expected one vertex per point")
         return
     _expect(tokens, "VERTICES", "VERTICES n_offsets n_connectivity", reader)
     if tokens[1:] != [str(n_points + 1), str(n_points)]:
-        raise reader.error(
-            f"{' '.join(tokens)!r}: expected 'VERTICES {n_points + 1} {n_points}' (one vertex per point)"
-        )
+        raise reader.error(f"VERTICES ({reader.place}): expected 'VERTICES n+1 n' for the n points of POINTS (one "
+                           "vertex per point)")
     for keyword, count, dtypes in (
         ("OFFSETS", n_points + 1, _OFFSETS_DTYPES), ("CONNECTIVITY", n_points, _CONNECTIVITY_DTYPES)
     ):
@@ -350,40 +374,45 @@ def _skip_vertices(n_points: int, version: str, reader) -> None:
         _expect(tokens, keyword, f"{keyword} type", reader)
         dtype = dtypes.get(tokens[1])
         if dtype is None:
-            raise reader.error(f"VERTICES {keyword} have type {tokens[1]!r}, expected one of {sorted(dtypes)}")
+            raise reader.error(f"VERTICES {keyword} ({reader.place}) have a type other than "
+                               f"{' or '.join(sorted(dtypes))}")
         values = reader.array(count, dtype, f"VERTICES {keyword}")
         if keyword == "OFFSETS" and [values[0], values[-1]] != [0, n_points]:
-            raise reader.error(f"VERTICES OFFSETS run from {values[0]} to {values[-1]}, not from 0 to {n_points}")
+            raise reader.error("VERTICES OFFSETS do not run from 0 to the number of points")
 
 
 def _read_point_data(n_points: int, reader) -> dict[str, np.ndarray]:
     tokens = reader.line("'POINT_DATA n'")
     _expect(tokens, "POINT_DATA", "POINT_DATA n", reader)
-    declared = _count(tokens[1], "POINT_DATA", reader)
+    declared = _count(tokens[1], "POINT_DATA", reader, "its number of points")
     if declared != n_points:
-        raise reader.error(f"POINT_DATA declares {declared} points but POINTS has {n_points}")
+        raise reader.error(f"POINT_DATA ({reader.place}) declares another number of points than POINTS")
     tokens = reader.line("'FIELD FieldData k'")
     _expect(tokens, "FIELD", "FIELD FieldData n_arrays", reader)
     if tokens[1] != "FieldData":
-        raise reader.error(f"{' '.join(tokens)!r}: expected 'FIELD FieldData n_arrays'")
+        raise reader.error(f"FIELD ({reader.place}): expected 'FIELD FieldData n_arrays'")
     arrays: dict[str, np.ndarray] = {}
-    for _ in range(_count(tokens[2], "FIELD", reader)):
+    for number in range(1, _count(tokens[2], "FIELD", reader, "its number of arrays") + 1):
         line = reader.line("a FIELD array line 'name n_components n_tuples type'")
         if len(line) != 4:
-            raise reader.error(f"malformed line {' '.join(line)!r}, expected 'name n_components n_tuples type'")
+            raise reader.error(f"malformed line ({reader.place}): {_words(len(line))}, expected 'name n_components "
+                               "n_tuples type'")
         name, components, tuples, vtk_type = line
-        what = f"field {name!r}"
+        # the name is the file's: given when LIGGGHTS writes it, else the array's place
+        what = f"field {name!r}" if _known(name, _FIELDS) else f"FIELD array {number}"
         if name == "points" or name in arrays:
-            raise reader.error(f"point-data array name {name!r} occurs twice or is reserved")
-        n_components = _count(components, what, reader)
+            raise reader.error(f"{what} ({reader.place}) repeats the name of an earlier array, or names the points")
+        n_components = _count(components, what, reader, "its number of components")
         if n_components < 1:
-            raise reader.error(f"{what} declares {n_components} components")
-        n_tuples = _count(tuples, what, reader)
+            raise reader.error(f"{what} ({reader.place}) declares no components")
+        n_tuples = _count(tuples, what, reader, "its number of tuples")
         if n_tuples != n_points:
-            raise reader.error(f"{what} has {n_tuples} tuples but the data section declares {n_points}")
+            raise reader.error(f"{what} ({reader.place}) declares another number of tuples than POINTS has points")
         dtype = _FIELD_DTYPES.get(vtk_type)
         if dtype is None:
-            raise reader.error(f"{what} has unknown data type {vtk_type!r} (LIGGGHTS writes int or double)")
+            named = _known(vtk_type, _DATA_TYPES)
+            kind = f"data type {named}" if named else "an unknown data type"
+            raise reader.error(f"{what} ({reader.place}) has {kind} (LIGGGHTS writes int or double)")
         values = reader.array(n_points * n_components, dtype, what, unit=n_components, unit_name="tuples")
         if values.dtype.kind == "f":
             _check_finite(values, what, reader, n_components)
@@ -402,9 +431,10 @@ def parse_legacy_vtk_views(content: bytes | np.ndarray, source: str = "<bytes>")
         reader = _AsciiReader(reader)
     tokens = reader.line("'POINTS n float'")
     _expect(tokens, "POINTS", "POINTS n float", reader)
-    n_points = _count(tokens[1], "POINTS", reader)
+    n_points = _count(tokens[1], "POINTS", reader, "its number of points")
     if tokens[2] != _POINTS_TYPE:
-        raise reader.error(f"POINTS have type {tokens[2]!r}, LIGGGHTS writes {_POINTS_TYPE!r}")
+        raise reader.error(f"POINTS ({reader.place}) have a type other than {_POINTS_TYPE!r}, the one LIGGGHTS "
+                           "writes")
     flat = reader.array(3 * n_points, _POINTS_DTYPE, "POINTS", unit=3, unit_name="points")
     _check_finite(flat, "POINTS", reader, 3)
     arrays = {"points": flat.reshape(n_points, 3)}

@@ -28,7 +28,7 @@ from engines.yade.blender import run_blender, write_blender_inputs
 from engines.yade.inputs import ENGINE_NAME
 from engines.yade.jenike import FORCES_NAME, check_jenike_case, jenike_contacts, run_jenike, write_jenike_inputs
 from engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
-from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs
+from engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs, check_programs
 from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
 from engines.yade.silo_recirculation import run_recirculation, write_recirculation_inputs
 from engines.yade.verification import run_verification, write_verification_inputs
@@ -80,6 +80,9 @@ class YadeEngine(Engine):
             Naming the config key and the limit.
         """
         _adapter(case)[3](case)
+
+    def check_installed(self, options: EngineOptions) -> None:
+        check_programs(options_from(options))
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
         self.check_case(case)

@@ -2,7 +2,9 @@
 
 The scripts write particle frames and the settled fill as numpy archives (``numpy.savez``: one array per quantity,
 read with ``numpy.load``) and the wall forces as a whitespace table with a ``# step time <wall>_fx ...`` title
-(read with ``numpy.loadtxt``), so no reader here parses bytes itself.
+(read with ``numpy.loadtxt``), so no reader here parses bytes itself. A message names the file, the place and what
+was expected there, never what the file holds: numpy's own messages quote it (the bytes of a damaged ``.npy`` header,
+the text of a row it could not convert), so they are not passed on (:mod:`analysis.data.file_messages`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from analysis.data.contacts import ContactFrame
 from analysis.data.forces import WallForceHistory
 from analysis.data.frames import ParticleFrame
 from analysis.data.settled import SettledFill
+from analysis.data.file_messages import first_not_read, unreadable
 from engines.yade.run import RESUME_STEM, WALL_FORCES_NAME, frame_files
 
 __all__ = ["DamagedOutput", "read_archive", "read_frame", "read_frames", "read_settled_fill", "read_wall_forces"]
@@ -31,8 +34,10 @@ def _archive(path: Path) -> dict:
     try:
         with np.load(path, allow_pickle=False) as archive:
             return {key: archive[key] for key in archive.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
-        raise DamagedOutput(f"{path}: not a readable numpy archive ({error})") from error
+    except OSError as error:
+        raise DamagedOutput(f"{path}: {unreadable(error)}") from None
+    except (ValueError, EOFError, zipfile.BadZipFile):
+        raise DamagedOutput(f"{path}: not a readable numpy archive") from None
 
 
 def read_archive(path: str | Path, required: tuple[str, ...]) -> dict:
@@ -89,8 +94,23 @@ def read_frames(run_dir: str | Path, prefix: str, on_damaged: str = "error") -> 
     return frames
 
 
+def _table_fault(lines: list[str], width: int) -> str:
+    """Where the first row that ``numpy.loadtxt`` refused is (lines from line 2, after the title), and why: its
+    message quotes the text it could not convert."""
+    for number, line in enumerate(lines, start=2):
+        words = line.split("#", 1)[0].split()  # loadtxt's comments and blank lines
+        if not words:
+            continue
+        if len(words) != width:
+            return f"line {number} holds {len(words)} values, expected {width}"
+        place = first_not_read(words)
+        if place is not None:
+            return f"line {number}, column {place} is not a number"
+    return "a value is not a number"
+
+
 def _wall_force_table(path: Path, tolerate_cut_line: bool) -> tuple[list[str], np.ndarray]:
-    with open(path, encoding="utf-8") as handle:
+    with open(path, encoding="utf-8", errors="replace") as handle:  # a codec's message quotes the byte
         title = handle.readline()
         lines = handle.read().splitlines()
     if not title.startswith("# step time "):
@@ -99,11 +119,14 @@ def _wall_force_table(path: Path, tolerate_cut_line: bool) -> tuple[list[str], n
     width = 2 + len(columns)
     if tolerate_cut_line and lines and len(lines[-1].split()) != width:
         lines = lines[:-1]  # the kill cut the last row of a superseded attempt
-    table = np.loadtxt(lines, ndmin=2) if lines else np.empty((0, width))
+    try:
+        table = np.loadtxt(lines, ndmin=2) if lines else np.empty((0, width))
+    except ValueError:
+        raise DamagedOutput(f"{path}: {_table_fault(lines, width)}") from None
     if table.shape[1] != width:
         raise DamagedOutput(f"{path}: rows of {table.shape[1]} columns under a title of {width}")
     if len(columns) % 6 or any(not c.endswith(tuple(f"_{q}" for q in _QUANTITIES)) for c in columns):
-        raise DamagedOutput(f"{path}: the columns {columns} are not six per wall")
+        raise DamagedOutput(f"{path}: the title's columns are not six per wall (<wall>_fx ... <wall>_tz)")
     walls = [columns[i].rsplit("_", 1)[0] for i in range(0, len(columns), 6)]
     return walls, table
 
@@ -132,7 +155,7 @@ def read_wall_forces(run_dir: str | Path, timestep: float) -> WallForceHistory:
         if walls is None:
             walls = names
         elif names != walls:
-            raise DamagedOutput(f"{path}: walls {names} differ from those of {first.name}: {walls}")
+            raise DamagedOutput(f"{path}: its walls (the title's columns) differ from those of {first.name}")
         for row in table:
             rows[int(row[0])] = row
     steps = sorted(rows)

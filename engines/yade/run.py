@@ -85,13 +85,20 @@ def _logs_text(run_dir: Path) -> str:
     return "\n".join(path.read_text(encoding="utf-8", errors="replace") for path in attempt_logs(run_dir))
 
 
-def script_command(options: YadeOptions, arguments: tuple[str, ...] = ()) -> list[str]:
-    """The command line of a run (no shell involved; the arguments are paths and step numbers siloflow made)."""
+def check_programs(options: YadeOptions) -> None:
+    """Refuse (EngineNotFound, naming the config key) a Python for YADE that is not an executable on PATH or at the
+    path given, or a machine without YADE's Python modules."""
     if shutil.which(options.python) is None:
-        raise EngineNotFound(f"Python 3 '{options.python}' for YADE not found; set engine.yade.python")
+        raise EngineNotFound(f"config key 'engine.yade.python': Python 3 '{options.python}' for YADE is not an "
+                             "executable on PATH or at that path; give the Python 3 that imports YADE (/usr/bin/python3)")
     if not Path(YADE_PYTHON_PATH, "yade").is_dir():
         raise EngineNotFound(f"YADE's Python modules are not in {YADE_PYTHON_PATH}; install YADE with `make install` "
                              "(Debian package yade, without recommends)")
+
+
+def script_command(options: YadeOptions, arguments: tuple[str, ...] = ()) -> list[str]:
+    """The command line of a run (no shell involved; the arguments are paths and step numbers siloflow made)."""
+    check_programs(options)
     return [options.python, f"deck/{DECK_NAME}", *arguments]
 
 

@@ -77,7 +77,11 @@ def _with(raw, path, value):
         (("engine", "mpi_ranks"), 1.5, "config key 'engine.mpi_ranks': 1.5 is not of type 'integer'"),
         (("silo_flat", "particle_model"), "sphere3", "config key 'silo_flat.particle_model': unknown particle model 'sphere3'; defined: sphere, sphere2, sphere4"),
         (("silo_flat", "wall_materials", "side"), "steel", "config key 'silo_flat.wall_materials.side': unknown material 'steel'"),
-        (("silo_flat", "widht"), 0.1, "config key 'silo_flat': Additional properties are not allowed ('widht' was unexpected)"),
+        (("silo_flat", "widht"), 0.1, "config key 'silo_flat.widht' is not a siloflow setting: did you mean "
+                                       "'silo_flat.width'? the keys here are beverloo, depth, discharge_time"),
+        (("silo_recirculation", "lti", "input_csv"), "in.csv", "config key 'silo_recirculation.lti.input_csv' is not a "
+         "siloflow setting: the keys here are passes, period_fractions, tolerance"),
+        (("jenike", "shear", "velocty"), 0.01, "did you mean 'jenike.shear.velocity'?"),
     ],
 )
 def test_bad_values_name_the_key(raw_default_config, path, value, expected):

@@ -1,19 +1,24 @@
 """Numbers bounded where an engine or the machine is: a value just beyond a bound is refused naming the key, within a
 second and before anything is written; the value at the bound is accepted, and where it is cheap to build, builds.
+No number of the default config set to an extreme (1e300, 1e-300, -1e300) overflows the planner or hangs it: each is
+accepted or refused with a ValueError, and values within their bounds that do not fit together are refused naming a key.
 """
 
 from __future__ import annotations
 
 import copy
+import signal
 import time
 
 import pytest
 
 from engines.cases import CASE_BUILDERS, cases_of
 from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
-from engines.cases.physics import MAX_STEPS, engine_seeds, steps_for
+from engines.cases.jenike_cell import segments_for_chord
+from engines.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
 from engines.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, ConfigError, load_config_file, load_schema, validate_config
+from engines.planning import config_estimates
 
 #: The bounds (schema maxima and minima): the largest seed, replicate count, MPI ranks, name length, and the
 #: smallest time step fraction and particle model scale.
@@ -27,6 +32,41 @@ SECTIONS = ("defaults", "silo_flat", "silo_recirculation", "blender", "jenike")
 REPLICATED_SECTIONS = SECTIONS[:-1]
 ON_YADE = {"silo_flat": {"engine": "yade"}}  # YADE's settings are refused unless a case runs on it
 
+#: The longest length of a case (m) and simulated time of a case (s): the schema's case_length and case_duration.
+LENGTH_MAX, DURATION_MAX = 100.0, 3600.0
+#: Every length of a case the engine builds or moves (case_length, and the tube width and ring offset, which may be 0).
+CASE_LENGTHS = [
+    ("defaults", "fill", "zone_height"),
+    *[("silo_flat", key) for key in ("width", "depth", "fill_height", "outlet_width", "sink_depth")],
+    *[("silo_recirculation", key) for key in ("width", "depth", "fill_height", "outlet_width", "channel_length")],
+    *[("silo_recirculation", "verification", key) for key in ("width", "depth", "fill_height")],
+    *[("blender", key) for key in ("width", "depth", "vertical_height", "outlet_width", "fill_height", "wall_thickness",
+                                   "tube_width", "sink_depth")],
+    *[("jenike", "cell", key) for key in ("inner_diameter", "wall_thickness", "bottom_ring_height",
+                                          "shear_ring_height", "initial_offset", "plate_size")],
+    ("jenike", "shear", "displacement"),
+    *[("cross_engine", key) for key in ("width", "fill_height", "outlet_width")],
+    *[("cross_engine", "jenike", key) for key in ("inner_diameter", "bottom_ring_height", "shear_ring_height",
+                                                  "shear_displacement")],
+]
+#: The lengths that validation requires to be less than another (the outlets of the sections whose silo width it knows).
+NARROWER = [("silo_recirculation", "outlet_width"), ("blender", "outlet_width")]
+#: Every simulated time of a case (case_duration).
+CASE_DURATIONS = [
+    ("defaults", "settle", "check_interval"), ("defaults", "settle", "max_time"),
+    ("silo_flat", "discharge_time"), ("silo_flat", "dump_interval"), ("silo_recirculation", "dump_interval"),
+    ("blender", "discharge", "time"), ("blender", "dump_interval"),
+    ("jenike", "fill", "settle_time"), ("jenike", "consolidation", "time"), ("jenike", "output_interval"),
+    ("cross_engine", "discharge_time"), ("cross_engine", "jenike", "settle_time"),
+    ("cross_engine", "jenike", "consolidation_time"),
+]
+
+
+def _sphere(position=(0.0, 0.0, 0.0), radius=0.0019) -> list:
+    """The spheres of a one-sphere particle model."""
+    return [{"position": list(position), "radius": radius}]
+
+
 #: (key named in the message, path, value at the bound, value just beyond it, other settings the value needs)
 BOUNDS = [
     *[(f"{section}.seed", (section, "seed"), SEED_MAX, SEED_MAX + 1, {}) for section in SECTIONS],
@@ -39,6 +79,7 @@ BOUNDS = [
     ("particle_models.sphere2.timestep_scale", ("particle_models", "sphere2", "timestep_scale"), SCALE_MIN, 0.099,
      {}),
     ("engine.mpi_ranks", ("engine", "mpi_ranks"), MPI_RANKS_MAX, MPI_RANKS_MAX + 1, {}),
+    ("jenike.consolidation.normal_stress", ("jenike", "consolidation", "normal_stress"), 1.0e7, 1.0001e7, {}),
     ("engine.yade.threads", ("engine", "yade", "threads"), 256, 257, ON_YADE),
     ("silo_flat.piv.resolutions[0][1]", ("silo_flat", "piv", "resolutions"), [[8192, 8192]], [[250, 8193]], {}),
     ("silo_flat.piv.window_px", ("silo_flat", "piv", "window_px"), 8192, 8193, {}),
@@ -57,6 +98,48 @@ BOUNDS = [
     ("blender.discharge.profile_windows", ("blender", "discharge", "profile_windows"), 100, 101, {}),
     ("blender.rtd.bins", ("blender", "rtd", "bins"), 1000, 1001, {}),
     ("blender.discontinuous.passes", ("blender", "discontinuous", "passes"), 100, 101, {}),
+    # magnitudes where no material, machine or engine run goes, which would overflow the planner
+    *[(".".join(path), path, LENGTH_MAX, LENGTH_MAX + 0.1, {}) for path in CASE_LENGTHS if path not in NARROWER],
+    # an outlet narrower than the silo is checked on validation: the widest accepted is just below the bound
+    *[(".".join(path), path, LENGTH_MAX - 0.1, LENGTH_MAX + 0.1, {path[0]: {"width": LENGTH_MAX}})
+      for path in NARROWER],
+    *[(".".join(path), path, DURATION_MAX, DURATION_MAX + 0.1, {}) for path in CASE_DURATIONS],
+    ("materials.hdpe.youngs_modulus", ("materials", "hdpe", "youngs_modulus"), 1e13, 1.01e13, {}),
+    ("materials.hdpe.youngs_modulus", ("materials", "hdpe", "youngs_modulus"), 1e3, 990.0, {}),
+    ("materials.hdpe.density", ("materials", "hdpe", "density"), 1e5, 1.01e5, {}),
+    ("materials.hdpe.density", ("materials", "hdpe", "density"), 1.0, 0.99, {}),
+    ("particle_models.sphere.spheres[0].radius", ("particle_models", "sphere", "spheres"), _sphere(radius=1.0),
+     _sphere(radius=1.01), {}),
+    ("particle_models.sphere.spheres[0].radius", ("particle_models", "sphere", "spheres"), _sphere(radius=1e-6),
+     _sphere(radius=0.99e-6), {}),
+    ("particle_models.sphere.spheres[0].position[0]", ("particle_models", "sphere", "spheres"),
+     _sphere(position=(1.0, 0.0, 0.0)), _sphere(position=(1.01, 0.0, 0.0)), {}),
+    ("particle_models.sphere.spheres[0].position[2]", ("particle_models", "sphere", "spheres"),
+     _sphere(position=(0.0, 0.0, -1.0)), _sphere(position=(0.0, 0.0, -1.01)), {}),
+    ("defaults.fill.bulk_density_estimate", ("defaults", "fill", "bulk_density_estimate"), 1e5, 1.01e5, {}),
+    ("defaults.fill.bulk_density_estimate", ("defaults", "fill", "bulk_density_estimate"), 1.0, 0.99, {}),
+    ("defaults.fill.insertion_velocity", ("defaults", "fill", "insertion_velocity"), 100, 100.1, {}),
+    ("silo_recirculation.feeder_velocity", ("silo_recirculation", "feeder_velocity"), 100, 100.1, {}),
+    ("silo_recirculation.feeder_velocity", ("silo_recirculation", "feeder_velocity"), 1e-3, 0.99e-3, {}),
+    ("silo_recirculation.channel_density_ratio", ("silo_recirculation", "channel_density_ratio"), 0.1, 0.099, {}),
+    ("silo_recirculation.recirculations", ("silo_recirculation", "recirculations"), 100, 100.1, {}),
+    ("silo_recirculation.verification.recirculations", ("silo_recirculation", "verification", "recirculations"), 100,
+     100.1, {}),
+    ("silo_recirculation.residence_time_ratios.internal_flow",
+     ("silo_recirculation", "residence_time_ratios", "internal_flow"), 100, 100.1, {}),
+    ("blender.hopper_half_angle", ("blender", "hopper_half_angle"), 1.0, 0.99, {}),
+    ("blender.gravity_factors[0]", ("blender", "gravity_factors"), [1000.0], [1000.1], {}),
+    ("blender.gravity_factors[0]", ("blender", "gravity_factors"), [0.01], [0.0099], {}),
+    ("jenike.shear.velocity", ("jenike", "shear", "velocity"), 100, 100.1, {}),
+    ("jenike.shear.velocity", ("jenike", "shear", "velocity"), 1e-5, 0.99e-5, {}),
+    ("jenike.sweep.shear_velocity_sensitivity[0]", ("jenike", "sweep", "shear_velocity_sensitivity"), [1e-5],
+     [0.99e-5], {}),
+    ("jenike.sweep.shear_velocity_sensitivity[0]", ("jenike", "sweep", "shear_velocity_sensitivity"), [100.0],
+     [100.1], {}),
+    ("jenike.fill.overfill", ("jenike", "fill", "overfill"), 1.0, 1.01, {}),
+    ("estimates.seconds_per_sphere_step", ("estimates", "seconds_per_sphere_step"), 1e-3, 1.01e-3, {}),
+    ("estimates.seconds_per_sphere_step_by_case.jenike", ("estimates", "seconds_per_sphere_step_by_case"),
+     {"jenike": 1e-3}, {"jenike": 1.01e-3}, {}),
 ]
 
 #: Integers of the schema that need no maximum, and why.
@@ -157,11 +240,120 @@ def test_steps_beyond_one_engine_run_command_are_refused_not_overflowed(raw_defa
     for duration, timestep in ((MAX_STEPS + 1.0, 1.0), (1.0, 1e-320)):  # the second is infinitely many
         with pytest.raises(ValueError, match=r"more than the 2147483647 \(2\^31 - 1\) one engine run command takes"):
             steps_for(duration, timestep)
-    # no schema bound stops an absurdly stiff material (1e18 times the Young's modulus of diamond); its step count does
+    # the schema bounds each value on its own; values within their bounds can still plan too many steps together, and
+    # the step count refuses them: the stiffest material (1e13 Pa, a step of 1.6e-8 s) discharged for an hour
     raw = copy.deepcopy(raw_default_config)
-    raw["materials"]["hdpe"]["youngs_modulus"] = 1e30
-    with pytest.raises(ValueError, match=r"2\^31 - 1"):
+    raw["materials"]["hdpe"]["youngs_modulus"] = 1e13
+    raw["silo_flat"]["discharge_time"] = DURATION_MAX
+    with pytest.raises(ValueError, match=r"3600.0 s at a time step of .* would take 2.2\de\+11 time steps.*2\^31 - 1"):
         build_silo_case(validate_config(raw))
+
+
+#: The values the sweep gives each number of the default config in turn: beyond every bound, next to 0, negative.
+EXTREMES = (1e300, 1e-300, -1e300)
+#: The longest one outcome of the sweep may take (s), and the longest before it counts as a hang.
+OUTCOME_S, HANG_S = 1.0, 10.0
+
+
+class _Hang(BaseException):
+    """Raised by the alarm of a configuration that takes :data:`HANG_S`; not an Exception, which code may catch."""
+
+
+def _numeric_leaves(node, path: tuple = ()):
+    """The path of every number of a configuration (booleans are no numbers here), depth first."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _numeric_leaves(value, (*path, key))
+    elif isinstance(node, list):
+        for index, value in enumerate(node):
+            yield from _numeric_leaves(value, (*path, index))
+    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+        yield path
+
+
+def _hang(signum, frame):
+    raise _Hang()
+
+
+def test_no_number_of_the_default_config_at_an_extreme_overflows_the_planner(default_config):
+    """Every number of the validated default config, set in turn to each of :data:`EXTREMES`, is accepted or refused
+    with a ConfigError or a ValueError within a second: never an OverflowError, ZeroDivisionError or other
+    ArithmeticError, nor a hang. Each configuration is validated, planned (:func:`engines.planning.config_estimates`,
+    which builds every case kind's runs with ``cases_of``) and its cross-engine check's runs are built. The sweep is
+    the full one, all of the config's some 350 numbers (about 1050 configurations, 15 to 20 s on the busy 2-core
+    development machine)."""
+    paths = list(_numeric_leaves(default_config))
+    assert len(paths) > 300  # the walk reached the nested sections and lists
+    defects, slow = [], []
+    previous = signal.signal(signal.SIGALRM, _hang)
+    try:
+        for path in paths:
+            for value in EXTREMES:
+                config = copy.deepcopy(default_config)
+                node = config
+                for key in path[:-1]:
+                    node = node[key]
+                node[path[-1]] = value
+                where = f"{'.'.join(map(str, path))} = {value:g}"
+                started = time.perf_counter()
+                signal.setitimer(signal.ITIMER_REAL, HANG_S)
+                try:
+                    planned = validate_config(config)
+                    config_estimates(planned)
+                    cross_engine_cases(planned)
+                    cross_engine_jenike_cases(planned)
+                except ValueError:  # a ConfigError (naming the key) or a case builder's refusal
+                    pass
+                except _Hang:
+                    defects.append(f"{where}: no outcome within {HANG_S:g} s")
+                except Exception as error:  # an OverflowError, ZeroDivisionError, ...: the defect
+                    defects.append(f"{where}: {type(error).__name__}: {error}")
+                finally:
+                    signal.setitimer(signal.ITIMER_REAL, 0)
+                if time.perf_counter() - started > OUTCOME_S:
+                    slow.append(f"{where}: {time.perf_counter() - started:.2f} s")
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    assert defects == []
+    assert slow == []
+
+
+#: Values within their bounds that do not fit together, each refused by a case builder naming the key:
+#: (id, path, value, the case kind, what the message says).
+MISFITS = [
+    ("huge-cell", ("jenike", "cell", "inner_diameter"), LENGTH_MAX, "jenike",
+     r"jenike.cell.inner_diameter \(100.0 m\) for spheres of radius 0.0015 m: a lid of radius 50 m .* up to 1.78e\+09 "
+     r"spheres, more than the 1000000"),
+    ("micrometre-spheres", ("particle_models", "sphere2", "spheres"),
+     _sphere((-1e-6, 0.0, 0.0), 1e-6) + _sphere((1e-6, 0.0, 0.0), 1e-6), "jenike",
+     r"jenike.cell.inner_diameter \(0.04 m\) for spheres of radius 1e-06 m: a lid .* more than the 1000000"),
+    ("cell-narrower-than-a-clump", ("jenike", "cell", "inner_diameter"), 0.003, "jenike",
+     r"jenike.cell.inner_diameter \(0.003 m\) is too small for clumps of bounding diameter 0.00375 m"),
+    ("zone-lower-than-a-clump", ("defaults", "fill", "zone_height"), 0.003, "silo_flat",
+     r"fill.zone_height \(0.003 m\) must exceed the clump's bounding diameter \(0.00375 m\)"),
+    ("outlet-narrower-than-a-clump", ("silo_recirculation", "outlet_width"), 0.003, "silo_recirculation",
+     r"^silo_recirculation.outlet_width \(0.003 m\) is narrower than one clump \(0.00375 m\)"),
+]
+
+
+@pytest.mark.parametrize("path, value, kind, message", [misfit[1:] for misfit in MISFITS],
+                         ids=[misfit[0] for misfit in MISFITS])
+def test_values_within_their_bounds_that_do_not_fit_together_are_refused_naming_the_key(
+        raw_default_config, path, value, kind, message):
+    config = validate_config(_with(raw_default_config, path, value, {}))
+    started = time.perf_counter()
+    with pytest.raises(ValueError, match=message):
+        cases_of(config, kind)
+    assert time.perf_counter() - started < 1.0  # the lid's spheres counted, not laid out
+
+
+def test_free_falls_and_polygons_stay_finite_where_a_difference_would_round_to_zero():
+    # a fall of 1e-15 m at 100 m/s takes 1e-17 s, not the 0 s of (sqrt(v^2 + 2 g h) - v) / g
+    assert free_fall_time(100.0, 1e-15, 9.81) == pytest.approx(1e-17, rel=1e-9)
+    # 1 - s / R rounds to 1 below s / R = 1e-16: acos gives 0, which divided pi by zero
+    assert segments_for_chord(50.0, 1e-8) == 157080  # the finest the schema's bounds allow (a 100 m cell, 1 um spheres)
+    with pytest.raises(ValueError, match=r"needs 4.06e\+11 polygon sides, more than the 1000000"):
+        segments_for_chord(5e17, 1.5e-5)
 
 
 def _long_names(raw: dict, model: str, material: str) -> dict:

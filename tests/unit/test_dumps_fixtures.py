@@ -282,7 +282,7 @@ def test_a_text_file_of_several_snapshots_gives_one_frame_each():
     np.testing.assert_allclose(last.velocity, exact.velocity, rtol=G6, atol=0)
     np.testing.assert_array_equal(last.mass, exact.mass)
     assert not np.allclose(frames[1].position, last.position)  # the spheres moved in between
-    with pytest.raises(DumpFormatError, match=r"series\.txt: holds 3 snapshots \(steps 0 to 1500\)"):
+    with pytest.raises(DumpFormatError, match=r"series\.txt: holds 3 snapshots; read them with read_file_frames$"):
         read_frame(path, TIMESTEP, density=DENSITY)
     with pytest.raises(ValueError, match="a text dump holds its own steps"):
         read_file_frames(path, TIMESTEP, step=3)

@@ -87,22 +87,24 @@ def test_an_empty_dump_of_each_version(version, tmp_path):
 
 def test_unsupported_versions_and_formats_are_named(tmp_path):
     content = (FIXTURES / "spheres_binary_1500.vtk").read_bytes()
+    # what the file holds is never quoted: the place and what was expected there
     assert rejection(content.replace(b"Version 5.1", b"Version 3.0", 1), "d_1.vtk") == (
-        "'# vtk DataFile Version 3.0': siloflow reads legacy VTK versions 4.2 and 5.1 (what LIGGGHTS writes when "
-        "built against VTK 8 or VTK 9)")
+        "line 1: a legacy VTK version siloflow does not read; it reads versions 4.2 and 5.1 (what LIGGGHTS writes "
+        "when built against VTK 8 or VTK 9)")
     assert rejection(content.replace(b"\nBINARY\n", b"\nBINARX\n", 1), "d_1.vtk") == (
-        "file format 'BINARX', expected BINARY or ASCII")
+        "line 3: the file format is neither BINARY nor ASCII")
     # a 4.2 header on 5.1 vertex cells: the cells are not the ones that version writes
     assert rejection(content.replace(b"Version 5.1", b"Version 4.2", 1), "d_1.vtk") == (
-        "'VERTICES 41 40': expected 'VERTICES 40 80' (one vertex per point)")
+        f"VERTICES (byte {content.index(b'VERTICES 41 40')}): expected 'VERTICES n 2n' for the n points of POINTS "
+        "(one vertex per point)")
     xml = tmp_path / "p_1.vtp"
     xml.write_bytes(b'<?xml version="1.0"?>\n<VTKFile type="PolyData">\n')
     with pytest.raises(DumpFormatError, match=rf"^{re.escape(str(xml))}: an XML VTK file; siloflow reads legacy VTK"):
         read_frame(xml, TIMESTEP)
     other = tmp_path / "p_1.vtk"
     other.write_bytes(b"hello\n")
-    with pytest.raises(DumpFormatError, match=rf"^{re.escape(str(other))}: not a LIGGGHTS particle dump: the first "
-                                              r"line b'hello' starts neither legacy VTK"):
+    with pytest.raises(DumpFormatError, match=rf"^{re.escape(str(other))}: not a LIGGGHTS particle dump: its first "
+                                              r"line starts neither legacy VTK"):
         read_frame(other, TIMESTEP)
     other.write_bytes(b"")  # what a run killed as it opened the file leaves
     with pytest.raises(DumpFormatError, match=rf"^{re.escape(str(other))}: the file is empty$"):
@@ -114,9 +116,9 @@ def test_version_4_2_vertex_cells_must_be_single_vertices():
     start = content.index(b"VERTICES 40 80\n") + len(b"VERTICES 40 80\n")
     assert content[start : start + 8] == b"\x00\x00\x00\x01\x00\x00\x00\x00"  # cell 0: size 1, point 0
     changed = content[:start] + b"\x00\x00\x00\x02" + content[start + 4 :]
-    assert rejection(changed, "v_1.vtk") == "VERTICES: cell 0 has 2 points, expected one vertex per point"
+    assert rejection(changed, "v_1.vtk") == "VERTICES: cell 0 is not a single vertex, expected one vertex per point"
     cut = start + 8 * 7 + 3  # 7 whole cells and part of the eighth
-    assert rejection(content[:cut], "v_1.vtk") == "VERTICES declares 40 cells but the file ends after 7"
+    assert rejection(content[:cut], "v_1.vtk") == "VERTICES declares more cells than the file holds: it ends after 7"
 
 
 # --------------------------------------------------------------------------- legacy VTK ASCII: damaged files
@@ -137,22 +139,24 @@ def test_a_cut_ascii_dump_names_the_field_and_the_counts():
     whole = tuples_before(in_a_line, header, 3)
     assert 0 < whole < 40
     assert rejection(in_a_line, "s_1.vtk") == (
-        f"field 'v' declares 40 tuples but the file ends after {whole} (and a last line without its newline, cut "
-        "short)")
+        f"field 'v' declares more tuples than the file holds: it ends after {whole} (and a last line without its "
+        "newline, cut short)")
     at_a_line = content[: line_end + 1]
     assert rejection(at_a_line, "s_1.vtk") == (
-        f"field 'v' declares 40 tuples but the file ends after {tuples_before(at_a_line, header, 3)}")
+        f"field 'v' declares more tuples than the file holds: it ends after {tuples_before(at_a_line, header, 3)}")
 
 
 ASCII_FAULTS = {
-    # (old, new, message): one change to the ASCII fixture each
-    "tuple-count": (b"v 3 40 double", b"v 3 41 double", "field 'v' has 41 tuples but the data section declares 40"),
+    # (old, new, message): one change to the ASCII fixture each; the message names the place, not what is there
+    "tuple-count": (b"v 3 40 double", b"v 3 41 double",
+                    "field 'v' (line 82) declares another number of tuples than POINTS has points"),
     "fewer-points": (b"POINTS 40 float", b"POINTS 39 float",
                      "where 'VERTICES n_cells size' was expected: the data hold more than the count declared"),
-    "more-points": (b"POINTS 40 float", b"POINTS 41 float", "POINTS declares 41 points but holds 40 before line 20"),
-    "section": (b"POINT_DATA 40", b"CELL_DATA 40", "unknown or unsupported section 'CELL_DATA'"),
+    "more-points": (b"POINTS 40 float", b"POINTS 41 float",
+                    "POINTS declares more points than it holds: 40 before line 20, which does not start with a number"),
+    "section": (b"POINT_DATA 40", b"CELL_DATA 40", "unsupported section CELL_DATA (line 62) where 'POINT_DATA n'"),
     "metadata": (b"\nradius 1 40 double", b"\nMETADATA\nINFORMATION 0\n\nradius 1 40 double",
-                 "malformed line 'METADATA', expected 'name n_components n_tuples type'"),
+                 "malformed line (line 112): 1 word, expected 'name n_components n_tuples type'"),
 }
 
 
@@ -172,16 +176,16 @@ def test_ascii_values_of_the_wrong_kind_are_named():
     words = line.split()
     assert len(words) == 9 and all(word in (b"1", b"2") for word in words)
     half = content[:start] + b" ".join(words[:3] + [b"1.5"] + words[4:]) + content[start + len(line) :]
-    assert rejection(half, "t_1.vtk") == "field 'type': value 3 ('1.5') is not an integer of type int32"
+    assert rejection(half, "t_1.vtk") == "field 'type': value 3 is not an integer of type int32"
     v = b"\nv 3 40 double\n"
     start = content.index(v) + len(v)
     line = content[start : content.index(b"\n", start)]
     words = line.split()
     nan = content[:start] + b" ".join(words[:7] + [b"nan"] + words[8:]) + content[start + len(line) :]
-    assert rejection(nan, "t_1.vtk") == "field 'v' contains a non-finite value (nan) at point 2"
+    assert rejection(nan, "t_1.vtk") == "field 'v' contains a non-finite value at point 2"
     next_line = content.count(b"\n") + 1
     assert rejection(content + b"METADATA\nINFORMATION 0\n", "t_1.vtk") == (
-        f"unexpected content at line {next_line} after the last section: b'METADATA'")
+        f"unexpected content at line {next_line} after the last section")
 
 
 # --------------------------------------------------------------------------- text dump custom
@@ -209,15 +213,18 @@ def test_header_items_of_a_text_dump():
     assert parse_custom_dump(triclinic, "s.txt")[0].boundary == ("ff", "ff", "pp")
 
 
-def test_a_cut_text_dump_names_the_step_and_the_counts():
+def test_a_cut_text_dump_names_the_lines_and_the_count_found():
     text = text_fixture()
     lines = text.splitlines(keepends=True)
     at_a_line = "".join(lines[: 9 + 30])
+    # the count and the step are the file's: the message gives their lines and the count of atom lines found
     assert rejection(at_a_line, "s.txt", parse_custom_dump) == (
-        "step 1500: NUMBER OF ATOMS declares 40 atoms but the file ends after 30")
+        "line 4: NUMBER OF ATOMS declares more atoms than the 30 lines after 'ITEM: ATOMS' (line 9) before the file "
+        "ends")
     in_a_line = at_a_line + lines[39][:12]
     assert rejection(in_a_line, "s.txt", parse_custom_dump) == (
-        "step 1500: NUMBER OF ATOMS declares 40 atoms but the file ends (with a last line cut short) after 30")
+        "line 4: NUMBER OF ATOMS declares more atoms than the 30 lines after 'ITEM: ATOMS' (line 9) before the file "
+        "ends (with a last line cut short)")
     assert rejection("".join(lines[:7]), "s.txt", parse_custom_dump) == (
         "the file ends where a BOX BOUNDS line was expected (after line 7)")
 
@@ -231,29 +238,35 @@ def row_changed(text: str, row: int, column: int, value: str) -> str:
     return "".join(lines)
 
 
-def test_malformed_text_dumps_are_refused_naming_line_or_step():
+def test_malformed_text_dumps_are_refused_naming_line_and_column():
     text = text_fixture()
     columns = "id type x y z vx vy vz fx fy fz omegax omegay omegaz radius mass"
     assert f"ITEM: ATOMS {columns} \n" in text
     lines = text.splitlines(keepends=True)
     short_row = "".join(lines[:14] + [" ".join(lines[14].split()[:-1]) + "\n"] + lines[15:])
+    # no message quotes a line, a word or a value of the file (not even a count or the step it declares)
     cases = {
-        short_row: f"line 15: 15 values, expected 16 ({columns})",
-        row_changed(text, 2, 5, "abc"): "line 12: vx 'abc' is not a number",
-        row_changed(text, 0, 2, "nan"): "line 10: x is not finite (nan)",
-        row_changed(text, 0, 0, "1.5"): "step 1500: id of atom row 0 is 1.5, not an integer",
-        text.replace("ITEM: NUMBER OF ATOMS\n40\n", "", 1): (
-            "line 3: expected 'ITEM: NUMBER OF ATOMS', found 'ITEM: BOX BOUNDS ff ff ff'"),
-        text.replace("\n40\n", "\n41\n", 1): "step 1500: NUMBER OF ATOMS declares 41 atoms but the file ends after 40",
+        short_row: "line 15 holds 15 values where 'ITEM: ATOMS' (line 9) names 16 columns",
+        row_changed(text, 2, 5, "abc"): "line 12, column 6 (vx) is not a number",
+        row_changed(text, 0, 2, "nan"): "line 10, column 3 (x) is not finite",
+        row_changed(text, 0, 0, "1.5"): "line 10, column 1 (id) is not an integer",
+        text.replace("ITEM: NUMBER OF ATOMS\n40\n", "", 1): "line 3: expected 'ITEM: NUMBER OF ATOMS'",
+        text.replace("\n40\n", "\n41\n", 1): (
+            "line 4: NUMBER OF ATOMS declares more atoms than the 40 lines after 'ITEM: ATOMS' (line 9) before the "
+            "file ends"),
         text.replace("\n40\n", "\n39\n", 1): (
-            f"line 49: step 1500 declares 39 atoms but more atom lines follow ({lines[48].rstrip(chr(10))[:40]!r})"),
-        text.replace("\n40\n", "\nforty\n", 1): "line 4: NUMBER OF ATOMS 'forty' is not an integer",
-        text.replace(" vz ", " vq ", 1): "step 1500: columns vx vy without vz",
-        text.replace(" fx ", " vx ", 1): "step 1500: column 'vx' occurs twice with different values",
-        text.replace("-0.01 0.01\n", "-0.01 a\n", 1): "line 6: box bounds '-0.01 a' are not 2 finite numbers",
+            "line 49: more lines follow the atoms that NUMBER OF ATOMS (line 4) declares, where 'ITEM: TIMESTEP' or "
+            "the end of the file was expected"),
+        text.replace("\n40\n", "\nforty\n", 1): "line 4: the NUMBER OF ATOMS is not an integer",
+        text.replace("\n40\n", "\n-40\n", 1): "line 4: the NUMBER OF ATOMS is negative",
+        text.replace(" vz ", " vq ", 1): "line 9: columns vx vy without vz",
+        text.replace(" fx ", " vx ", 1): "line 9: column 9 (vx) repeats the name of column 6 but not its values",
+        text.replace(" fx ", " c_f ", 1).replace(" fy ", " c_f ", 1): (
+            "line 9: column 10 repeats the name of column 9 but not its values"),
+        text.replace("-0.01 0.01\n", "-0.01 a\n", 1): "line 6: the box bounds are not 2 finite numbers",
         text.replace("ITEM: BOX BOUNDS ff ff ff", "ITEM: BOX BOUNDS ff ff", 1): (
-            "line 5: 'ITEM: BOX BOUNDS ff ff' does not give 3 boundary flags"),
-        text.replace("ITEM: TIMESTEP", "ITEM: TIME", 1): "line 1: expected 'ITEM: TIMESTEP', found 'ITEM: TIME'",
+            "line 5: 'ITEM: BOX BOUNDS' gives 2 boundary flags, expected 3"),
+        text.replace("ITEM: TIMESTEP", "ITEM: TIME", 1): "line 1: expected 'ITEM: TIMESTEP'",
         "": "no snapshot (an empty file?)",
     }
     for content, message in cases.items():

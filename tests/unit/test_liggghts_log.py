@@ -97,9 +97,14 @@ def test_engine_command_serial_and_mpi():
     assert engine_command("d", executable="true", mpi_ranks=2, mpirun="true")[:4] == ["true", "-np", "2", "--oversubscribe"]
 
 
-def test_missing_executable_is_a_clear_error():
-    with pytest.raises(EngineNotFound, match="'no-such-liggghts' not found"):
+def test_missing_executable_is_a_clear_error_naming_its_key():
+    with pytest.raises(EngineNotFound, match=r"^config key 'engine.liggghts.executable': LIGGGHTS executable "
+                                             r"'no-such-liggghts' is not an executable on PATH"):
         engine_command("d", executable="no-such-liggghts")
+    with pytest.raises(EngineNotFound, match=r"^config key 'engine.mpirun': MPI launcher 'no-such-mpirun' "
+                                             r"\(engine.mpi_ranks is 2\)"):
+        engine_command("d", executable="true", mpi_ranks=2, mpirun="no-such-mpirun")
+    engine_command("d", executable="true", mpi_ranks=1, mpirun="no-such-mpirun")  # serial: no launcher needed
 
 
 def test_an_earlier_attempt_is_moved_aside_not_deleted(tmp_path):

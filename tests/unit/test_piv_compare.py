@@ -234,7 +234,10 @@ def test_a_configured_sequence_is_read_in_order_from_its_patterns(tmp_path):
 
 @pytest.mark.parametrize("content, message", [
     ("# x y u v flags mask\n16 16 1 1 0\n", "bad.txt: 5 columns, expected 6"),
-    ("# x y u v flags mask\nnan 16 1 1 0 0\n16 48 1 1 0 0\n", "bad.txt: 1 vector.s. without a finite position"),
+    ("# x y u v flags mask\nnan 16 1 1 0 0\n16 48 1 1 0 0\n",
+     r"bad.txt: 1 vector.s. without a finite position \(first: line 2\)$"),
+    # a configuration that points at /proc/self/environ: the message places the failure, never quotes the file
+    ("SECRET_TOKEN=abc\x00SHELL=/bin/sh\x00", "bad.txt: line 1, column 1 is not a number$"),
 ])
 def test_a_bad_measured_file_is_named_with_its_problem(tmp_path, content, message):
     (tmp_path / "bad.txt").write_text(content)

@@ -84,17 +84,22 @@ def test_pivpys_openpiv_sample_with_the_signal_to_noise_ratio_fifth():
     assert kinds(rows) == ["unflagged"] * 12  # the file says nothing of validation
     rows = read_openpiv(path, fifth_column="sig2noise", sig2noise_threshold=50.0)
     assert kinds(rows) == ["measured" if s >= 50.0 else "invalid" for s in s2n] and 0 < (s2n < 50).sum() < 12
-    with pytest.raises(PivFormatError, match=r"exp1_001_b_s2n.txt: the fifth \(mask\) column holds 51.1181, not a "
-                                             r"whole number >= 0; if it is the signal-to-noise ratio, set "
-                                             r"silo_flat.piv.measured.openpiv.fifth_column: sig2noise"):
+    with pytest.raises(PivFormatError, match=r"exp1_001_b_s2n.txt: line 1, column 5 \(mask\) is not a whole number "
+                                             r">= 0; if the column holds the signal-to-noise ratio, set "
+                                             r"silo_flat.piv.measured.openpiv.fifth_column: sig2noise$"):
         read_openpiv(path)
 
 
 @pytest.mark.parametrize("content, message", [
-    ("# x y u v vorticity\n16 16 1 1 0\n", r"the header '# x y u v vorticity' is none of OpenPIV's"),
+    ("# x y u v vorticity\n16 16 1 1 0\n", r"the header on line 1 has 5 names \(not all OpenPIV's\), none of "
+                                           r"OpenPIV's: '# x y u v s2n mask' \(windef.save"),
+    ("\n# x y u v flags\n16 16 1 1 0\n", r"the header on line 2 names x, y, u, v, flags, none of OpenPIV's: '# x y "),
     ("16 16 1 1 0 0\n", r"6 columns, expected 5 \(OpenPIV wrote five columns \(x y u v mask\) without a header"),
-    ("# x y u v flags mask\n16 16 1 1 3 0\n", "flag 3 in the flags column"),
-    ("# x y u v flags mask\n16 16 1 1 0 0.5\n", "the mask column holds 0.5"),
+    ("# x y u v flags mask\n16 16 1 1 3 0\n", r"line 2, column 5 \(flags\) holds a flag OpenPIV does not write; "
+                                              r"OpenPIV writes 0 \(valid\), 1 \(invalid\) or 2 \(interpolated\) there"),
+    ("# x y u v flags mask\n16 16 1 1 0 0.5\n", r"line 2, column 6 \(mask\) is not a whole number >= 0; OpenPIV "
+                                                r"writes 0 or 1 \(inside the image mask\) there"),
+    ("# x y u v mask\n16 16 1 1 0\n\n16 48 1 1 -1\n", r"line 4, column 5 \(mask\) is not a whole number >= 0"),
     ("# x y u v flags mask\n16 16 1 1 0 0\n48 16 1 1 0 0\n", "a single grid row does not show which way y points"),
     ("# x y u v flags mask\n48 16 1 1 0 0\n16 16 1 1 0 0\n", "x decreases along a grid row"),
 ])
@@ -183,13 +188,13 @@ CALIBRATED = "PIVlab, ASCII chart output - 28-Nov-2026\r\nFRAME: 1, filenames: a
     ("0.00025", "0.00025", "x [m],y [m],u [m/frame],v [m/frame],Vector type [-]", "0,0,1,1,1\r\n0,0.1,1,1,1",
      "velocities in m/frame"),
     ("0.00025", "0.00025", "x [m],y [m],u [m/s],v [m/s],Vector type [-]", "0,0,1,1,1\r\n0,0.1,1,1,1",
-     "the conversion factors xy and uv are equal"),
+     "line 2: the conversion factors xy and uv are equal: PIVlab's displacement-only"),
     ("1", "1", "x [m],y [m],u [m/s],v [m/s],Vector type [-]", "0,0,1,1,1\r\n0,0.1,1,1,1",
      "the header says m, the conversion factors say px"),
     ("1", "1", "x [px],y [px],u [m/s],v [m/s],Vector type [-]", "0,0,1,1,1\r\n0,1,1,1,1",
-     r"units x \[px\], u \[m/s\]"),
+     r"the header on line 3 gives units x \[px\], u \[m/s\]; PIVlab writes px with px/frame or m with m/s"),
     ("1", "1", "x [px],y [px],u [px/frame],v [px/frame],Vector type [-]", "16,16,1,1,4\r\n16,48,1,1,1",
-     "vector type 4"),
+     "line 4 has a vector type PIVlab does not write; PIVlab's types are 0 .masked."),
     ("1", "1", "x [px],y [px],u [px/frame],v [px/frame],Vector type [-]", "48,16,1,1,1\r\n16,16,1,1,1",
      "x increases to the left"),
     ("0.001", "0.25", "x [m],y [m],u [m/s],v [m/s],Vector type [-]", "0,0,1,1,1\r\n0.1,0,1,1,1",
@@ -350,9 +355,10 @@ def _gui(**changes) -> dict:
 
 @pytest.mark.parametrize("changes, message", [
     ({"units": "[m] respectively [m/frame]"}, "velocities in m/frame"),
-    ({"units": "[mm] respectively [mm/s]"}, "units '.mm. respectively .mm/s.'"),
+    ({"units": "[mm] respectively [mm/s]"}, "the units variable is none of PIVlab's: '.px. respectively .px/frame.' "
+                                            "or '.m. respectively .m/s.'"),
     ({"u_filtered": np.zeros((0, 0))}, r"frame 1: u_filtered empty \(PIVlab fills the filtered field only for frames"),
-    ({"typevector_filtered": np.full((3, 4), 5.0)}, "frame 1: vector type 5"),
+    ({"typevector_filtered": np.full((3, 4), 5.0)}, "frame 1: vector 1 has a vector type PIVlab does not write"),
     ({"v_filtered": np.zeros((2, 4))}, "frame 1: arrays of different shapes"),
 ])
 def test_a_pivlab_mat_file_siloflow_cannot_read_right_is_refused_naming_why(tmp_path, changes, message):
@@ -440,11 +446,29 @@ def test_an_uncalibrated_davis_field_is_in_pixels_with_y_down(tmp_path):
     assert rows.x[:2].tolist() == [8.0, 24.0] and rows.y[[0, 5]].tolist() == [8.0, 24.0]  # (i + 0.5) 16 px
 
 
+@pytest.mark.parametrize("length, speed, units", [
+    ("mm", "mm", "units mm and mm"),
+    # units this reader does not know are the file's text: not quoted
+    ("SECRET_TOKEN=abc", "m/s", "a length or velocity unit this reader does not know"),
+])
+def test_davis_units_other_than_pixels_or_metres_are_refused_quoting_only_known_units(tmp_path, length, speed, units):
+    def other_units(lvpyio, frame):
+        scales = frame.scales
+        frame.scales = lvpyio.Scales(lvpyio.Scale(scales.x.slope, scales.x.offset, length, ""), scales.y, scales.z,
+                                     lvpyio.Scale(scales.i.slope, scales.i.offset, speed, ""))
+
+    path = _davis_variant(tmp_path, other_units)
+    with pytest.raises(PivFormatError) as raised:
+        read_davis(path)
+    assert str(raised.value) == f"{path}: {units}; expected pixel, or mm or m with m/s or mm/s"
+
+
 def test_a_davis_active_choice_davis_does_not_write_is_refused(tmp_path):
     def odd(lvpyio, frame):
         frame.components["ACTIVE_CHOICE"].planes[0][0, 0] = 7
 
-    with pytest.raises(PivFormatError, match="B00001.vc7: active choice 7; DaVis writes 0 to 3"):
+    with pytest.raises(PivFormatError, match=r"B00001.vc7: vector 1 \(row by row\) has an active choice DaVis does "
+                                             r"not write; DaVis writes 0 to 3"):
         read_davis(_davis_variant(tmp_path, odd))
 
 

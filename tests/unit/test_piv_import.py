@@ -117,7 +117,11 @@ def test_a_csv_field_round_trips_bit_for_bit(tmp_path):
 @pytest.mark.parametrize("content, message", [
     ("x_m,z_m,u_m_s,w_m_s,valid\n0,0,1,1\n", "4 columns, expected 5"),
     ("x_m,z_m,u_m_s,w_m_s,valid\nnan,0,1,1,1\n", "without a finite position"),
-    ("x,z,u,w,valid\n0,0,1,1,1\n", "the header is"),
+    ("x,z,u,w,valid\n0,0,1,1,1\n", r"the header on line 1 has 5 names \(not all siloflow's\); siloflow's is "
+                                     "x_m,z_m,u_m_s,w_m_s,valid"),
+    ("z_m,x_m,u_m_s,w_m_s,valid\n0,0,1,1,1\n", "the header on line 1 names z_m, x_m, u_m_s, w_m_s, valid; "),
+    ("x_m,z_m,u_m_s,w_m_s,valid\n0,0,1,1,1\n\n0,1,1,x,1\n", "line 4, column 4 is not a number"),
+    ("x_m,z_m,u_m_s,w_m_s,valid\n", "no vectors"),
     ("x_m,z_m,u_m_s,w_m_s,valid\n0,0,1,1,1\n0.1,0.1,1,1,1\n", "do not fill a regular grid"),
 ])
 def test_a_bad_csv_is_refused_naming_the_file_and_the_problem(tmp_path, content, message):
@@ -133,10 +137,11 @@ def test_a_bad_openpiv_or_pivlab_file_is_refused_naming_it(tmp_path):
     with pytest.raises(PivFormatError, match="short.txt: 5 columns, expected 6"):
         read_openpiv(path, y_down=True)
     path.write_text("x [px],y [px],u [px/frame]\n1,2,3,4\n")
-    with pytest.raises(PivFormatError, match="short.txt: the header names x, y, u over 4 columns"):
+    with pytest.raises(PivFormatError, match="short.txt: the header on line 1 names x, y, u over 4 columns"):
         read_pivlab_txt(path)
     path.write_text("x,y,u,v\n1,2,3,4\n")
-    with pytest.raises(PivFormatError, match="short.txt: line 1 is neither PIVlab's information lines, its header"):
+    with pytest.raises(PivFormatError, match="short.txt: line 1 is neither PIVlab's information lines, its header "
+                                             "nor numbers$"):
         read_pivlab_txt(path)
 
 

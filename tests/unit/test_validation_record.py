@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from analysis.data.record import RunRecord
+from analysis.data.record import RunRecord, RunRecordError
 from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            read_validation_rows, restore_products, write_group_record)
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time
@@ -40,6 +40,14 @@ def test_the_provenance_row_names_the_run_its_engine_and_its_time():
                    "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5, "cores": 2,
                    "date": "2026-11-28"}
     assert math.isnan(simulated_time(_record(stages={"fill": {"step": 3}})))
+
+
+@pytest.mark.parametrize("key, value", [("run_id", "sphere2-abc\n"), ("engine", "liggghts\n")])
+def test_a_run_record_s_names_are_matched_whole(key, value):
+    """A run id or engine name with a trailing newline (which ``$`` alone lets through) is refused, naming the key."""
+    assert RunRecord.from_dict(_record().to_dict()).run_id == "sphere2-abc"
+    with pytest.raises(RunRecordError, match=f"run record: key '{key}': .* does not match"):
+        RunRecord.from_dict({**_record().to_dict(), key: value})
 
 
 def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):

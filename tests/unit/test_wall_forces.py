@@ -162,7 +162,7 @@ def test_a_cut_last_line_is_an_error_when_no_later_file_supersedes_it(tmp_path):
 def test_resumed_files_must_have_the_same_walls_and_time_step(tmp_path):
     _write(tmp_path / WALL_FORCES_NAME, [_row(0, 0.0)])
     resumed = _write(tmp_path / f"{RESUMED_WALL_FORCES_PREFIX}_10.txt", [_row(400, 0.0, WALLS[:2])], _header(WALLS[:2]))
-    message = r": time step .* and walls \['wall_left', 'floor_left'\] differ"
+    message = rf": its time step or walls \(title and column header\) differ from those of {WALL_FORCES_NAME}$"
     with pytest.raises(ValueError, match=re.escape(str(resumed)) + message):
         read_wall_forces(tmp_path)
 
@@ -179,11 +179,12 @@ def test_resumed_files_must_have_the_same_walls_and_time_step(tmp_path):
         ("siloflow wall forces, time step 1e-5 s\n# TimeStep v_a_fx v_a_fy v_a_fz v_a_tx v_a_ty v_b_tz\n",
          "line 2: columns .* are not v_<wall>_fx"),
         ("siloflow wall forces, time step 1e-5 s\n# TimeStep" + " v_a_fx v_a_fy v_a_fz v_a_tx v_a_ty v_a_tz" * 2 + "\n",
-         "line 2 names wall 'a' twice"),
-        (_header() + _row(0, 0.0).replace("1.0", "abc", 1) + "\n", "line 3 is not numeric"),
-        (_header() + _row(0, 0.0).replace("1.0", "nan", 1) + "\n", "line 3 holds a non-finite value"),
-        (_header() + _row(400, 0.0) + "\n" + _row(400, 1.0) + "\n", "line 4: step 400 does not follow step 400"),
-        (_header() + "0.5" + _row(0, 0.0)[1:] + "\n", "line 3 is not numeric"),
+         "line 2: columns 8 to 13 name the wall of columns 2 to 7 again"),
+        (_header() + _row(0, 0.0).replace("1.0", "abc", 1) + "\n", "line 3, column 3 is not a number$"),
+        (_header() + _row(0, 0.0).replace("1.0", "nan", 1) + "\n", "line 3, column 3 is not finite$"),
+        (_header() + _row(400, 0.0) + "\n" + _row(400, 1.0) + "\n",
+         "line 4: the step does not follow the step of line 3$"),
+        (_header() + "0.5" + _row(0, 0.0)[1:] + "\n", r"line 3, column 1 is not a step \(an integer\)$"),
     ],
 )
 def test_reader_names_the_file_and_line_of_bad_content(tmp_path, content, message):

@@ -1,83 +1,47 @@
-# Shared set-up: validate the configuration first thing, build every case it defines, let each case's engine accept
-# it (or refuse it, naming the key) before anything runs, and derive the targets from the one results layout.
+# Shared set-up: check the configuration first thing (engines.preflight: validate it, build every case it defines,
+# let each case's engine accept it, find the engines and read the files it names, or refuse it naming the key) before
+# anything runs, and derive the targets from the one results layout.
 
 import sys
 from pathlib import Path
 
 sys.path.insert(0, workflow.basedir)
 
-from analysis.io.measured_piv import load_measured_piv, measured_piv_paths
-from analysis.piv.measured import check_windows, measured_piv_settings
+from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
 from calibration.parameters import calibrated_config
 from engines.cases import CASE_BUILDERS, cases_of
 from engines.cases.silo_flat import build_silo_case, parametric_variants
 from engines.cases.silo_recirculation import SECTION as RECIRCULATION
-from engines.config import ConfigError, validate_config
-from engines.config_yaml import ConfigFileError, read_config_file
+from engines.preflight import PreflightError, preflight
 from engines.estimates import InsufficientDiskSpace, format_bytes
 from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from engines.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from engines.layout import CASE_SUMMARY, RESULTS, RUN_BENCHMARK, RUN_RECORD, case_root, run_dir, run_path
-from engines.planning import config_estimates, ensure_disk_space, run_priorities
+from engines.planning import ensure_disk_space, run_priorities
 
 # Snakemake has read the config files already, through YTE when a file asks for it (Snakemake has no switch to refuse
-# that); siloflow reads them again as plain data, so that such a file, a repeated key or a YAML 1.1 boolean word stops
-# the workflow here, before anything runs.
-for configfile_path in workflow.configfiles:
-    try:
-        read_config_file(configfile_path)
-    except (ConfigFileError, OSError) as error:
-        raise WorkflowError(f"Invalid configuration: {error}") from None
-
+# that); engines.preflight reads them again as plain data, so that such a file, a repeated key or a YAML 1.1 boolean
+# word stops the workflow here, then validates the configuration, builds every case, finds the engines' programs and
+# the runs siloflow did not make; analysis.io.measured_inputs then reads the measured files it names. All before anything
+# runs.
 try:
-    # In place, so that scripts see the defaults through snakemake.config too.
-    config.update(validate_config(config))
-except ConfigError as error:
-    raise WorkflowError(f"Invalid configuration: {error}") from None
-
-
-def check_cases(configuration):
-    """Build every case and let its engine accept it: geometry, sizing and engine limits fail here, first.
-    Returns ``{case kind: {run id: case}}``, so that the rules need not build the cases again."""
-    built = {}
-    for kind in CASE_BUILDERS:
-        try:
-            built[kind] = cases_of(configuration, kind)
-            engine = engine_for(configuration, kind)
-            for case in built[kind].values():
-                engine.check_case(case)
-        except CaseNotSupported as error:
-            raise WorkflowError(f"The {kind} runs cannot run on their engine: {error}") from None
-        except (ValueError, KeyError) as error:
-            raise WorkflowError(f"Invalid {kind} configuration: {error}") from None
-    return built
-
+    PREFLIGHT = preflight(config, workflow.configfiles)
+    #: The measured PIV files, read and checked with the measured profiles; empty for no comparison.
+    MEASURED_PIV_FILES = check_measured_inputs(PREFLIGHT.config["silo_flat"])
+except (PreflightError, MeasuredInputError) as error:
+    raise WorkflowError(str(error)) from None
+# In place, so that scripts see the defaults through snakemake.config too.
+config.update(PREFLIGHT.config)
 
 #: Every case the validated configuration defines (the flat-bottom silo's as configured, before calibration).
-CASES = check_cases(config)
+CASES = PREFLIGHT.cases
 
 #: Snakemake priority of each case kind's engine runs, longest estimated run first, so that both cores stay busy to
 #: the end (the Jenike runs, short, fill in).
 #: The estimate of every run, made once: the priorities below and the disk check at the start read it.
-ESTIMATES = config_estimates(config)
+ESTIMATES = PREFLIGHT.estimates
 RUN_PRIORITY = run_priorities(ESTIMATES)
-
-
-def check_measured_piv(measured):
-    """The measured PIV files, read, scaled and filtered once before anything runs, so that a bad file or marker set
-    stops the workflow first, naming it."""
-    if not measured["files"]:
-        return []
-    try:
-        paths = measured_piv_paths(measured["files"])
-        check_windows(load_measured_piv(measured, measured_piv_settings(measured), paths), measured["windows"])
-    except ValueError as error:
-        raise WorkflowError(f"Invalid measured PIV (silo_flat.piv.measured): {error}") from None
-    return paths
-
-
-MEASURED_PIV_FILES = check_measured_piv(config["silo_flat"]["piv"]["measured"])
 
 
 def cases(kind):

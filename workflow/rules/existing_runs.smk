@@ -1,24 +1,16 @@
 # Flat-bottom silo runs siloflow did not make (silo_flat.existing_runs): a user's own engine run, known from its
 # particle dumps alone -> flow metrics, coarse-grained fields and profiles in results/existing_runs/silo_flat/<name>/.
-# Each run's folder and dumps are checked here, when the workflow starts, before any step runs. The dump files are the
+# Each run's folder and dumps are checked when the workflow starts (engines.preflight), before any step runs. The dump files are the
 # rules' inputs (a changed dump reruns its run's analysis); the run's description reaches the scripts as data only.
 
-from engines.existing_runs import check_existing_runs
 from engines.layout import existing_run_dir, existing_run_path
 
 wildcard_constraints:
     existing="[A-Za-z0-9][A-Za-z0-9_.-]*",
 
 
-def _checked_existing_runs():
-    try:
-        return check_existing_runs(config)
-    except ConfigError as error:
-        raise WorkflowError(f"Invalid existing run (silo_flat.existing_runs): {error}") from None
-
-
-#: Each configured run's dump files, by name.
-EXISTING_SILO_DUMPS = _checked_existing_runs()
+#: Each configured run's dump files, by name (checked by engines.preflight when the workflow is parsed).
+EXISTING_SILO_DUMPS = PREFLIGHT.existing_dumps
 
 
 def existing_dumps(wildcards):

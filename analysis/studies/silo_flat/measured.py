@@ -26,9 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.data.file_messages import unreadable
 from analysis.numerics.profiles import ProfileErrors, profile_errors
 
 COLUMNS = ("z_m", "x_m", "window", "v_z_m_s", "v_x_m_s", "uncertainty_m_s")
+#: The columns that must hold a finite number on every row.
+_NUMBERS = ("z_m", "x_m", "v_z_m_s", "v_x_m_s")
 
 
 class MeasurementFormatError(ValueError):
@@ -59,31 +62,56 @@ class MeasuredProfile:
     uncertainty: np.ndarray | None
 
 
+def _number(row: dict, column: str, source: str, line: int) -> float:
+    """The value of ``column`` in ``row`` (from the file's ``line``), refused without quoting it: the file may be any
+    file a configuration names."""
+    try:
+        return float(row[column])
+    except (TypeError, ValueError):
+        raise MeasurementFormatError(f"{source}: line {line}, column {column} is not a number") from None
+
+
+def _line(reader: csv.DictReader, numbers: list[int]) -> int:
+    """The line in the file (``numbers``: the line number of each line given to ``reader``) of the record ``reader``
+    read last or failed on: its last line, as a quoted field may span lines. The csv reader's own count, as
+    DictReader's lags behind a line it fails on."""
+    return numbers[max(reader.reader.line_num, 1) - 1]
+
+
 def parse_measured_profiles(text: str, source: str = "<text>") -> list[MeasuredProfile]:
     """Parse the measured-profile CSV format (see the module docstring) into profiles.
 
     Raises
     ------
     MeasurementFormatError
-        Naming ``source`` and the line for a missing column, a non-numeric or non-finite value.
+        Naming ``source`` and, for a value, its line in the text (from 1, comment and blank lines counted) and its
+        column: a missing column, text that is not CSV, a value that is not a number or not finite. No message
+        quotes the text.
     """
-    lines = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
-    reader = csv.DictReader(io.StringIO("\n".join(lines)))
-    missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
-    if missing:
-        raise MeasurementFormatError(f"{source}: missing column(s) {', '.join(missing)}; expected {','.join(COLUMNS)}")
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    numbered = [(number, line) for number, line in enumerate(lines, start=1)
+                if line.strip() and not line.lstrip().startswith("#")]
+    numbers = [number for number, _ in numbered]
+    reader = csv.DictReader(line for _, line in numbered)
     groups: dict[tuple[float, str], list[tuple[float, float, float, float]]] = {}
-    for number, row in enumerate(reader, start=2):
-        try:
-            values = [float(row[c]) for c in ("z_m", "x_m", "v_z_m_s", "v_x_m_s")]
+    try:
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise MeasurementFormatError(f"{source}: missing column(s) {', '.join(missing)}; expected "
+                                         f"{','.join(COLUMNS)}")
+        for row in reader:
+            line = _line(reader, numbers)
+            values = [_number(row, c, source, line) for c in _NUMBERS]
             raw = (row["uncertainty_m_s"] or "").strip()
-            uncertainty = float(raw) if raw else math.nan
-        except (TypeError, ValueError):
-            raise MeasurementFormatError(f"{source}: data line {number}: a value is not a number") from None
-        if not all(math.isfinite(v) for v in values):
-            raise MeasurementFormatError(f"{source}: data line {number}: non-finite value")
-        z, x, v_z, v_x = values
-        groups.setdefault((z, row["window"].strip()), []).append((x, v_z, v_x, uncertainty))
+            uncertainty = _number(row, "uncertainty_m_s", source, line) if raw else math.nan
+            infinite = [c for c, v in zip(_NUMBERS, values) if not math.isfinite(v)]
+            if infinite:
+                raise MeasurementFormatError(f"{source}: line {line}, column {infinite[0]} is not finite")
+            z, x, v_z, v_x = values
+            groups.setdefault((z, row["window"].strip()), []).append((x, v_z, v_x, uncertainty))
+    except csv.Error:
+        # the csv module's messages describe the text it met; the line is enough
+        raise MeasurementFormatError(f"{source}: line {_line(reader, numbers)} is not CSV") from None
     profiles = []
     for (z, window), points in sorted(groups.items()):
         points.sort()
@@ -97,9 +125,25 @@ def parse_measured_profiles(text: str, source: str = "<text>") -> list[MeasuredP
 
 
 def read_measured_profiles(path: str | Path) -> list[MeasuredProfile]:
-    """Read a measured-profile CSV file."""
+    """Read a measured-profile CSV file (UTF-8).
+
+    Raises
+    ------
+    MeasurementFormatError
+        Naming the file: a folder, a file that cannot be read, a line that is not UTF-8, or what
+        :func:`parse_measured_profiles` refuses.
+    """
     path = Path(path)
-    return parse_measured_profiles(path.read_text(encoding="utf-8"), str(path))
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise MeasurementFormatError(f"{path}: {unreadable(error)}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        raise MeasurementFormatError(f"{path}: line {line} is not UTF-8 text") from None
+    return parse_measured_profiles(text, str(path))
 
 
 @dataclass(frozen=True)
