@@ -65,8 +65,6 @@ LID_SPHERE_SPACING = 1.4
 LID_PLACEMENT_GAP = 0.05
 #: Fraction of the consolidation time over which F_N is ramped up from 0 (-).
 LOAD_RAMP_FRACTION = 0.25
-#: Relaxation after levelling (s).
-LEVEL_RELAX_TIME = 0.02
 #: Particle dumps during consolidation and shear (one at the start, then this many during the shear).
 SHEAR_DUMPS = 10
 
@@ -383,10 +381,11 @@ def fill_column(
 
 
 def plan_fill(
-    geometry: CellGeometry, particle: ParticleTemplate, overfill: float, settle_time: float, timestep: float
+    geometry: CellGeometry, particle: ParticleTemplate, overfill: float, settle_time: float, timestep: float,
+    relax_time: float,
 ) -> JenikeFill:
     """Size the pour: clump count for the overfilled sample, the loose column it is created in
-    (:func:`fill_column`), steps."""
+    (:func:`fill_column`), steps (the fall and ``settle_time`` before levelling, ``relax_time`` after it; s)."""
     n_clumps, centres, radius, z_min, z_max = fill_column(geometry, particle, overfill)
     fall_time = math.sqrt(2.0 * z_max / GRAVITY)
     largest_sphere = float(particle.sphere_radii.max())
@@ -397,7 +396,7 @@ def plan_fill(
         region_z=(z_min, z_max),
         steps=steps_for(fall_time + settle_time, timestep),
         level_z=geometry.ring_top - largest_sphere,
-        relax_steps=steps_for(LEVEL_RELAX_TIME, timestep),
+        relax_steps=steps_for(relax_time, timestep),
     )
 
 
@@ -485,7 +484,8 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         particle.timestep_scale,
     )
     timestep = timestep_choice.timestep
-    fill = plan_fill(geometry, particle, overfill, jenike["fill"]["settle_time"], timestep)
+    fill = plan_fill(geometry, particle, overfill, jenike["fill"]["settle_time"], timestep,
+                     jenike["fill"]["relax_time"])
 
     normal_force = jenike["consolidation"]["normal_stress"] * geometry.area
     lid_radius = radius - geometry.lid_clearance

@@ -184,7 +184,7 @@ def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
     config = str(REPO_ROOT / "config" / "validation.yaml")
     assert status_main(["check", "blending_1", config, str(tmp_path)]) == 0
     assert status_main(["check", "silos", config, str(tmp_path)]) == 2
-    assert "unknown validation group 'silos'; this configuration's groups and parts are calibration," in (
+    assert "unknown validation group 'silos'; this configuration's groups and parts are calibration_1," in (
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert status_main(["check", "blending", config, str(tmp_path)]) == 2
@@ -286,14 +286,14 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
         check_reads("calibration_checks", {"calibration": MISSING, "calibration_shapes": MISSING})
     # through the command line, before anything runs: the validation config plans the checks, the empty record has none
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert status_main(["check", "calibration", config, str(tmp_path)]) == 0
-    assert status_main(["check", "calibration_checks", config, str(tmp_path)]) == 2
-    assert "run make validate GROUP=calibration then" in capsys.readouterr().err
+    assert status_main(["check", "calibration_1", config, str(tmp_path)]) == 0
+    assert status_main(["check", "calibration_checks_1", config, str(tmp_path)]) == 2
+    assert "run make validate GROUP=calibration_1 then make validate GROUP=calibration_2 then" in capsys.readouterr().err
     # restoring the runs a group reads checks first: nothing is copied for a group that cannot run yet
     workdir = tmp_path / "work"
-    assert status_main(["restore", "calibration_checks", config, str(tmp_path), str(workdir)]) == 2
-    assert "run make validate GROUP=calibration then" in capsys.readouterr().err and not workdir.exists()
-    assert status_main(["restore", "calibration", config, str(tmp_path), str(workdir)]) == 0
+    assert status_main(["restore", "calibration_checks_1", config, str(tmp_path), str(workdir)]) == 2
+    assert "run make validate GROUP=calibration_1 then make validate GROUP=calibration_2 then" in capsys.readouterr().err and not workdir.exists()
+    assert status_main(["restore", "calibration_1", config, str(tmp_path), str(workdir)]) == 0
     assert capsys.readouterr().out == "" and not workdir.exists()
     # a group read in parts is named part by part
     assert status_main(["check", "silo_series_1", config, str(tmp_path)]) == 2
