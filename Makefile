@@ -41,14 +41,14 @@ RUN_SNAKEMAKE = $(PYTHON) -m engines.workflow_lock --snakefile $(CURDIR)/Snakefi
 
 # The report collects every plot with its caption and the summary page (RUN_DIR/results/report.html).
 # Reruns follow changed inputs and parameters, not changed siloflow code: an upgrade must not repeat hours of
-# finished simulations (run ids already change with every parameter that defines a run). --rerun-incomplete redoes
-# the outputs a killed run left unfinished. RUN_DIR is where results/ and .snakemake/ go.
+# finished simulations (run ids already change with every parameter that defines a run), and the outputs a killed run
+# left unfinished are redone. The workflow's own profile (profiles/default/) sets that policy for every Snakemake
+# call, these and a plain `snakemake` alike. RUN_DIR is where results/ and .snakemake/ go.
 RUN_DIR ?= .
 
 run: install
 	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
-	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES) \
-		--rerun-incomplete --rerun-triggers mtime params input
+	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
 		--report $(abspath $(RUN_DIR))/results/report.html
 
@@ -59,7 +59,7 @@ CHECKS_CONFIG := $(CURDIR)/config/checks.yaml
 verify: install
 	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG)) $(CHECKS_CONFIG)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
-		--cores $(CORES) --rerun-incomplete --rerun-triggers mtime params input
+		--cores $(CORES)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
 		--report $(abspath $(RUN_DIR))/results/report.html
 
@@ -88,11 +88,10 @@ validate: install
 	$(if $(GROUP),$(VALIDATION_RECORD_CLI) restore '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD) $(VALIDATION_DIR))
 	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) $(VALIDATION_OPTIONS) --cores $(CORES) \
-		--rerun-incomplete --rerun-triggers mtime params input --keep-going
+		--keep-going
 	@groups="$$($(VALIDATION_RECORD_CLI) finished $(VALIDATION_CONFIG) $(VALIDATION_DIR) $(if $(GROUP),'$(GROUP)'))" || exit 1; \
 	for group in $$groups; do \
-		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --cores $(CORES) --rerun-incomplete \
-			--rerun-triggers mtime params input && \
+		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --cores $(CORES) && \
 		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --report $(abspath $(VALIDATION_DIR))/report-$$group.html && \
 		$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $$group || exit 1; \
 	done
