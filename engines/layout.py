@@ -22,7 +22,8 @@ import os
 from pathlib import Path, PurePosixPath
 
 __all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
-           "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "VALIDATION_RECORD", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
+           "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "CALIBRATION_DIR", "CALIBRATED_PARAMETERS",
+           "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
@@ -30,7 +31,7 @@ RESULTS = "results"
 
 #: Folder of each case's runs under :data:`RESULTS`.
 CASE_ROOTS = {
-    "jenike": "calibration/runs",
+    "jenike": "calibration/runs",   # inside CALIBRATION_DIR
     "silo_flat": "silo_flat",
     "silo_recirculation": "silo_recirculation",
     "blender": "blender",
@@ -43,9 +44,20 @@ RUN_RECORD = "run.json"
 #: Snakemake's benchmark of a run step: its wall time (column ``s``) and memory.
 RUN_BENCHMARK = "logs/run_benchmark.tsv"
 
+#: The products across runs, each in its folder under :data:`RESULTS`: the calibration (tables, charts, the chosen
+#: parameters), the summary (the validation table, the report's summary page, the validation record), the DEM
+#: verification suite and the cross-engine check.
+CALIBRATION_DIR = f"{RESULTS}/calibration"
+SUMMARY_DIR = f"{RESULTS}/summary"
+VERIFICATION_DIR = f"{RESULTS}/verification"
+CROSS_ENGINE_DIR = f"{RESULTS}/cross_engine"
+
+#: The calibration's chosen parameters, which a silo run with calibrated parameters reads.
+CALIBRATED_PARAMETERS = f"{CALIBRATION_DIR}/parameters.yaml"
+
 #: Each validation group's record as the pipeline writes it (``<group>/``), before `make validate` copies it into
 #: the repository's ``docs/validation/``.
-VALIDATION_RECORD = f"{RESULTS}/summary/record"
+VALIDATION_RECORD = f"{SUMMARY_DIR}/record"
 
 #: The products of a flat-bottom silo run its validation rows are read from, by the name the rows call them.
 SILO_ROW_PRODUCTS = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",

@@ -3,7 +3,6 @@
 from engines.cases.jenike_sweep import diagnostic_points, is_chart_point
 
 JENIKE_CASES = cases("jenike")
-CALIBRATION = f"{RESULTS}/calibration"
 
 
 def jenike_point(run):
@@ -52,7 +51,7 @@ def lid_comparison_targets():
     sweep = config["jenike"]["sweep"]
     if not (sweep["lid_comparison"] and "internal" in sweep["tests"]):
         return []
-    return [f"{CALIBRATION}/lid_comparison.csv", f"{CALIBRATION}/charts/lid_comparison.png"]
+    return [f"{CALIBRATION_DIR}/lid_comparison.csv", f"{CALIBRATION_DIR}/charts/lid_comparison.png"]
 
 
 def diagnostic_targets(runs=None):
@@ -66,9 +65,9 @@ def diagnostic_targets(runs=None):
 def calibration_targets():
     return [
         *diagnostic_targets(),
-        f"{CALIBRATION}/bulk_friction.csv",
-        f"{CALIBRATION}/parameters.yaml",
-        *[f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names()],
+        f"{CALIBRATION_DIR}/bulk_friction.csv",
+        CALIBRATED_PARAMETERS,
+        *[f"{CALIBRATION_DIR}/charts/{name}.png" for name in calibration_chart_names()],
         *lid_comparison_targets(),
         *[run_path("jenike", "metrics/fill_balance.json", run) for run in JENIKE_CASES],
     ]
@@ -124,9 +123,9 @@ rule calibration_table:
     input:
         summaries=[run_path("jenike", "metrics/bulk_friction.json", run) for run in sorted(JENIKE_CASES)],
     output:
-        table=f"{CALIBRATION}/bulk_friction.csv",
+        table=f"{CALIBRATION_DIR}/bulk_friction.csv",
     log:
-        f"{CALIBRATION}/logs/table.log",
+        f"{CALIBRATION_DIR}/logs/table.log",
     script:
         "../scripts/calibration_table.py"
 
@@ -135,7 +134,7 @@ rule calibration_chart:
     input:
         summaries=lambda wildcards: summaries_of(chart_runs(wildcards.chart)),
     output:
-        chart=report(f"{CALIBRATION}/charts/{{chart}}.png", caption="../report/calibration_chart.rst",
+        chart=report(f"{CALIBRATION_DIR}/charts/{{chart}}.png", caption="../report/calibration_chart.rst",
                      category="1 Calibration", subcategory="Charts", labels={"figure": "{chart}"}),
     wildcard_constraints:
         chart="|".join(calibration_chart_names()) or "no chart",
@@ -145,7 +144,7 @@ rule calibration_chart:
         shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
     log:
-        f"{CALIBRATION}/logs/chart_{{chart}}.log",
+        f"{CALIBRATION_DIR}/logs/chart_{{chart}}.log",
     script:
         "../scripts/calibration_charts.py"
 
@@ -154,14 +153,14 @@ checkpoint calibration_parameters:
     input:
         summaries=summaries_of(calibration_shape_runs()),
     output:
-        parameters=f"{CALIBRATION}/parameters.yaml",
+        parameters=CALIBRATED_PARAMETERS,
     params:
         calibration=config["calibration"],
         base_restitution=config["jenike"]["sweep"]["restitution"],
         shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
     log:
-        f"{CALIBRATION}/logs/parameters.log",
+        f"{CALIBRATION_DIR}/logs/parameters.log",
     script:
         "../scripts/calibration_parameters.py"
 
@@ -170,13 +169,13 @@ rule lid_comparison:
     input:
         summaries=summaries_of(lid_comparison_runs()),
     output:
-        table=f"{CALIBRATION}/lid_comparison.csv",
-        plot=report(f"{CALIBRATION}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
+        table=f"{CALIBRATION_DIR}/lid_comparison.csv",
+        plot=report(f"{CALIBRATION_DIR}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
     params:
         base_restitution=config["jenike"]["sweep"]["restitution"],
         shear_velocity=config["jenike"]["shear"]["velocity"],
     log:
-        f"{CALIBRATION}/logs/lid_comparison.log",
+        f"{CALIBRATION_DIR}/logs/lid_comparison.log",
     script:
         "../scripts/lid_comparison.py"
 

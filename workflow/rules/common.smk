@@ -17,7 +17,8 @@ from engines.estimates import InsufficientDiskSpace, format_bytes
 from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from engines.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
-from engines.layout import CASE_SUMMARY, RESULTS, RUN_BENCHMARK, RUN_RECORD, case_root, run_dir, run_path
+from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CASE_SUMMARY, CROSS_ENGINE_DIR, RESULTS, RUN_BENCHMARK,
+                            RUN_RECORD, SUMMARY_DIR, VERIFICATION_DIR, case_root, run_dir, run_path)
 from engines.planning import ensure_disk_space, run_priorities
 
 # Snakemake has read the config files already, through YTE when a file asks for it (Snakemake has no switch to refuse

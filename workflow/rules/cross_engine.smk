@@ -3,7 +3,6 @@
 # flow rate and centreline velocity, each Jenike run's bulk friction, and one table of the engines' means and spreads
 # and their difference in standard errors.
 
-CROSS_ENGINE_DIR = f"{RESULTS}/cross_engine"
 CROSS_ENGINE_RUNS = cross_engine_cases(config)
 try:
     CROSS_ENGINE_JENIKE_RUNS = cross_engine_jenike_cases(config)

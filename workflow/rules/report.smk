@@ -4,7 +4,7 @@
 
 rule report_summary:
     input:
-        parameters=f"{RESULTS}/calibration/parameters.yaml",
+        parameters=CALIBRATED_PARAMETERS,
         flows=lambda wildcards: [run_path("silo_flat", "metrics/flow.json", run) for run in run_ids("silo_flat")],
         measured=lambda wildcards: [run_path("silo_flat", name, run) for run in run_ids("silo_flat")
                                     for name in measured_comparison_names() if name.endswith(".csv")],
@@ -15,9 +15,9 @@ rule report_summary:
                                     for kind in FILL_BALANCE_CASES for run in run_ids(kind)],
         validation=rules.validation_table.output.table,
     output:
-        page=report(f"{RESULTS}/summary/summary.html", caption="../report/summary.rst", category="0 Summary",
+        page=report(f"{SUMMARY_DIR}/summary.html", caption="../report/summary.rst", category="0 Summary",
                     labels={"figure": "figures of merit"}),
     log:
-        f"{RESULTS}/summary/summary.log",
+        f"{SUMMARY_DIR}/summary.log",
     script:
         "../scripts/report_summary.py"

@@ -4,11 +4,10 @@
 
 from engines.cases import REFERENCE, VARIANT, run_roles
 from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
-from engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, VALIDATION_RECORD
+from engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, SUMMARY_DIR, VALIDATION_RECORD
 from engines.planning import group_runs as planned_group_runs
 from engines.validation_groups import GROUPS, part_of_runs, split_groups
 
-VALIDATION = f"{RESULTS}/summary"
 
 
 def roles(kind):
@@ -55,7 +54,7 @@ def group_rows_inputs(group):
         if kind == "jenike":
             found = {"summaries": [run_path("jenike", "metrics/bulk_friction.json", run) for run in group_runs(group)]}
             if CALIBRATION_CHART in GROUPS[group].roles:
-                found["parameters"] = f"{CALIBRATION}/parameters.yaml"
+                found["parameters"] = CALIBRATED_PARAMETERS
             return found
         if kind == "silo_flat":
             labels = front_wall_labels()
@@ -111,27 +110,27 @@ for _group in ROW_GROUPS:
         input:
             unpack(group_rows_inputs(_group)),
         output:
-            rows=f"{VALIDATION}/rows/{_group}.csv",
+            rows=f"{SUMMARY_DIR}/rows/{_group}.csv",
         params:
             **group_rows_params(_group),
             # the Jenike rows take the reference point's seeds from the calibration table
             reference=lambda wildcards, kind=GROUPS[_group].kind: [] if kind == "jenike" else references(kind),
             labels=lambda wildcards, group=_group: front_wall_labels() if GROUPS[group].kind == "silo_flat" else {},
         log:
-            f"{VALIDATION}/rows/{_group}.log",
+            f"{SUMMARY_DIR}/rows/{_group}.log",
         script:
             "../scripts/validation_rows.py"
 
 
 rule validation_table:
     input:
-        rows=[f"{VALIDATION}/rows/{group}.csv" for group in ROW_GROUPS],
+        rows=[f"{SUMMARY_DIR}/rows/{group}.csv" for group in ROW_GROUPS],
     output:
-        table=f"{VALIDATION}/validation.csv",
-        page=report(f"{VALIDATION}/validation.html", caption="../report/validation.rst", category="0 Summary",
+        table=f"{SUMMARY_DIR}/validation.csv",
+        page=report(f"{SUMMARY_DIR}/validation.html", caption="../report/validation.rst", category="0 Summary",
                     labels={"figure": "validation table"}),
     log:
-        f"{VALIDATION}/validation.log",
+        f"{SUMMARY_DIR}/validation.log",
     script:
         "../scripts/validation_table.py"
 
@@ -157,7 +156,7 @@ def group_targets(group):
     every other kind's as a whole."""
     spec, made = GROUPS[group], group_made(group)
     if spec.kind == "jenike":
-        parameters = [f"{CALIBRATION}/parameters.yaml"] if spec.makes(spec.kind, CALIBRATION_CHART) else []
+        parameters = [CALIBRATED_PARAMETERS] if spec.makes(spec.kind, CALIBRATION_CHART) else []
         return [*run_targets("jenike", made), *record_plots(group).values(), *parameters]
     if spec.kind == "silo_flat":
         return [*run_targets("silo_flat", made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
@@ -205,7 +204,7 @@ def record_plots(group):
     and gravity series."""
     kind = GROUPS[group].kind
     if kind == "jenike":
-        plots = {f"{name}.png": f"{CALIBRATION}/charts/{name}.png" for name in calibration_chart_names(group_made(group))}
+        plots = {f"{name}.png": f"{CALIBRATION_DIR}/charts/{name}.png" for name in calibration_chart_names(group_made(group))}
         if GROUPS[group].makes(kind, CHECK):
             plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
         return plots
@@ -246,7 +245,7 @@ for _group in ROW_GROUPS:
             f"validation_record_{_group}"
         input:
             # input functions, as above: the runs of a calibrated silo are known after the calibration
-            rows=f"{VALIDATION}/rows/{_group}.csv",
+            rows=f"{SUMMARY_DIR}/rows/{_group}.csv",
             records=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_RECORD, run)
                                                      for run in group_runs(group)],
             benchmarks=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_BENCHMARK, run)

@@ -3,7 +3,6 @@
 # engine (`snakemake verification`). Cheap: seconds per run. A row outside its tolerance is reported with its known reason;
 # an unexplained one fails the table.
 
-VERIFICATION_DIR = f"{RESULTS}/verification"
 VERIFICATION_PROBLEMS = verification_cases()
 
 

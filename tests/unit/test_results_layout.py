@@ -1,0 +1,27 @@
+"""The results layout is defined once (engines/layout.py): the rule files build every path from its names, and never
+write a folder of results/ themselves."""
+
+from __future__ import annotations
+
+import re
+
+from engines.config import REPO_ROOT
+from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CASE_ROOTS, CROSS_ENGINE_DIR, RESULTS, SUMMARY_DIR,
+                            VALIDATION_RECORD, VERIFICATION_DIR)
+
+
+def test_the_rule_files_write_no_results_folder_of_their_own():
+    for path in sorted((REPO_ROOT / "workflow" / "rules").glob("*.smk")):
+        text = path.read_text()
+        assert not re.search(r"\{RESULTS\}/", text.replace('{RESULTS}/ (', "")), f"{path.name} builds a results path"
+        assert '"results/' not in text, f"{path.name} names a results folder"
+
+
+def test_the_folders_across_runs_lie_in_results_and_the_case_roots_apart():
+    folders = [CALIBRATION_DIR, SUMMARY_DIR, VERIFICATION_DIR, CROSS_ENGINE_DIR]
+    assert all(folder.startswith(f"{RESULTS}/") for folder in folders) and len(set(folders)) == 4
+    assert CALIBRATED_PARAMETERS == "results/calibration/parameters.yaml"
+    assert VALIDATION_RECORD == "results/summary/record"
+    # the Jenike runs sit inside the calibration's folder; no other case root is a folder across runs
+    assert f"{RESULTS}/{CASE_ROOTS['jenike']}".startswith(f"{CALIBRATION_DIR}/")
+    assert not {f"{RESULTS}/{root}" for kind, root in CASE_ROOTS.items() if kind != "jenike"} & set(folders)
