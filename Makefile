@@ -8,7 +8,7 @@ SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 
-.PHONY: install install-system install-python run verify validate validate-status test test-physics test-unit test-integration dry-run bench estimate
+.PHONY: install install-system install-python run verify validate validate-status test test-physics test-unit test-integration dry-run bench estimate docs
 
 install: install-system install-python
 
@@ -31,9 +31,10 @@ install-system:
 		echo "YADE: $(YADE_MODULES)"; \
 	fi
 
-# pip is a no-op when everything is already satisfied.
+# pip is a no-op when everything is already satisfied. The docs extra builds the documentation site (`make docs`,
+# which `make test` checks).
 install-python:
-	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test,docs]"
 
 # Snakemake goes through engines.workflow_lock: after a killed run it removes the stale Snakemake lock first, and it
 # refuses to start (unlocking nothing) while another run is live in the same directory.
@@ -137,3 +138,10 @@ bench: install
 	$(PYTHON) -m tests.bench.bench_decks results/bench/decks.csv
 	$(PYTHON) -m tests.bench.bench_engines results/bench/engines.csv
 	$(PYTHON) -m tests.bench.bench_piv results/bench/piv.csv
+
+# The documentation site (mkdocs.yml, docs/): --strict fails on a broken link, a missing page or a docstring the API
+# reference cannot render. Open $(DOCS_SITE)/index.html.
+DOCS_SITE ?= build/site
+
+docs: install-python
+	NO_MKDOCS_2_WARNING=1 $(PYTHON) -m mkdocs build --strict --site-dir $(DOCS_SITE)

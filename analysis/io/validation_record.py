@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import os
 import shutil
+import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
@@ -118,7 +119,10 @@ def read_record(record_dir: str | os.PathLike, groups: Iterable[str]) -> dict[st
 def restore_products(directory: str | os.PathLike, workdir: str | os.PathLike) -> list[Path]:
     """Copy the products a group's record keeps (its folder ``directory``) into the working directory ``workdir``
     where they are missing, so that the workflow reads them instead of making their runs again; a file already
-    there is left as it is. Returns the files copied."""
+    there is left as it is. Returns the files copied.
+
+    Every file copied gets one modification time: a run's record copied after its metrics would otherwise look newer
+    than them, and Snakemake would make the metrics again, and the run before them."""
     directory, workdir = Path(directory), Path(workdir)
     copied = []
     for name in read_group_record(directory).products:
@@ -127,4 +131,7 @@ def restore_products(directory: str | os.PathLike, workdir: str | os.PathLike) -
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(directory / PRODUCTS / name, target)
             copied.append(target)
+    stamp = time.time()
+    for target in copied:
+        os.utime(target, (stamp, stamp))
     return copied

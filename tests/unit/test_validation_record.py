@@ -151,8 +151,13 @@ def test_a_record_keeps_the_products_other_groups_read_and_restores_only_what_is
     (fresh / run).parent.mkdir(parents=True)
     (fresh / run).write_text("mine")
     assert restore_products(kept, fresh) == [fresh / summary]
+    # restored together, with one time: none looks newer than another, so Snakemake makes none of them again
+    write_group_record(kept, _rows(), runs, {}, {summary: workdir / summary, run: workdir / run,
+                                                 "results/x/metrics/a.json": workdir / run})
+    again = tmp_path / "again"
+    assert len({path.stat().st_mtime_ns for path in restore_products(kept, again)}) == 1
     assert (fresh / summary).read_text() == '{"bulk_friction": 0.5}' and (fresh / run).read_text() == "mine"
-    assert restore_products(kept, fresh) == []
+    assert restore_products(kept, fresh) == [fresh / "results/x/metrics/a.json"]
     with pytest.raises(ValueError, match="a path inside the working directory"):
         write_group_record(kept, _rows(), runs, {}, {"../outside.json": workdir / run})
 
