@@ -1,7 +1,7 @@
 """Contact diagnostics of a shear cell: mobilised friction of contacts and directions of vectors.
 
 Pure functions on numpy arrays; no file I/O. Contact forces come already split into their normal and
-tangential parts, as the engine reads them back (:class:`analysis.data.contacts.ContactFrame`). SI units:
+tangential parts, as the engine reads them back (:class:`model.contacts.ContactFrame`). SI units:
 forces in N, lengths in m, angles in rad.
 """
 
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from analysis.checks import finite_array
+from model.checks import finite_array
 
 __all__ = ["mobilised_friction_histogram", "angular_histogram", "mobilised_friction_by_azimuth"]
 

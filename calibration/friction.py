@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array
+from model.checks import finite_array
 from analysis.numerics.uncertainty import batch_means
 
 __all__ = [

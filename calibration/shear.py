@@ -1,6 +1,6 @@
 """The shear stage of a Jenike direct shear test, cut out of its wall force history and signed for the bulk friction.
 
-Input is the engine-neutral :class:`analysis.data.forces.WallForceHistory` of a Jenike run: walls ``lid``,
+Input is the engine-neutral :class:`model.forces.WallForceHistory` of a Jenike run: walls ``lid``,
 ``shear_ring`` and ``base`` (the bottom ring or the wall-test plate) with the forces they exert on the particles,
 and the signal ``mass_above`` (clump mass above the shear plane, kg). Output is :class:`ShearSignals`, the input
 of :func:`calibration.friction.bulk_friction_of_shear`. SI units: s, N, kg, m/s^2.
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
-from analysis.data.forces import WallForceHistory
+from model.constants import GRAVITY
+from model.forces import WallForceHistory
 
 __all__ = ["ShearSignals", "shear_signals"]
 
@@ -56,7 +56,7 @@ def shear_signals(history: WallForceHistory, shear_start: float, shear_end: floa
 
     Parameters
     ----------
-    history : analysis.data.forces.WallForceHistory
+    history : model.forces.WallForceHistory
         Walls ``lid``, ``shear_ring``, ``base`` (forces on the particles, N) and the signal ``mass_above`` (kg).
     shear_start, shear_end : float
         Times bounding the shear stage (s); samples after ``shear_start`` and no later than ``shear_end``

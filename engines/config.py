@@ -24,7 +24,7 @@ from typing import Any, Iterable, Mapping
 import jsonschema
 import yaml
 
-from analysis.data.existing_run import ExistingRunError, ExistingSiloRun
+from model.existing_run import ExistingRunError, ExistingSiloRun
 from engines.cases.blender_geometry import INSERT_PRESETS
 from engines.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
 from engines.config_yaml import ConfigFileError, read_config_file

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from analysis.data.existing_run import ExistingRunError, ExistingSiloRun
-from analysis.data.frames import ParticleFrame
+from model.existing_run import ExistingRunError, ExistingSiloRun
+from model.frames import ParticleFrame
 from engines.config import EXISTING_RUNS_KEY, ConfigError, existing_silo_runs
 from engines.interface import CaseNotSupported, DumpFile, engine_named
 

@@ -1,7 +1,7 @@
 """The seam between a case and the engine that runs it: one small interface and a registry of engines by name.
 
 A case (:mod:`engines.cases`) is engine-neutral data. An engine turns it into input files, runs them and reads the
-outputs back into neutral objects (:mod:`analysis.data`): particle frames, the force and torque each wall exerts on
+outputs back into neutral objects (:mod:`model`): particle frames, the force and torque each wall exerts on
 the particles, contact forces at saved instants, and the typed run record. Nothing outside an engine's own package
 (``engines/<name>/``) and templates (``templates/<name>/``) knows its file names or formats.
 
@@ -31,11 +31,11 @@ from engines.cases import CASE_BUILDERS
 from engines.cases.common import engine_kind
 
 if TYPE_CHECKING:  # the neutral types appear in signatures only
-    from analysis.data.contacts import ContactFrame
-    from analysis.data.forces import WallForceHistory
-    from analysis.data.frames import ParticleFrame
-    from analysis.data.record import RunRecord
-    from analysis.data.settled import SettledFill
+    from model.contacts import ContactFrame
+    from model.forces import WallForceHistory
+    from model.frames import ParticleFrame
+    from model.record import RunRecord
+    from model.settled import SettledFill
     from engines.estimates import MeasuredWork
 
 __all__ = [
@@ -221,7 +221,7 @@ class Engine(ABC):
 
         Raises
         ------
-        analysis.data.existing_run.ExistingRunError
+        model.existing_run.ExistingRunError
             Naming ``folder`` (missing) or ``dumps`` (a pattern the engine does not write, or no file).
         CaseNotSupported
             When the engine reads no dumps of runs siloflow did not make.

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.forces import WallForceHistory
-from analysis.data.record import RunRecord
+from model.forces import WallForceHistory
+from model.record import RunRecord
 from engines.cases.jenike import JenikeCase
-from analysis.data.file_messages import first_not_read
+from model.file_messages import first_not_read
 from engines.interface import EngineRunError
 from engines.markers import Marker
 
@@ -107,7 +107,7 @@ def jenike_wall_forces(history: dict[str, np.ndarray]) -> WallForceHistory:
 
     Returns
     -------
-    analysis.data.forces.WallForceHistory
+    model.forces.WallForceHistory
         Walls ``lid``, ``shear_ring``, ``base`` (the bottom ring or plate) with the forces they exert on the
         particles [N] (the file holds those of the particles on them: negated); torques NaN (not written);
         signals ``lid_z`` (the lid's height) [m] and ``mass_above`` (clump mass above the shear plane) [kg].

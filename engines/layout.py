@@ -4,7 +4,7 @@ The workflow's rules, the run planning (estimates, disk checks) and the tests al
 
     results/<case root>/<run id>/
         deck/            the engine's input files; deck/case.json (the neutral case summary) is written last
-        run.json         the typed run record (analysis.data.record), written last, only when the run passed its checks
+        run.json         the typed run record (model.record), written last, only when the run passed its checks
         logs/            one log per workflow step, and the run step's timing (logs/run_benchmark.tsv)
         metrics/ fields/ plots/ tracks.npz ...   analysis products
         failed_attempts/ output of unfinished earlier attempts, moved aside, never deleted

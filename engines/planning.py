@@ -15,7 +15,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from analysis.data.record import RunRecordError, read_run_record
+from model.record import RunRecordError, read_run_record
 from engines.cases import CASE_BUILDERS, cases_of, run_roles
 from engines.config import load_config
 from engines.interface import engine_for

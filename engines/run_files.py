@@ -8,7 +8,7 @@ import shutil
 import time
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.estimates import format_bytes
 from engines.layout import RUN_RECORD, write_text_atomic
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases import case_for_run
 from engines.cases.common import engine_kind
 from engines.estimates import estimate_case

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.silo_flat import SiloCase
 from engines.estimates import CostModel, silo_run_steps
 from engines.interface import EngineRunError

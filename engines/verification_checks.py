@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.verification import VerificationCase
 from engines.interface import EngineRunError
 from engines.markers import Marker

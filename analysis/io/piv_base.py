@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.file_messages import unreadable
+from model.file_messages import unreadable
 
 __all__ = ["PivFormatError", "axis_steps", "finite_positions", "first_at", "header_names", "not_a_number",
            "numeric_table", "readable_file", "text_lines"]

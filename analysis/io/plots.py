@@ -18,7 +18,7 @@ matplotlib.use("Agg")  # headless: runs on clusters and in CI
 
 import numpy as np  # noqa: E402
 
-from analysis.checks import finite_array  # noqa: E402
+from model.checks import finite_array  # noqa: E402
 from analysis.io.tables import atomic_output  # noqa: E402
 
 __all__ = [

@@ -10,7 +10,7 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.io.tables import write_flow_table
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from analysis.studies.validation.rows import COLUMNS

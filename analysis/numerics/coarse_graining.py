@@ -89,7 +89,7 @@ import math
 import numba
 import numpy as np
 
-from analysis.checks import compute_backend, finite_array, per_particle_values, points3, positive_number
+from model.checks import compute_backend, finite_array, per_particle_values, points3, positive_number
 from analysis.numerics.grid import DEFAULT_DENSITY_THRESHOLD, Fields, Grid, checked_density_threshold
 
 __all__ = [

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.checks import points3
+from model.checks import points3
 from analysis.numerics.coarse_graining import DEFAULT_CUTOFF, deposit
 from analysis.numerics.grid import Grid
 

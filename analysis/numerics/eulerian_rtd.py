@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from model.checks import finite_array, positive_number
 from analysis.numerics.grid import Grid
 from analysis.numerics.pathlines import PathlineResult, integrate_pathlines
 from analysis.numerics.tracer_seeds import lattice_seeds

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import linregress
 
-from analysis.data.constants import GRAVITY
-from analysis.checks import finite_array, non_negative_number, per_particle_values, positive_number
+from model.constants import GRAVITY
+from model.checks import finite_array, non_negative_number, per_particle_values, positive_number
 from analysis.numerics.uncertainty import Estimate, batch_means
 
 __all__ = [
@@ -134,7 +134,7 @@ def beverloo_mass_flow_rate(
     shape_coefficient : float, optional
         Empty-annulus coefficient k [-] (default 1.5).
     gravity : float, optional
-        Gravitational acceleration g [m/s2] (default :data:`analysis.data.constants.GRAVITY`).
+        Gravitational acceleration g [m/s2] (default :data:`model.constants.GRAVITY`).
 
     Returns
     -------

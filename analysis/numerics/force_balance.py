@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.settled import SettledFill
+from model.frames import clumps_from_frame
+from model.settled import SettledFill
 
 __all__ = ["PlaneLoad", "FillBalance", "plane_loads", "fill_balance", "settled_fill_balance", "mean_balance",
            "BalanceTolerances", "balance_problems"]
@@ -278,7 +278,7 @@ def settled_fill_balance(settled: SettledFill | Sequence[SettledFill], heights: 
     averaged over the steps of its snapshot (:func:`mean_balance`).
 
     A clump's centre of mass is the mean of its sphere centres (exact for the symmetric templates of siloflow's
-    particle models); its mass is its own (see :func:`analysis.data.frames.clumps_from_frame`).
+    particle models); its mass is its own (see :func:`model.frames.clumps_from_frame`).
 
     Parameters
     ----------

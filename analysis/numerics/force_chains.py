@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.contacts import ContactFrame
+from model.contacts import ContactFrame
 
 __all__ = ["ForceChainSegments", "force_chain_segments"]
 

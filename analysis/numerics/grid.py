@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import points3, vector3
+from model.checks import points3, vector3
 
 __all__ = ["DEFAULT_SPACING", "DEFAULT_DENSITY_THRESHOLD", "Grid", "Fields", "checked_density_threshold"]
 

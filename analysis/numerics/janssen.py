@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
-from analysis.checks import non_negative_number, positive_number
+from model.constants import GRAVITY
+from model.checks import non_negative_number, positive_number
 
 __all__ = ["janssen_coefficient", "janssen_characteristic_depth", "janssen_vertical_stress"]
 
@@ -83,7 +83,7 @@ def janssen_vertical_stress(
     internal_friction_angle_deg : float
         Bulk internal friction angle phi [deg].
     gravity : float, optional
-        g [m/s2] (default :data:`analysis.data.constants.GRAVITY`).
+        g [m/s2] (default :data:`model.constants.GRAVITY`).
 
     Returns
     -------

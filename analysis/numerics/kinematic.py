@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import curve_fit
 
-from analysis.checks import non_negative_number, positive_number
+from model.checks import non_negative_number, positive_number
 from analysis.numerics.profiles import checked_profile
 
 __all__ = ["KinematicFit", "kinematic_velocity", "fit_kinematic_constant", "kinematic_horizontal_velocity"]

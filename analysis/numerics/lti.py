@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import convolve
 
-from analysis.checks import (
+from model.checks import (
     finite_array,
     finite_number,
     integer_at_least,

@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from analysis.checks import compute_backend, finite_array, finite_number, points3, positive_number, vector3
+from model.checks import compute_backend, finite_array, finite_number, points3, positive_number, vector3
 
 
 __all__ = [

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import trapezoid
 
-from analysis.checks import finite_array, positive_number
+from model.checks import finite_array, positive_number
 from analysis.numerics.grid import Fields
 
 __all__ = [

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, integer_at_least, positive_number
+from model.checks import finite_array, integer_at_least, positive_number
 from analysis.numerics.uncertainty import Estimate, combine_independent, seed_spread
 
 __all__ = [

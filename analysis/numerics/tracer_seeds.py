@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.checks import vector3
+from model.checks import vector3
 
 __all__ = ["lattice_seeds"]
 

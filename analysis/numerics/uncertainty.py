@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from analysis.checks import finite_array, finite_number, increasing_times, positive_number
+from model.checks import finite_array, finite_number, increasing_times, positive_number
 
 __all__ = [
     "batch_count",

@@ -24,7 +24,7 @@ import math
 import numpy as np
 from scipy import special, stats
 
-from analysis.checks import finite_array
+from model.checks import finite_array
 
 __all__ = [
     "HERTZ_TIME_CONSTANT",

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from analysis.checks import positive_number
+from model.checks import positive_number
 
 __all__ = [
     "CEILING_FACTOR",

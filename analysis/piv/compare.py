@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.piv.derived import field_quantities, planar_profile
 from analysis.piv.field import PlanarField, time_average
 from analysis.piv.front_wall import front_wall_spheres, window_mean_velocity

@@ -11,7 +11,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from analysis.data.frames import ClumpFrame
+from model.frames import ClumpFrame
 
 __all__ = ["CROSS_ENGINE_QUANTITIES", "centreline_vertical_velocity", "compare_engines"]
 

@@ -68,7 +68,7 @@ class VerificationRow:
 
 
 def trajectories_from_frames(frames) -> Trajectories:
-    """The trajectories of a run's frames (:class:`analysis.data.frames.ParticleFrame`, oldest first), spheres in
+    """The trajectories of a run's frames (:class:`model.frames.ParticleFrame`, oldest first), spheres in
     the order of their ids.
 
     Raises

@@ -29,7 +29,7 @@ from engines.cases.blender_meshes import blender_meshes
 from engines.cases.geometry import horizontal_rectangle
 from engines.cases.particles import model_parameters, particle_template
 from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.common import (
     SettleCriterion, clump_energy_scale, defining_settle, engine_kind, largest_impact_velocity, material_table,
     plan_fill, run_id, without_fill_checks,

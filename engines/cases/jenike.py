@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
 from engines.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
 from engines.cases.particles import ParticleTemplate, model_parameters, particle_template

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 
 
 #: The most spheres a rigid lid may have: far above a 1 m cell's lid of the study's 3 mm spheres (some 2e5), and a

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from analysis.checks import finite_array
+from model.checks import finite_array
 
 #: A particle model's ``timestep_scale`` when it gives none.
 DEFAULT_TIMESTEP_SCALE = 1.0

@@ -16,7 +16,7 @@ import copy
 import math
 from dataclasses import asdict, dataclass, field
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.common import (
     FillPlan, MaterialTable, SettleCriterion, defining_settle, engine_kind, fill_zone, largest_impact_velocity,
     material_table, plan_fill, run_id, settle_criterion, without_fill_checks,

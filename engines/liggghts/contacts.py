@@ -13,7 +13,7 @@ The silo deck writes ``compute pair/gran/local pos id force`` through ``dump loc
 
 ``f`` is the force on particle i by particle j (N). Parsing is pure (text in, arrays out); reading a file
 is a thin wrapper. A message names the file, the line and column and what was expected there, never what the file
-holds (:mod:`analysis.data.file_messages`).
+holds (:mod:`model.file_messages`).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.contacts import ContactFrame
-from analysis.data.file_messages import first_not_read
+from model.contacts import ContactFrame
+from model.file_messages import first_not_read
 
 N_COLUMNS = 12
 

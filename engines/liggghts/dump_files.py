@@ -26,9 +26,9 @@ import re
 from collections.abc import Sequence
 from pathlib import Path, PurePosixPath
 
-from analysis.data.existing_run import ExistingRunError
-from analysis.data.frames import ParticleFrame
-from analysis.data.file_messages import not_regular
+from model.existing_run import ExistingRunError
+from model.frames import ParticleFrame
+from model.file_messages import not_regular
 from engines.interface import DumpFile
 from engines.liggghts.dumps import PerType, dump_format, readable_frames
 
@@ -67,7 +67,7 @@ def check_dump_pattern(pattern: str) -> None:
 
 
 def _regular(pattern: str, folder: Path, entry: Path, relative: PurePosixPath) -> None:
-    """Refuse an ``entry`` of the pattern that is no regular file (:func:`analysis.data.file_messages.not_regular`), naming
+    """Refuse an ``entry`` of the pattern that is no regular file (:func:`model.file_messages.not_regular`), naming
     it by ``relative``, its path in ``folder``."""
     refused = not_regular(entry)
     if refused is not None:

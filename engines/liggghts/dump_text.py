@@ -31,7 +31,7 @@ Why not ``numpy.loadtxt`` alone: it reads one table, not a file of several snaps
 errors name a row of the table but not the file, the snapshot or the column. This parser reads the headers itself,
 hands each snapshot's atom lines to ``numpy.loadtxt``, checks every count LIGGGHTS writes and raises
 :class:`~engines.liggghts.vtk_legacy.DumpFormatError` naming the file, the line (and column) and what is wrong, never
-what the line holds (:mod:`analysis.data.file_messages`: a configuration may point the reader at any file); a column is
+what the line holds (:mod:`model.file_messages`: a configuration may point the reader at any file); a column is
 named by its place, and by its name too where the reader knows the name. On a text dump of
 500,000 spheres (10 columns, 41 MB) :func:`read_custom_dump` took 1.7-1.8 s, 1.2-1.3 times as long as
 ``numpy.loadtxt`` of its table alone.
@@ -47,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.file_messages import first_not_read, refuse_irregular, unreadable
+from model.file_messages import first_not_read, refuse_irregular, unreadable
 from engines.liggghts.vtk_legacy import DumpFormatError
 
 __all__ = ["CustomDumpSnapshot", "FIRST_LINE", "INTEGER_COLUMNS", "VECTOR_COLUMNS", "parse_custom_dump",

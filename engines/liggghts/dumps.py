@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
-from analysis.data.file_messages import refuse_irregular, unreadable
+from model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from model.file_messages import refuse_irregular, unreadable
 from engines.liggghts.dump_text import FIRST_LINE, CustomDumpSnapshot, parse_custom_dump, read_custom_dump
 from engines.liggghts.vtk_legacy import DumpFormatError, parse_legacy_vtk_polydata, parse_legacy_vtk_views
 

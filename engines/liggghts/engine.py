@@ -2,7 +2,7 @@
 
 :class:`LiggghtsEngine` dispatches each case kind to its deck module (:mod:`engines.liggghts.silo_flat`,
 :mod:`~engines.liggghts.silo_recirculation`, :mod:`~engines.liggghts.blender`, :mod:`~engines.liggghts.jenike`) and
-reads the engine's files back into the neutral objects of :mod:`analysis.data`. Its templates live in
+reads the engine's files back into the neutral objects of :mod:`model`. Its templates live in
 ``templates/liggghts/``; every case template extends :attr:`LiggghtsEngine.base_template`.
 """
 
@@ -12,10 +12,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from analysis.data.forces import WallForceHistory
-from analysis.data.frames import ParticleFrame
-from analysis.data.record import RunRecord
-from analysis.data.settled import SettledFill
+from model.forces import WallForceHistory
+from model.frames import ParticleFrame
+from model.record import RunRecord
+from model.settled import SettledFill
 from engines.cases.blender import BlenderCase
 from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import SiloCase

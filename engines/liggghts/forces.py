@@ -1,4 +1,4 @@
-"""LIGGGHTS: reading the wall forces a run wrote into a :class:`analysis.data.forces.WallForceHistory`.
+"""LIGGGHTS: reading the wall forces a run wrote into a :class:`model.forces.WallForceHistory`.
 
 Silo-type runs (flat-bottom silo, recirculating silo, blender)
     The deck (``templates/liggghts/macros.j2``, ``wall_force_output``) writes, from the fill on, one sample every
@@ -18,7 +18,7 @@ Silo-type runs (flat-bottom silo, recirculating silo, blender)
     from the earlier files; a file's sample at its own restart step is dropped. A killed attempt may have cut
     its last line: in a file that a later one supersedes, an unreadable last line is ignored; anything else
     that is not well formed is an error naming the file, the line (and column) and what was expected there, never
-    what the file holds (:mod:`analysis.data.file_messages`).
+    what the file holds (:mod:`model.file_messages`).
 
 Jenike shear cell
     The deck writes ``<run>/forces.txt`` in the engines' one Jenike format (:mod:`engines.jenike_checks`, read
@@ -38,8 +38,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.forces import WallForceHistory
-from analysis.data.file_messages import first_not_read
+from model.forces import WallForceHistory
+from model.file_messages import first_not_read
 from engines.jenike_checks import jenike_wall_forces, read_jenike_force_history
 from engines.liggghts.jenike import FORCES_NAME
 from engines.liggghts.run import WALL_FORCES_NAME
@@ -192,7 +192,7 @@ def read_silo_wall_forces(run_dir: str | Path) -> WallForceHistory:
 
     Returns
     -------
-    analysis.data.forces.WallForceHistory
+    model.forces.WallForceHistory
         Walls in the deck's order (primitive walls, then meshes); no signals. Forces [N] and torques about the
         origin [N m] on the particles; times [s] from the run's start.
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.geometry import write_stl
 from engines.layout import write_text_atomic
 

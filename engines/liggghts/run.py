@@ -20,7 +20,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.interface import EngineNotFound, EngineRunError
 from engines.run_files import output_bytes, write_run_record
 from engines.run_files import set_aside_previous_attempt as set_aside

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.contacts import ContactFrame
-from analysis.data.frames import ParticleFrame
-from analysis.data.settled import SettledFill
+from model.contacts import ContactFrame
+from model.frames import ParticleFrame
+from model.settled import SettledFill
 from engines.liggghts.contacts import ContactDumpError, parse_local_table, read_contacts
 from engines.liggghts.dumps import frame_from_arrays, list_dumps
 from engines.liggghts.forces import QUANTITIES, read_wall_force_file

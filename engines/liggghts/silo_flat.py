@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.silo_flat import SiloCase, silo_meshes
 from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from engines.liggghts.inputs import ENGINE_NAME, common_context, processor_grid, write_case_inputs

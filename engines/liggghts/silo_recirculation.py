@@ -13,7 +13,7 @@ from pathlib import Path
 
 from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
 from engines.liggghts.run import Resume, run_checked
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.liggghts.silo_flat import silo_deck_context
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.liggghts.inputs import ENGINE_NAME, write_case_inputs

@@ -7,7 +7,7 @@ import math
 from dataclasses import asdict
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.verification import VerificationCase
 from engines.liggghts.inputs import ENGINE_NAME, processor_grid, write_case_inputs
 from engines.liggghts.run import DUMP_PREFIX, run_checked

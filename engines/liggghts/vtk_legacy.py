@@ -42,7 +42,7 @@ dump. ASCII files put empty lines between some sections; they are skipped.
 :func:`parse_legacy_vtk_polydata` reads that layout and nothing else: another VTK version, another dataset,
 SCALARS/VECTORS attributes, CELL_DATA, METADATA or any other section raises :class:`DumpFormatError` naming the
 file, the place (line or byte) and what was expected there. A message never quotes what the file holds there (a
-configuration may point the reader at any file, :mod:`analysis.data.file_messages`): no line, no word, no value, no count
+configuration may point the reader at any file, :mod:`model.file_messages`): no line, no word, no value, no count
 it declares; a section, a dataset, a field or a data type is named only when it is one VTK or LIGGGHTS names. Its one
 latitude: 5.1's CONNECTIVITY may also be ``vtkIdType`` (4 bytes), as newer VTK releases (9.7, the one pyvista ships)
 write it; the vertex cells are checked for their counts and skipped, since a sphere is its point.
@@ -72,7 +72,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.data.file_messages import first_not_read
+from model.file_messages import first_not_read
 
 __all__ = ["DumpFormatError", "SUPPORTED_VERSIONS", "parse_legacy_vtk_polydata", "parse_legacy_vtk_views"]
 

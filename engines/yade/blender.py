@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.blender import GATE, BlenderCase, blender_mesh_set
 from engines.templating import render_deck
 from engines.yade.inputs import exploded_speed, write_script_inputs

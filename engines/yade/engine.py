@@ -2,7 +2,7 @@
 
 :class:`YadeEngine` renders each case it builds into a Python script from ``templates/yade/`` (every case template
 extends :attr:`YadeEngine.base_template`), runs it with :mod:`engines.yade.run` and reads its outputs back with
-:mod:`engines.yade.outputs` into the neutral objects of :mod:`analysis.data`. The rolling-resistance model differs
+:mod:`engines.yade.outputs` into the neutral objects of :mod:`model`. The rolling-resistance model differs
 from the LIGGGHTS decks' (:mod:`engines.yade.inputs` says how).
 """
 
@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from analysis.data.forces import WallForceHistory
-from analysis.data.frames import ParticleFrame
-from analysis.data.record import RunRecord
-from analysis.data.settled import SettledFill
+from model.forces import WallForceHistory
+from model.frames import ParticleFrame
+from model.record import RunRecord
+from model.settled import SettledFill
 from engines.cases.blender import GATE, BlenderCase
 from engines.cases.jenike import JenikeCase
 from engines.cases.silo_flat import FLOOR_MESHES, SiloCase

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.particles import clump_inertia
 from engines.interface import CaseNotSupported
 from engines.layout import write_text_atomic

@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.contacts import ContactFrame, WallContactFrame
-from analysis.data.record import RunRecord
+from model.contacts import ContactFrame, WallContactFrame
+from model.record import RunRecord
 from engines.cases.jenike import LID_TYPE, PLATE_TYPE, RING_TYPE, JenikeCase
 from engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from engines.templating import render_deck

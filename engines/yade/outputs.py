@@ -1,10 +1,10 @@
-"""Reading what a YADE script wrote back into the neutral objects of :mod:`analysis.data`.
+"""Reading what a YADE script wrote back into the neutral objects of :mod:`model`.
 
 The scripts write particle frames and the settled fill as numpy archives (``numpy.savez``: one array per quantity,
 read with ``numpy.load``) and the wall forces as a whitespace table with a ``# step time <wall>_fx ...`` title
 (read with ``numpy.loadtxt``), so no reader here parses bytes itself. A message names the file, the place and what
 was expected there, never what the file holds: numpy's own messages quote it (the bytes of a damaged ``.npy`` header,
-the text of a row it could not convert), so they are not passed on (:mod:`analysis.data.file_messages`).
+the text of a row it could not convert), so they are not passed on (:mod:`model.file_messages`).
 """
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.contacts import ContactFrame
-from analysis.data.forces import WallForceHistory
-from analysis.data.frames import ParticleFrame
-from analysis.data.settled import SettledFill
-from analysis.data.file_messages import first_not_read, unreadable
+from model.contacts import ContactFrame
+from model.forces import WallForceHistory
+from model.frames import ParticleFrame
+from model.settled import SettledFill
+from model.file_messages import first_not_read, unreadable
 from engines.yade.run import RESUME_STEM, WALL_FORCES_NAME, frame_files
 
 __all__ = ["DamagedOutput", "read_archive", "read_frame", "read_frames", "read_settled_fill", "read_wall_forces"]

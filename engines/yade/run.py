@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.interface import EngineNotFound, EngineRunError
 from engines.markers import Marker, parse_markers
 from engines.progress import run_with_progress

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.cases.silo_recirculation import RecirculationCase, recirculation_meshes
 from engines.templating import render_deck
 from engines.yade.inputs import write_script_inputs

@@ -6,8 +6,8 @@ from __future__ import annotations
 from dataclasses import asdict
 from pathlib import Path
 
-from analysis.data.constants import GRAVITY
-from analysis.data.record import RunRecord
+from model.constants import GRAVITY
+from model.record import RunRecord
 from engines.cases.verification import VerificationCase
 from engines.templating import render_deck
 from engines.verification_checks import check_verification_run, verification_record

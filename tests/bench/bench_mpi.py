@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from analysis.data.frames import clumps_from_frame
+from model.frames import clumps_from_frame
 from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
 from engines.interface import EngineOptions
 from engines.liggghts.inputs import DECK_NAME

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_events, recirculation_tracks
 from analysis.studies.validation.blending import blender_rows, gravity_rows
 from analysis.studies.validation.rows import Criteria

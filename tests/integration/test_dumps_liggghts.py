@@ -25,8 +25,8 @@ import numpy as np
 import pytest
 import pyvista
 
-from analysis.data.frames import ParticleFrame, clumps_from_frame
-from analysis.data.record import RunRecord
+from model.frames import ParticleFrame, clumps_from_frame
+from model.record import RunRecord
 from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
 from engines.cases.silo_flat import SiloCase, build_silo_case
 from engines.config import load_config_file, validate_config

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.data.existing_run import ExistingSiloRun
+from model.existing_run import ExistingSiloRun
 from analysis.io.tables import read_table
 from analysis.studies.silo_flat.existing_run import analyse_existing_run
 from analysis.studies.silo_flat.field_study import SiloFieldOptions

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals

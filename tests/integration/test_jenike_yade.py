@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.data.frames import clumps_from_frame
+from model.frames import clumps_from_frame
 from engines.config import validate_config
 from tests.conftest import FAST_POUR, TINY_SETTLE, require_yade, run_first_case
 

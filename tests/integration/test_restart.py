@@ -19,7 +19,7 @@ import time
 import pytest
 import yaml
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.layout import run_dir as layout_run_dir, run_path
 from engines.liggghts.run import restart_files

@@ -16,8 +16,8 @@ import yaml
 
 import pyvista
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.record import read_run_record
+from model.frames import clumps_from_frame
+from model.record import read_run_record
 from analysis.io.tables import read_table
 from analysis.io.validation_record import read_group_record
 from analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv

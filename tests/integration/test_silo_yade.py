@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.data.frames import clumps_from_frame
+from model.frames import clumps_from_frame
 from analysis.numerics.force_balance import settled_fill_balance
 from engines.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.constants import GRAVITY
+from model.frames import clumps_from_frame
+from model.constants import GRAVITY
 from engines.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for

@@ -2,7 +2,8 @@
 package and templates know LIGGGHTS (its code, file names and formats).
 
 Layers (../shared/design/ARCHITECTURE.md): workflow -> engines, analysis, calibration; calibration -> analysis;
-engines -> the neutral bottom of analysis only (``analysis.data``, ``analysis.checks``); analysis -> nothing else.
+engines and analysis -> the neutral model (``model``), which imports nothing else of siloflow; engines import nothing
+of analysis, analysis nothing of engines.
 """
 
 from __future__ import annotations
@@ -16,9 +17,7 @@ import pytest
 from engines.config import REPO_ROOT
 from engines.interface import ENGINE_KINDS, engine_named
 
-PACKAGES = ("engines", "analysis", "calibration")
-#: What engines may take from analysis: the neutral types and the argument checks.
-NEUTRAL_ANALYSIS = ("analysis.data", "analysis.checks")
+PACKAGES = ("model", "engines", "analysis", "calibration")
 
 
 def _module_name(path: Path) -> str:
@@ -104,16 +103,14 @@ def test_layers_point_one_way():
         top = module.split(".")[0]
         for target in targets:
             other = target.split(".")[0]
-            if top == "analysis" and other != "analysis":
+            if top == "model" and other != "model":
+                wrong.append(f"{module} -> {target} (the neutral model depends on nothing above it)")
+            if top == "analysis" and other not in ("analysis", "model"):
                 wrong.append(f"{module} -> {target} (analysis imports nothing from {other})")
-            if top == "calibration" and other not in ("calibration", "analysis"):
-                wrong.append(f"{module} -> {target} (calibration may use analysis only)")
-            if top == "engines" and other == "analysis" and not target.startswith(NEUTRAL_ANALYSIS):
-                wrong.append(f"{module} -> {target} (engines take only the neutral types from analysis)")
-            if top == "engines" and other == "calibration":
-                wrong.append(f"{module} -> {target} (engines import nothing from calibration)")
-            if module.startswith("analysis.data") and not target.startswith(NEUTRAL_ANALYSIS):
-                wrong.append(f"{module} -> {target} (the neutral types depend on nothing above them)")
+            if top == "calibration" and other not in ("calibration", "analysis", "model"):
+                wrong.append(f"{module} -> {target} (calibration may use analysis and the model only)")
+            if top == "engines" and other not in ("engines", "model"):
+                wrong.append(f"{module} -> {target} (engines take only the neutral model)")
             if module.startswith("engines.cases") and target.startswith(("engines.liggghts", "engines.interface")):
                 wrong.append(f"{module} -> {target} (the case model knows no engine)")
     assert not wrong, "\n".join(sorted(wrong))

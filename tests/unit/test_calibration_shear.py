@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.data.forces import WallForceHistory
+from model.forces import WallForceHistory
 from calibration.shear import shear_signals
 
 

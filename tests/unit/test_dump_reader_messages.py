@@ -21,10 +21,10 @@ from pathlib import Path
 
 import pytest
 
-from analysis.data.existing_run import ExistingSiloRun
+from model.existing_run import ExistingSiloRun
 from engines.config import ConfigError
 from engines.existing_runs import check_existing_run
-from analysis.data.file_messages import first_not_read, not_regular, unreadable
+from model.file_messages import first_not_read, not_regular, unreadable
 from engines.jenike_checks import FORCE_COLUMNS, read_jenike_force_history
 from engines.liggghts.contacts import ContactDumpError, read_contacts
 from engines.liggghts.dump_text import read_custom_dump

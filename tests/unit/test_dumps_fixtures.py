@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import pyvista
 
-from analysis.data.frames import ParticleFrame, clumps_from_frame
+from model.frames import ParticleFrame, clumps_from_frame
 from engines.liggghts.dumps import (
     DumpFormatError,
     parse_legacy_vtk_polydata,

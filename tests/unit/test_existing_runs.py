@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from analysis.data.existing_run import ExistingSiloRun
-from analysis.data.frames import ClumpFrame, ParticleFrame
-from analysis.data.constants import GRAVITY
+from model.existing_run import ExistingSiloRun
+from model.frames import ClumpFrame, ParticleFrame
+from model.constants import GRAVITY
 from analysis.studies.silo_flat.existing_run import (
     SKIPPED_ANALYSES,
     analyses_summary,

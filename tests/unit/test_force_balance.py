@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.data.contacts import ContactFrame
-from analysis.data.frames import ParticleFrame
-from analysis.data.settled import SettledFill
+from model.contacts import ContactFrame
+from model.frames import ParticleFrame
+from model.settled import SettledFill
 from analysis.numerics.force_balance import (
     BalanceTolerances,
     balance_problems,

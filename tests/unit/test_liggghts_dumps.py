@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import pyvista
 
-from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 from engines.liggghts.dumps import (
     DumpFormatError,
     dump_step,

@@ -7,7 +7,7 @@ import math
 import pytest
 
 import engines.planning as planning
-from analysis.data.record import RunRecord
+from model.record import RunRecord
 from engines.config import load_config
 from engines.estimates import CostModel, InsufficientDiskSpace, MeasuredWork, RunEstimate
 from engines.planning import (

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from engines.cases.blender import build_blender_case
 from engines.cases.silo_flat import build_silo_case
 from engines.cases.silo_recirculation import build_recirculation_case

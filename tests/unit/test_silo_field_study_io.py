@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from analysis.data.frames import ClumpFrame
+from model.frames import ClumpFrame
 from analysis.io.fields import load_fields_npz, read_fields_vti
 from analysis.io.silo_field_study import SILO_FIELD_STUDY_FILES, write_silo_field_study
 from analysis.io.tables import read_table

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from analysis.data.contacts import ContactFrame
-from analysis.data.frames import ClumpFrame
-from analysis.data.constants import GRAVITY
+from model.contacts import ContactFrame
+from model.frames import ClumpFrame
+from model.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.profiles import flow_channel_boundary, velocity_profile

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.data.frames import ClumpFrame
+from model.frames import ClumpFrame
 from analysis.numerics.flow import DischargeHistory, steady_flow_rate
 from analysis.studies.silo_flat.metrics import (
     FLOW_RATE_BATCHES,

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.data.frames import ClumpFrame, ParticleFrame
+from model.frames import ClumpFrame, ParticleFrame
 from analysis.numerics.rtd import rtd_from_exit_times
 from analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,

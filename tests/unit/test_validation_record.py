@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from analysis.data.record import RunRecord, RunRecordError
+from model.record import RunRecord, RunRecordError
 from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            read_validation_rows, restore_products, write_group_record)
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time

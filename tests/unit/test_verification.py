@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from analysis.data.frames import ParticleFrame
+from model.frames import ParticleFrame
 from analysis.numerics.verification import (
     HERTZ_TIME_CONSTANT,
     axis_precession_angle,

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.data.forces import WallForceHistory
+from model.forces import WallForceHistory
 from engines.config import load_config
 from engines.cases.silo_flat import build_silo_case
 from engines.liggghts.forces import (

@@ -14,7 +14,7 @@ from analysis.studies.blender.window_fields import (
     window_average_field,
 )
 from analysis.studies.blender.window_fields_io import write_frame_fields, write_planar_fields
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_tracks
 from analysis.numerics.eulerian_rtd import silo_bins
 from analysis.numerics.flow import steady_flow_rate

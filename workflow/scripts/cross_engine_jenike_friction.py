@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.tables import write_json
 from calibration.friction import bulk_friction_of_shear
 from calibration.shear import shear_signals

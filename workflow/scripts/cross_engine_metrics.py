@@ -3,8 +3,8 @@
 import json
 from pathlib import Path
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.record import read_run_record
+from model.frames import clumps_from_frame
+from model.record import read_run_record
 from analysis.io.tables import write_json
 from analysis.studies.cross_engine import centreline_vertical_velocity
 from analysis.studies.silo_flat.metrics import silo_flow_metrics

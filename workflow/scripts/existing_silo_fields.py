@@ -7,7 +7,7 @@ velocity of a flat-bottom silo run siloflow did not make. Reads its dumps throug
 import json
 from pathlib import Path
 
-from analysis.data.existing_run import ExistingSiloRun
+from model.existing_run import ExistingSiloRun
 from analysis.io.silo_field_study import write_silo_field_study
 from analysis.io.tables import write_json
 from analysis.studies.silo_flat.existing_run import analyses_summary, existing_field_study

@@ -1,7 +1,7 @@
 """Snakemake adapter: flow metrics, tables and the discharge plot of a flat-bottom silo run siloflow did not make.
 Reads its dumps through its engine, calls :func:`analysis.studies.silo_flat.existing_run.existing_flow`, writes."""
 
-from analysis.data.existing_run import ExistingSiloRun
+from model.existing_run import ExistingSiloRun
 from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json
 from analysis.studies.silo_flat.existing_run import existing_flow, existing_flow_row
 from analysis.studies.silo_flat.plots import plot_discharge

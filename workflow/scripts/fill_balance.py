@@ -3,7 +3,7 @@ silo-like (see analysis.numerics.force_balance)."""
 
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.tables import write_json
 from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from engines.interface import engine_named

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.tables import write_json
 from calibration.charts import plot_polar_histogram
 from calibration.contact_diagnostics import angular_histogram, mobilised_friction_by_azimuth

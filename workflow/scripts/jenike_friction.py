@@ -5,7 +5,7 @@ from pathlib import Path
 from analysis.io.tables import write_json
 from calibration.charts import plot_force_history
 from calibration.friction import bulk_friction_of_shear, bulk_friction_summary
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from calibration.shear import shear_signals
 from engines.interface import engine_named
 from engines.logs import logged_to

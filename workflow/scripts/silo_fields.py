@@ -6,8 +6,8 @@ force chains of one flat-bottom silo run. Reads the run, calls
 import json
 from pathlib import Path
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.record import read_run_record
+from model.frames import clumps_from_frame
+from model.record import read_run_record
 from analysis.io.fields import write_fields_vti
 from analysis.io.silo_field_study import write_silo_field_study
 from analysis.io.tables import write_flow_table

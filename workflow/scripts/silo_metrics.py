@@ -3,8 +3,8 @@
 import json
 from pathlib import Path
 
-from analysis.data.frames import clumps_from_frame
-from analysis.data.record import read_run_record
+from model.frames import clumps_from_frame
+from model.record import read_run_record
 from analysis.studies.silo_flat.plots import plot_discharge
 from analysis.studies.silo_flat.metrics import flow_table_row, silo_flow_metrics
 from analysis.io.tables import write_discharge_history_csv, write_flow_table, write_json

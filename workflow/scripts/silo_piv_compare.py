@@ -3,7 +3,7 @@
 import json
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.measured_piv import load_measured_piv
 from analysis.io.tables import read_table, write_flow_table
 from analysis.piv.compare import piv_comparison

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.tables import write_flow_table
 from analysis.piv.accuracy import PivSettings, accuracy_table
 from analysis.studies.silo_flat.piv_plots import plot_piv_accuracy

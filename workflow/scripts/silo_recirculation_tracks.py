@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_tracks
 from analysis.studies.silo_recirculation.tracks_io import write_tracks
 from engines.interface import engine_named

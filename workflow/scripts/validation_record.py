@@ -5,7 +5,7 @@ import subprocess
 from datetime import datetime, timezone
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.validation_record import benchmark_wall_time, read_validation_rows, write_group_record
 from analysis.studies.validation.record import provenance_row
 from engines.interface import engine_named

@@ -3,7 +3,7 @@
 import json
 from pathlib import Path
 
-from analysis.data.record import read_run_record
+from model.record import read_run_record
 from analysis.io.tables import write_flow_table, write_text
 from analysis.report.summary import summary_html
 from analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table

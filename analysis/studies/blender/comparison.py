@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 from analysis.numerics.replicates import REPLICATES_KEY, SEED_STD_SUFFIX
-from analysis.checks import number_or_nan, positive_number
+from model.checks import number_or_nan, positive_number
 from analysis.numerics.uncertainty import Significance, combine_independent, difference_significant
 from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling
 

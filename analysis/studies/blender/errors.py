@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, integer_at_least, positive_number
+from model.checks import finite_array, finite_number, integer_at_least, positive_number
 from analysis.numerics.residence_statistics import appearance_times
 from analysis.numerics.uncertainty import Estimate, batch_count, batch_means, batch_rate, combine_independent
 from analysis.studies.blender.profiles import passage_mean_v_z

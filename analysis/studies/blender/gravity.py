@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from model.checks import finite_array, positive_number
 
 __all__ = ["GravityScaling", "gravity_normalised_time", "gravity_normalised_velocity", "gravity_scaling"]
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from model.checks import finite_array, positive_number
 from analysis.numerics.lti import VRRTable, recirculations_to_homogenise, vrr_versus_period
 from analysis.numerics.tracer_seeds import lattice_seeds
 from analysis.studies.blender.errors import homogenisation_error

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.checks import finite_array, number_or_nan, positive_number  # noqa: E402
+from model.checks import finite_array, number_or_nan, positive_number  # noqa: E402
 from analysis.io.plots import non_empty_list, positive_finite_points, save_png, tuple_entry  # noqa: E402
 from analysis.numerics.rtd import RTD  # noqa: E402
 from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity  # noqa: E402

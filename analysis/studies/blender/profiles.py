@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number
+from model.checks import finite_array, finite_number
 from analysis.numerics.profiles import flow_channel_boundary
 from analysis.studies.blender.steady_field import BlenderField, at_height, checked_field
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number, uniform_step
+from model.checks import finite_array, positive_number, uniform_step
 from analysis.numerics.grid import Fields
 from analysis.numerics.profiles import velocity_profile
 

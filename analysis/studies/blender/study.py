@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from analysis.checks import number_or_nan, positive_number
+from model.checks import number_or_nan, positive_number
 from analysis.numerics.rtd import RTD
 from analysis.studies.blender.comparison import BlenderMetrics
 from analysis.studies.blender.errors import (

@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.io.tables import markdown_table
 from analysis.numerics.rtd import RTD
 from analysis.numerics.uncertainty import format_estimate

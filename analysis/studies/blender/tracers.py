@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, positive_number
+from model.checks import finite_array, finite_number, positive_number
 from analysis.numerics.pathlines import PathlineResult, integrate_pathlines
 from analysis.numerics.rtd import RTD, rtd_from_exit_times
 from analysis.numerics.tracer_seeds import lattice_seeds

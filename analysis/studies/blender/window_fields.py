@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_number, positive_number
+from model.checks import finite_number, positive_number
 from analysis.numerics.eulerian_rtd import bin_sums
 from analysis.numerics.grid import Grid
 from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events

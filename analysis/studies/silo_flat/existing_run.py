@@ -2,7 +2,7 @@
 
 A user's own run leaves particle dumps only. :func:`analyse_existing_run` takes their frames (read by the run's
 engine, :func:`engines.existing_runs.read_existing_frames`, in the dumps' own coordinates) and the run's
-description (:class:`~analysis.data.existing_run.ExistingSiloRun`) and makes what siloflow makes of its own silo
+description (:class:`~model.existing_run.ExistingSiloRun`) and makes what siloflow makes of its own silo
 runs from frames:
 
 - the frames from the opening on (:func:`opening_frames`): a step dumped twice is kept once, the later copy; the
@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.existing_run import ExistingSiloRun
-from analysis.data.frames import ParticleFrame, clumps_from_frame
+from model.existing_run import ExistingSiloRun
+from model.frames import ParticleFrame, clumps_from_frame
 from analysis.studies.silo_flat.field_study import SiloDimensions, SiloFieldOptions, SiloFieldStudy, analyse_silo_fields
 from analysis.studies.silo_flat.metrics import SiloFlowMetrics, flow_table_row, silo_flow_metrics
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.grid import Fields
 from analysis.numerics.profiles import velocity_profile

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import number_or_nan
-from analysis.data.contacts import ContactFrame
-from analysis.data.frames import ClumpFrame
-from analysis.data.constants import GRAVITY
+from model.checks import number_or_nan
+from model.contacts import ContactFrame
+from model.frames import ClumpFrame
+from model.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.flow import column_surface_heights
 from analysis.numerics.coarse_graining import kernel_support_radius

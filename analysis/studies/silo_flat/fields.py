@@ -1,6 +1,6 @@
 """Continuum view of a flat-bottom silo run: coarse-grained fields and the quantities compared with PIV.
 
-Pure computation on clump frames and contact frames (:mod:`analysis.data.frames`, :mod:`analysis.data.contacts`);
+Pure computation on clump frames and contact frames (:mod:`model.frames`, :mod:`model.contacts`);
 writers live in :mod:`analysis.io.fields` and :mod:`analysis.studies.silo_flat.plots`. Coordinates as everywhere in
 siloflow: x across the width (0 on the axis), y front to back (0 at the front wall), z up (0 at the outlet).
 """
@@ -16,7 +16,7 @@ import numpy as np
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.field_ops import average_fields, depth_average
 from analysis.numerics.coarse_graining import coarse_grain
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
 from analysis.numerics.kinematic import fit_kinematic_constant, kinematic_horizontal_velocity

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.data.file_messages import unreadable
+from model.file_messages import unreadable
 from analysis.numerics.profiles import ProfileErrors, profile_errors
 
 COLUMNS = ("z_m", "x_m", "window", "v_z_m_s", "v_x_m_s", "uncertainty_m_s")

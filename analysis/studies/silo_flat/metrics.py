@@ -1,6 +1,6 @@
 """Discharge metrics of a flat-bottom silo run from a sequence of clump frames.
 
-Pure computation: the frames come in as :class:`analysis.data.frames.ClumpFrame` objects (or anything with
+Pure computation: the frames come in as :class:`model.frames.ClumpFrame` objects (or anything with
 ``time``, ``clump_id``, ``position`` and ``mass``), the results go out as dataclasses.
 
 Uncertainties (standard errors, in the unit of their figure; :mod:`analysis.numerics.uncertainty`):
@@ -25,7 +25,7 @@ from typing import Sequence
 
 import numpy as np
 
-from analysis.data.constants import GRAVITY
+from model.constants import GRAVITY
 from analysis.numerics.flow import (
     BulkDensity,
     DischargeHistory,

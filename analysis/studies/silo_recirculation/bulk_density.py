@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, positive_number
+from model.checks import finite_array, positive_number
 from analysis.numerics.uncertainty import batch_means
 
 __all__ = ["FlowingBulkDensity", "slab_bulk_density", "flowing_bulk_density"]

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, integer_at_least, positive_number
+from model.checks import finite_array, finite_number, integer_at_least, positive_number
 from analysis.numerics.lti import recirculate
 from analysis.studies.silo_recirculation.tracks import RecirculationEvents
 from analysis.studies.silo_recirculation.validation import event_times, open_fraction

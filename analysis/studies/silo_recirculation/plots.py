@@ -27,7 +27,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from analysis.checks import finite_array, positive_number  # noqa: E402
+from model.checks import finite_array, positive_number  # noqa: E402
 from analysis.io.plots import (  # noqa: E402
     finite_abscissa,
     matching_ordinate,

@@ -43,7 +43,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.numerics.rtd import RTD, johanson_rtd
 from analysis.numerics.residence_statistics import appearance_times, residence_time_resolution
 from analysis.numerics.uncertainty import Significance, combine_independent, difference_significant

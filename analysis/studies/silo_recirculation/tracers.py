@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_number, integer_at_least, positive_number
+from model.checks import finite_number, integer_at_least, positive_number
 from analysis.studies.silo_recirculation.tracks import RecirculationEvents
 
 __all__ = ["TracerPasses", "tracer_passes", "tracer_count"]

@@ -1,6 +1,6 @@
 """Clump tracks of a recirculating silo and the events on them: outlet crossings, re-entries, passes.
 
-Pure functions on numpy arrays and :mod:`analysis.data.frames`; no file I/O. SI units: positions in m,
+Pure functions on numpy arrays and :mod:`model.frames`; no file I/O. SI units: positions in m,
 velocities in m/s, masses in kg, times in s.
 
 Geometry
@@ -42,8 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_number, increasing_times
-from analysis.data.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from model.checks import finite_number, increasing_times
+from model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 
 __all__ = [
     "ClumpTracks",
@@ -241,7 +241,7 @@ def clump_tracks(times, ids_per_frame, positions_per_frame) -> ClumpTracks:
         Frame times, strictly increasing [s].
     ids_per_frame : sequence of array_like
         One 1-D array of integer clump ids per frame, in any order (e.g.
-        :attr:`analysis.data.frames.ClumpFrame.clump_id`). Ids may be negative; duplicates within a
+        :attr:`model.frames.ClumpFrame.clump_id`). Ids may be negative; duplicates within a
         frame are an error.
     positions_per_frame : sequence of array_like
         One array of shape ``(len(ids), 3)`` of clump centres per frame, finite [m].
@@ -295,10 +295,10 @@ def recirculation_tracks(
     ----------
     frames : iterable of ParticleFrame or ClumpFrame
         The saved frames of the run in time order, as the engine reads them. A
-        :class:`~analysis.data.frames.ParticleFrame` is grouped into clumps by
-        :func:`~analysis.data.frames.clumps_from_frame` with z periodic in ``domain_z`` (a clump that
+        :class:`~model.frames.ParticleFrame` is grouped into clumps by
+        :func:`~model.frames.clumps_from_frame` with z periodic in ``domain_z`` (a clump that
         straddles the periodic boundary is put back together and its centre wrapped into the domain);
-        a :class:`~analysis.data.frames.ClumpFrame` is taken as it is (its centres already in the domain).
+        a :class:`~model.frames.ClumpFrame` is taken as it is (its centres already in the domain).
     domain_z : (float, float)
         Bottom and top of the periodic domain [m].
 

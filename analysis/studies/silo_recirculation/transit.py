@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, increasing_times, integer_at_least, positive_number
+from model.checks import finite_array, finite_number, increasing_times, integer_at_least, positive_number
 from analysis.numerics.uncertainty import Estimate, batch_means, proportion_error
 from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationEvents, above_outlet
 from analysis.studies.silo_recirculation.validation import event_times

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.checks import finite_array, finite_number, increasing_times, integer_at_least, positive_number
+from model.checks import finite_array, finite_number, increasing_times, integer_at_least, positive_number
 from analysis.numerics.uncertainty import Estimate, batch_means, batch_rate, combine_independent
 from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_ceiling, vrr_near_ceiling
 from analysis.studies.silo_recirculation.validation import event_times, open_fraction

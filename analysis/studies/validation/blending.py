@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
 from analysis.studies.validation.rows import Criteria, plus_minus, ratio, resolved, row, verdict
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
 from analysis.studies.validation.rows import NO, Criteria, plus_minus, resolved, row, verdict
 

@@ -14,8 +14,8 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from analysis.checks import number_or_nan
-from analysis.data.record import RunRecord
+from model.checks import number_or_nan
+from model.record import RunRecord
 from analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
 
 __all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "simulated_time", "record_page"]

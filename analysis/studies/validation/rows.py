@@ -17,7 +17,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from analysis.checks import number_or_nan
+from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
 
 __all__ = ["YES", "NO", "UNKNOWN", "COLUMNS", "Criteria", "row", "verdict", "ratio", "resolved", "plus_minus"]

@@ -8,8 +8,8 @@ column, byte, field) and what was expected, and never quotes the text, the words
 not a token, not a value, nor a count or a step the file declares; nor the message of numpy or of a codec, which quote
 what they could not convert. A name found in the file (a column, a field, a section) is given only when the reader
 knows it: it is then the reader's word, not the file's. Counts the reader makes itself (how many lines or values it
-found) are given. In the neutral bottom of :mod:`analysis`, so that the engines' readers and the PIV readers
-(:mod:`analysis.io.piv_base`) share it.
+found) are given. In the neutral model, so that the engines' readers and the PIV readers (:mod:`analysis.io.piv_base`)
+share it.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from analysis.data.arrays import frozen_array
+from model.arrays import frozen_array
 
 __all__ = ["WallForceHistory"]
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.data.arrays import frozen_array
+from model.arrays import frozen_array
 
 __all__ = ["ParticleFrame", "ClumpFrame", "clumps_from_frame"]
 

@@ -9,9 +9,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from analysis.data.arrays import frozen_array
-from analysis.data.contacts import ContactFrame
-from analysis.data.frames import ParticleFrame
+from model.arrays import frozen_array
+from model.contacts import ContactFrame
+from model.frames import ParticleFrame
 
 __all__ = ["SettledFill"]
 
