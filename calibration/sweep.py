@@ -1,7 +1,7 @@
 """The calibration sweep after its runs: which rows of its table make the charts and the lid comparison.
 
 The sweep points themselves (the Jenike runs a configuration asks for), their roles and which get diagnostics are
-designed by :mod:`engines.cases.jenike_sweep`.
+designed by :mod:`model.cases.jenike_sweep`.
 
 A sweep point is a plain dict (it keys the run and travels through Snakemake unchanged)::
 

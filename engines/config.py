@@ -25,8 +25,8 @@ import jsonschema
 import yaml
 
 from model.existing_run import ExistingRunError, ExistingSiloRun
-from engines.cases.blender_geometry import INSERT_PRESETS
-from engines.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
+from model.cases.blender_geometry import INSERT_PRESETS
+from model.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
 from engines.config_yaml import ConfigFileError, read_config_file
 
 REPO_ROOT = Path(__file__).resolve().parent.parent

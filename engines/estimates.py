@@ -1,7 +1,7 @@
 """What a run will cost before it starts: engine steps, sphere-steps, simulated and wall time, dump frames and disk.
 
-Pure computation: callers pass case objects (:mod:`engines.cases.silo_flat`, :mod:`engines.cases.silo_recirculation`,
-:mod:`engines.cases.blender`, :mod:`engines.cases.jenike`), log text and numbers; nothing here reads or writes files.
+Pure computation: callers pass case objects (:mod:`model.cases.silo_flat`, :mod:`model.cases.silo_recirculation`,
+:mod:`model.cases.blender`, :mod:`model.cases.jenike`), log text and numbers; nothing here reads or writes files.
 
 The cost model (:class:`CostModel`) is linear in the work, counted in sphere-steps: the spheres the engine holds,
 summed over its time steps. A run of W sphere-steps costs ``W c`` seconds on one core, with c measured on this
@@ -25,17 +25,17 @@ import math
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Sequence
 
-from engines.cases.blender import BlenderCase
-from engines.cases.jenike import FILL_SOLID_FRACTION, JenikeCase
-from engines.cases.silo_flat import SiloCase
-from engines.cases.silo_recirculation import RecirculationCase
+from model.cases.blender import BlenderCase
+from model.cases.jenike import FILL_SOLID_FRACTION, JenikeCase
+from model.cases.silo_flat import SiloCase
+from model.cases.silo_recirculation import RecirculationCase
 
 #: Kinds of run this module estimates.
 SILO_FLAT, RECIRCULATION, BLENDER, JENIKE = "silo_flat", "silo_recirculation", "blender", "jenike"
 KINDS = (SILO_FLAT, RECIRCULATION, BLENDER, JENIKE)
 
 #: The Jenike deck runs one step after ``delete_atoms`` so LIGGGHTS removes the partner spheres of the
-#: deleted clumps (:mod:`engines.cases.jenike`, stage 2).
+#: deleted clumps (:mod:`model.cases.jenike`, stage 2).
 JENIKE_LEVEL_DELETION_STEPS = 1
 
 #: Contact snapshots the silo decks write: one local dump of the settled fill (``contacts_<step>.txt``).
@@ -163,7 +163,7 @@ class StageWork:
     Attributes
     ----------
     stage : str
-        Stage kind (:data:`engines.cases.stages.STAGE_KINDS`: ``fill``, ``settle``, ``discharge``, ...).
+        Stage kind (:data:`model.cases.stages.STAGE_KINDS`: ``fill``, ``settle``, ``discharge``, ...).
     steps : int
         Time steps of the stage (-).
     sphere_steps : float
@@ -596,7 +596,7 @@ def _estimate_silo_deck(
 
 
 def estimate_silo_case(case: SiloCase, mpi_ranks: int = 1, model: CostModel = CostModel()) -> RunEstimate:
-    """Estimate a flat-bottom silo run (:class:`engines.cases.silo_flat.SiloCase`).
+    """Estimate a flat-bottom silo run (:class:`model.cases.silo_flat.SiloCase`).
 
     The discharge drains the fill at Beverloo's rate (:func:`silo_drain_rate`, fill volume W T H) once the first
     clumps have fallen ``sink_depth`` out of the domain (:func:`sink_fall_time`); the stagnant zones a flat floor
@@ -651,7 +651,7 @@ def jenike_lid_atoms(case: JenikeCase) -> int:
 
 def jenike_levelled_clumps(case: JenikeCase) -> int:
     """Clumps left after levelling: those the sample volume holds at the solid fraction the pour was sized with,
-    ``round(phi A H / V_clump)`` (:data:`engines.cases.jenike.FILL_SOLID_FRACTION`), at most the clumps created."""
+    ``round(phi A H / V_clump)`` (:data:`model.cases.jenike.FILL_SOLID_FRACTION`), at most the clumps created."""
     geometry = case.geometry
     kept = int(round(FILL_SOLID_FRACTION * geometry.area * geometry.sample_height / case.particle.volume))
     return min(case.fill.n_clumps, kept)

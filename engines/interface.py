@@ -1,6 +1,6 @@
 """The seam between a case and the engine that runs it: one small interface and a registry of engines by name.
 
-A case (:mod:`engines.cases`) is engine-neutral data. An engine turns it into input files, runs them and reads the
+A case (:mod:`model.cases`) is engine-neutral data. An engine turns it into input files, runs them and reads the
 outputs back into neutral objects (:mod:`model`): particle frames, the force and torque each wall exerts on
 the particles, contact forces at saved instants, and the typed run record. Nothing outside an engine's own package
 (``engines/<name>/``) and templates (``templates/<name>/``) knows its file names or formats.
@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
-from engines.cases import CASE_BUILDERS
-from engines.cases.common import engine_kind
+from model.cases import CASE_BUILDERS
+from model.cases.common import engine_kind
 
 if TYPE_CHECKING:  # the neutral types appear in signatures only
     from model.contacts import ContactFrame

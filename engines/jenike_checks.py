@@ -15,7 +15,7 @@ import numpy as np
 
 from model.forces import WallForceHistory
 from model.record import RunRecord
-from engines.cases.jenike import JenikeCase
+from model.cases.jenike import JenikeCase
 from model.file_messages import first_not_read
 from engines.interface import EngineRunError
 from engines.markers import Marker

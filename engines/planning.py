@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from model.record import RunRecordError, read_run_record
-from engines.cases import CASE_BUILDERS, cases_of, run_roles
+from model.cases import CASE_BUILDERS, cases_of, run_roles
 from engines.config import load_config
 from engines.interface import engine_for
 from engines.estimates import (

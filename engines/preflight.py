@@ -16,7 +16,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from engines.cases import CASE_BUILDERS, cases_of
+from model.cases import CASE_BUILDERS, cases_of
 from engines.config import ConfigError, engines_in_use, validate_config
 from engines.config_yaml import ConfigFileError, read_config_file
 from engines.existing_runs import check_existing_runs

@@ -1,7 +1,7 @@
 """One engine run of one case, from a validated configuration to its checked run record.
 
 The workflow's deck and run steps call these two functions: they build the case the configuration defines for a
-run id (:mod:`engines.cases`), pick the engine that runs it (:mod:`engines.interface`) and, before a run, check the
+run id (:mod:`model.cases`), pick the engine that runs it (:mod:`engines.interface`) and, before a run, check the
 disk and log what it will cost (:mod:`engines.planning`).
 """
 
@@ -11,8 +11,8 @@ import logging
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases import case_for_run
-from engines.cases.common import engine_kind
+from model.cases import case_for_run
+from model.cases.common import engine_kind
 from engines.estimates import estimate_case
 from engines.interface import EngineOptions, engine_for
 from engines.planning import cost_model, preflight

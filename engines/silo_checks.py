@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases.silo_flat import SiloCase
+from model.cases.silo_flat import SiloCase
 from engines.estimates import CostModel, silo_run_steps
 from engines.interface import EngineRunError
 from engines.markers import Marker

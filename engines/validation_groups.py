@@ -16,8 +16,8 @@ import math
 from dataclasses import dataclass
 from typing import Iterable, Mapping, Sequence
 
-from engines.cases import REFERENCE, VARIANT
-from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
+from model.cases import REFERENCE, VARIANT
+from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.estimates import BLENDER, JENIKE, RECIRCULATION, SILO_FLAT, RunEstimate
 
 @dataclass(frozen=True)
@@ -29,7 +29,7 @@ class Group:
     kind : str
         The case kind whose runs it makes.
     roles : tuple of str, optional
-        The roles of that kind's runs it makes (:func:`engines.cases.run_roles`); None: all of them.
+        The roles of that kind's runs it makes (:func:`model.cases.run_roles`); None: all of them.
     reads : tuple of str
         Groups (earlier in :data:`GROUPS`) whose runs its rows compare against.
     """
@@ -74,7 +74,7 @@ COMPLETE, STALE, MISSING = "complete", "stale", "missing"
 
 
 def group_of(kind: str, role: str) -> str:
-    """The group that makes a run of case kind ``kind`` with ``role`` (:func:`engines.cases.run_roles`)."""
+    """The group that makes a run of case kind ``kind`` with ``role`` (:func:`model.cases.run_roles`)."""
     for name, group in GROUPS.items():
         if group.makes(kind, role):
             return name
@@ -89,7 +89,7 @@ def assign(estimates: Sequence[RunEstimate], roles: Mapping[str, str]) -> dict[s
     estimates : sequence of RunEstimate
         A configuration's run estimates (:func:`engines.planning.config_estimates`).
     roles : mapping
-        ``{run id: role}`` of every run (:func:`engines.cases.run_roles`).
+        ``{run id: role}`` of every run (:func:`model.cases.run_roles`).
     """
     made: dict[str, list[RunEstimate]] = {name: [] for name in GROUPS}
     for estimate in estimates:

@@ -1,4 +1,4 @@
-"""What a finished verification run (:mod:`engines.cases.verification`) must show, whatever engine ran it: the
+"""What a finished verification run (:mod:`model.cases.verification`) must show, whatever engine ran it: the
 ``done`` stage marker and its frames; and the run record built from them."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases.verification import VerificationCase
+from model.cases.verification import VerificationCase
 from engines.interface import EngineRunError
 from engines.markers import Marker
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.cases import cases_of
+from model.cases import cases_of
 from engines.interface import EngineOptions, engine_for, engine_named
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"

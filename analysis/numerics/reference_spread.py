@@ -1,5 +1,5 @@
 """The spread between seeds when only the reference configuration of a comparison runs with several seeds and the
-others with one (``reference_replicates``, :func:`engines.cases.cases_of`).
+others with one (``reference_replicates``, :func:`model.cases.cases_of`).
 
 A run's figures come as a nested summary (its JSON files, its CSV tables as lists of rows): every number ``x`` whose
 standard error sits at the same place under the name ``x_error`` (``{"flow": 0.1, "flow_error": 0.002}``,

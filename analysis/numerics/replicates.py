@@ -1,7 +1,7 @@
 """Replicate runs (the same case with different seeds) combined into one figure with its uncertainty.
 
 A configuration with ``replicates: N`` runs every case N times, seed, seed + 1, ..., seed + N - 1
-(:func:`engines.cases.cases_of`). A stage table then has N rows per configuration; :func:`combine_replicates`
+(:func:`model.cases.cases_of`). A stage table then has N rows per configuration; :func:`combine_replicates`
 turns them into one row per configuration: the mean of each figure and its standard error.
 
 Which error: with N >= 2 the spread over seeds is the honest uncertainty of a figure, since it includes

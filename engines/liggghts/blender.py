@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from engines.cases.blender import GATE, BlenderCase, blender_mesh_set
+from model.cases.blender import GATE, BlenderCase, blender_mesh_set
 from engines.liggghts.run import Resume, run_checked
 from model.record import RunRecord
 from engines.liggghts.silo_flat import silo_deck_context

@@ -16,15 +16,15 @@ from model.forces import WallForceHistory
 from model.frames import ParticleFrame
 from model.record import RunRecord
 from model.settled import SettledFill
-from engines.cases.blender import BlenderCase
-from engines.cases.jenike import JenikeCase
-from engines.cases.silo_flat import SiloCase
-from engines.cases.silo_recirculation import RecirculationCase
-from engines.cases.verification import VerificationCase
+from model.cases.blender import BlenderCase
+from model.cases.jenike import JenikeCase
+from model.cases.silo_flat import SiloCase
+from model.cases.silo_recirculation import RecirculationCase
+from model.cases.verification import VerificationCase
 from engines.estimates import MeasuredWork
 from engines.interface import CaseNotSupported, DumpFile, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
-from engines.cases.blender import GATE
+from model.cases.blender import GATE
 from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
 from engines.liggghts.dump_files import match_dump_files, read_dump_files
@@ -44,7 +44,7 @@ from engines.liggghts.jenike import (
 from engines.liggghts.cost import measured_work as work_from_logs
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs, check_programs
 from engines.liggghts.settled import read_settled_fill
-from engines.cases.silo_flat import FLOOR_MESHES
+from model.cases.silo_flat import FLOOR_MESHES
 from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 from engines.liggghts.verification import run_verification, write_verification_inputs

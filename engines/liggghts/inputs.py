@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from model.constants import GRAVITY
-from engines.cases.geometry import write_stl
+from model.cases.geometry import write_stl
 from engines.layout import write_text_atomic
 
 #: The engine's registry name (engine.kind), written into every run record.

@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from model.contacts import ContactFrame, WallContactFrame
-from engines.cases.geometry import write_stl
-from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
+from model.cases.geometry import write_stl
+from model.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
 from model.record import RunRecord
 from engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from engines.layout import RUN_RECORD

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from model.record import RunRecord
-from engines.cases.silo_flat import SiloCase, silo_meshes
+from model.cases.silo_flat import SiloCase, silo_meshes
 from engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from engines.liggghts.inputs import ENGINE_NAME, common_context, processor_grid, write_case_inputs
 from engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
+from model.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
 from engines.liggghts.run import Resume, run_checked
 from model.record import RunRecord
 from engines.liggghts.silo_flat import silo_deck_context

@@ -8,7 +8,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases.verification import VerificationCase
+from model.cases.verification import VerificationCase
 from engines.liggghts.inputs import ENGINE_NAME, processor_grid, write_case_inputs
 from engines.liggghts.run import DUMP_PREFIX, run_checked
 from engines.templating import render_deck

@@ -1,5 +1,5 @@
 """YADE scripts of the multi-flow blender: the batch silo's script (:mod:`engines.yade.silo_flat`) with the blender's
-closed wall meshes (hopper, insert and tube plates: :func:`engines.cases.blender.blender_mesh_set`) as facets and
+closed wall meshes (hopper, insert and tube plates: :func:`model.cases.blender.blender_mesh_set`) as facets and
 front and back planes, at the case's gravity. Batch discharge removes clumps below the outlet; continuous discharge
 moves a clump that fell below the domain to its top (whole, with its x, y and velocity) every :data:`REENTRY_EVERY`
 steps, as the LIGGGHTS deck's periodic z, and the run is checked for an unchanged clump count.
@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases.blender import GATE, BlenderCase, blender_mesh_set
+from model.cases.blender import GATE, BlenderCase, blender_mesh_set
 from engines.templating import render_deck
 from engines.yade.inputs import exploded_speed, write_script_inputs
 from engines.yade.run import YadeOptions

@@ -14,11 +14,11 @@ from model.forces import WallForceHistory
 from model.frames import ParticleFrame
 from model.record import RunRecord
 from model.settled import SettledFill
-from engines.cases.blender import GATE, BlenderCase
-from engines.cases.jenike import JenikeCase
-from engines.cases.silo_flat import FLOOR_MESHES, SiloCase
-from engines.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase
-from engines.cases.verification import VerificationCase
+from model.cases.blender import GATE, BlenderCase
+from model.cases.jenike import JenikeCase
+from model.cases.silo_flat import FLOOR_MESHES, SiloCase
+from model.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase
+from model.cases.verification import VerificationCase
 from engines.estimates import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from model.constants import GRAVITY
-from engines.cases.particles import clump_inertia
+from model.cases.particles import clump_inertia
 from engines.interface import CaseNotSupported
 from engines.layout import write_text_atomic
 
@@ -71,7 +71,7 @@ def hertz_stiffness_at_load(radius: float, youngs_modulus: float, poisson_ratio:
 
 def principal_clump(particle) -> tuple[np.ndarray, np.ndarray]:
     """The clump's sphere centres in its principal frame [m] and its principal moments of inertia [kg m2] (exact
-    union, :func:`engines.cases.particles.clump_inertia`)."""
+    union, :func:`model.cases.particles.clump_inertia`)."""
     tensor = clump_inertia(particle.sphere_positions, particle.sphere_radii, particle.density)
     moments, axes = np.linalg.eigh(tensor)
     return particle.sphere_positions @ axes, moments

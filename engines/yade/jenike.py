@@ -2,7 +2,7 @@
 written into a run's ``deck/`` folder, the run checked as every engine's Jenike runs are
 (:mod:`engines.jenike_checks`), and its contact snapshots read back.
 
-How the script carries out the case's stages (:mod:`engines.cases.jenike`): the rings, the mould and a wall test's
+How the script carries out the case's stages (:mod:`model.cases.jenike`): the rings, the mould and a wall test's
 plate are facets from the case's meshes; the shear ring and the mould move by their prescribed velocity (YADE moves a
 non-dynamic body by its velocity). The rigid lid is a clump of the case's lid spheres with x and y held (its x
 velocity is the shear velocity during the shear), free to tilt, as the LIGGGHTS deck's ``fix rigid``. The servo lid is
@@ -34,7 +34,7 @@ import numpy as np
 
 from model.contacts import ContactFrame, WallContactFrame
 from model.record import RunRecord
-from engines.cases.jenike import LID_TYPE, PLATE_TYPE, RING_TYPE, JenikeCase
+from model.cases.jenike import LID_TYPE, PLATE_TYPE, RING_TYPE, JenikeCase
 from engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from engines.templating import render_deck
 from engines.yade.inputs import (

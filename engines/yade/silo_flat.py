@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from model.record import RunRecord
-from engines.cases.silo_flat import SiloCase, silo_meshes
+from model.cases.silo_flat import SiloCase, silo_meshes
 from engines.interface import CaseNotSupported
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from engines.templating import render_deck

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from model.record import RunRecord
-from engines.cases.silo_recirculation import RecirculationCase, recirculation_meshes
+from model.cases.silo_recirculation import RecirculationCase, recirculation_meshes
 from engines.templating import render_deck
 from engines.yade.inputs import write_script_inputs
 from engines.yade.run import YadeOptions

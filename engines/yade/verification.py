@@ -8,7 +8,7 @@ from pathlib import Path
 
 from model.constants import GRAVITY
 from model.record import RunRecord
-from engines.cases.verification import VerificationCase
+from model.cases.verification import VerificationCase
 from engines.templating import render_deck
 from engines.verification_checks import check_verification_run, verification_record
 from engines.yade.inputs import ENGINE_NAME, hertz_stiffness_at_load, write_script_inputs

@@ -56,10 +56,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from engines.cases.blender import BlenderCase, build_blender_case
-from engines.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
-from engines.cases.jenike_sweep import sweep_points
-from engines.cases.silo_flat import SiloCase
+from model.cases.blender import BlenderCase, build_blender_case
+from model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from model.cases.jenike_sweep import sweep_points
+from model.cases.silo_flat import SiloCase
 from engines.interface import Engine, EngineOptions, engine_for
 from engines.liggghts.cost import StageCost, stage_costs
 from engines.markers import parse_markers

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import copy
 
-from engines.cases.silo_flat import SiloCase, build_silo_case
+from model.cases.silo_flat import SiloCase, build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import Engine, engine_for
 

@@ -22,7 +22,7 @@ from model.record import read_run_record
 from analysis.studies.silo_recirculation.tracks import recirculation_events, recirculation_tracks
 from analysis.studies.validation.blending import blender_rows, gravity_rows
 from analysis.studies.validation.rows import Criteria
-from engines.cases.blender import blender_cases
+from model.cases.blender import blender_cases
 from engines.config import validate_config
 from engines.layout import case_root, run_dir
 from tests.conftest import (FAST_POUR, NO_BLENDING, STAGE_TIMESTEP_FRACTION, TINY_BLENDER, TINY_SILO, liggghts,

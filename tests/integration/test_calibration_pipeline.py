@@ -21,8 +21,8 @@ import yaml
 
 from calibration.friction import bulk_friction_of_shear
 from calibration.shear import shear_signals
-from engines.cases import cases_of
-from engines.cases.jenike import build_jenike_case
+from model.cases import cases_of
+from model.cases.jenike import build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_for
 from tests.conftest import (NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts,

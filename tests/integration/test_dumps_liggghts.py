@@ -27,8 +27,8 @@ import pyvista
 
 from model.frames import ParticleFrame, clumps_from_frame
 from model.record import RunRecord
-from engines.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
-from engines.cases.silo_flat import SiloCase, build_silo_case
+from model.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
+from model.cases.silo_flat import SiloCase, build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions
 from engines.liggghts.dumps import (

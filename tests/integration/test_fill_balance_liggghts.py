@@ -26,7 +26,7 @@ import pytest
 
 from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from analysis.numerics.janssen import janssen_vertical_stress
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, require_liggghts

@@ -26,7 +26,7 @@ import scipy.stats
 
 from analysis.numerics.force_balance import settled_fill_balance
 from analysis.numerics.janssen import janssen_vertical_stress
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_named
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_liggghts, require_yade

@@ -23,7 +23,7 @@ from analysis.numerics.force_balance import BalanceTolerances, balance_problems,
 from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals
 from engines.config import validate_config
-from engines.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
 from engines.liggghts.run import DUMP_PREFIX
 from engines.liggghts.jenike import (
     FORCES_NAME,

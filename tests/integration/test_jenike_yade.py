@@ -19,7 +19,7 @@ from model.record import RunRecord
 from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
 from calibration.friction import BulkFriction, bulk_friction
 from calibration.shear import ShearSignals, shear_signals
-from engines.cases.jenike import JenikeCase, build_jenike_case
+from model.cases.jenike import JenikeCase, build_jenike_case
 from engines.config import validate_config
 from engines.interface import EngineOptions, engine_named
 from tests.conftest import RunsOnDemand, require_yade

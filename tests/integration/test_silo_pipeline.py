@@ -24,8 +24,8 @@ from analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
 from analysis.piv.front_wall import front_wall_image, front_wall_spheres
 from analysis.piv.synthetic import piv_displacements
 from analysis.studies.silo_flat.metrics import silo_flow_metrics
-from engines.cases import cases_of
-from engines.cases.silo_flat import build_silo_case
+from model.cases import cases_of
+from model.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_named
 from engines.layout import READ_PRODUCTS

@@ -23,7 +23,7 @@ from analysis.studies.validation.blending import recirculation_rows
 from analysis.studies.validation.rows import Criteria
 from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.silo_recirculation.tracks_io import load_tracks
-from engines.cases.silo_recirculation import recirculation_cases
+from model.cases.silo_recirculation import recirculation_cases
 from model.record import read_run_record
 from engines.config import validate_config
 from engines.layout import case_root, run_dir, run_path

@@ -17,7 +17,7 @@ import pytest
 
 from model.frames import clumps_from_frame
 from analysis.numerics.force_balance import settled_fill_balance
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_for
 from engines.yade.run import restart_files

@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table
-from engines.cases.verification import verification_cases
+from model.cases.verification import verification_cases
 from engines.interface import EngineOptions, engine_named
 from engines.config import REPO_ROOT
 from tests.conftest import DEFAULT_CONFIG, NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake

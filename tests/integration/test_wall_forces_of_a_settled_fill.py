@@ -13,7 +13,7 @@ import pytest
 
 from model.frames import clumps_from_frame
 from model.constants import GRAVITY
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, require_liggghts

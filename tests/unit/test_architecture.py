@@ -111,8 +111,6 @@ def test_layers_point_one_way():
                 wrong.append(f"{module} -> {target} (calibration may use analysis and the model only)")
             if top == "engines" and other not in ("engines", "model"):
                 wrong.append(f"{module} -> {target} (engines take only the neutral model)")
-            if module.startswith("engines.cases") and target.startswith(("engines.liggghts", "engines.interface")):
-                wrong.append(f"{module} -> {target} (the case model knows no engine)")
     assert not wrong, "\n".join(sorted(wrong))
 
 

@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.cases.blender import (
+from model.cases.blender import (
     blender_case_for_run, blender_cases, blender_mesh_set, build_blender_case, fill_cross_section_area,
 )
-from engines.cases.blender_geometry import blender_geometry
-from engines.cases.blender_meshes import is_watertight
+from model.cases.blender_geometry import blender_geometry
+from model.cases.blender_meshes import is_watertight
 from engines.config import ConfigError, load_config, validate_config
 from engines.liggghts.blender import render_blender_deck, write_blender_inputs
 from tests.golden_files import assert_matches_golden

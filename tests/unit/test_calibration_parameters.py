@@ -4,7 +4,7 @@ import pytest
 
 from calibration.parameters import apply_calibrated_parameters
 from engines.config import validate_config
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 
 PARAMETERS = {
     "shape": "sphere4",

@@ -3,7 +3,7 @@
 import pytest
 
 from calibration.sweep import chart_rows, lid_comparison
-from engines.cases.jenike_sweep import (CALIBRATION_CHART, CHECK, SHAPE_CHART, diagnostic_points, is_chart_point,
+from model.cases.jenike_sweep import (CALIBRATION_CHART, CHECK, SHAPE_CHART, diagnostic_points, is_chart_point,
                                         point_role, sweep_points)
 from engines.config import ConfigError, validate_config
 

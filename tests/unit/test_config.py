@@ -7,8 +7,8 @@ import copy
 import pytest
 import yaml
 
-from engines.cases import cases_of
-from engines.cases.silo_flat import build_silo_case
+from model.cases import cases_of
+from model.cases.silo_flat import build_silo_case
 from engines.config import SCHEMA_PATH, ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_for
 

@@ -12,11 +12,11 @@ import time
 
 import pytest
 
-from engines.cases import CASE_BUILDERS, cases_of
-from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
-from engines.cases.jenike_cell import segments_for_chord
-from engines.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
-from engines.cases.silo_flat import build_silo_case
+from model.cases import CASE_BUILDERS, cases_of
+from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
+from model.cases.jenike_cell import segments_for_chord
+from model.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
+from model.cases.silo_flat import build_silo_case
 from engines.config import REPO_ROOT, ConfigError, load_config_file, load_schema, validate_config
 from engines.planning import config_estimates
 

@@ -10,7 +10,7 @@ import pytest
 
 from model.frames import ClumpFrame
 from analysis.studies.cross_engine import centreline_vertical_velocity, compare_engines
-from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases, jenike_point_label
+from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases, jenike_point_label
 from engines.config import ConfigError, validate_config
 
 

@@ -9,8 +9,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from engines.cases.blender import blender_cases, build_blender_case
-from engines.cases.silo_recirculation import recirculation_cases
+from model.cases.blender import blender_cases, build_blender_case
+from model.cases.silo_recirculation import recirculation_cases
 from engines.config import REPO_ROOT, load_config
 from analysis.numerics.flow import beverloo_mass_flow_rate
 from engines.estimates import (
@@ -42,9 +42,9 @@ from engines.estimates import (
     total_dump_bytes,
     wall_time,
 )
-from engines.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
+from model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
 from engines.liggghts.cost import StageCost, TimedRun, calibrate_cost_model, measured_work, stage_costs, timed_runs
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
     "shape": "sphere2",

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from model.existing_run import ExistingRunError, ExistingSiloRun
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.config import ConfigError, existing_silo_runs, validate_config
 from engines.existing_runs import check_existing_run, check_existing_runs, opening_files, read_existing_frames
 from engines.interface import DumpFile, engine_named

@@ -20,7 +20,7 @@ from analysis.numerics.flow import (
     steady_flow_rate,
     volumetric_flow_rate,
 )
-from engines.cases.particles import clump_volume, equivalent_diameter
+from model.cases.particles import clump_volume, equivalent_diameter
 
 # --------------------------------------------------------------------------- Beverloo
 

@@ -14,8 +14,8 @@ import pytest
 from engines.interface import CaseNotSupported, engine_named
 
 from engines.config import load_config, validate_config
-from engines.cases.geometry import read_stl
-from engines.cases.jenike import (
+from model.cases.geometry import read_stl
+from model.cases.jenike import (
     FILL_SOLID_FRACTION,
     LID_TYPE,
     PARTICLE_TYPE,
@@ -24,7 +24,7 @@ from engines.cases.jenike import (
     build_jenike_case,
     force_sample_every,
 )
-from engines.cases.jenike_cell import circle_intersection_area
+from model.cases.jenike_cell import circle_intersection_area
 from engines.interface import EngineRunError
 from engines.markers import Marker
 from engines.jenike_checks import FORCE_COLUMNS, check_jenike_run, read_jenike_force_history
@@ -36,7 +36,7 @@ from engines.liggghts.jenike import (
     set_aside_previous_jenike_attempt,
     write_jenike_inputs,
 )
-from engines.cases.physics import hertz_contact_time, rayleigh_time
+from model.cases.physics import hertz_contact_time, rayleigh_time
 from engines.templating import UnsafeDeckValue, render_deck
 from tests.golden_files import assert_matches_golden
 

@@ -10,7 +10,7 @@ from engines.liggghts.run import engine_command, set_aside_previous_attempt
 from engines.liggghts.markers import error_lines
 from engines.markers import parse_markers
 from engines.silo_checks import check_silo_run
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 
 LOG = """\
 print "SILOFLOW filled step=$(step) time=$(time) clumps=${n_clumps} ke_per_clump=${ke_per_clump}"

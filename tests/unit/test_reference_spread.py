@@ -9,9 +9,9 @@ import pytest
 from analysis.numerics.reference_spread import (combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
                                                with_reference_spread)
 from calibration.friction import SECOND_HALF, STEADY, combined_window_method
-from engines.cases import cases_of, reference_runs
-from engines.cases.jenike import jenike_cases
-from engines.cases.jenike_sweep import reference_point, sweep_points
+from model.cases import cases_of, reference_runs
+from model.cases.jenike import jenike_cases
+from model.cases.jenike_sweep import reference_point, sweep_points
 from engines.config import validate_config
 
 

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from engines.config import validate_config
-from engines.cases.common import material_table, run_id
-from engines.cases.silo_flat import build_silo_case, silo_case_for_run
+from model.cases.common import material_table, run_id
+from model.cases.silo_flat import build_silo_case, silo_case_for_run
 
 
 def test_clump_count_follows_the_fill_height(tiny_config):

@@ -10,16 +10,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.cases.silo_recirculation import (
+from model.cases.silo_recirculation import (
     apply_flow_pattern,
     build_recirculation_case,
     estimated_residence_time,
     recirculation_case_for_run,
     recirculation_cases,
 )
-from engines.cases.physics import steps_for
+from model.cases.physics import steps_for
 from engines.config import ConfigError, load_config, validate_config
-from engines.cases.silo_recirculation import recirculation_meshes
+from model.cases.silo_recirculation import recirculation_meshes
 from engines.liggghts.silo_recirculation import render_recirculation_deck, write_recirculation_inputs
 from tests.golden_files import assert_matches_golden
 

@@ -11,7 +11,7 @@ import pytest
 from engines.config import ConfigError, load_config, validate_config
 from engines.liggghts.inputs import processor_grid
 from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.templating import (
     UnsafeDeckValue,
     check_context,

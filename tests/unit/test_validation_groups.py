@@ -6,8 +6,8 @@ import pytest
 
 from engines.config import REPO_ROOT, load_config
 from engines.estimates import RunEstimate
-from engines.cases import REFERENCE, VARIANT
-from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
+from model.cases import REFERENCE, VARIANT
+from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
 from engines.planning import config_estimates, group_runs
 from engines.validation_groups import (
     COMPLETE,

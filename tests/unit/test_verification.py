@@ -22,7 +22,7 @@ from analysis.numerics.verification import (
     zero_crossings,
 )
 from analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
-from engines.cases.verification import PROBLEMS, verification_cases
+from model.cases.verification import PROBLEMS, verification_cases
 
 
 def test_hertz_time_constant_is_the_integral_it_names():

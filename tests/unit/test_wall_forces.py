@@ -11,7 +11,7 @@ import pytest
 
 from model.forces import WallForceHistory
 from engines.config import load_config
-from engines.cases.silo_flat import build_silo_case
+from model.cases.silo_flat import build_silo_case
 from engines.liggghts.forces import (
     RESUMED_WALL_FORCES_PREFIX,
     read_jenike_forces,

@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.cases import cases_of
-from engines.cases.common import material_table
-from engines.cases.particles import clump_inertia, clump_volume
-from engines.cases.blender import build_blender_case
-from engines.cases.silo_flat import build_silo_case
-from engines.cases.silo_recirculation import build_recirculation_case
+from model.cases import cases_of
+from model.cases.common import material_table
+from model.cases.particles import clump_inertia, clump_volume
+from model.cases.blender import build_blender_case
+from model.cases.silo_flat import build_silo_case
+from model.cases.silo_recirculation import build_recirculation_case
 from engines.config import ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_named
 from engines.templating import UnsafeDeckValue, deck_string, render_deck

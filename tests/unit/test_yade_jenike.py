@@ -8,7 +8,7 @@ import ast
 import numpy as np
 import pytest
 
-from engines.cases.jenike import build_jenike_case, jenike_cases
+from model.cases.jenike import build_jenike_case, jenike_cases
 from engines.config import validate_config
 from engines.interface import engine_named
 from engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS, jenike_wall_forces, read_jenike_force_history

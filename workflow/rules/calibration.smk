@@ -1,6 +1,6 @@
 # Calibration: Jenike shear-cell sweep -> bulk friction per point -> table, charts -> chosen parameters.
 
-from engines.cases.jenike_sweep import diagnostic_points, is_chart_point
+from model.cases.jenike_sweep import diagnostic_points, is_chart_point
 
 JENIKE_CASES = cases("jenike")
 

@@ -9,13 +9,13 @@ sys.path.insert(0, workflow.basedir)
 
 from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
 from calibration.parameters import calibrated_config
-from engines.cases import CASE_BUILDERS, cases_of
-from engines.cases.silo_flat import build_silo_case, parametric_variants
-from engines.cases.silo_recirculation import SECTION as RECIRCULATION
+from model.cases import CASE_BUILDERS, cases_of
+from model.cases.silo_flat import build_silo_case, parametric_variants
+from model.cases.silo_recirculation import SECTION as RECIRCULATION
 from engines.preflight import PreflightError, preflight
 from engines.estimates import InsufficientDiskSpace, format_bytes
-from engines.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
-from engines.cases.verification import verification_cases
+from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
+from model.cases.verification import verification_cases
 from engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CASE_SUMMARY, CROSS_ENGINE_DIR, RESULTS, RUN_BENCHMARK,
                             RUN_RECORD, SUMMARY_DIR, VERIFICATION_DIR, case_root, run_dir, run_path)

@@ -2,8 +2,8 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
-from engines.cases import REFERENCE, VARIANT, run_roles
-from engines.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
+from model.cases import REFERENCE, VARIANT, run_roles
+from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, SUMMARY_DIR, VALIDATION_RECORD
 from engines.planning import group_runs as planned_group_runs
 from engines.validation_groups import GROUPS, part_of_runs, split_groups

@@ -1,4 +1,4 @@
-# The DEM verification suite: single-sphere problems with closed-form answers (engines.cases.verification), each run
+# The DEM verification suite: single-sphere problems with closed-form answers (model.cases.verification), each run
 # on every engine siloflow has, and one table of closed form, measured value, relative error and tolerance per
 # engine (`snakemake verification`). Cheap: seconds per run. A row outside its tolerance is reported with its known reason;
 # an unexplained one fails the table.

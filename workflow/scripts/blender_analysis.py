@@ -25,8 +25,8 @@ from analysis.studies.blender.tables import (
     vrr_period_rows,
 )
 from analysis.io.tables import write_flow_table, write_json
-from engines.cases import case_for_run
-from engines.cases.blender_passages import annulus_bounds
+from model.cases import case_for_run
+from model.cases.blender_passages import annulus_bounds
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from engines.cases.cross_engine import cross_engine_jenike_cases
+from model.cases.cross_engine import cross_engine_jenike_cases
 from engines.interface import EngineOptions, engine_named
 from engines.logs import logged_to
 

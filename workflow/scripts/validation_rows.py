@@ -16,7 +16,7 @@ from analysis.studies.validation.rows import Criteria
 from analysis.numerics.reference_spread import floor_table, seed_note, with_reference_spread
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
 from calibration.table import point_table
-from engines.cases.particles import particle_template
+from model.cases.particles import particle_template
 from engines.logs import logged_to
 
 

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from engines.cases.verification import verification_cases
+from model.cases.verification import verification_cases
 from engines.interface import EngineOptions, engine_named
 from engines.logs import logged_to
 

@@ -111,7 +111,7 @@ def key_heights(insert: Mapping, bin_size: float, fill_height: float, heights_ab
     ----------
     insert : mapping
         ``z_insert_outlet``, ``inlet`` (the plate's upper end (x, z); None without an insert) and ``z_tube_inlet``
-        (None without a tube), as in :func:`engines.cases.blender_passages.geometry_summary` [m].
+        (None without a tube), as in :func:`model.cases.blender_passages.geometry_summary` [m].
     bin_size : float
         Bin edge of the fields [m].
     fill_height : float

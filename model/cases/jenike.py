@@ -1,6 +1,6 @@
 """The Jenike direct shear cell: an engine-neutral case built from validated configuration.
 
-Coordinates (SI units) and the cell's parts are those of :mod:`engines.cases.jenike_cell`: the cell axis is z,
+Coordinates (SI units) and the cell's parts are those of :mod:`model.cases.jenike_cell`: the cell axis is z,
 shear is along +x. ``test = "internal"`` tests internal friction between a bottom ring and a shear ring;
 ``test = <wall material>`` tests wall friction, the bottom ring replaced by a flat plate of the wall material.
 
@@ -21,7 +21,7 @@ Stages (:meth:`JenikeCase.stages`; how an engine carries them out is that engine
    (rigid lid: its x velocity is set to the shear velocity and its x, y translation is not integrated;
    servo lid: its mesh is moved at the same x velocity).
 
-Lids (``rigid`` or ``servo``): :mod:`engines.cases.jenike_lids`.
+Lids (``rigid`` or ``servo``): :mod:`model.cases.jenike_lids`.
 """
 
 from __future__ import annotations
@@ -32,15 +32,15 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from model.constants import GRAVITY
-from engines.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
-from engines.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
-from engines.cases.particles import ParticleTemplate, model_parameters, particle_template
-from engines.cases.physics import (
+from model.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
+from model.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
+from model.cases.particles import ParticleTemplate, model_parameters, particle_template
+from model.cases.physics import (
     ChosenTimestep, TimestepChoice, engine_seeds, free_fall_velocity, stable_timestep, steps_for,
 )
-from engines.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
-from engines.cases.jenike_sweep import sweep_points
-from engines.cases.stages import Stage
+from model.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
+from model.cases.jenike_sweep import sweep_points
+from model.cases.stages import Stage
 
 CASE_NAME = "jenike"
 
@@ -160,7 +160,7 @@ class JenikeCase(ChosenTimestep):
     domain: tuple[float, float, float, float, float, float]
     seeds: tuple[int, ...]
     defining_parameters: dict = field(repr=False)
-    #: The point as the sweep designed it (:func:`engines.cases.jenike_sweep.sweep_points`): ``point`` with ``lid``,
+    #: The point as the sweep designed it (:func:`model.cases.jenike_sweep.sweep_points`): ``point`` with ``lid``,
     #: ``replicate`` and ``shear_velocity`` where the sweep set them.
     sweep_point: dict = field(default_factory=dict, repr=False)
 
@@ -251,7 +251,7 @@ POINT_KEYS = ("shape", "test", "sliding_friction", "rolling_friction", "restitut
 
 def _check_point(point: dict) -> dict:
     """The point with exactly :data:`POINT_KEYS`, numbers as floats. Its values come from the validated
-    ``jenike.sweep`` section (:func:`engines.cases.jenike_sweep.sweep_points`): the schema is their one validator."""
+    ``jenike.sweep`` section (:func:`model.cases.jenike_sweep.sweep_points`): the schema is their one validator."""
     missing = [key for key in POINT_KEYS if key not in point]
     extra = sorted(set(point) - set(POINT_KEYS))
     if missing or extra:

@@ -11,8 +11,8 @@ import json
 import math
 from dataclasses import dataclass
 
-from engines.cases.particles import ParticleTemplate
-from engines.cases.physics import check_steps, free_fall_time, free_fall_velocity, steps_for
+from model.cases.particles import ParticleTemplate
+from model.cases.physics import check_steps, free_fall_time, free_fall_velocity, steps_for
 
 
 @dataclass(frozen=True)

@@ -5,13 +5,13 @@ body that translates vertically and may tilt and rotate, loaded by a constant ve
 with its weight cancelled. Its spheres have the radius of the smallest particle sphere and the
 particle density (the lid material has no density in the configuration).
 
-``servo``: a flat disk mesh (:meth:`engines.cases.jenike_cell.CellGeometry.servo_lid`) that cannot tilt
+``servo``: a flat disk mesh (:meth:`model.cases.jenike_cell.CellGeometry.servo_lid`) that cannot tilt
 or rotate, loaded by the same constant force. A lid held still while the shear ring moves away would turn
 the test into a wall-friction test of the ring against the sample; so the lid mesh moves along x at the
 shear velocity (with the ring) and along z with a proxy body of the lid's mass driven by the particles'
 force on the mesh minus F_N (:class:`ServoLid`).
 
-Coordinates (SI units) are those of the cell (:mod:`engines.cases.jenike_cell`).
+Coordinates (SI units) are those of the cell (:mod:`model.cases.jenike_cell`).
 """
 
 from __future__ import annotations

@@ -17,14 +17,14 @@ import math
 from dataclasses import asdict, dataclass, field
 
 from model.constants import GRAVITY
-from engines.cases.common import (
+from model.cases.common import (
     FillPlan, MaterialTable, SettleCriterion, defining_settle, engine_kind, fill_zone, largest_impact_velocity,
     material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
 )
-from engines.cases.geometry import horizontal_rectangle
-from engines.cases.particles import ParticleTemplate, model_parameters, particle_template
-from engines.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
-from engines.cases.stages import Stage
+from model.cases.geometry import horizontal_rectangle
+from model.cases.particles import ParticleTemplate, model_parameters, particle_template
+from model.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
+from model.cases.stages import Stage
 
 CASE_NAME = "silo_flat"
 

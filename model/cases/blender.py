@@ -1,6 +1,6 @@
 """The multi-flow blender: an engine-neutral case built from validated configuration.
 
-Geometry (SI units, :mod:`engines.cases.blender_geometry`): a planar silo of inner width W and depth T whose vertical
+Geometry (SI units, :mod:`model.cases.blender_geometry`): a planar silo of inner width W and depth T whose vertical
 section sits on a planar hopper of half-angle alpha with a slot outlet of width B0 at z = 0; inside, a
 cone-in-cone insert (two inclined plates) and a central blending tube, every wall ``wall_thickness`` thick.
 
@@ -23,18 +23,18 @@ import copy
 import math
 from dataclasses import dataclass, field
 
-from engines.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
-from engines.cases.blender_passages import clear_widths, geometry_summary
-from engines.cases.blender_meshes import blender_meshes
-from engines.cases.geometry import horizontal_rectangle
-from engines.cases.particles import model_parameters, particle_template
-from engines.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
+from model.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
+from model.cases.blender_passages import clear_widths, geometry_summary
+from model.cases.blender_meshes import blender_meshes
+from model.cases.geometry import horizontal_rectangle
+from model.cases.particles import model_parameters, particle_template
+from model.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from model.constants import GRAVITY
-from engines.cases.common import (
+from model.cases.common import (
     SettleCriterion, clump_energy_scale, defining_settle, engine_kind, largest_impact_velocity, material_table,
     plan_fill, run_id, without_fill_checks,
 )
-from engines.cases.silo_flat import SiloCase
+from model.cases.silo_flat import SiloCase
 
 CASE_NAME = "blender"
 MODES = ("continuous", "batch")
@@ -159,7 +159,7 @@ def fill_cross_section_area(geometry: BlenderGeometry, height: float) -> float:
 
 
 def insert_spec(config: dict, configuration: str):
-    """The insert specification of ``configuration`` for :func:`engines.cases.blender_geometry.blender_geometry`."""
+    """The insert specification of ``configuration`` for :func:`model.cases.blender_geometry.blender_geometry`."""
     blender = config["blender"]
     if configuration in blender["inserts"]:
         return dict(blender["inserts"][configuration])

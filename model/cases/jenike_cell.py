@@ -18,7 +18,7 @@ Wall friction test
 
 Circles are n-gons (:func:`segments_for_chord`) built by the primitives :func:`cylinder_wall`,
 :func:`annulus` and :func:`disk`; :class:`CellGeometry` assembles them into the case's meshes. The case
-itself (:mod:`engines.cases.jenike`) derives a :class:`CellGeometry` from the configuration.
+itself (:mod:`model.cases.jenike`) derives a :class:`CellGeometry` from the configuration.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engines.cases.geometry import TriangleMesh, horizontal_rectangle
+from model.cases.geometry import TriangleMesh, horizontal_rectangle
 
 
 # ---------------------------------------------------------------------------------------------- meshes

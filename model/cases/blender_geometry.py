@@ -28,8 +28,8 @@ Tube
     Two plates centred on x = +-tw from the insert outlet level z_o (the tube outlet; the reference level when
     there is no insert) up to z_t + ``tube_inlet_above_transition`` (the tube inlet).
 
-The wall solids (closed meshes with outward normals) are built by :mod:`engines.cases.blender_meshes`; the clear
-passages between the walls and the plain-data summary by :mod:`engines.cases.blender_passages`.
+The wall solids (closed meshes with outward normals) are built by :mod:`model.cases.blender_meshes`; the clear
+passages between the walls and the plain-data summary by :mod:`model.cases.blender_passages`.
 """
 
 from __future__ import annotations

@@ -31,9 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engines.cases.common import run_id
-from engines.cases.particles import clump_inertia, clump_volume
-from engines.cases.stages import Stage
+from model.cases.common import run_id
+from model.cases.particles import clump_inertia, clump_volume
+from model.cases.stages import Stage
 
 __all__ = ["MATERIAL", "PROBLEMS", "VerificationCase", "VerificationSphere", "verification_cases"]
 

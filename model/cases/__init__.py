@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import copy
 
-from engines.cases.blender import blender_cases
-from engines.cases.jenike import jenike_cases
-from engines.cases.jenike_sweep import point_role
-from engines.cases.silo_flat import silo_cases
-from engines.cases.silo_recirculation import recirculation_cases
+from model.cases.blender import blender_cases
+from model.cases.jenike import jenike_cases
+from model.cases.jenike_sweep import point_role
+from model.cases.silo_flat import silo_cases
+from model.cases.silo_recirculation import recirculation_cases
 
 __all__ = ["CASE_BUILDERS", "REFERENCE", "VARIANT", "case_for_run", "cases_of", "reference_runs", "run_roles"]
 
@@ -85,7 +85,7 @@ REFERENCE, VARIANT = "reference", "variant"
 
 def run_roles(config: dict, case: str) -> dict[str, str]:
     """``{run id: role}`` of the runs of case kind ``case``: a Jenike run's sweep role
-    (:data:`engines.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), any
+    (:data:`model.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), any
     other run :data:`REFERENCE` when it is one of :func:`reference_runs` and :data:`VARIANT` otherwise."""
     runs, reference = _runs_and_reference(config, case)
     if case == "jenike":

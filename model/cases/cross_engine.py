@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import copy
 
-from engines.cases.jenike import JenikeCase, build_jenike_case
-from engines.cases.silo_flat import SiloCase, build_silo_case
+from model.cases.jenike import JenikeCase, build_jenike_case
+from model.cases.silo_flat import SiloCase, build_silo_case
 
 __all__ = ["JENIKE_CELL_KEYS", "SIZE_KEYS", "cross_engine_cases", "cross_engine_jenike_cases"]
 

@@ -1,6 +1,6 @@
 """Closed wall solids of the planar blender: thick walls extruded over the depth, and mesh checks.
 
-Coordinates are those of :mod:`engines.cases.blender_geometry` (SI units, m): x across the width, y through the
+Coordinates are those of :mod:`model.cases.blender_geometry` (SI units, m): x across the width, y through the
 depth, z up. Every wall is a 2-D outline in the x-z plane between its two surfaces (two matching polylines),
 triangulated and extruded over y in [0, T] into a closed solid with outward normals, for the engine's mesh walls;
 the left half mirrors the right one (:func:`mirror_x`). :func:`is_watertight` and :func:`signed_volume` check
@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 
-from engines.cases.blender_geometry import BlenderGeometry, positive_number
-from engines.cases.geometry import TriangleMesh
+from model.cases.blender_geometry import BlenderGeometry, positive_number
+from model.cases.geometry import TriangleMesh
 
 
 def _subdivided_rails(inner: np.ndarray, outer: np.ndarray, max_edge: float | None) -> tuple[np.ndarray, np.ndarray]:

@@ -1,6 +1,6 @@
 """The passages of a planar blender between its walls, and its plain-data summary.
 
-Functions of a :class:`~engines.cases.blender_geometry.BlenderGeometry` (coordinates and units as there: SI, m, the
+Functions of a :class:`~model.cases.blender_geometry.BlenderGeometry` (coordinates and units as there: SI, m, the
 right half x > 0): the clear x-intervals at a height (:func:`annulus_bounds`), the narrowest clear width of each
 passage, which the case checks against the clump size (:func:`clear_widths`), and the summary the case records in
 ``case.json`` (:func:`geometry_summary`).
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from engines.cases.blender_geometry import BlenderGeometry, finite_number
+from model.cases.blender_geometry import BlenderGeometry, finite_number
 
 
 def annulus_bounds(geometry: BlenderGeometry, z: float) -> dict[str, tuple[float, float]]:

@@ -1,6 +1,6 @@
 """The recirculating flat-bottom silo of the blending study: an engine-neutral case from validated configuration.
 
-Geometry (SI units, as :mod:`engines.cases.silo_flat`): the planar silo of width W and depth T with its floor and outlet
+Geometry (SI units, as :mod:`model.cases.silo_flat`): the planar silo of width W and depth T with its floor and outlet
 plane at z = 0, plus a vertical channel of the outlet width B0 from z = 0 down to z = -L (``channel_length``).
 In the lower half of the channel a feeder holds the clumps at the downward velocity ``V_out``. The domain is
 periodic in z: a clump leaving the bottom z = -L re-enters at the top of the domain (above the pile) and falls
@@ -21,9 +21,9 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from engines.cases.common import run_id
-from engines.cases.geometry import vertical_rectangle_x
-from engines.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
+from model.cases.common import run_id
+from model.cases.geometry import vertical_rectangle_x
+from model.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
 
 CASE_NAME = "silo_recirculation"
 #: The config section of the case.
