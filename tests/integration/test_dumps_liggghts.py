@@ -204,7 +204,9 @@ def test_a_truncated_real_dump_names_file_field_and_counts(jenike, tmp_path):
     cut.write_bytes(content[: content.index(header) + len(header) + 24 * 10 + 7])  # 10 tuples and a bit
     with pytest.raises(DumpFormatError) as error:
         read_frame(cut, jenike.record.timestep_s)
-    assert str(error.value) == f"{cut}: field 'omega' declares {n} tuples but the file ends after 10"
+    # the count the file declares is its content: the message gives only what the reader found
+    assert str(error.value) == f"{cut}: field 'omega' declares more tuples than the file holds: it ends after 10"
+    assert str(n) not in str(error.value).replace(str(cut), "")
 
 
 def test_parser_agrees_exactly_with_vtk(run_and_fields):
