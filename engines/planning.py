@@ -17,7 +17,7 @@ from pathlib import Path
 
 from model.record import RunRecordError, read_run_record
 from model.cases import CASE_BUILDERS, cases_of, run_roles
-from engines.config import load_config
+from engines.config import ConfigError, load_config
 from engines.interface import engine_for
 from engines.estimates import (
     CostModel,
@@ -296,10 +296,15 @@ def main(argv: list[str] | None = None) -> int:
     if len(argv) not in (1, 2):
         print("usage: python -m engines.planning CONFIG [RESULTS_DIR] [--cores N]", file=sys.stderr)
         return 2
-    config = load_config(argv[0])
+    try:
+        config = load_config(argv[0])
+        apriori = cost_model(config)
+        estimates = config_estimates(config, apriori)
+    except (ConfigError, ValueError) as error:
+        # a configuration that cannot be read or planned: the message names the file and the key, no traceback
+        print(f"siloflow: invalid configuration: {error}", file=sys.stderr)
+        return 2
     results = argv[1] if len(argv) == 2 else "results"
-    apriori = cost_model(config)
-    estimates = config_estimates(config, apriori)
     measured = measured_runs(config, estimates, results)
     model = apriori
     if not measured:

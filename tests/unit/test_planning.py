@@ -84,6 +84,17 @@ def test_the_estimate_table_and_command(estimates, capsys):
     assert main([]) == 2
 
 
+def test_the_estimate_command_refuses_a_config_it_cannot_read_without_a_traceback(tmp_path, capsys):
+    """`make estimate` on a file that asks Snakemake to evaluate it (YTE) evaluates nothing and says why."""
+    config = tmp_path / "yte.yaml"
+    marker = tmp_path / "evaluated"
+    config.write_text(f"__use_yte__: true\ndefaults:\n  seed: ?__import__('pathlib').Path('{marker}').touch() or 1\n")
+    assert main([str(config)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"siloflow: invalid configuration: {config}: sets __use_yte__") and "Traceback" not in err
+    assert not marker.exists()
+
+
 def test_a_finished_run_without_engine_timing_leaves_the_config_cost_model(estimates, tmp_path):
     run_dir = run_directory(tmp_path, estimates[0])
     run_dir.mkdir(parents=True)
