@@ -96,6 +96,34 @@ def test_a_row_whose_shear_tests_did_not_all_reach_a_steady_window_does_not_show
     assert "(the others do not say)" in judged["unsaid"][chosen]["evidence"]
 
 
+def test_a_calibrated_coefficient_is_judged_on_the_points_its_band_lies_between_on_its_own_wall_curve():
+    """The particle-particle coefficient read between 0.232 and 0.284 rests on the steady points at 0.1 and 0.3, not on
+    the transients at 0.5 and 0.8; the particle-aluminium one is read from the wall test of aluminium."""
+    internal = [_bulk("sphere2", 0.1, 0.44, 0.004, rolling=0.1), _bulk("sphere2", 0.3, 0.62, 0.006, rolling=0.1),
+                _bulk("sphere2", 0.5, 0.73, 0.01, rolling=0.1, window="second half"),
+                _bulk("sphere2", 0.8, 0.86, 0.02, rolling=0.1, window="second half")]
+    wall = [{**_bulk("sphere2", mu, bulk, 0.002, test="wall", rolling=0.1), "wall_material": "aluminium"}
+            for mu, bulk in ((0.1, 0.099), (0.3, 0.299), (0.5, 0.445))]
+    parameters = {"shape": "sphere2", "rolling_friction": 0.1, "tolerance_deg": 1.0,
+                  "targets_deg": {"internal": 30.0, "aluminium": 9.5},
+                  "particle_particle": {"sliding_friction": 0.258, "sliding_friction_error": 0.014, "lower": 0.232,
+                                        "upper": 0.284, "band_clipped": False},
+                  "particle_wall": {"aluminium": {"sliding_friction": 0.170, "sliding_friction_error": 0.013,
+                                                  "lower": 0.152, "upper": 0.188, "band_clipped": False}}}
+    table = calibration_rows(internal + wall, parameters, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA,
+                             sections=("calibrated",))
+    chosen = {r["figure"]: r for r in table}
+    particle = chosen["Calibrated particle sliding friction (particle-particle)"]
+    aluminium = chosen["Calibrated particle sliding friction (particle-aluminium)"]
+    assert particle["scale_shows"] == YES and "steady shear window in 2 of 2 shear tests" in particle["evidence"]
+    assert aluminium["scale_shows"] == YES and "steady shear window in 2 of 2 shear tests" in aluminium["evidence"]
+    # a band reaching past the steady points rests on the transient beyond them
+    wide = {**parameters, "particle_particle": {**parameters["particle_particle"], "upper": 0.35}}
+    (row_wide,) = [r for r in calibration_rows(internal + wall, wide, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03,
+                                               CRITERIA, sections=("calibrated",)) if "particle-particle" in r["figure"]]
+    assert row_wide["scale_shows"] == NO and "steady shear window in 2 of 3 shear tests" in row_wide["evidence"]
+
+
 def test_a_curve_of_two_points_cannot_show_where_it_stops_rising():
     rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01)]
     (curve, _) = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)

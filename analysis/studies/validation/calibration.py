@@ -219,6 +219,18 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, c
     return rows
 
 
+def _bracketing(entries: Sequence[Mapping], lower: float, upper: float) -> list[Mapping]:
+    """The points of a curve (sorted by particle friction) that a coefficient read between ``lower`` and ``upper``
+    rests on: those inside the band and the nearest on either side of it. A transient at a particle friction far
+    from the band does not make the coefficient one."""
+    frictions = [float(entry["particle_friction"]) for entry in entries]
+    below = [index for index, value in enumerate(frictions) if value < lower]
+    above = [index for index, value in enumerate(frictions) if value > upper]
+    first = below[-1] if below else 0
+    last = above[0] if above else len(entries) - 1
+    return list(entries[first:last + 1])
+
+
 def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diameters: Mapping[str, float],
                      chart_entries: Mapping[tuple, list], criteria: Criteria) -> list[dict]:
     shape = parameters["shape"]
@@ -231,8 +243,12 @@ def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diamete
             continue
         target = parameters["targets_deg"].get(test)
         clipped = bool(result.get("band_clipped"))
-        # the chart this coefficient was read from: the calibration shape's curve of this test
-        cell_ok, cell_text = _judged(cell, chart_entries.get((shape, test, float(parameters["rolling_friction"])), []))
+        # the chart this coefficient was read from: the calibration shape's curve of this test (a wall material's
+        # points are the test "wall" of that material), and on it the points the band lies between
+        curve = ("internal", None) if test == "internal" else ("wall", test)
+        entries = [entry for entry in chart_entries.get((shape, curve[0], float(parameters["rolling_friction"])), [])
+                   if curve[1] is None or entry.get("wall_material") == curve[1]]
+        cell_ok, cell_text = _judged(cell, _bracketing(entries, result["lower"], result["upper"]))
         rows.append(row(
             GROUP, f"Calibrated particle sliding friction ({'particle-particle' if test == 'internal' else 'particle-' + test})",
             f"{shape}, rolling {parameters['rolling_friction']:g}", result["sliding_friction"],
