@@ -124,6 +124,18 @@ def test_a_calibrated_coefficient_is_judged_on_the_points_its_band_lies_between_
     assert row_wide["scale_shows"] == NO and "steady shear window in 2 of 3 shear tests" in row_wide["evidence"]
 
 
+def test_a_curve_that_falls_at_its_end_has_stopped_rising():
+    """The wall test's bulk friction past its maximum (0.445 at 0.5, 0.325 at 0.8): the last step is a resolved fall,
+    not a rise, so the curve shows where it stops rising."""
+    rows = [{**_bulk("sphere2", mu, bulk, 0.002, test="wall", rolling=0.1), "wall_material": "aluminium"}
+            for mu, bulk in ((0.1, 0.099), (0.3, 0.299), (0.5, 0.445), (0.8, 0.325))]
+    (curve,) = calibration_rows(rows, None, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA,
+                                sections=("curves",))
+    assert curve["scale_shows"] == YES
+    assert curve["evidence"].endswith("last step -0.12 ± 0.0028: bulk friction stops rising and falls at its end "
+                                      "within the swept range")
+
+
 def test_a_curve_of_two_points_cannot_show_where_it_stops_rising():
     rows = [_bulk("sphere2", 0.1, 0.40, 0.01), _bulk("sphere2", 0.3, 0.55, 0.01)]
     (curve, _) = calibration_rows(rows, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)

@@ -93,6 +93,13 @@ def _judged(cell: tuple[bool, str], entries: Sequence[Mapping]) -> tuple[bool | 
     return _both(cell[0], steady_ok), f"{cell[1]}; {steady_text}"
 
 
+def _rise(step: tuple[float, float], k: float) -> bool | None:
+    """Whether a step of a curve (its change and that change's standard error) is a rise resolved at ``k`` standard
+    errors: True, False (no resolved rise, a resolved fall included), None when its error is not known."""
+    changes = resolved(*step, k)
+    return None if changes is None else changes and step[0] > 0.0
+
+
 def _curve_row(label: str, key: tuple, entries: list, cell_ok: bool, cell_text: str, criteria: Criteria) -> dict:
     shape, test, rolling = key
     points = [_point(entry) for entry in entries]
@@ -106,9 +113,12 @@ def _curve_row(label: str, key: tuple, entries: list, cell_ok: bool, cell_text: 
                    "three points cannot show where bulk friction stops rising")
     first = (points[1][1] - points[0][1], combine_independent([points[1][2], points[0][2]]))
     last = (points[-1][1] - points[-2][1], combine_independent([points[-1][2], points[-2][2]]))
-    first_rises, last_rises = resolved(*first, k), resolved(*last, k)
+    # a step resolved from zero is a rise only when it is positive: a curve that falls at its end has passed its
+    # maximum, so it stopped rising too
+    first_rises, last_rises, last_changes = _rise(first, k), _rise(last, k), resolved(*last, k)
     shows = verdict(cell_ok, first_rises, _not(last_rises))
-    stops = {True: "still rises", False: "stops rising", None: "unknown"}[last_rises]
+    stops = ("unknown" if last_rises is None else "still rises" if last_rises else
+             "stops rising and falls at its end" if last_changes else "stops rising")
     return row(GROUP, f"Bulk friction at particle friction {mu:g} ({label})", f"{shape}, {test}, rolling {rolling:g}",
                bulk, error, "-", "", shows,
                f"{cell_text}; particle friction -> bulk friction {text}; first step {plus_minus(*first)}, last step "
