@@ -380,6 +380,16 @@ def fill_column(
     return n_clumps, centres, radius, z_min, z_min + max(column, 2.0 * r_b)
 
 
+def _sized_by_cell(cell_diameter: float, sphere_radius: float, make, *arguments):
+    """``make(*arguments)``, a part whose size the cell's diameter over the spheres' radius sets (the rings' polygon
+    sides, the lid's spheres); its refusal of a part too large names ``jenike.cell.inner_diameter``."""
+    try:
+        return make(*arguments)
+    except ValueError as error:
+        raise ValueError(f"jenike.cell.inner_diameter ({cell_diameter} m) for spheres of radius {sphere_radius:.4g} m: "
+                         f"{error}") from None
+
+
 def plan_fill(
     geometry: CellGeometry, particle: ParticleTemplate, overfill: float, settle_time: float, timestep: float,
     relax_time: float,
@@ -447,11 +457,8 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
 
     radius = 0.5 * cell["inner_diameter"]
     check_cell_fits(radius, particle)  # before the rings' polygons, which need a cell wider than the chord error
-    try:
-        segments = segments_for_chord(radius, CHORD_TOLERANCE * particle.smallest_radius)
-    except ValueError as error:
-        raise ValueError(f"jenike.cell.inner_diameter ({cell['inner_diameter']} m) for spheres of radius "
-                         f"{particle.smallest_radius:.4g} m: {error}") from None
+    segments = _sized_by_cell(cell["inner_diameter"], particle.smallest_radius, segments_for_chord, radius,
+                              CHORD_TOLERANCE * particle.smallest_radius)
     displacement = jenike["shear"]["displacement"]
     overfill = jenike["fill"]["overfill"]
     sample_height = cell["shear_ring_height"] + (0.0 if wall_test else cell["bottom_ring_height"])
@@ -490,11 +497,8 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     normal_force = jenike["consolidation"]["normal_stress"] * geometry.area
     lid_radius = radius - geometry.lid_clearance
     sphere_radius = particle.smallest_radius
-    try:
-        lid_spheres = lid_sphere_layout(lid_radius - sphere_radius, LID_SPHERE_SPACING * sphere_radius)
-    except ValueError as error:
-        raise ValueError(f"jenike.cell.inner_diameter ({cell['inner_diameter']} m) for spheres of radius "
-                         f"{sphere_radius:.4g} m: {error}") from None
+    lid_spheres = _sized_by_cell(cell["inner_diameter"], sphere_radius, lid_sphere_layout, lid_radius - sphere_radius,
+                                 LID_SPHERE_SPACING * sphere_radius)
     rigid_lid = RigidLid(
         positions=lid_spheres + np.array(geometry.ring_centre),
         sphere_radius=sphere_radius,

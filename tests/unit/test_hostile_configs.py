@@ -9,12 +9,12 @@ hostile.yaml`` merges them; the file is also read again as plain data, as the wo
 
 from __future__ import annotations
 
-import copy
 import time
 from pathlib import Path
 
 import pytest
 import yaml
+from snakemake.utils import update_config
 
 from engines.config import REPO_ROOT, load_config_file
 from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
@@ -115,14 +115,6 @@ def _workflow_checks(config: dict, config_files: list) -> list:
     return check_measured_inputs(preflight(config, config_files).config["silo_flat"])
 
 
-def _deep_merge(base: dict, override: dict) -> dict:
-    merged = copy.deepcopy(base)
-    for key, value in override.items():
-        merged[key] = (_deep_merge(merged[key], value) if isinstance(value, dict) and isinstance(merged.get(key), dict)
-                       else value)
-    return merged
-
-
 def _as_snakemake_merges(text: str) -> dict:
     """The configuration Snakemake hands the workflow: the default file with the hostile one laid over it where
     that file reads as YAML at all (one it cannot read leaves the default, which the re-reading then refuses)."""
@@ -133,7 +125,8 @@ def _as_snakemake_merges(text: str) -> dict:
         return default
     if not isinstance(override, dict) or "__use_yte__" in override or len(text) > 1_000_000:
         return default
-    return _deep_merge(default, override)
+    update_config(default, override)  # Snakemake's own merge of its --configfile files
+    return default
 
 
 @pytest.mark.parametrize("name, text, expected", HOSTILE, ids=[case[0] for case in HOSTILE])

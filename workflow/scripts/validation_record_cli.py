@@ -87,20 +87,23 @@ def _planned(config_path: str) -> dict[str, set[str]]:
     return planned_runs(_plan(config_path)[1])
 
 
+def _check(name: str, made: dict[str, list], record_dir: str | Path) -> None:
+    parts = split_groups(made)
+    check_reads(find_part(name, parts).group, group_status(planned_runs(made), recorded_runs(record_dir)), parts)
+
+
 def check(name: str, config_path: str, record_dir: str | Path) -> None:
     """`make validate GROUP=<name>`'s check before anything runs: ``name`` is a group or a part of one that
     ``config_path`` plans, and the groups its rows compare against are complete in the record (ValueError)."""
-    made = _plan(config_path)[1]
-    parts = split_groups(made)
-    check_reads(find_part(name, parts).group, group_status(planned_runs(made), recorded_runs(record_dir)), parts)
+    _check(name, _plan(config_path)[1], record_dir)
 
 
 def restore(name: str, config_path: str, record_dir: str | Path, workdir: str | Path) -> dict[str, int]:
     """:func:`check` group or part ``name``, then copy into ``workdir`` the products of the runs of the groups it
     reads that their records in ``record_dir`` keep and ``workdir`` lacks
     (:func:`analysis.io.validation_record.restore_products`). Returns ``{group read: files copied}``."""
-    check(name, config_path, record_dir)
     made = _plan(config_path)[1]
+    _check(name, made, record_dir)
     reads = GROUPS[group_of_part(name)].reads
     restored = {other: len(restore_products(Path(record_dir) / other, workdir)) for other in reads}
     results = Path(workdir) / RESULTS
