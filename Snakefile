@@ -13,11 +13,17 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
-include: "workflow/rules/calibration.smk"
-include: "workflow/rules/silo.smk"
+
+
+# One rule file per case kind, as its registry entry names it (model.cases.kinds); each adds its products to
+# CASE_TARGETS.
+for _kind in CASE_KINDS.values():
+    if _kind.rules is not None:
+
+        include: f"workflow/rules/{_kind.rules}"
+
+
 include: "workflow/rules/existing_runs.smk"
-include: "workflow/rules/silo_recirculation.smk"
-include: "workflow/rules/blender.smk"
 include: "workflow/rules/fill_balance.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/verification.smk"
@@ -27,12 +33,8 @@ include: "workflow/rules/report.smk"
 
 rule all:
     input:
-        calibration_targets(),
-        silo_flat_targets,
+        *CASE_TARGETS.values(),
         existing_runs_targets,
-        parametric_targets,
-        recirculation_targets,
-        blender_targets,
         f"{RESULTS}/summary/summary.html",
         f"{RESULTS}/summary/validation.csv",
         verification_targets(),

@@ -69,11 +69,3 @@ def calibrated_config(config: dict, parameters_path) -> dict:
     with open(parameters_path, encoding="utf-8") as handle:
         parameters = yaml.safe_load(handle)
     return apply_calibrated_parameters(config, parameters, config["silo_flat"]["particle_material"])
-
-
-def case_config(config: dict, case_kind: str, parameters_path) -> dict:
-    """The configuration the runs of ``case_kind`` use: the flat-bottom silo's with the calibration's choice applied
-    when ``silo_flat.parameters`` is ``calibrated`` (:func:`calibrated_config`); every other case's as given."""
-    if case_kind != "silo_flat":
-        return config
-    return calibrated_config(config, parameters_path)

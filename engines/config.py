@@ -25,16 +25,13 @@ import jsonschema
 import yaml
 
 from model.existing_run import ExistingRunError, ExistingSiloRun
-from model.cases.blender_geometry import INSERT_PRESETS
 from model.cases.common import SETTLE_ENERGY_KEY, SETTLE_RATIO_KEY
+from model.cases.config_checks import ConfigError, require
+from model.cases.kinds import CASE_KINDS, configured_kinds
 from engines.config_yaml import ConfigFileError, read_config_file
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
-
-
-class ConfigError(ValueError):
-    """A configuration value is invalid; the message names the key."""
 
 
 #: Keys a silo-type case section inherits from ``defaults`` when it leaves them out.
@@ -42,8 +39,9 @@ SHARED_KEYS = (
     "particle_model", "particle_material", "wall_materials", "fill", "settle", "timestep_fraction", "timestep_hertz_fraction",
     "seed", "replicates", "reference_replicates",
 )
-#: The case sections that inherit from ``defaults``.
-INHERITING_SECTIONS = ("silo_flat", "silo_recirculation", "blender")
+def inheriting_sections() -> tuple[str, ...]:
+    """The case sections that inherit from ``defaults`` (their registry entries say so)."""
+    return tuple(name for name, kind in CASE_KINDS.items() if kind.inherits_defaults)
 
 #: Keys of earlier siloflow versions and where their values went: a config using one is refused with the new name.
 RENAMED_KEYS = {
@@ -86,7 +84,7 @@ def inherit_defaults(config: Mapping) -> dict:
     if not isinstance(defaults, Mapping):
         return inherited  # the schema reports the wrong type
     shared = {key: value for key, value in defaults.items() if key in SHARED_KEYS}
-    for section in INHERITING_SECTIONS:
+    for section in inheriting_sections():
         own = inherited.get(section)
         if own is None:
             own = {}
@@ -148,7 +146,25 @@ def load_schema(path: Path = SCHEMA_PATH) -> dict:
     for each caller. Every validation reads it, and parsing it every time took most of a validation's half second.
     """
     path = Path(path)
-    return copy.deepcopy(_parsed_schema(path, path.stat().st_mtime_ns))
+    return _with_case_kinds(copy.deepcopy(_parsed_schema(path, path.stat().st_mtime_ns)))
+
+
+def _with_case_kinds(schema: dict) -> dict:
+    """``schema`` with each registered case kind's section (its schema fragment, :mod:`model.cases.kinds`) among its
+    properties, right after ``defaults`` (the order a configuration's sections are listed in), and the kinds' names
+    where the schema keys a mapping by case kind."""
+    properties = {}
+    for key, value in schema["properties"].items():
+        properties[key] = value
+        if key == "defaults":
+            for name, kind in CASE_KINDS.items():
+                if kind.schema is not None:
+                    fragment = Path(kind.schema)
+                    properties[name] = copy.deepcopy(_parsed_schema(fragment, fragment.stat().st_mtime_ns))
+    schema["properties"] = properties
+    by_case = properties["estimates"]["properties"]["seconds_per_sphere_step_by_case"]
+    by_case["propertyNames"] = {"enum": list(configured_kinds())}
+    return schema
 
 
 def load_config_file(path: str | Path) -> dict:
@@ -354,14 +370,13 @@ def _check_settle_criteria(raw: Mapping, given: Mapping) -> None:
 
 
 #: The case sections, each run by its own ``engine`` or by ``engine.kind``.
-CASE_SECTIONS = ("jenike", "silo_flat", "silo_recirculation", "blender")
 #: Settings of one engine only: ``engine.<kind>.*``, and the MPI keys, which only LIGGGHTS uses.
 ENGINE_ONLY_KEYS = {"liggghts": (("engine", "mpi_ranks"), ("engine", "mpirun")), "yade": ()}
 
 
 def engines_in_use(filled: Mapping) -> set[str]:
     """The engines that run at least one case section of a validated configuration."""
-    return {filled[section].get("engine") or filled["engine"]["kind"] for section in CASE_SECTIONS}
+    return {filled[section].get("engine") or filled["engine"]["kind"] for section in configured_kinds()}
 
 
 def _engine_defaults() -> dict:
@@ -407,11 +422,6 @@ def _check_finite(node: Any, path: tuple) -> None:
 def _check_references(config: dict) -> None:
     materials = config["materials"]
 
-    def require(name: str, defined: Mapping, key: str, kind: str) -> None:
-        if name not in defined:
-            known = ", ".join(sorted(defined)) or "none"
-            raise ConfigError(f"config key '{key}': unknown {kind} '{name}'; defined: {known}")
-
     for index, contact in enumerate(config["contacts"]):
         for material in contact["materials"]:
             require(material, materials, f"contacts[{index}].materials", "material")
@@ -425,14 +435,23 @@ def _check_references(config: dict) -> None:
             )
         seen[pair] = index
 
-    for section in ("defaults", *INHERITING_SECTIONS):
-        _check_case_materials(config, section, require, seen)
-    _check_jenike_references(config, require, seen)
-    _check_recirculation_references(config, require)
-    _check_blender_references(config, require)
+    for section in ("defaults", *inheriting_sections()):
+        _check_case_materials(config, section, seen)
+    for section in inheriting_sections():
+        _check_outlet(config[section], section)
+    for kind in CASE_KINDS.values():
+        if kind.check_config is not None:
+            kind.check_config(config, seen)
 
 
-def _check_case_materials(config: dict, section: str, require, contact_pairs: dict) -> None:
+def _check_outlet(silo: Mapping, section: str) -> None:
+    """A silo-type section's slot outlet is narrower than its silo: checked here only, for every such section."""
+    if silo["outlet_width"] >= silo["width"]:
+        raise ConfigError(f"config key '{section}.outlet_width': {silo['outlet_width']} m must be smaller than "
+                          f"{section}.width ({silo['width']} m)")
+
+
+def _check_case_materials(config: dict, section: str, contact_pairs: dict) -> None:
     """The particle model, particle material and wall materials of a silo-type section exist, the particle
     material has a density and every particle-wall pair it uses has contact parameters."""
     case = config[section]
@@ -454,60 +473,6 @@ def _check_case_materials(config: dict, section: str, require, contact_pairs: di
             )
 
 
-def _check_recirculation_references(config: dict, require) -> None:
-    blending = config["silo_recirculation"]
-    presets = blending["presets"]
-    for index, pattern in enumerate(blending["flow_patterns"]):
-        require(pattern, presets, f"silo_recirculation.flow_patterns[{index}]", "preset")
-    require(blending["verification"]["flow_pattern"], presets, "silo_recirculation.verification.flow_pattern", "preset")
-    for pattern in blending["residence_time_ratios"]:
-        require(pattern, presets, f"silo_recirculation.residence_time_ratios.{pattern}", "preset")
-    names = [layout["name"] for layout in blending["layouts"]]
-    for index, name in enumerate(names):
-        if names.index(name) != index:
-            raise ConfigError(f"config key 'silo_recirculation.layouts[{index}].name': layout name '{name}' is used twice")
-    if blending["outlet_width"] >= blending["width"]:
-        raise ConfigError(
-            f"config key 'silo_recirculation.outlet_width': {blending['outlet_width']} m must be smaller than "
-            f"silo_recirculation.width ({blending['width']} m)"
-        )
-    low, high = blending["bulk_density_slab"]
-    if not low < high:
-        raise ConfigError(f"config key 'silo_recirculation.bulk_density_slab': {[low, high]} must be an increasing "
-                          "pair of fractions of fill_height")
-
-
-def _check_blender_references(config: dict, require) -> None:
-
-    blender = config["blender"]
-    for name in blender["inserts"]:
-        if name in INSERT_PRESETS:
-            raise ConfigError(
-                f"config key 'blender.inserts.{name}': '{name}' is a built-in preset; give your insert another name"
-            )
-    defined = {**{name: None for name in INSERT_PRESETS}, **blender["inserts"]}
-    for index, name in enumerate(blender["configurations"]):
-        require(name, defined, f"blender.configurations[{index}]", "insert configuration")
-    if blender["outlet_width"] >= blender["width"]:
-        raise ConfigError(
-            f"config key 'blender.outlet_width': {blender['outlet_width']} m must be smaller than blender.width "
-            f"({blender['width']} m)"
-        )
-    if blender["pathlines"]["release_height"] >= blender["fill_height"]:
-        raise ConfigError(
-            f"config key 'blender.pathlines.release_height': {blender['pathlines']['release_height']} m must be below "
-            f"the fill height blender.fill_height ({blender['fill_height']} m)"
-        )
-    _require_subset(blender["gravity_configurations"], blender["configurations"], "blender.gravity_configurations",
-                    "blender.configurations")
-    start, end = blender["discharge"]["steady_window"]
-    if not start < end <= blender["discharge"]["time"]:
-        raise ConfigError(
-            f"config key 'blender.discharge.steady_window': {[start, end]} must be an increasing window within "
-            f"blender.discharge.time ({blender['discharge']['time']} s)"
-        )
-
-
 def _settle_criteria_in_use(filled: dict) -> None:
     """Null, in a validated configuration, the settle keys that are not in use: the ratio of a section with an
     absolute threshold, both in the blender's ``settle``. The schema fills the ratio's default wherever it is left
@@ -518,50 +483,6 @@ def _settle_criteria_in_use(filled: dict) -> None:
         if settle[energy] is not None:
             settle[ratio] = None
     filled["blender"]["settle"].update({ratio: None, energy: None})
-
-
-def _require_subset(chosen, among, key: str, among_key: str) -> None:
-    """A list key that picks from another list (null picks all): every entry must be in ``among``."""
-    for index, name in enumerate(chosen or []):
-        if name not in among:
-            raise ConfigError(f"config key '{key}[{index}]': '{name}' is not among {among_key} {list(among)}")
-
-
-def _check_jenike_references(config: dict, require, contact_pairs: dict) -> None:
-    materials = config["materials"]
-    jenike = config["jenike"]
-    sweep = jenike["sweep"]
-    particle = jenike["particle_material"]
-    for key in ("particle_material", "ring_material", "lid_material"):
-        require(jenike[key], materials, f"jenike.{key}", "material")
-    if "density" not in materials[particle]:
-        raise ConfigError(f"config key 'materials.{particle}.density': the particle material needs a density")
-    for index, shape in enumerate(sweep["shapes"]):
-        require(shape, config["particle_models"], f"jenike.sweep.shapes[{index}]", "particle model")
-    for key in ("wall_test_shapes", "sensitivity_shapes"):
-        _require_subset(sweep[key], sweep["shapes"], f"jenike.sweep.{key}", "jenike.sweep.shapes")
-    _require_subset(sweep["sensitivity_tests"], sweep["tests"], "jenike.sweep.sensitivity_tests", "jenike.sweep.tests")
-    wall_tests = []
-    for index, test in enumerate(sweep["tests"]):
-        if test != "internal":
-            require(test, materials, f"jenike.sweep.tests[{index}]", "test ('internal' or a wall material)")
-            wall_tests.append(test)
-    for material in sorted({particle, jenike["ring_material"], jenike["lid_material"], *wall_tests}):
-        if frozenset((particle, material)) not in contact_pairs:
-            raise ConfigError(
-                f"config key 'contacts': no contact parameters for the pair [{particle}, {material}] used by jenike"
-            )
-    calibration = config["calibration"]
-    if calibration["shape"] not in sweep["shapes"]:
-        raise ConfigError(
-            f"config key 'calibration.shape': '{calibration['shape']}' is not among jenike.sweep.shapes "
-            f"{sweep['shapes']}"
-        )
-    if calibration["rolling_friction"] not in sweep["rolling_friction"]:
-        raise ConfigError(
-            f"config key 'calibration.rolling_friction': {calibration['rolling_friction']} is not among "
-            f"jenike.sweep.rolling_friction {sweep['rolling_friction']}"
-        )
 
 
 def load_config(path: str | Path) -> dict:

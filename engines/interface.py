@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
-from model.cases import CASE_BUILDERS
+from model.cases.kinds import configured_kinds
 from model.cases.common import engine_kind
 
 if TYPE_CHECKING:  # the neutral types appear in signatures only
@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # the neutral types appear in signatures only
     from model.frames import ParticleFrame
     from model.record import RunRecord
     from model.settled import SettledFill
-    from engines.estimates import MeasuredWork
+    from model.cost import MeasuredWork
 
 __all__ = [
     "ENGINE_KINDS",
@@ -276,6 +276,6 @@ def engine_named(name: str) -> Engine:
 
 def engine_for(config: Mapping, section: str) -> Engine:
     """The engine that runs the cases of config section ``section``."""
-    if section not in CASE_BUILDERS:
-        raise KeyError(f"unknown case section {section!r}; the cases are {', '.join(CASE_BUILDERS)}")
+    if section not in configured_kinds():
+        raise KeyError(f"unknown case section {section!r}; the cases are {', '.join(configured_kinds())}")
     return engine_named(engine_kind(config, section))

@@ -2,7 +2,7 @@
 
 The workflow's rules, the run planning (estimates, disk checks) and the tests all build paths here::
 
-    results/<case root>/<run id>/
+    results/<case root>/<run id>/        (each case kind's root is in its registry entry, model.cases.kinds)
         deck/            the engine's input files; deck/case.json (the neutral case summary) is written last
         run.json         the typed run record (model.record), written last, only when the run passed its checks
         logs/            one log per workflow step, and the run step's timing (logs/run_benchmark.tsv)
@@ -21,21 +21,15 @@ from __future__ import annotations
 import os
 from pathlib import Path, PurePosixPath
 
-__all__ = ["RESULTS", "CASE_ROOTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
+from model.cases.kinds import case_kind
+
+__all__ = ["RESULTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
            "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "CALIBRATION_DIR", "CALIBRATED_PARAMETERS",
            "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
 RESULTS = "results"
-
-#: Folder of each case's runs under :data:`RESULTS`.
-CASE_ROOTS = {
-    "jenike": "calibration/runs",   # inside CALIBRATION_DIR
-    "silo_flat": "silo_flat",
-    "silo_recirculation": "silo_recirculation",
-    "blender": "blender",
-}
 
 #: The neutral case summary an engine writes last into ``deck/`` (the product of a deck step).
 CASE_SUMMARY = "deck/case.json"
@@ -82,10 +76,9 @@ EXISTING_RUN_WILDCARD = "{existing}"
 
 
 def case_root(case: str, results: str = RESULTS) -> str:
-    """``results/<case root>``: the folder that holds every run of case kind ``case``."""
-    if case not in CASE_ROOTS:
-        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_ROOTS)}")
-    return str(PurePosixPath(results) / CASE_ROOTS[case])
+    """``results/<case root>``: the folder that holds every run of case kind ``case`` (its registry entry's
+    :attr:`~model.cases.kinds.CaseKind.results_root`)."""
+    return str(PurePosixPath(results) / case_kind(case).results_root)
 
 
 def run_dir(case: str, run: str = RUN_WILDCARD, results: str = RESULTS) -> str:
@@ -103,9 +96,7 @@ def run_path(case: str, relative: str, run: str = RUN_WILDCARD, results: str = R
 def existing_run_dir(case: str, name: str = EXISTING_RUN_WILDCARD, results: str = RESULTS) -> str:
     """The folder of the analysis of run ``name`` siloflow did not make, of case ``case``:
     ``results/existing_runs/<case root>/<name>`` (with the default ``{existing}``: the rules' wildcard pattern)."""
-    if case not in CASE_ROOTS:
-        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_ROOTS)}")
-    return str(PurePosixPath(results) / EXISTING_RUNS / CASE_ROOTS[case] / name)
+    return str(PurePosixPath(results) / EXISTING_RUNS / case_kind(case).results_root / name)
 
 
 def existing_run_path(case: str, relative: str, name: str = EXISTING_RUN_WILDCARD, results: str = RESULTS) -> str:

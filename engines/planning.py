@@ -16,13 +16,12 @@ import sys
 from pathlib import Path
 
 from model.record import RunRecordError, read_run_record
-from model.cases import CASE_BUILDERS, cases_of, run_roles
+from model.cases import cases_of, run_roles
+from model.cases.kinds import configured_kinds
 from engines.config import ConfigError, load_config
 from engines.interface import engine_for
+from model.cost import CostModel, MeasuredWork, RunEstimate
 from engines.estimates import (
-    CostModel,
-    MeasuredWork,
-    RunEstimate,
     check_disk_space,
     estimate_case,
     estimate_rows,
@@ -47,7 +46,7 @@ def config_estimates(config: dict, model: CostModel | None = None) -> list[RunEs
     parametric variants, recirculation runs, blender runs, each with its replicates), in that order; ``model``
     defaults to the config's."""
     model, ranks = model or cost_model(config), config["engine"]["mpi_ranks"]
-    return [estimate_case(case, ranks, model) for kind in CASE_BUILDERS for case in cases_of(config, kind).values()]
+    return [estimate_case(case, ranks, model) for kind in configured_kinds() for case in cases_of(config, kind).values()]
 
 
 def run_priorities(estimates: list[RunEstimate]) -> dict[str, int]:
@@ -279,7 +278,7 @@ def comparison_report(measured: list[tuple[RunEstimate, MeasuredWork]], steps: l
 
 def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[RunEstimate]]:
     """The runs each validation group makes, of a configuration's ``estimates`` (:func:`engines.validation_groups.assign`)."""
-    return assign(estimates, {run: role for kind in CASE_BUILDERS for run, role in run_roles(config, kind).items()})
+    return assign(estimates, {run: role for kind in configured_kinds() for run, role in run_roles(config, kind).items()})
 
 
 def main(argv: list[str] | None = None) -> int:

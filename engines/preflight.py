@@ -16,7 +16,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from model.cases import CASE_BUILDERS, cases_of
+from model.cases import cases_of
+from model.cases.kinds import configured_kinds
 from engines.config import ConfigError, engines_in_use, validate_config
 from engines.config_yaml import ConfigFileError, read_config_file
 from engines.existing_runs import check_existing_runs
@@ -67,7 +68,7 @@ def _read_files(config_files: Iterable[str | os.PathLike]) -> None:
 def _cases(config: Mapping) -> dict:
     """Build every case and let its engine accept it: geometry, sizing and engine limits fail here, first."""
     built = {}
-    for kind in CASE_BUILDERS:
+    for kind in configured_kinds():
         try:
             built[kind] = cases_of(config, kind)
             engine = engine_for(config, kind)

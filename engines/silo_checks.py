@@ -8,7 +8,8 @@ from pathlib import Path
 
 from model.record import RunRecord
 from model.cases.silo_flat import SiloCase
-from engines.estimates import CostModel, silo_run_steps
+from model.cost import CostModel
+from model.cases.silo_cost import silo_run_steps
 from engines.interface import EngineRunError
 from engines.markers import Marker
 

@@ -18,7 +18,7 @@ from typing import Iterable, Mapping, Sequence
 
 from model.cases import REFERENCE, VARIANT
 from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
-from engines.estimates import BLENDER, JENIKE, RECIRCULATION, SILO_FLAT, RunEstimate
+from model.cost import RunEstimate
 
 @dataclass(frozen=True)
 class Group:
@@ -49,13 +49,13 @@ class Group:
 #: speed, seeds), the flat-bottom silo in two (its base configuration over seeds, and the front-wall friction series
 #: compared against it).
 GROUPS: dict[str, Group] = {
-    "calibration": Group(JENIKE, (CALIBRATION_CHART,)),
-    "calibration_shapes": Group(JENIKE, (SHAPE_CHART,)),
-    "calibration_checks": Group(JENIKE, (CHECK,), reads=("calibration", "calibration_shapes")),
-    "silo": Group(SILO_FLAT, (REFERENCE,)),
-    "silo_series": Group(SILO_FLAT, (VARIANT,), reads=("silo",)),
-    "blending": Group(RECIRCULATION),
-    "blender": Group(BLENDER),
+    "calibration": Group("jenike", (CALIBRATION_CHART,)),
+    "calibration_shapes": Group("jenike", (SHAPE_CHART,)),
+    "calibration_checks": Group("jenike", (CHECK,), reads=("calibration", "calibration_shapes")),
+    "silo": Group("silo_flat", (REFERENCE,)),
+    "silo_series": Group("silo_flat", (VARIANT,), reads=("silo",)),
+    "blending": Group("silo_recirculation"),
+    "blender": Group("blender"),
 }
 
 #: The longest a group (or a part of one) may take on :data:`PART_CORES` cores (s): a working session.

@@ -12,7 +12,8 @@ schema_version : int
 engine : str
     Registry name of the engine that ran the case (``liggghts``).
 case : str
-    Case kind: ``jenike``, ``silo_flat``, ``silo_recirculation`` or ``blender``.
+    Case kind: a registered kind's name (:data:`model.cases.kinds.CASE_KINDS`: ``jenike``, ``silo_flat``,
+    ``silo_recirculation``, ``blender``, ``verification``).
 run_id : str
     Run directory name: a label plus a hash of every parameter that defines the run, engine included.
 timestep_s : float
@@ -53,6 +54,8 @@ from pathlib import Path
 
 import jsonschema
 
+from model.cases.kinds import CASE_KINDS
+
 __all__ = ["SCHEMA_VERSION", "RUN_RECORD_SCHEMA", "RunRecord", "RunRecordError", "read_run_record"]
 
 #: Version of the record layout written by this siloflow; bump it when a key changes meaning.
@@ -72,7 +75,8 @@ RUN_RECORD_SCHEMA = {
     "properties": {
         "schema_version": {"const": SCHEMA_VERSION},
         "engine": {"type": "string", "pattern": "^[a-z][a-z0-9_]*$(?!\\n)"},
-        "case": {"enum": ["jenike", "silo_flat", "silo_recirculation", "blender", "verification"]},
+        # one of the registered case kinds (model.cases.kinds), checked after the schema
+        "case": {"type": "string", "pattern": "^[a-z][a-z0-9_]*$(?!\\n)"},
         "run_id": {"type": "string", "pattern": "^[A-Za-z0-9_.=,+-]+$(?!\\n)"},
         "timestep_s": {"type": "number", "exclusiveMinimum": 0},
         "n_clumps": {"type": "integer", "minimum": 0},
@@ -162,6 +166,9 @@ def _validate(data: dict, source: str) -> None:
         error = errors[0]
         key = ".".join(str(part) for part in error.absolute_path) or "<top level>"
         raise RunRecordError(f"{source}: key '{key}': {error.message}")
+    if data["case"] not in CASE_KINDS:
+        raise RunRecordError(f"{source}: key 'case': not a case kind siloflow knows; the kinds are "
+                             f"{', '.join(CASE_KINDS)}")
     for key in ("timestep_s", "open_time_s", "outlet_z"):
         value = data.get(key)
         if isinstance(value, float) and not math.isfinite(value):

@@ -8,7 +8,7 @@ import math
 import re
 from collections.abc import Iterable, Iterator, Mapping
 
-from engines.estimates import CostModel, MeasuredWork
+from model.cost import CostModel, MeasuredWork
 from engines.liggghts.thermo import ThermoProgress
 
 __all__ = ["StageCost", "TimedRun", "calibrate_cost_model", "measured_work", "stage_costs", "timed_runs"]

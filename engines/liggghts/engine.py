@@ -16,12 +16,10 @@ from model.forces import WallForceHistory
 from model.frames import ParticleFrame
 from model.record import RunRecord
 from model.settled import SettledFill
-from model.cases.blender import BlenderCase
 from model.cases.jenike import JenikeCase
-from model.cases.silo_flat import SiloCase
-from model.cases.silo_recirculation import RecirculationCase
+from model.cases.kinds import case_kind, kind_of_case
 from model.cases.verification import VerificationCase
-from engines.estimates import MeasuredWork
+from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, DumpFile, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
 from model.cases.blender import GATE
@@ -49,64 +47,77 @@ from engines.liggghts.silo_flat import run_silo, write_silo_inputs
 from engines.liggghts.silo_recirculation import run_recirculation, write_recirculation_inputs
 from engines.liggghts.verification import run_verification, write_verification_inputs
 
-__all__ = ["LiggghtsEngine", "MIN_RESTITUTION"]
+__all__ = ["ADAPTERS", "Adapter", "LiggghtsEngine", "MIN_RESTITUTION"]
 
 #: LIGGGHTS 3.8 refuses a coefficient of restitution at or below this value (it requires 0.05 < e <= 1).
 MIN_RESTITUTION = 0.05
 
-#: Per case that saves a settled fill, the walls (meshes) that make its floor: the plates and the gate of the silos,
-#: the blender's gate (its hopper and inserts are walls).
-FLOOR_WALLS = {"silo_flat": FLOOR_MESHES, "silo_recirculation": FLOOR_MESHES, "blender": (GATE,)}
+def _table_pairs(table) -> list[tuple[str, str, float, str]]:
+    """The particle's pairs of a material table (its first material is the particle's), keyed ``contacts``."""
+    return [(table.names[0], table.names[j], float(value), "contacts") for j, value in enumerate(table.restitution[0])]
 
-#: The stage sequences the decks implement, per case kind.
-_STAGES = {
-    "silo_flat": ("fill", "settle", "open", "discharge"),
-    "silo_recirculation": ("fill", "settle", "open", "recirculate"),
-    "blender": ("fill", "settle", "open", "discharge"),
-    "jenike": ("fill", "settle", "consolidate", "shear"),
-    "verification": ("release",),
-}
+
+def _silo_pairs(case) -> list[tuple[str, str, float, str]]:
+    return _table_pairs(case.materials)
+
+
+def _wrapped_silo_pairs(case) -> list[tuple[str, str, float, str]]:
+    """The pairs of a case built around a silo (the recirculating silo, the blender)."""
+    return _table_pairs(case.silo.materials)
+
+
+def _jenike_pairs(case: JenikeCase) -> list[tuple[str, str, float, str]]:
+    names = case.materials.names
+    found = []
+    # the sweep point sets the restitution of both contact sets: name its key first
+    for contacts, key in ((case.test_contacts, "jenike.sweep.restitution"), (case.fill_contacts, "contacts")):
+        for j, value in enumerate(contacts.restitution[0]):
+            found.append((names[0], names[j], float(value), key))
+    return found
+
+
+def _verification_pairs(case: VerificationCase) -> list[tuple[str, str, float, str]]:
+    return [("sphere", "sphere", case.restitution, f"verification problem {case.name}")]
 
 
 @dataclass(frozen=True)
-class _Adapter:
-    """How one case kind is rendered and run."""
+class Adapter:
+    """How LIGGGHTS renders and runs one case kind.
 
-    kind: str
+    Attributes
+    ----------
+    write, run : callable
+        ``write(case, deck_dir)`` and ``run(case, run_dir, *, executable, mpi_ranks, mpirun) -> RunRecord``.
+    restitution_pairs : callable
+        ``(case) -> [(material a, material b, restitution, config key), ...]``: every pair with a particle in it,
+        which LIGGGHTS' restitution limit is checked on.
+    floor_walls : tuple of str or None
+        The walls (meshes) that make the floor of its settled fill; None: it saves none.
+    """
+
     write: Callable
     run: Callable
+    restitution_pairs: Callable
+    floor_walls: tuple[str, ...] | None = None
 
 
-_ADAPTERS = {
-    SiloCase: _Adapter("silo_flat", write_silo_inputs, run_silo),
-    RecirculationCase: _Adapter("silo_recirculation", write_recirculation_inputs, run_recirculation),
-    BlenderCase: _Adapter("blender", write_blender_inputs, run_blender),
-    JenikeCase: _Adapter("jenike", write_jenike_inputs, run_jenike),
-    VerificationCase: _Adapter("verification", write_verification_inputs, run_verification),
+#: The case kinds LIGGGHTS runs, one adapter each, by the kind's name (:mod:`model.cases.kinds`): the plates and
+#: gate of the silos, the blender's gate (its hopper and inserts are walls) and the Jenike cell's base make floors.
+ADAPTERS = {
+    "silo_flat": Adapter(write_silo_inputs, run_silo, _silo_pairs, FLOOR_MESHES),
+    "silo_recirculation": Adapter(write_recirculation_inputs, run_recirculation, _wrapped_silo_pairs, FLOOR_MESHES),
+    "blender": Adapter(write_blender_inputs, run_blender, _wrapped_silo_pairs, (GATE,)),
+    "jenike": Adapter(write_jenike_inputs, run_jenike, _jenike_pairs, JENIKE_FLOOR_WALLS),
+    "verification": Adapter(write_verification_inputs, run_verification, _verification_pairs),
 }
 
 
-def _adapter(case) -> _Adapter:
-    try:
-        return _ADAPTERS[type(case)]
-    except KeyError:
-        raise TypeError(f"LIGGGHTS cannot run a {type(case).__name__}; it runs {', '.join(c.__name__ for c in _ADAPTERS)}") from None
-
-
-def _restitution_pairs(case) -> list[tuple[str, str, float, str]]:
-    """(material a, material b, restitution, config key) of every pair with a particle in it."""
-    if isinstance(case, VerificationCase):
-        return [("sphere", "sphere", case.restitution, f"verification problem {case.name}")]
-    if isinstance(case, JenikeCase):
-        names = case.materials.names
-        found = []
-        # the sweep point sets the restitution of both contact sets: name its key first
-        for contacts, key in ((case.test_contacts, "jenike.sweep.restitution"), (case.fill_contacts, "contacts")):
-            for j, value in enumerate(contacts.restitution[0]):
-                found.append((names[0], names[j], float(value), key))
-        return found
-    table = case.silo.materials if isinstance(case, (RecirculationCase, BlenderCase)) else case.materials
-    return [(table.names[0], table.names[j], float(value), "contacts") for j, value in enumerate(table.restitution[0])]
+def _adapter(case) -> tuple[str, Adapter]:
+    """The name of ``case``'s kind and LIGGGHTS' adapter for it."""
+    kind = kind_of_case(case).name
+    if kind not in ADAPTERS:
+        raise CaseNotSupported(f"LIGGGHTS has no deck for {kind} cases; it runs {', '.join(ADAPTERS)}")
+    return kind, ADAPTERS[kind]
 
 
 @register
@@ -125,16 +136,16 @@ class LiggghtsEngine(Engine):
         CaseNotSupported
             Naming the config key, the value and the limit.
         """
-        adapter = _adapter(case)
+        name, adapter = _adapter(case)
         kinds = tuple(stage.kind for stage in case.stages())
-        if kinds != _STAGES[adapter.kind]:
-            raise CaseNotSupported(f"{adapter.kind} run {case.run_id}: LIGGGHTS has no deck for the stages {kinds}; "
-                                   f"it runs {_STAGES[adapter.kind]}")
-        for a, b, value, key in _restitution_pairs(case):
+        if kinds != case_kind(name).stages:
+            raise CaseNotSupported(f"{name} run {case.run_id}: LIGGGHTS has no deck for the stages {kinds}; "
+                                   f"it runs {case_kind(name).stages}")
+        for a, b, value, key in adapter.restitution_pairs(case):
             if not value > MIN_RESTITUTION:
                 raise CaseNotSupported(
                     f"config key '{key}': restitution {value:g} of the pair [{a}, {b}] is not accepted by LIGGGHTS 3.8, "
-                    f"which requires {MIN_RESTITUTION} < e <= 1 ({adapter.kind} run {case.run_id}); raise it (the study "
+                    f"which requires {MIN_RESTITUTION} < e <= 1 ({name} run {case.run_id}); raise it (the study "
                     "found bulk behaviour insensitive to restitution) or run this case on another engine"
                 )
 
@@ -144,13 +155,13 @@ class LiggghtsEngine(Engine):
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
         self.check_case(case)
-        _adapter(case).write(case, Path(run_dir) / "deck")
+        _adapter(case)[1].write(case, Path(run_dir) / "deck")
         return Path(run_dir) / CASE_SUMMARY
 
     def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:
         self.check_case(case)
         settings = dict(options.settings or {})
-        return _adapter(case).run(case, Path(run_dir), executable=settings.get("executable", "liggghts"),
+        return _adapter(case)[1].run(case, Path(run_dir), executable=settings.get("executable", "liggghts"),
                                   mpi_ranks=options.mpi_ranks, mpirun=options.mpirun)
 
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
@@ -178,12 +189,13 @@ class LiggghtsEngine(Engine):
 
     def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
         dumps = Path(run_dir) / "dumps"
-        if record.case == "jenike":
-            return read_settled_fill(dumps, record.timestep_s, JENIKE_FLOOR_WALLS, SETTLED_CONTACT_PREFIX,
-                                     read_jenike_pair_contacts)
-        if record.case not in FLOOR_WALLS:
+        adapter = ADAPTERS.get(record.case)
+        if adapter is None or adapter.floor_walls is None:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on LIGGGHTS")
-        return read_settled_fill(dumps, record.timestep_s, FLOOR_WALLS[record.case])
+        if record.case == "jenike":
+            return read_settled_fill(dumps, record.timestep_s, adapter.floor_walls, SETTLED_CONTACT_PREFIX,
+                                     read_jenike_pair_contacts)
+        return read_settled_fill(dumps, record.timestep_s, adapter.floor_walls)
 
     def dump_files(self, folder: str | Path, pattern: str) -> list[DumpFile]:
         return match_dump_files(folder, pattern)

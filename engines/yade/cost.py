@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from engines.estimates import MeasuredWork
+from model.cost import MeasuredWork
 from engines.markers import parse_markers
 
 __all__ = ["measured_seconds_per_sphere_step", "measured_work"]

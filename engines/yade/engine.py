@@ -8,18 +8,19 @@ from the LIGGGHTS decks' (:mod:`engines.yade.inputs` says how).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from model.forces import WallForceHistory
 from model.frames import ParticleFrame
 from model.record import RunRecord
 from model.settled import SettledFill
-from model.cases.blender import GATE, BlenderCase
-from model.cases.jenike import JenikeCase
-from model.cases.silo_flat import FLOOR_MESHES, SiloCase
-from model.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase
-from model.cases.verification import VerificationCase
-from engines.estimates import MeasuredWork
+from model.cases.blender import GATE
+from model.cases.kinds import kind_of_case
+from model.cases.silo_flat import FLOOR_MESHES
+from model.cases.silo_recirculation import CHANNEL_MESHES
+from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.layout import CASE_SUMMARY
@@ -33,26 +34,37 @@ from engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
 from engines.yade.silo_recirculation import run_recirculation, write_recirculation_inputs
 from engines.yade.verification import run_verification, write_verification_inputs
 
-__all__ = ["YadeEngine"]
+__all__ = ["ADAPTERS", "Adapter", "YadeEngine"]
 
-#: What each case kind YADE builds is written and run with, and the walls that make its floor.
-_ADAPTERS = {
-    SiloCase: ("silo_flat", write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES),
-    RecirculationCase: ("silo_recirculation", write_recirculation_inputs, run_recirculation,
-                        lambda case: check_silo_case(case.silo), FLOOR_MESHES + CHANNEL_MESHES),
-    BlenderCase: ("blender", write_blender_inputs, run_blender, lambda case: check_silo_case(case.silo), (GATE,)),
-    JenikeCase: ("jenike", write_jenike_inputs, run_jenike, check_jenike_case, JENIKE_FLOOR_WALLS),
-    VerificationCase: ("verification", write_verification_inputs, run_verification, lambda case: None, None),
+@dataclass(frozen=True)
+class Adapter:
+    """How YADE writes, runs and checks one case kind, and the walls that make the floor of its settled fill (None:
+    it saves none)."""
+
+    write: Callable
+    run: Callable
+    check: Callable
+    floor_walls: tuple[str, ...] | None = None
+
+
+#: The case kinds YADE runs, one adapter each, by the kind's name (:mod:`model.cases.kinds`).
+ADAPTERS = {
+    "silo_flat": Adapter(write_silo_inputs, run_silo, check_silo_case, FLOOR_MESHES),
+    "silo_recirculation": Adapter(write_recirculation_inputs, run_recirculation,
+                                   lambda case: check_silo_case(case.silo), FLOOR_MESHES + CHANNEL_MESHES),
+    "blender": Adapter(write_blender_inputs, run_blender, lambda case: check_silo_case(case.silo), (GATE,)),
+    "jenike": Adapter(write_jenike_inputs, run_jenike, check_jenike_case, JENIKE_FLOOR_WALLS),
+    "verification": Adapter(write_verification_inputs, run_verification, lambda case: None),
 }
 
 
-def _adapter(case):
-    try:
-        return _ADAPTERS[type(case)]
-    except KeyError:
+def _adapter(case) -> Adapter:
+    kind = kind_of_case(case).name
+    if kind not in ADAPTERS:
         raise CaseNotSupported(
-            f"YADE has no script for a {type(case).__name__} yet; it runs {', '.join(c.__name__ for c in _ADAPTERS)}: "
-            "set this case section's 'engine' (or engine.kind) to liggghts") from None
+            f"YADE has no script for {kind} cases yet; it runs {', '.join(ADAPTERS)}: set this case section's "
+            "'engine' (or engine.kind) to liggghts")
+    return ADAPTERS[kind]
 
 
 def options_from(options: EngineOptions) -> YadeOptions:
@@ -79,21 +91,21 @@ class YadeEngine(Engine):
         CaseNotSupported
             Naming the config key and the limit.
         """
-        _adapter(case)[3](case)
+        _adapter(case).check(case)
 
     def check_installed(self, options: EngineOptions) -> None:
         check_programs(options_from(options))
 
     def write_inputs(self, case, run_dir: str | Path) -> Path:
         self.check_case(case)
-        _adapter(case)[1](case, Path(run_dir) / "deck")
+        _adapter(case).write(case, Path(run_dir) / "deck")
         return Path(run_dir) / CASE_SUMMARY
 
     def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:
         # one process, engine.yade.threads OpenMP threads; engine.mpi_ranks is LIGGGHTS' (engines.config refuses it
         # when no case runs on LIGGGHTS)
         self.check_case(case)
-        return _adapter(case)[2](case, Path(run_dir), options_from(options))
+        return _adapter(case).run(case, Path(run_dir), options_from(options))
 
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
         return work_from_logs(attempt_logs(run_dir))
@@ -116,7 +128,7 @@ class YadeEngine(Engine):
         return [fill.contacts for fill in self.settled_fill(run_dir, record)]
 
     def settled_fill(self, run_dir: str | Path, record: RunRecord) -> tuple[SettledFill, ...]:
-        floors = {kind: floor for kind, _, _, _, floor in _ADAPTERS.values() if floor is not None}
-        if record.case not in floors:
+        adapter = ADAPTERS.get(record.case)
+        if adapter is None or adapter.floor_walls is None:
             raise CaseNotSupported(f"{record.case} runs save no settled fill snapshot on YADE")
-        return read_settled_fill(run_dir, SETTLED_FILL_PREFIX, floors[record.case])
+        return read_settled_fill(run_dir, SETTLED_FILL_PREFIX, adapter.floor_walls)

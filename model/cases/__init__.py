@@ -1,38 +1,24 @@
 """The engine-neutral case model: every case siloflow can run, as plain data built from validated configuration.
 
-:data:`CASE_BUILDERS` is the one list of case kinds: each maps a validated configuration to its runs, keyed by run
-id. The workflow, the run planning and the tests all take the cases from here.
+The case kinds are registered in :mod:`model.cases.kinds`, each with the builder that maps a validated configuration
+to its runs; :func:`cases_of` adds the replicates a section asks for. The workflow, the run planning and the tests
+all take the runs from here.
 """
 
 from __future__ import annotations
 
 import copy
 
-from model.cases.blender import blender_cases
-from model.cases.jenike import jenike_cases
-from model.cases.jenike_sweep import point_role
-from model.cases.silo_flat import silo_cases
-from model.cases.silo_recirculation import recirculation_cases
+from model.cases.kinds import case_kind
 
-__all__ = ["CASE_BUILDERS", "REFERENCE", "VARIANT", "case_for_run", "cases_of", "reference_runs", "run_roles"]
-
-#: Case kind -> function of a validated configuration returning its runs ``{run id: case}``.
-CASE_BUILDERS = {
-    "jenike": jenike_cases,
-    "silo_flat": silo_cases,
-    "silo_recirculation": recirculation_cases,
-    "blender": blender_cases,
-}
-
-
-#: The case kinds whose section has ``replicates`` (the Jenike sweep is not replicated: its calibration's
-#: uncertainty is the band of friction values that reproduce the target within its tolerance).
-REPLICATED_CASES = ("silo_flat", "silo_recirculation", "blender")
+__all__ = ["REFERENCE", "VARIANT", "case_for_run", "cases_of", "reference_runs", "run_roles"]
 
 
 def _replicates(config: dict, case: str) -> tuple[int, int]:
-    """``(N, M)``: runs of every configuration and of the reference configuration (M >= N)."""
-    section = config.get(case, {}) if case in REPLICATED_CASES else {}
+    """``(N, M)``: runs of every configuration and of the reference configuration (M >= N); 1 for a kind whose
+    section has no replicates (the Jenike sweep's uncertainty is the band of friction values that reproduce the
+    target within its tolerance)."""
+    section = config.get(case, {}) if case_kind(case).replicated else {}
     replicates = section.get("replicates", 1)
     return replicates, max(replicates, section.get("reference_replicates", 1))
 
@@ -41,7 +27,7 @@ def _reseeded(config: dict, case: str, offset: int) -> dict:
     """The runs of ``case`` with its section's seed raised by ``offset``, in the builder's order."""
     reseeded = copy.deepcopy(config)
     reseeded[case]["seed"] += offset
-    return CASE_BUILDERS[case](reseeded)
+    return case_kind(case).build(reseeded)
 
 
 def cases_of(config: dict, case: str) -> dict:
@@ -58,9 +44,10 @@ def cases_of(config: dict, case: str) -> dict:
 
 def _runs_and_reference(config: dict, case: str) -> tuple[dict, list[str]]:
     """The runs of :func:`cases_of` and the run ids of :func:`reference_runs`, from one build of each seed."""
-    if case not in CASE_BUILDERS:
-        raise KeyError(f"unknown case {case!r}; the cases are {', '.join(CASE_BUILDERS)}")
-    runs = CASE_BUILDERS[case](config)
+    kind = case_kind(case)
+    if kind.build is None:
+        raise KeyError(f"case kind {case!r} has no config section; its runs are not built from a configuration")
+    runs = kind.build(config)
     # the builders list the reference configuration first
     reference = list(runs)[:1]
     replicates, seeds = _replicates(config, case)
@@ -84,13 +71,13 @@ REFERENCE, VARIANT = "reference", "variant"
 
 
 def run_roles(config: dict, case: str) -> dict[str, str]:
-    """``{run id: role}`` of the runs of case kind ``case``: a Jenike run's sweep role
-    (:data:`model.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), any
-    other run :data:`REFERENCE` when it is one of :func:`reference_runs` and :data:`VARIANT` otherwise."""
+    """``{run id: role}`` of the runs of case kind ``case``: the role its kind gives it (a Jenike run's sweep role,
+    :data:`model.cases.jenike_sweep.ROLES`: the calibration shape's charts, another shape's, or a check), for other
+    kinds :data:`REFERENCE` when it is one of :func:`reference_runs` and :data:`VARIANT` otherwise."""
     runs, reference = _runs_and_reference(config, case)
-    if case == "jenike":
-        return {run: point_role(job.sweep_point, config["jenike"]["sweep"]["restitution"],
-                                config["calibration"]["shape"]) for run, job in runs.items()}
+    role = case_kind(case).run_role
+    if role is not None:
+        return {run: role(config, job) for run, job in runs.items()}
     return {run: REFERENCE if run in reference else VARIANT for run in runs}
 
 

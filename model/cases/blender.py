@@ -19,11 +19,14 @@ insertion velocity.
 
 from __future__ import annotations
 
+from typing import Mapping
+
 import copy
 import math
 from dataclasses import dataclass, field
 
 from model.cases.blender_geometry import BlenderGeometry, blender_geometry, INSERT_PRESETS
+from model.cases.config_checks import ConfigError, require, require_subset
 from model.cases.blender_passages import clear_widths, geometry_summary
 from model.cases.blender_meshes import blender_meshes
 from model.cases.geometry import horizontal_rectangle
@@ -107,6 +110,16 @@ class BlenderCase:
         """Factor 1/sqrt(f) applied to the flow times of the run (-)."""
         return 1.0 / math.sqrt(self.gravity_factor)
 
+    @property
+    def domain_z(self) -> tuple[float, float]:
+        """Bottom and top of the periodic domain (m): the sink below the outlet up to the silo's top."""
+        return (-self.silo.sink_depth, self.silo.domain_top)
+
+    @property
+    def outlet_z(self) -> float:
+        """Height of the outlet plane (m): the origin of z."""
+        return 0.0
+
     def stages(self):
         """The silo's stages; the discharge is continuous (periodic, no clump may leave) or a batch."""
         return self.silo.stages(last="discharge")
@@ -126,8 +139,8 @@ class BlenderCase:
                 "steady_window": list(self.steady_window),
                 "profile_windows": self.profile_windows,
                 "fill_area_m2": self.fill_area,
-                "domain_z": [-self.silo.sink_depth, self.silo.domain_top],
-                "outlet_z": 0.0,
+                "domain_z": list(self.domain_z),
+                "outlet_z": self.outlet_z,
                 "geometry": geometry_summary(self.geometry),
                 "parameters": self.defining_parameters,
             }
@@ -357,3 +370,31 @@ def blender_mesh_set(case: BlenderCase) -> dict:
     half_outlet = 0.5 * case.geometry.outlet_width
     meshes[GATE] = horizontal_rectangle(-half_outlet, half_outlet, 0.0, case.geometry.depth, 0.0)
     return meshes
+
+
+def check_blender_config(config: Mapping, contact_pairs: Mapping) -> None:
+    """The blender's own checks: its configurations name inserts (a preset's name is not taken), its pathlines start
+    below the fill, its gravity series picks configurations, its steady window lies within the discharge. Its outlet
+    is checked with every silo-type section's (:mod:`engines.config`)."""
+    blender = config["blender"]
+    for name in blender["inserts"]:
+        if name in INSERT_PRESETS:
+            raise ConfigError(
+                f"config key 'blender.inserts.{name}': '{name}' is a built-in preset; give your insert another name"
+            )
+    defined = {**{name: None for name in INSERT_PRESETS}, **blender["inserts"]}
+    for index, name in enumerate(blender["configurations"]):
+        require(name, defined, f"blender.configurations[{index}]", "insert configuration")
+    if blender["pathlines"]["release_height"] >= blender["fill_height"]:
+        raise ConfigError(
+            f"config key 'blender.pathlines.release_height': {blender['pathlines']['release_height']} m must be below "
+            f"the fill height blender.fill_height ({blender['fill_height']} m)"
+        )
+    require_subset(blender["gravity_configurations"], blender["configurations"], "blender.gravity_configurations",
+                    "blender.configurations")
+    start, end = blender["discharge"]["steady_window"]
+    if not start < end <= blender["discharge"]["time"]:
+        raise ConfigError(
+            f"config key 'blender.discharge.steady_window': {[start, end]} must be an increasing window within "
+            f"blender.discharge.time ({blender['discharge']['time']} s)"
+        )

@@ -157,10 +157,6 @@ class BlenderGeometry:
         alpha = finite_number("hopper_half_angle", self.hopper_half_angle)
         if not 0.0 < alpha < 90.0:
             raise ValueError(f"hopper_half_angle must lie in (0, 90) degrees, got {self.hopper_half_angle!r}")
-        if not self.outlet_width < self.width:
-            raise ValueError(
-                f"outlet_width must be smaller than width: outlet_width={self.outlet_width!r}, width={self.width!r}"
-            )
         tube_width = finite_number("tube_width", self.tube_width)
         if tube_width < 0:
             raise ValueError(f"tube_width must be >= 0 (0 for no tube), got {self.tube_width!r}")

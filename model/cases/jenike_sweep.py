@@ -11,6 +11,10 @@ extra seeds and ``"shear_velocity"`` (m/s) on its shear-speed study.
 
 from __future__ import annotations
 
+from typing import Mapping
+
+from model.cases.config_checks import ConfigError, require, require_subset
+
 INTERNAL = "internal"
 
 #: The role of a sweep point (:func:`point_role`): a point of the calibration shape's charts, of another shape's
@@ -152,3 +156,48 @@ def diagnostic_points(points: list[dict], sweep: dict, lid: str) -> list[dict]:
     if sweep["diagnostics"] == "all":
         return chart
     return [p for p in chart if p["sliding_friction"] == middle_sliding_friction(sweep)]
+
+
+def jenike_run_role(config: Mapping, case) -> str:
+    """The role (:data:`ROLES`) of a Jenike run of a validated configuration: its sweep point's."""
+    return point_role(case.sweep_point, config["jenike"]["sweep"]["restitution"], config["calibration"]["shape"])
+
+
+def check_jenike_config(config: Mapping, contact_pairs: Mapping) -> None:
+    """The Jenike cell's own checks: its materials, shapes and tests are defined and every pair it brings into contact
+    has contact parameters; its sensitivity and wall-test picks are among the sweep's; the calibration's shape and
+    rolling friction are points of the sweep."""
+    materials = config["materials"]
+    jenike = config["jenike"]
+    sweep = jenike["sweep"]
+    particle = jenike["particle_material"]
+    for key in ("particle_material", "ring_material", "lid_material"):
+        require(jenike[key], materials, f"jenike.{key}", "material")
+    if "density" not in materials[particle]:
+        raise ConfigError(f"config key 'materials.{particle}.density': the particle material needs a density")
+    for index, shape in enumerate(sweep["shapes"]):
+        require(shape, config["particle_models"], f"jenike.sweep.shapes[{index}]", "particle model")
+    for key in ("wall_test_shapes", "sensitivity_shapes"):
+        require_subset(sweep[key], sweep["shapes"], f"jenike.sweep.{key}", "jenike.sweep.shapes")
+    require_subset(sweep["sensitivity_tests"], sweep["tests"], "jenike.sweep.sensitivity_tests", "jenike.sweep.tests")
+    wall_tests = []
+    for index, test in enumerate(sweep["tests"]):
+        if test != "internal":
+            require(test, materials, f"jenike.sweep.tests[{index}]", "test ('internal' or a wall material)")
+            wall_tests.append(test)
+    for material in sorted({particle, jenike["ring_material"], jenike["lid_material"], *wall_tests}):
+        if frozenset((particle, material)) not in contact_pairs:
+            raise ConfigError(
+                f"config key 'contacts': no contact parameters for the pair [{particle}, {material}] used by jenike"
+            )
+    calibration = config["calibration"]
+    if calibration["shape"] not in sweep["shapes"]:
+        raise ConfigError(
+            f"config key 'calibration.shape': '{calibration['shape']}' is not among jenike.sweep.shapes "
+            f"{sweep['shapes']}"
+        )
+    if calibration["rolling_friction"] not in sweep["rolling_friction"]:
+        raise ConfigError(
+            f"config key 'calibration.rolling_friction': {calibration['rolling_friction']} is not among "
+            f"jenike.sweep.rolling_friction {sweep['rolling_friction']}"
+        )

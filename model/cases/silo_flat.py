@@ -154,10 +154,6 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
     particle = particle_template(
         silo["particle_model"], config["particle_models"][silo["particle_model"]], material["density"]
     )
-    if silo["outlet_width"] >= silo["width"]:
-        raise ValueError(
-            f"{section}.outlet_width ({silo['outlet_width']} m) must be smaller than {section}.width ({silo['width']} m)"
-        )
     if silo["depth"] < 2.0 * particle.bounding_radius:
         raise ValueError(
             f"{section}.depth ({silo['depth']} m) is thinner than one clump ({2 * particle.bounding_radius:.4g} m)"

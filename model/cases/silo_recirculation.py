@@ -18,10 +18,13 @@ when both are made of the same material.
 
 from __future__ import annotations
 
+from typing import Mapping
+
 import copy
 from dataclasses import dataclass, field
 
 from model.cases.common import run_id
+from model.cases.config_checks import ConfigError, require, require_subset
 from model.cases.geometry import vertical_rectangle_x
 from model.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
 
@@ -97,6 +100,11 @@ class RecirculationCase:
         prefix = self.pattern if self.role == "blending" else f"thin-{self.pattern}"
         return run_id(prefix, self.defining_parameters)
 
+    @property
+    def domain_z(self) -> tuple[float, float]:
+        """Bottom and top of the periodic domain (m): the return channel below the outlet up to the silo's top."""
+        return (-self.channel_length, self.silo.domain_top)
+
     def stages(self):
         """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`)."""
         return self.silo.stages(last="recirculate")
@@ -115,7 +123,7 @@ class RecirculationCase:
                 "feeder_zone": list(self.feeder_zone),
                 "estimated_residence_time_s": self.estimated_residence_time,
                 "recirculation_time_s": self.recirculation_time,
-                "domain_z": [-self.channel_length, self.silo.domain_top],
+                "domain_z": list(self.domain_z),
                 "parameters": self.defining_parameters,
             }
         )
@@ -265,3 +273,23 @@ def recirculation_case_for_run(config: dict, run: str) -> RecirculationCase:
         raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
     return cases[run]
 
+
+def check_recirculation_config(config: Mapping, contact_pairs: Mapping) -> None:
+    """The recirculating silo's own checks: its flow patterns name presets, its layouts have distinct names, its
+    bulk density slab is an increasing pair. Its outlet is checked with every silo-type
+    section's (:mod:`engines.config`)."""
+    blending = config["silo_recirculation"]
+    presets = blending["presets"]
+    for index, pattern in enumerate(blending["flow_patterns"]):
+        require(pattern, presets, f"silo_recirculation.flow_patterns[{index}]", "preset")
+    require(blending["verification"]["flow_pattern"], presets, "silo_recirculation.verification.flow_pattern", "preset")
+    for pattern in blending["residence_time_ratios"]:
+        require(pattern, presets, f"silo_recirculation.residence_time_ratios.{pattern}", "preset")
+    names = [layout["name"] for layout in blending["layouts"]]
+    for index, name in enumerate(names):
+        if names.index(name) != index:
+            raise ConfigError(f"config key 'silo_recirculation.layouts[{index}].name': layout name '{name}' is used twice")
+    low, high = blending["bulk_density_slab"]
+    if not low < high:
+        raise ConfigError(f"config key 'silo_recirculation.bulk_density_slab': {[low, high]} must be an increasing "
+                          "pair of fractions of fill_height")

@@ -184,7 +184,6 @@ def test_clear_widths_of_the_diverging_insert():
 @pytest.mark.parametrize(
     "changes, insert, message",
     [
-        ({"outlet_width": 0.5}, "diverging", "outlet_width"),
         ({"wall_thickness": -0.005}, "diverging", "wall_thickness"),
         ({"hopper_half_angle": 90.0}, "diverging", "hopper_half_angle"),
         ({"tube_inlet_above_transition": -0.2}, "diverging", "tube_inlet_above_transition"),

@@ -72,9 +72,10 @@ STUDY = BlenderStudy(
 METRICS = BlenderMetrics(name="straight", mass_flow_rate=0.01, exterior_v_z=-0.04, interior_v_z=-0.05, tube_v_z=NAN,
                          rtd_mean=2.0, rtd_spread=math.sqrt(1.25) / 2.0, ts_over_td=0.5 / 3.5,
                          recirculations_to_homogenise=3.0, vrr_by_period={1.0: 4.0})
-CASE = {"run_id": "blender_cd34", "configuration": "straight", "gravity_factor": 1.0,
-        "geometry": {"z_insert_outlet": 0.04, "inlet": [0.05, 0.11], "z_tube_inlet": None}, "mode": "continuous",
-        "n_clumps": 1234, "steady_window": [1.0, 2.0], "width_m": 0.2}
+#: What of the run's case the summary holds, as the adapter passes it (the steady window a tuple, as in the case).
+RUN = {"run_id": "blender_cd34", "configuration": "straight", "gravity_factor": 1.0,
+       "geometry": {"z_insert_outlet": 0.04, "inlet": [0.05, 0.11], "z_tube_inlet": None}, "mode": "continuous",
+       "n_clumps": 1234, "steady_window": (1.0, 2.0)}
 FLOW = {"mass_flow_rate_kg_s": 0.01, "mass_flow_rate_standard_error_kg_s": 1e-4, "time_since_open_s": [0.0, 1.0],
         "discharged_mass_kg": [0.0, 0.01], "mean_v_z_m_s": [0.0, -0.05], "beverloo_ratio": 1.1}
 
@@ -89,13 +90,13 @@ def assert_rows(rows, columns, expected):
 
 
 def test_blender_summary_adds_the_case_flow_rtd_curve_and_history_to_the_study_summary():
-    summary = blender_summary(CASE, FLOW, STUDY, METRICS)
+    summary = blender_summary(FLOW, STUDY, METRICS, **RUN)
     assert list(summary)[:8] == ["run_id", "configuration", "gravity_factor", "geometry", "mode", "n_clumps",
                                  "steady_window_s", "mass_flow_rate_standard_error_kg_s"]
     assert list(summary)[-2:] == ["rtd_curve", "flow_history"]
     assert {key: summary[key] for key in list(summary)[:8]} == {
         "run_id": "blender_cd34", "configuration": "straight", "gravity_factor": 1.0,
-        "geometry": CASE["geometry"], "mode": "continuous", "n_clumps": 1234, "steady_window_s": [1.0, 2.0],
+        "geometry": RUN["geometry"], "mode": "continuous", "n_clumps": 1234, "steady_window_s": [1.0, 2.0],
         "mass_flow_rate_standard_error_kg_s": 1e-4,
     }
     assert summary["flow_history"] == {"time_since_open_s": [0.0, 1.0], "discharged_mass_kg": [0.0, 0.01],
@@ -111,7 +112,7 @@ def test_blender_summary_adds_the_case_flow_rtd_curve_and_history_to_the_study_s
 
 
 def test_blender_summary_round_trips_through_json_to_the_comparison_inputs(tmp_path):
-    loaded = json.loads(write_json(tmp_path / "blender.json", blender_summary(CASE, FLOW, STUDY, METRICS)).read_text())
+    loaded = json.loads(write_json(tmp_path / "blender.json", blender_summary(FLOW, STUDY, METRICS, **RUN)).read_text())
     back = metrics_from_summary(loaded)
     assert back.name == "straight" and back.mass_flow_rate == 0.01 and math.isnan(back.tube_v_z)
     assert back.vrr_by_period == {1.0: 4.0}

@@ -9,7 +9,7 @@ import yaml
 
 from model.cases import cases_of
 from model.cases.silo_flat import build_silo_case
-from engines.config import SCHEMA_PATH, ConfigError, load_config, validate_config
+from engines.config import SCHEMA_PATH, ConfigError, load_config, load_schema, validate_config
 from engines.interface import CaseNotSupported, engine_for
 
 
@@ -25,7 +25,7 @@ def _schema_properties(node, path="", definitions=None):
 
 
 def test_every_schema_key_has_description_and_default():
-    schema = yaml.safe_load(SCHEMA_PATH.read_text())
+    schema = load_schema()  # the main schema with every case kind's fragment
     for path, sub in _schema_properties(schema):
         assert "description" in sub, f"{path} has no description"
         assert "default" in sub, f"{path} has no default"
@@ -198,3 +198,12 @@ def test_replicates_must_be_at_least_one(raw_default_config):
     raw["blender"]["replicates"] = 0
     with pytest.raises(ConfigError, match="blender.replicates"):
         validate_config(raw)
+
+
+@pytest.mark.parametrize("section", ["silo_flat", "silo_recirculation", "blender"])
+def test_an_outlet_as_wide_as_its_silo_is_refused_in_every_silo_type_section(section):
+    raw = {section: {"width": 0.1, "outlet_width": 0.1}}
+    with pytest.raises(ConfigError, match=rf"^config key '{section}.outlet_width': 0.1 m must be smaller than "
+                                          rf"{section}.width \(0.1 m\)$"):
+        validate_config(raw)
+    validate_config({section: {"width": 0.1, "outlet_width": 0.099}})

@@ -12,7 +12,8 @@ import time
 
 import pytest
 
-from model.cases import CASE_BUILDERS, cases_of
+from model.cases import cases_of
+from model.cases.kinds import configured_kinds
 from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
 from model.cases.jenike_cell import segments_for_chord
 from model.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
@@ -50,7 +51,7 @@ CASE_LENGTHS = [
                                                   "shear_displacement")],
 ]
 #: The lengths that validation requires to be less than another (the outlets of the sections whose silo width it knows).
-NARROWER = [("silo_recirculation", "outlet_width"), ("blender", "outlet_width")]
+NARROWER = [("silo_flat", "outlet_width"), ("silo_recirculation", "outlet_width"), ("blender", "outlet_width")]
 #: Every simulated time of a case (case_duration).
 CASE_DURATIONS = [
     ("defaults", "settle", "check_interval"), ("defaults", "settle", "max_time"),
@@ -211,7 +212,7 @@ def test_the_largest_seeds_give_engine_seeds_far_below_the_engines_limit_and_bui
     raw.setdefault("cross_engine", {})["seeds"] = REPLICATES_MAX
     config = validate_config(raw)
     started = time.perf_counter()
-    cases = [case for kind in CASE_BUILDERS for case in cases_of(config, kind).values()]
+    cases = [case for kind in configured_kinds() for case in cases_of(config, kind).values()]
     cases += [case for runs in cross_engine_cases(config).values() for case in runs.values()]
     cases += [case for runs in cross_engine_jenike_cases(config).values() for _, case in runs.values()]
     assert time.perf_counter() - started < 10.0  # about 800 runs

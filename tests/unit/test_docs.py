@@ -18,7 +18,7 @@ from pathlib import Path, PurePosixPath
 import pytest
 import yaml
 
-from engines.config import RENAMED_KEYS, REPLACED_KEYS, REPO_ROOT
+from engines.config import RENAMED_KEYS, REPLACED_KEYS, REPO_ROOT, load_schema
 from engines.validation_groups import group_of_part
 
 README_MAX_LINES = 220
@@ -94,7 +94,7 @@ def test_the_readme_is_a_short_entry_point_with_the_two_commands():
 #   variable    a variable a command sets (`make estimate CONFIG=...`, `SILOFLOW_UPDATE_GOLDEN=1 python ...`): the
 #               Makefile or the Python source reads it
 #   group       a validation group or part (`make validate GROUP=silo_2`)
-#   identifier  a class of the project (`PlanarField.kind`, `RunRecord`) or a module-level constant (`CASE_BUILDERS`)
+#   identifier  a class of the project (`PlanarField.kind`, `RunRecord`) or a module-level constant (`CASE_KINDS`)
 #   function    a called name (`engine_named(record.engine)`, `stages()`): a function or method of the project
 #   defined     a name the prose places in a file ("`stable_timestep` in `model/cases/physics.py`")
 # Anything else (engine commands, math, output columns and files, values, results/ paths) is prose and is not
@@ -330,8 +330,7 @@ def doc_names() -> tuple[DocName, ...]:
 
 @functools.lru_cache(maxsize=None)
 def _schema() -> dict:
-    return yaml.load((REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text(encoding="utf-8"),
-                     Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    return load_schema()  # the main schema with every case kind's fragment
 
 
 def _schema_nodes(node) -> list[dict]:
@@ -474,7 +473,7 @@ def _project_functions() -> frozenset[str]:
 
 
 def _identifier_resolves(name: str) -> bool:
-    """A class (`RunRecord`, `Engine.measured_cost`) or a module-level constant (`CASE_BUILDERS`) of the project."""
+    """A class (`RunRecord`, `Engine.measured_cost`) or a module-level constant (`CASE_KINDS`) of the project."""
     base, _, attribute = name.partition(".")
     return any(_has_attributes(_import(module), [base, *([attribute] if attribute else [])])
                for module in _project_definitions().get(base, []))
@@ -580,7 +579,7 @@ def test_the_deliberately_undefined_names_are_still_in_the_docs_and_still_undefi
     ("`fill.zone_heigth: 0.02`", False),
     ("`estimates.seconds_per_sphere_step_by_case.blender`", True),
     ("`estimates.seconds_per_sphere_step_by_case.hopper`", False),  # not one of its propertyNames
-    ("`PlanarField.kind` and `CASE_BUILDERS`", True),
+    ("`PlanarField.kind` and `CASE_KINDS`", True),
     ("`PlanarField.knd`", False),
     ("`stable_timestep` in `model/cases/particles.py`", False),
     ("`analysis/studies/blender/`: `modes.py`, `mode.py`", False),

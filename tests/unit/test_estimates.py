@@ -13,35 +13,37 @@ from model.cases.blender import blender_cases, build_blender_case
 from model.cases.silo_recirculation import recirculation_cases
 from engines.config import REPO_ROOT, load_config
 from analysis.numerics.flow import beverloo_mass_flow_rate
-from engines.estimates import (
-    ESTIMATE_COLUMNS,
-    KINDS,
+from model.cost import (
     CostModel,
-    InsufficientDiskSpace,
     MeasuredWork,
     RunEstimate,
     StageWork,
     beverloo_clump_rate,
-    check_disk_space,
     drain_sphere_steps,
     dump_frames,
-    estimate_blender_case,
-    estimate_jenike_case,
-    estimate_recirculation_case,
-    estimate_rows,
     estimate_run,
-    estimate_silo_case,
-    format_bytes,
-    format_duration,
-    jenike_levelled_clumps,
-    jenike_run_steps,
     parallel_speedup,
     pour_sphere_steps,
-    silo_run_steps,
-    sink_fall_time,
-    total_dump_bytes,
     wall_time,
 )
+from model.cases.silo_cost import (
+    estimate_blender_case,
+    estimate_recirculation_case,
+    estimate_silo_case,
+    silo_run_steps,
+    sink_fall_time,
+)
+from model.cases.jenike_cost import estimate_jenike_case, jenike_levelled_clumps, jenike_run_steps
+from engines.estimates import (
+    ESTIMATE_COLUMNS,
+    InsufficientDiskSpace,
+    check_disk_space,
+    estimate_rows,
+    format_bytes,
+    format_duration,
+    total_dump_bytes,
+)
+from model.cases.kinds import CASE_KINDS, configured_kinds
 from model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
 from engines.liggghts.cost import StageCost, TimedRun, calibrate_cost_model, measured_work, stage_costs, timed_runs
 from model.cases.silo_flat import build_silo_case
@@ -277,7 +279,7 @@ def test_stage_work_mean_spheres():
 
 @pytest.mark.parametrize(
     "changes, message",
-    [({"kind": "hopper"}, "unknown run kind 'hopper'"), ({"mpi_ranks": 0}, "mpi_ranks"),
+    [({"kind": ""}, "kind must name a case kind"), ({"mpi_ranks": 0}, "mpi_ranks"),
      ({"timestep": 0.0}, "timestep"), ({"clumps": -1}, "clumps"), ({"spheres_per_clump": 0}, "spheres_per_clump"),
      ({"dump_frames": 2.5}, "dump_frames")],
 )
@@ -525,8 +527,10 @@ def test_jenike_cases_from_config_count_all_stages_and_the_lid(config):
         assert estimate.run_id == case.run_id
 
 
-def test_kinds_are_the_four_run_kinds():
-    assert KINDS == ("silo_flat", "silo_recirculation", "blender", "jenike")
+def test_every_configured_kind_names_its_cost_model():
+    assert configured_kinds() == ("jenike", "silo_flat", "silo_recirculation", "blender")
+    assert [CASE_KINDS[kind].estimate for kind in configured_kinds()] == [
+        estimate_jenike_case, estimate_silo_case, estimate_recirculation_case, estimate_blender_case]
 
 
 # ---------------------------------------------------------------------------------------------- disk

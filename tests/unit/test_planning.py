@@ -9,7 +9,8 @@ import pytest
 import engines.planning as planning
 from model.record import RunRecord
 from engines.config import load_config
-from engines.estimates import CostModel, InsufficientDiskSpace, MeasuredWork, RunEstimate
+from model.cost import CostModel, MeasuredWork, RunEstimate
+from engines.estimates import InsufficientDiskSpace
 from engines.planning import (
     COMPARISON_COLUMNS,
     calibrated_model,
@@ -208,8 +209,8 @@ def test_each_measured_kind_takes_its_own_cost_and_an_unmeasured_one_keeps_the_c
     # the blender has not run: the cost the config gives it; the recirculating silo its own measured one
     assert calibrated.seconds_for("blender") == 6.0e-7
     assert calibrated.seconds_for("silo_recirculation") == pytest.approx(9.0e-7, rel=1e-12)
-    with pytest.raises(ValueError, match="unknown run kind 'silo'"):
-        CostModel(kind_seconds_per_sphere_step={"silo": 1.0e-6})
+    with pytest.raises(ValueError, match="keys are case kinds' names, got ''"):
+        CostModel(kind_seconds_per_sphere_step={"": 1.0e-6})
 
 
 def test_a_kind_s_own_cost_sets_its_estimates(estimates):

@@ -6,8 +6,9 @@ from __future__ import annotations
 import re
 
 from engines.config import REPO_ROOT
-from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CASE_ROOTS, CROSS_ENGINE_DIR, RESULTS, SUMMARY_DIR,
-                            VALIDATION_RECORD, VERIFICATION_DIR)
+from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CROSS_ENGINE_DIR, RESULTS, SUMMARY_DIR, VALIDATION_RECORD,
+                            VERIFICATION_DIR, case_root)
+from model.cases.kinds import configured_kinds
 
 
 def test_the_rule_files_write_no_results_folder_of_their_own():
@@ -23,5 +24,7 @@ def test_the_folders_across_runs_lie_in_results_and_the_case_roots_apart():
     assert CALIBRATED_PARAMETERS == "results/calibration/parameters.yaml"
     assert VALIDATION_RECORD == "results/summary/record"
     # the Jenike runs sit inside the calibration's folder; no other case root is a folder across runs
-    assert f"{RESULTS}/{CASE_ROOTS['jenike']}".startswith(f"{CALIBRATION_DIR}/")
-    assert not {f"{RESULTS}/{root}" for kind, root in CASE_ROOTS.items() if kind != "jenike"} & set(folders)
+    assert case_root("jenike").startswith(f"{CALIBRATION_DIR}/")
+    assert not {case_root(kind) for kind in configured_kinds() if kind != "jenike"} & set(folders)
+    # the verification suite's problems are a case kind without a config section; their runs fill its folder
+    assert case_root("verification") == VERIFICATION_DIR

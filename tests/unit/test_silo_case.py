@@ -141,12 +141,12 @@ def test_unknown_run_is_reported_with_the_defined_ones(tiny_config):
 @pytest.mark.parametrize(
     "key, value, message",
     [
-        ("outlet_width", 0.2, "outlet_width .* must be smaller than silo_flat.width"),
         ("depth", 0.002, "depth .* is thinner than one clump"),
         ("sink_depth", 0.001, "sink_depth .* must exceed one clump size"),
     ],
 )
 def test_inconsistent_geometry_is_refused(tiny_config, key, value, message):
+    # an outlet wider than the silo is refused where the configuration is validated (test_config)
     config = copy.deepcopy(tiny_config)
     config["silo_flat"][key] = value
     with pytest.raises(ValueError, match=message):

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
+from model.cases.silo_flat import build_silo_case
 from model.contacts import ContactFrame
 from model.frames import ClumpFrame
 from model.constants import GRAVITY
@@ -294,11 +297,12 @@ FIELD_SECTION = {
                 "front_wall_friction_angle_deg": 0.0},
     "force_chain_slice": 0.004, "measured_profiles": None, "measured_plane": "front_wall",
 }
-CASE = {"width_m": 0.06, "depth_m": 0.012, "outlet_width_m": 0.02, "equivalent_diameter_m": 0.002,
-        "clump_mass_kg": 1e-5, "run_id": "lattice"}
+#: What of a silo case the field study reads (:meth:`SiloDimensions.from_case`), with round numbers.
+CASE = SimpleNamespace(width=0.06, depth=0.012, outlet_width=0.02,
+                       particle=SimpleNamespace(equivalent_diameter=0.002, mass=1e-5))
 
 
-def test_settings_and_dimensions_from_the_config_section_and_the_case_summary():
+def test_settings_and_dimensions_from_the_config_section_and_the_silo_case():
     options = SiloFieldOptions.from_config(FIELD_SECTION)
     assert options.spacing == (0.006, 0.004, 0.006) and options.profile_heights == (0.03, 0.04, 0.06)
     assert options.average_window is None and options.vtk_every == 2 and options.force_chain_slice == 0.004
@@ -306,8 +310,20 @@ def test_settings_and_dimensions_from_the_config_section_and_the_case_summary():
     assert SiloFieldOptions.from_config({**FIELD_SECTION, "average_window": [0.2, 0.8]}).average_window == (0.2, 0.8)
     settings = options.field_settings(0.001)
     assert settings == FieldSettings((0.006, 0.004, 0.006), "gaussian", 0.003, 3.0)
-    silo = SiloDimensions.from_case_summary(CASE)
+    silo = SiloDimensions.from_case(CASE)
     assert silo == SiloDimensions(width=0.06, depth=0.012, outlet_width=0.02, particle_radius=0.001, clump_mass=1e-5)
+
+
+def test_dimensions_of_a_built_silo_case_are_the_numbers_of_its_case_json(tiny_config):
+    # the analysis once read these from deck/case.json: the typed case must give them unchanged
+    case = build_silo_case(tiny_config)
+    summary = json.loads(json.dumps(case.summary(), default=float))
+    silo = SiloDimensions.from_case(case)
+    assert (silo.width, silo.depth, silo.outlet_width) == (0.08, 0.012, 0.024)
+    assert silo == SiloDimensions(width=summary["width_m"], depth=summary["depth_m"],
+                                  outlet_width=summary["outlet_width_m"],
+                                  particle_radius=0.5 * summary["equivalent_diameter_m"],
+                                  clump_mass=summary["clump_mass_kg"])
 
 
 SPEEDS = (0.1, 0.2, 0.4)  # downward speed of the whole lattice in each frame (m/s)
@@ -333,7 +349,7 @@ def lattice_study():
     with warnings.catch_warnings():
         # A flat profile gives the kinematic fit no curvature to fit (scipy warns; B is not asserted here).
         warnings.simplefilter("ignore", OptimizeWarning)
-        study = analyse_silo_fields(frames, contacts, SiloDimensions.from_case_summary(CASE),
+        study = analyse_silo_fields(frames, contacts, SiloDimensions.from_case(CASE),
                                     SiloFieldOptions.from_config(FIELD_SECTION), STEADY_WINDOW, BULK_DENSITY)
     return frames, contacts, study
 
@@ -394,7 +410,7 @@ def test_silo_field_study_contact_stress_janssen_and_force_chains(lattice_study)
 
 def test_silo_field_study_needs_a_frame():
     with pytest.raises(ValueError, match="frames"):
-        analyse_silo_fields([], None, SiloDimensions.from_case_summary(CASE),
+        analyse_silo_fields([], None, SiloDimensions.from_case(CASE),
                             SiloFieldOptions.from_config(FIELD_SECTION), STEADY_WINDOW, BULK_DENSITY)
 
 

@@ -104,8 +104,8 @@ RESULT = BlendingResult(
     vrr_square=VRRTable(period_over_tm=np.array([0.5]), period=np.array([1.0]), vrr=np.array([8.0]), t_mean=2.0,
                         waveform="square", n_periods=4),
 )
-CASE = {"run_id": "recirculation_ab12", "flow_pattern": "mass flow", "estimated_residence_time_s": 2.5,
-        "width_m": 0.2}
+#: What of the run's case the blending summary holds.
+RUN = {"run_id": "recirculation_ab12", "flow_pattern": "mass flow", "estimated_residence_time": 2.5}
 
 
 def assert_rows(rows, columns, expected):
@@ -219,7 +219,7 @@ def test_clumps_per_window_is_throughput_times_window():
 
 
 def test_blending_summary_holds_timing_rtds_and_every_layout():
-    summary = blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)
+    summary = blending_summary(RESULT, EULERIAN_RTD, 0.005, **RUN)
     half, top = summary.pop("layouts").values()
     # t_s / t_d = 5 / 11 with t_s and t_d both +- 1.25 s: (5 / 11) sqrt((1.25 / 1.25)^2 + (1.25 / 2.75)^2)
     ratio_error = (5.0 / 11.0) * math.sqrt(1.0 + (5.0 / 11.0) ** 2)
@@ -243,7 +243,7 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         # no Little's law on the transit clumps in this result: unknown, not zero
         **NO_TRANSIT,
     })
-    assert list(blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)["layouts"]) == ["bottom half", "top 25 %"]
+    assert list(blending_summary(RESULT, EULERIAN_RTD, 0.005, **RUN)["layouts"]) == ["bottom half", "top 25 %"]
     # RMS of (0.5 - 0.25, 0.75 - 0.75) over the two windows with data: sqrt(0.0625 / 2)
     np.testing.assert_equal(half, {
         "blue_fraction": 0.5, "sublayers": 1, "vrr_by_recirculation": [4.0, NAN], "vrr_predicted": [16.0, NAN],
@@ -285,7 +285,7 @@ TRACER_TRANSIT_MEAN = Estimate(1.1, 0.05, 30, "tracer sample", 29)
 
 def test_blending_summary_reports_littles_law_on_the_transit_clumps_beside_the_holdup_residence_time():
     result = dataclasses.replace(RESULT, transit=TRANSIT, tracer_transit_mean=TRACER_TRANSIT_MEAN)
-    summary = blending_summary(CASE, result, EULERIAN_RTD, 0.005)
+    summary = blending_summary(result, EULERIAN_RTD, 0.005, **RUN)
     transit_error = 1.2 * math.hypot(0.025, 0.04)
     expected = {
         "transit_horizon_s": 3.0, "transit_holdup_clumps": 12.0, "transit_holdup_clumps_error": 0.3,
@@ -305,24 +305,24 @@ def test_blending_summary_reports_littles_law_on_the_transit_clumps_beside_the_h
     # the holdup residence time (stagnant zones included) stays what it was
     assert summary["residence_time_s"] == 2.0
     # ... but not within one: 0.1 s > 0.0755 s
-    tight = blending_summary(CASE, result, EULERIAN_RTD, 0.005, k=1.0)
+    tight = blending_summary(result, EULERIAN_RTD, 0.005, **RUN, k=1.0)
     assert (tight["littles_law_significance"], tight["littles_law_coverage_factor"]) == ("significant", 1.0)
     wide_apart = dataclasses.replace(result, tracer_transit_mean=Estimate(0.8, 0.05, 30, "tracer sample", 29))
-    assert blending_summary(CASE, wide_apart, EULERIAN_RTD, 0.005)["littles_law_significance"] == "significant"
+    assert blending_summary(wide_apart, EULERIAN_RTD, 0.005, **RUN)["littles_law_significance"] == "significant"
 
 
 def test_blending_summary_flags_vrrs_at_the_ceiling_with_its_factor():
-    summary = blending_summary(CASE, with_throughput(8.0), EULERIAN_RTD, 0.005)
+    summary = blending_summary(with_throughput(8.0), EULERIAN_RTD, 0.005, **RUN)
     assert (summary["vrr_sampling_limit"], summary["vrr_ceiling_factor"]) == (8.0, 2.0)
     assert [layout["vrr_at_ceiling"] for layout in summary["layouts"].values()] == [[True, False], [False, False]]
-    summary = blending_summary(CASE, with_throughput(8.0), EULERIAN_RTD, 0.005, factor=8.0 / 3.0)
+    summary = blending_summary(with_throughput(8.0), EULERIAN_RTD, 0.005, **RUN, factor=8.0 / 3.0)
     assert summary["vrr_ceiling_factor"] == 8.0 / 3.0
     assert [layout["vrr_at_ceiling"] for layout in summary["layouts"].values()] == [[True, False], [True, False]]
 
 
 def test_blending_summary_and_tables_write_as_json_and_csv(tmp_path):
     loaded = json.loads(write_json(tmp_path / "blending.json",
-                                   blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)).read_text())
+                                   blending_summary(RESULT, EULERIAN_RTD, 0.005, **RUN)).read_text())
     # arrays become lists, NaN and inf become null
     assert loaded["layouts"]["bottom half"]["vrr_by_recirculation"] == [4.0, None]
     assert loaded["layouts"]["top 25 %"]["vrr_predicted"] == [None, None]
@@ -368,7 +368,7 @@ UNKNOWN_DIFFERENCE = {"mean_difference_s": None, "mean_difference_s_error": NAN,
 def test_verification_summary_names_bin_sizes_in_millimetres():
     # particles 1 and 3 s: mean 2 s, s = sqrt(2) s, error sqrt(2) / sqrt(2) = 1 s; 5 mm: 2 and 4 s, 3 +- 1 s.
     # The difference 1 s is within 2 x sqrt(1 + 1) s: the means agree.
-    summary = verification_summary(CASE, VERIFICATION)
+    summary = verification_summary(VERIFICATION, run_id=RUN["run_id"])
     np.testing.assert_equal(summary, {
         "run_id": "recirculation_ab12", "residence_time_s": 2.0, "residence_time_s_error": 0.125, "n_tracers": 3,
         "coverage_factor": 2.0,
@@ -389,13 +389,13 @@ def test_verification_summary_says_whether_each_bin_size_agrees_with_the_particl
         0.015: np.array([5.0, NAN]),  # one tracer out: no error, so the agreement is unknown
         0.02: np.array([5.0, 7.0]),  # 6 +- 1 s: 4 s away, more than 2 sqrt(2) s
     })
-    eulerian = verification_summary(CASE, verification)["eulerian"]
+    eulerian = verification_summary(verification, run_id=RUN["run_id"])["eulerian"]
     assert [(stats["mean_difference_significance"], stats["means_agree"]) for stats in eulerian.values()] == [
         ("not significant", True), ("significant", False), ("unknown", None), ("significant", False)]
     assert eulerian["10 mm"]["mean_difference_s"] == 4.0 and eulerian["10 mm"]["mean_difference_s_error"] == 1.0
     assert eulerian["15 mm"]["mean_difference_s"] == 3.0 and math.isnan(eulerian["15 mm"]["mean_difference_s_error"])
     # with k = 4: 20 mm's 4 s is within 4 sqrt(2) s, and 10 mm's 4 s is not more than 4 x 1 s
-    loose = verification_summary(CASE, verification, k=4.0)
+    loose = verification_summary(verification, run_id=RUN["run_id"], k=4.0)
     assert loose["coverage_factor"] == 4.0
     assert (loose["eulerian"]["20 mm"]["means_agree"], loose["eulerian"]["10 mm"]["means_agree"]) == (True, True)
     assert loose["eulerian"]["20 mm"]["mean_difference_s_error"] == math.sqrt(2.0)
@@ -464,7 +464,7 @@ def test_summary_rows_carry_the_errors_the_summary_holds():
 
 def test_summary_rows_of_a_written_summary_give_the_errors_blending_summary_computed(tmp_path):
     written = json.loads(write_json(tmp_path / "blending.json",
-                                    blending_summary(CASE, RESULT, EULERIAN_RTD, 0.005)).read_text())
+                                    blending_summary(RESULT, EULERIAN_RTD, 0.005, **RUN)).read_text())
     rows, _ = summary_rows([written])
     half = rows[0]
     assert (half["residence_time_s"], half["residence_time_s_error"]) == (2.0, 0.125)
@@ -475,7 +475,7 @@ def test_summary_rows_of_a_written_summary_give_the_errors_blending_summary_comp
     assert math.isnan(half["transit_residence_time_s"]) and math.isnan(half["rtd_mean_ids_transit_s_error"])
     result = dataclasses.replace(RESULT, transit=TRANSIT, tracer_transit_mean=TRACER_TRANSIT_MEAN)
     written = json.loads(write_json(tmp_path / "transit.json",
-                                    blending_summary(CASE, result, EULERIAN_RTD, 0.005)).read_text())
+                                    blending_summary(result, EULERIAN_RTD, 0.005, **RUN)).read_text())
     half = summary_rows([written])[0][0]
     assert (half["transit_residence_time_s"], half["transit_residence_time_s_error"]) == (
         1.2, 1.2 * math.hypot(0.025, 0.04))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from engines.config import REPO_ROOT, load_config
-from engines.estimates import RunEstimate
+from model.cost import RunEstimate
 from model.cases import REFERENCE, VARIANT
 from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
 from engines.planning import config_estimates, group_runs

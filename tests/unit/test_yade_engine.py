@@ -21,7 +21,7 @@ from model.cases.silo_recirculation import build_recirculation_case
 from engines.config import ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_named
 from engines.templating import UnsafeDeckValue, deck_string, render_deck
-from engines.estimates import MeasuredWork
+from model.cost import MeasuredWork
 from engines.yade.cost import measured_seconds_per_sphere_step, measured_work
 from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
 from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces

@@ -2,11 +2,41 @@
 # modes per configuration; a comparison of the configurations; gravity scaling when several factors are run.
 
 
+def blender_runs():
+    """Run ids of the blender runs (configurations x gravity factors)."""
+    return run_ids("blender")
+
+
+def blender_targets(wildcards=None, runs=None):
+    """The products of the blender's runs (``runs``: those of these run ids, without the comparisons across runs;
+    all with the comparisons when None)."""
+    chosen = among(blender_runs(), runs)
+    targets = [
+        run_path("blender", name, run)
+        for run in chosen
+        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png",
+                     "plots/insert_velocities.png", "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png",
+                     "plots/discontinuous.png", "plots/vrr_period.png")
+    ]
+    if runs is not None:
+        return targets
+    if chosen:
+        targets += [f"{case_root('blender')}/comparison/{name}"
+                    for name in ("configurations.csv", "significance.csv", "configurations.md", "configurations.png", "rtd.png")]
+    if len(config["blender"]["gravity_factors"]) > 1:
+        targets += [f"{case_root('blender')}/gravity/scaling.csv", f"{case_root('blender')}/gravity/scaling.png"]
+    return targets
+
+
+CASE_TARGETS["blender"] = blender_targets
+
+
 rule blender_deck:
     output:
         case=deck_rule_output("blender"),
     params:
-        case="blender",
+        kind="blender",
+        case=typed_case("blender"),
         defining=lambda wildcards: cases("blender")[wildcards.run].defining_parameters,
     # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
     # once its deck is written
@@ -23,7 +53,8 @@ rule blender_run:
     output:
         record=run_rule_output("blender"),
     params:
-        case="blender",
+        kind="blender",
+        case=typed_case("blender"),
         engine=config["engine"],
     resources:
         tasks=config["engine"]["mpi_ranks"],
@@ -39,14 +70,15 @@ rule blender_run:
 
 rule blender_fields:
     input:
-        record=rules.blender_run.output.record,
         case=rules.blender_deck.output.case,
+        record=rules.blender_run.output.record,
     output:
         fields=f"{run_dir('blender')}/fields/fields.npz",
         flow=f"{run_dir('blender')}/metrics/flow.json",
         # each frame of the steady window: the series whose batch means give the passage velocities' errors
         frames=f"{run_dir('blender')}/fields/steady_frames.npz",
     params:
+        case=typed_case("blender"),
         bin_size=config["blender"]["bin_size"],
         on_damaged=config["dumps"]["on_damaged"],
     log:
@@ -75,6 +107,7 @@ rule blender_analysis:
         discontinuous_plot=report(f"{run_dir('blender')}/plots/discontinuous.png", caption="../report/blender_discontinuous.rst", category="4 Blender", subcategory="{run}", labels={"figure": "discontinuous"}),
         vrr_plot=report(f"{run_dir('blender')}/plots/vrr_period.png", caption="../report/blender_vrr.rst", category="4 Blender", subcategory="{run}", labels={"figure": "VRR vs period"}),
     params:
+        case=typed_case("blender"),
         blender=lambda wildcards: {key: config["blender"][key] for key in (
             "bin_size", "fill_height", "profile_heights_above", "pathlines", "rtd", "discontinuous", "continuous")},
     log:

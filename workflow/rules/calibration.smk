@@ -62,7 +62,12 @@ def diagnostic_targets(runs=None):
     return [run_path("jenike", f"plots/{name}.png", run) for run in chosen for name in ("mobilised_friction", "angular_velocity")]
 
 
-def calibration_targets():
+def calibration_targets(wildcards=None, runs=None):
+    """The calibration's products: of ``runs`` (Jenike run ids) on their own, or of every run with the table, the
+    charts, the chosen parameters and the lid comparison."""
+    if runs is not None:
+        return [*(run_path("jenike", name, run) for run in runs
+                  for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")), *diagnostic_targets(runs)]
     return [
         *diagnostic_targets(),
         f"{CALIBRATION_DIR}/bulk_friction.csv",
@@ -73,11 +78,15 @@ def calibration_targets():
     ]
 
 
+CASE_TARGETS["jenike"] = calibration_targets
+
+
 rule jenike_deck:
     output:
         case=deck_rule_output("jenike"),
     params:
-        case="jenike",
+        kind="jenike",
+        case=typed_case("jenike"),
         defining=lambda wildcards: JENIKE_CASES[wildcards.run].defining_parameters,
     log:
         run_path("jenike", "logs/deck.log"),
@@ -91,7 +100,8 @@ rule jenike_run:
     output:
         record=run_rule_output("jenike"),
     params:
-        case="jenike",
+        kind="jenike",
+        case=typed_case("jenike"),
         engine=config["engine"],
     resources:
         tasks=config["engine"]["mpi_ranks"],
@@ -182,12 +192,14 @@ rule lid_comparison:
 
 rule jenike_diagnostics:
     input:
-        record=rules.jenike_run.output.record,
         case=rules.jenike_deck.output.case,
+        record=rules.jenike_run.output.record,
     output:
         friction=report(run_path("jenike", "plots/mobilised_friction.png"), caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
         rotation=report(run_path("jenike", "plots/angular_velocity.png"), caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
         summary=run_path("jenike", "metrics/diagnostics.json"),
+    params:
+        case=typed_case("jenike"),
     log:
         run_path("jenike", "logs/diagnostics.log"),
     script:

@@ -9,7 +9,8 @@ sys.path.insert(0, workflow.basedir)
 
 from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
 from calibration.parameters import calibrated_config
-from model.cases import CASE_BUILDERS, cases_of
+from model.cases import cases_of
+from model.cases.kinds import CASE_KINDS
 from model.cases.silo_flat import build_silo_case, parametric_variants
 from model.cases.silo_recirculation import SECTION as RECIRCULATION
 from engines.preflight import PreflightError, preflight
@@ -45,11 +46,34 @@ ESTIMATES = PREFLIGHT.estimates
 RUN_PRIORITY = run_priorities(ESTIMATES)
 
 
+#: Each case kind's products, ``{kind: targets(wildcards=None, runs=None)}``: its rule file adds its own. With ``runs``
+#: (run ids) the products of those runs on their own; without, of every run and the analyses across them.
+CASE_TARGETS = {}
+
+
+#: The flat-bottom silo's runs with calibrated parameters, built once per version of the calibration's choice.
+_CALIBRATED_CASES = {}
+
+
 def cases(kind):
-    """The runs of case ``kind``: the flat-bottom silo's with calibrated parameters applied when asked for."""
+    """The runs of case ``kind``: the flat-bottom silo's with calibrated parameters applied when asked for (the only
+    place they are applied)."""
     if kind == "silo_flat" and uses_calibrated_parameters():
-        return cases_of(silo_config(), kind)
+        path = calibrated_parameters_file()
+        version = (path, Path(path).stat().st_mtime_ns)
+        if version not in _CALIBRATED_CASES:
+            _CALIBRATED_CASES[version] = cases_of(silo_config(), kind)
+        return _CALIBRATED_CASES[version]
     return CASES[kind]
+
+
+def typed_case(kind):
+    """A deck or run job's case, as built when the workflow was parsed: the job builds none. Snakemake hands it to
+    the script as it is; it stays out of the rerun check (Snakemake compares only plain values), where the run id and
+    the ``defining`` parameters stand for it."""
+    def case(wildcards):
+        return cases(kind)[wildcards.run]
+    return case
 
 
 def check_disk_for_pending_runs():
@@ -86,118 +110,13 @@ def run_ids(kind):
     return list(cases(kind))
 
 
-def silo_flat_targets(wildcards=None, runs=None):
-    """The products of the flat-bottom silo's runs (``runs``: its run ids, all when None)."""
-    return [
-        run_path("silo_flat", name, run)
-        for run in (run_ids("silo_flat") if runs is None else runs)
-        for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
-                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names(),
-                     *piv_names())
-    ]
-
-
-def piv_names():
-    names = []
-    if config["silo_flat"]["piv"]["enabled"]:
-        names += ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
-    if MEASURED_PIV_FILES:
-        names += ["metrics/piv_comparison.csv", "plots/piv_comparison.png"]
-    return names
-
-
-def measured_comparison_names():
-    if config["silo_flat"]["fields"]["measured_profiles"] is None:
-        return []
-    return ["metrics/measured_comparison.csv", "plots/measured_comparison.png"]
-
-
-def parametric_studies():
-    """``{study: [(label, run id), ...]}`` of the configured parametric silo studies, base run first."""
-    base = silo_config()
-    base_run = build_silo_case(base).run_id
-    return {
-        study: [("base", base_run)] + [(label, build_silo_case(variant).run_id) for label, variant in runs]
-        for study, runs in parametric_variants(base).items()
-    }
-
-
-def parametric_targets(wildcards=None):
-    return [
-        f"{case_root('silo_flat')}/parametric/{study}.{ext}" for study in parametric_studies() for ext in ("csv", "png")
-    ]
-
-
-def recirculation_runs(role="blending"):
-    """Run ids of the recirculating-silo runs with the given role (the blending study or the thin verification silo)."""
-    return [run for run, case in cases(RECIRCULATION).items() if case.role == role]
-
-
-def shortcut_measured():
-    """Whether the blending runs go on past where the study's shortcut stops, so that it can be measured on them."""
-    blending = config[RECIRCULATION]
-    return blending["recirculations"] > blending["tracer"]["start_recirculations"] + blending["shortcut"]["residence_times"]
-
-
 def among(found, runs):
     """The run ids of ``found`` that are in ``runs`` (all of them when ``runs`` is None), in ``found``'s order."""
     return list(found) if runs is None else [run for run in found if run in runs]
 
 
-def recirculation_targets(wildcards=None, runs=None):
-    """The products of the recirculating silo's runs (``runs``: those of these run ids, without the summary across
-    runs; all with the summary when None)."""
-    blending = among(recirculation_runs(), runs)
-    targets = [
-        run_path(RECIRCULATION, name, run)
-        for run in blending
-        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png",
-                     "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
-                     "plots/snapshots")
-    ]
-    if shortcut_measured():
-        targets += [run_path(RECIRCULATION, name, run) for run in blending for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
-    if runs is None and blending:
-        targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
-    verification = among(recirculation_runs("verification"), runs)
-    targets += [
-        run_path(RECIRCULATION, f"verification/{name}", run)
-        for run in verification
-        for name in ("verification.json", "paths.png", "residence_times.png")
-    ]
-    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in verification]
-    return targets
-
-
-def blender_runs():
-    """Run ids of the blender runs (configurations x gravity factors)."""
-    return run_ids("blender")
-
-
-def blender_targets(wildcards=None, runs=None):
-    """The products of the blender's runs (``runs``: those of these run ids, without the comparisons across runs;
-    all with the comparisons when None)."""
-    chosen = among(blender_runs(), runs)
-    targets = [
-        run_path("blender", name, run)
-        for run in chosen
-        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png",
-                     "plots/insert_velocities.png", "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png",
-                     "plots/discontinuous.png", "plots/vrr_period.png")
-    ]
-    if runs is not None:
-        return targets
-    if chosen:
-        targets += [f"{case_root('blender')}/comparison/{name}"
-                    for name in ("configurations.csv", "significance.csv", "configurations.md", "configurations.png", "rtd.png")]
-    if len(config["blender"]["gravity_factors"]) > 1:
-        targets += [f"{case_root('blender')}/gravity/scaling.csv", f"{case_root('blender')}/gravity/scaling.png"]
-    return targets
-
-
 def print_result_locations():
-    for path in [*calibration_targets(), *silo_flat_targets(), *existing_runs_targets(), *parametric_targets(),
-                 *recirculation_targets(), *blender_targets()]:
+    for path in [*(path for targets in CASE_TARGETS.values() for path in targets()), *existing_runs_targets()]:
         print(f"siloflow result: {Path(path).resolve()}")
 
 

@@ -3,7 +3,8 @@
 # against the weight. A fill that is not at rest, or whose planes carry more than the weight above, stops the
 # pipeline here with a message that says so.
 
-FILL_BALANCE_CASES = ("jenike", "silo_flat", RECIRCULATION, "blender")
+#: The case kinds whose registry entry asks for the balance.
+FILL_BALANCE_CASES = tuple(name for name, kind in CASE_KINDS.items() if kind.fill_balance)
 
 
 def fill_balance_params(kind):

@@ -4,13 +4,64 @@ wildcard_constraints:
     run="[A-Za-z0-9_.-]+",
 
 
+def silo_flat_targets(wildcards=None, runs=None):
+    """The products of the flat-bottom silo's runs (``runs``: its run ids, all when None)."""
+    return [
+        run_path("silo_flat", name, run)
+        for run in (run_ids("silo_flat") if runs is None else runs)
+        for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
+                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names(),
+                     *piv_names())
+    ]
+
+
+def piv_names():
+    names = []
+    if config["silo_flat"]["piv"]["enabled"]:
+        names += ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
+    if MEASURED_PIV_FILES:
+        names += ["metrics/piv_comparison.csv", "plots/piv_comparison.png"]
+    return names
+
+
+def measured_comparison_names():
+    if config["silo_flat"]["fields"]["measured_profiles"] is None:
+        return []
+    return ["metrics/measured_comparison.csv", "plots/measured_comparison.png"]
+
+
+def parametric_studies():
+    """``{study: [(label, run id), ...]}`` of the configured parametric silo studies, base run first."""
+    base = silo_config()
+    base_run = build_silo_case(base).run_id
+    return {
+        study: [("base", base_run)] + [(label, build_silo_case(variant).run_id) for label, variant in runs]
+        for study, runs in parametric_variants(base).items()
+    }
+
+
+def parametric_targets(wildcards=None):
+    return [
+        f"{case_root('silo_flat')}/parametric/{study}.{ext}" for study in parametric_studies() for ext in ("csv", "png")
+    ]
+
+
+def silo_flat_products(wildcards=None, runs=None):
+    """The flat-bottom silo's products: its runs' (``runs``: these run ids only), with the parametric studies when all."""
+    return silo_flat_targets(runs=runs) + (parametric_targets() if runs is None else [])
+
+
+CASE_TARGETS["silo_flat"] = silo_flat_products
+
+
 rule silo_deck:
     input:
         parameters=calibrated_parameters_file,
     output:
         case=deck_rule_output("silo_flat"),
     params:
-        case="silo_flat",
+        kind="silo_flat",
+        case=typed_case("silo_flat"),
         defining=lambda wildcards: cases("silo_flat")[wildcards.run].defining_parameters,
     # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
     # once its deck is written
@@ -28,7 +79,8 @@ rule silo_run:
     output:
         record=run_rule_output("silo_flat"),
     params:
-        case="silo_flat",
+        kind="silo_flat",
+        case=typed_case("silo_flat"),
         engine=config["engine"],
     resources:
         tasks=config["engine"]["mpi_ranks"],
@@ -44,14 +96,15 @@ rule silo_run:
 
 rule silo_metrics:
     input:
-        record=rules.silo_run.output.record,
         case=rules.silo_deck.output.case,
+        record=rules.silo_run.output.record,
     output:
         table=f"{run_dir('silo_flat')}/metrics/flow.csv",
         history=f"{run_dir('silo_flat')}/metrics/discharge.csv",
         summary=f"{run_dir('silo_flat')}/metrics/flow.json",
         plot=report(f"{run_dir('silo_flat')}/plots/discharge.png", caption="../report/silo_discharge.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "discharge"}),
     params:
+        case=typed_case("silo_flat"),
         analysis=lambda wildcards: {
             "steady_window": config["silo_flat"]["steady_window"],
             "beverloo": config["silo_flat"]["beverloo"],
@@ -65,8 +118,8 @@ rule silo_metrics:
 
 rule silo_fields:
     input:
-        record=rules.silo_run.output.record,
         case=rules.silo_deck.output.case,
+        record=rules.silo_run.output.record,
         flow=rules.silo_metrics.output.summary,
     output:
         pvd=f"{run_dir('silo_flat')}/fields/fields.pvd",
@@ -86,6 +139,7 @@ rule silo_fields:
         janssen_plot=report(f"{run_dir('silo_flat')}/plots/janssen.png", caption="../report/silo_janssen.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "Janssen"}),
         force_chain_plot=report(f"{run_dir('silo_flat')}/plots/force_chains.png", caption="../report/silo_force_chains.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "force chains"}),
     params:
+        case=typed_case("silo_flat"),
         settings=lambda wildcards: config["silo_flat"]["fields"],
         on_damaged=config["dumps"]["on_damaged"],
     log:
@@ -96,13 +150,14 @@ rule silo_fields:
 
 rule silo_piv_synthetic:
     input:
-        record=rules.silo_run.output.record,
         case=rules.silo_deck.output.case,
+        record=rules.silo_run.output.record,
     output:
         table=f"{run_dir('silo_flat')}/metrics/piv_accuracy.csv",
         profiles=f"{run_dir('silo_flat')}/metrics/piv_accuracy_profiles.csv",
         plot=report(f"{run_dir('silo_flat')}/plots/piv_accuracy.png", caption="../report/silo_piv_accuracy.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV accuracy"}),
     params:
+        case=typed_case("silo_flat"),
         piv=config["silo_flat"]["piv"],
         heights=config["silo_flat"]["fields"]["profile_heights"],
         on_damaged=config["dumps"]["on_damaged"],
@@ -114,14 +169,15 @@ rule silo_piv_synthetic:
 
 rule silo_piv_compare:
     input:
-        record=rules.silo_run.output.record,
         case=rules.silo_deck.output.case,
+        record=rules.silo_run.output.record,
         profiles=rules.silo_piv_synthetic.output.profiles,
         measured=lambda wildcards: [str(p) for p in MEASURED_PIV_FILES],
     output:
         table=f"{run_dir('silo_flat')}/metrics/piv_comparison.csv",
         plot=report(f"{run_dir('silo_flat')}/plots/piv_comparison.png", caption="../report/silo_piv_comparison.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV comparison"}),
     params:
+        case=typed_case("silo_flat"),
         piv=config["silo_flat"]["piv"],
         heights=config["silo_flat"]["fields"]["profile_heights"],
         on_damaged=config["dumps"]["on_damaged"],

@@ -2,11 +2,51 @@
 # RTDs and LTI predictions per flow pattern; the one-particle-thick verification of the Eulerian RTD; a summary.
 
 
+def recirculation_runs(role="blending"):
+    """Run ids of the recirculating-silo runs with the given role (the blending study or the thin verification silo)."""
+    return [run for run, case in cases(RECIRCULATION).items() if case.role == role]
+
+
+def shortcut_measured():
+    """Whether the blending runs go on past where the study's shortcut stops, so that it can be measured on them."""
+    blending = config[RECIRCULATION]
+    return blending["recirculations"] > blending["tracer"]["start_recirculations"] + blending["shortcut"]["residence_times"]
+
+
+def recirculation_targets(wildcards=None, runs=None):
+    """The products of the recirculating silo's runs (``runs``: those of these run ids, without the summary across
+    runs; all with the summary when None)."""
+    blending = among(recirculation_runs(), runs)
+    targets = [
+        run_path(RECIRCULATION, name, run)
+        for run in blending
+        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png",
+                     "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
+                     "plots/snapshots")
+    ]
+    if shortcut_measured():
+        targets += [run_path(RECIRCULATION, name, run) for run in blending for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
+    if runs is None and blending:
+        targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
+    verification = among(recirculation_runs("verification"), runs)
+    targets += [
+        run_path(RECIRCULATION, f"verification/{name}", run)
+        for run in verification
+        for name in ("verification.json", "paths.png", "residence_times.png")
+    ]
+    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in verification]
+    return targets
+
+
+CASE_TARGETS[RECIRCULATION] = recirculation_targets
+
+
 rule silo_recirculation_deck:
     output:
         case=deck_rule_output(RECIRCULATION),
     params:
-        case=RECIRCULATION,
+        kind=RECIRCULATION,
+        case=typed_case(RECIRCULATION),
         defining=lambda wildcards: cases(RECIRCULATION)[wildcards.run].defining_parameters,
     # as the run it feeds: Snakemake does not pass a priority on to a job's inputs, and the run can only start
     # once its deck is written
@@ -23,7 +63,8 @@ rule silo_recirculation_run:
     output:
         record=run_rule_output(RECIRCULATION),
     params:
-        case=RECIRCULATION,
+        kind=RECIRCULATION,
+        case=typed_case(RECIRCULATION),
         engine=config["engine"],
     resources:
         tasks=config["engine"]["mpi_ranks"],
@@ -53,8 +94,8 @@ rule silo_recirculation_tracks:
 
 rule silo_recirculation_analysis:
     input:
-        tracks=rules.silo_recirculation_tracks.output.tracks,
         case=rules.silo_recirculation_deck.output.case,
+        tracks=rules.silo_recirculation_tracks.output.tracks,
     output:
         summary=f"{run_dir(RECIRCULATION)}/metrics/blending.json",
         concentration=f"{run_dir(RECIRCULATION)}/metrics/concentration.csv",
@@ -73,6 +114,7 @@ rule silo_recirculation_analysis:
                          labels={"figure": "snapshots {layout}"}),
         per_layout=directory(f"{run_dir(RECIRCULATION)}/plots/layouts"),
     params:
+        case=typed_case(RECIRCULATION),
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
                                     ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
                                      "eulerian", "snapshots", "bulk_density_slab")},
@@ -84,12 +126,13 @@ rule silo_recirculation_analysis:
 
 rule silo_recirculation_shortcut:
     input:
-        tracks=rules.silo_recirculation_tracks.output.tracks,
         case=rules.silo_recirculation_deck.output.case,
+        tracks=rules.silo_recirculation_tracks.output.tracks,
     output:
         table=report(f"{run_dir(RECIRCULATION)}/metrics/shortcut.csv", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut table"}),
         plot=report(f"{run_dir(RECIRCULATION)}/plots/shortcut.png", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut"}),
     params:
+        case=typed_case(RECIRCULATION),
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
                                     ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
                                      "shortcut")},
@@ -101,14 +144,15 @@ rule silo_recirculation_shortcut:
 
 rule silo_recirculation_verification:
     input:
-        tracks=rules.silo_recirculation_tracks.output.tracks,
         case=rules.silo_recirculation_deck.output.case,
+        tracks=rules.silo_recirculation_tracks.output.tracks,
     output:
         table=f"{run_dir(RECIRCULATION)}/verification/residence_times.csv",
         summary=f"{run_dir(RECIRCULATION)}/verification/verification.json",
         paths_plot=report(f"{run_dir(RECIRCULATION)}/verification/paths.png", caption="../report/silo_recirculation_paths.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "paths"}),
         residence_plot=report(f"{run_dir(RECIRCULATION)}/verification/residence_times.png", caption="../report/silo_recirculation_residence.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "residence times"}),
     params:
+        case=typed_case(RECIRCULATION),
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in ("verification", "tracer", "eulerian")},
     log:
         f"{run_dir(RECIRCULATION)}/logs/verification.log",

@@ -140,14 +140,7 @@ rule validation_table:
 # of its runs only (the Makefile then writes the group's record once its last run has finished).
 def run_targets(kind, runs):
     """The products of each of ``runs`` of case ``kind`` on its own (the products across runs come with the record)."""
-    if kind == "jenike":
-        return [*(run_path("jenike", name, run) for run in runs
-                  for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")), *diagnostic_targets(runs)]
-    if kind == "silo_flat":
-        return silo_flat_targets(runs=runs)
-    if kind == RECIRCULATION:
-        return recirculation_targets(runs=runs)
-    return blender_targets(runs=runs)
+    return CASE_TARGETS[kind](runs=runs)
 
 
 def group_targets(group):
@@ -160,7 +153,7 @@ def group_targets(group):
         return [*run_targets("jenike", made), *record_plots(group).values(), *parameters]
     if spec.kind == "silo_flat":
         return [*run_targets("silo_flat", made), *(parametric_targets() if made and spec.makes(spec.kind, VARIANT) else [])]
-    return recirculation_targets() if spec.kind == RECIRCULATION else blender_targets()
+    return CASE_TARGETS[spec.kind]()
 
 #: Each group's parts, from the configuration's own cost estimates (engines.validation_groups.split).
 PARTS = split_groups(planned_group_runs(config, ESTIMATES))

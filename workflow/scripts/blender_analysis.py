@@ -25,27 +25,31 @@ from analysis.studies.blender.tables import (
     vrr_period_rows,
 )
 from analysis.io.tables import write_flow_table, write_json
-from model.cases import case_for_run
-from model.cases.blender_passages import annulus_bounds
+from model.cases.blender_passages import annulus_bounds, geometry_summary
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     blender = snakemake.params.blender
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     flow = json.loads(Path(snakemake.input.flow).read_text())
-    geometry = case_for_run(snakemake.config, "blender", case["run_id"]).geometry
+    geometry = case.geometry
+    # the insert's key levels as the case summary states them, for the profile heights and blender.json
+    insert = geometry_summary(geometry)
     steady, windows = read_planar_fields(snakemake.input.fields)
     settings = BlenderSettings.from_config(blender)
-    heights = key_heights(case["geometry"], blender["bin_size"], blender["fill_height"], blender["profile_heights_above"])
+    heights = key_heights(insert, blender["bin_size"], blender["fill_height"], blender["profile_heights_above"])
     window_times = [0.5 * (w.window[0] + w.window[1]) - windows[0].window[0] for w in windows]
     study = analyse_blender(BlenderField.from_planar(steady), [BlenderField.from_planar(w) for w in windows],
                             window_times, heights, partial(annulus_bounds, geometry), geometry.wall_x, settings)
-    name = f"{case['configuration']} ({case['gravity_factor']:g} g)"
-    rate = steady_flow_rate_estimate(flow["time_since_open_s"], flow["discharged_mass_kg"], tuple(case["steady_window"]))
+    name = f"{case.configuration} ({case.gravity_factor:g} g)"
+    rate = steady_flow_rate_estimate(flow["time_since_open_s"], flow["discharged_mass_kg"], case.steady_window)
     frames = [BlenderField.from_planar(frame) for frame in read_frame_fields(snakemake.input.frames)]
-    metrics = study_metrics(case["configuration"], study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions,
+    metrics = study_metrics(case.configuration, study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions,
                             mass_flow_rate_error=rate.std_error, frames=frames, resolution=settings.integration_step)
-    write_json(snakemake.output.summary, blender_summary(case, flow, study, metrics))
+    write_json(snakemake.output.summary, blender_summary(
+        flow, study, metrics, run_id=case.run_id, configuration=case.configuration,
+        gravity_factor=case.gravity_factor, geometry=insert, mode=case.mode, n_clumps=case.silo.fill.n_clumps,
+        steady_window=case.steady_window))
     write_flow_table(snakemake.output.profiles, profile_rows(study.profiles))
     write_flow_table(snakemake.output.residence, residence_rows(study.pathlines))
     write_flow_table(snakemake.output.rtd, rtd_rows(study.rtd.rtd))
@@ -64,7 +68,7 @@ with logged_to(snakemake.log[0]) as log:
     plot_continuous_mode({name: study.continuous}, snakemake.output.vrr_plot, f"Continuous mode, sine inputs: {name}")
     log.info("%s: flow %.4g +- %.2g kg/s (batch rate of %d batches); exterior/interior/tube v_z %.3g/%.3g/%.3g "
              "+- %.2g/%.2g/%.2g m/s (batch means of %d frames); RTD t_m %.3g +- %.2g s, sigma/t_m %.3g +- %.2g, "
-             "t_s/t_d %.3g +- %.2g; homogenised after %.3g passes; VRR %s +- %s (ceiling %.4g)", case["run_id"],
+             "t_s/t_d %.3g +- %.2g; homogenised after %.3g passes; VRR %s +- %s (ceiling %.4g)", case.run_id,
              metrics.mass_flow_rate, metrics.mass_flow_rate_error, rate.n, metrics.exterior_v_z, metrics.interior_v_z,
              metrics.tube_v_z, metrics.exterior_v_z_error, metrics.interior_v_z_error, metrics.tube_v_z_error,
              len(frames), metrics.rtd_mean, metrics.rtd_mean_error, metrics.rtd_spread, metrics.rtd_spread_error,

@@ -2,7 +2,6 @@
 series whose batch means give the errors of the steady passage velocities) and the discharge rate of one blender
 run."""
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -25,35 +24,36 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
+    silo = case.silo
     frames = engine_named(record.engine).read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
     recorded = recirculation_tracks(frames, record.domain_z)
     tracks = recorded.tracks
     since_open = tracks.times - record.open_time_s
-    grid = silo_bins(case["width_m"], case["depth_m"], case["fill_height_m"], snakemake.params.bin_size)
-    density = case["clump_mass_kg"] / case["clump_volume_m3"]
-    steady_window = tuple(case["steady_window"])
+    grid = silo_bins(silo.width, silo.depth, silo.fill_height, snakemake.params.bin_size)
+    density = silo.particle.mass / silo.particle.volume
+    steady_window = case.steady_window
 
     def averaged(window):
         return window_average_field(tracks.position, recorded.velocity, recorded.mass, since_open, grid, window, density)
 
     steady = averaged(steady_window)
-    edges = np.linspace(0.0, steady_window[1], case["profile_windows"] + 1)
+    edges = np.linspace(0.0, steady_window[1], case.profile_windows + 1)
     windows = [averaged((start, end)) for start, end in zip(edges[:-1], edges[1:])]
     write_planar_fields(snakemake.output.fields, steady, windows)
     steady_frames = frame_fields(tracks.position, recorded.velocity, recorded.mass, since_open, grid, steady_window,
                                  density)
     write_frame_fields(snakemake.output.frames, steady_frames)
 
-    time, discharged = discharged_mass_history(tracks, recorded.mass, case["mode"], case["outlet_z"], case["domain_z"])
+    time, discharged = discharged_mass_history(tracks, recorded.mass, case.mode, case.outlet_z, case.domain_z)
     fit = steady_flow_rate(time - record.open_time_s, discharged, window=steady_window)
     write_json(snakemake.output.flow, {
-        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
-        "mode": case["mode"], "n_clumps": case["n_clumps"], "mass_flow_rate_kg_s": fit.mass_flow_rate,
+        "run_id": case.run_id, "configuration": case.configuration, "gravity_factor": case.gravity_factor,
+        "mode": case.mode, "n_clumps": silo.fill.n_clumps, "mass_flow_rate_kg_s": fit.mass_flow_rate,
         "mass_flow_rate_standard_error_kg_s": fit.standard_error, "steady_window_s": list(steady_window),
         "time_since_open_s": (time - record.open_time_s).tolist(), "discharged_mass_kg": discharged.tolist(),
-        "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case["outlet_z"]).tolist(),
+        "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case.outlet_z).tolist(),
     })
     log.info("%s: %d frames, steady window %s s (%d frames, %d frame fields), mass flow rate %.5g +- %.2g kg/s",
-             case["run_id"], tracks.n_times, steady_window, steady.n_frames, len(steady_frames), fit.mass_flow_rate,
+             case.run_id, tracks.n_times, steady_window, steady.n_frames, len(steady_frames), fit.mass_flow_rate,
              fit.standard_error)

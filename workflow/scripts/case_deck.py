@@ -1,11 +1,10 @@
-"""Snakemake adapter: the engine inputs of one run of any case (deck/case.json written last)."""
+"""Snakemake adapter: the engine inputs of one run of any case (deck/case.json written last), from the case the
+workflow built."""
 
 from pathlib import Path
 
-from calibration.parameters import case_config
 from engines.logs import logged_to
 from engines.runs import render_run
 
 with logged_to(snakemake.log[0]):
-    config = case_config(snakemake.config, snakemake.params.case, snakemake.input.get("parameters"))
-    render_run(config, snakemake.params.case, snakemake.wildcards.run, Path(snakemake.output.case).parent.parent)
+    render_run(snakemake.config, snakemake.params.kind, snakemake.params.case, Path(snakemake.output.case).parent.parent)

@@ -1,6 +1,5 @@
 """Snakemake adapter: polar diagrams of wall friction mobilisation and particle rotation of one shear test."""
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +15,9 @@ with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
     engine = engine_named(record.engine)
-    case = json.loads(Path(snakemake.input.case).read_text())
-    shear_plane = case["geometry"]["shear_plane"]
-    band = 2.0 * case["clump_volume_m3"] ** (1.0 / 3.0)  # about one clump size either side of the plane
+    case = snakemake.params.case
+    shear_plane = case.geometry.shear_plane
+    band = 2.0 * case.particle.volume ** (1.0 / 3.0)  # about one clump size either side of the plane
 
     # The last snapshots of the shear stage.
     snapshots = engine.contacts(run_dir, record, "wall")

@@ -20,9 +20,9 @@ with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
     engine = engine_named(record.engine)
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     flow = json.loads(Path(snakemake.input.flow).read_text())
-    silo = SiloDimensions.from_case_summary(case)
+    silo = SiloDimensions.from_case(case)
     options = SiloFieldOptions.from_config(snakemake.params.settings)
     frames = [clumps_from_frame(frame) for frame in
               engine.read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
@@ -36,7 +36,7 @@ with logged_to(snakemake.log[0]) as log:
     log.info("grid %s cells of %s m, %d frames", study.grid.shape, study.grid.spacing, len(study.fields))
 
     fields_dir = write_silo_field_study(snakemake.output, study, options.vtk_every, flow["mass_flow_rate_kg_s"],
-                                        silo.width, silo.outlet_width, case["run_id"])
+                                        silo.width, silo.outlet_width, case.run_id)
     # What needs the settled fill's contacts: its contact stress (ParaView, beside the time series), Janssen, chains.
     write_fields_vti(fields_dir / "settled_stress.vti", study.grid, study.fields[0], time=0.0,
                      extra_arrays={"contact_stress": study.stress})

@@ -1,6 +1,5 @@
 """Snakemake adapter: flow metrics, tables and the discharge plot of one flat-bottom silo run."""
 
-import json
 from pathlib import Path
 
 from model.frames import clumps_from_frame
@@ -14,7 +13,7 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     analysis = snakemake.params.analysis
     beverloo = analysis["beverloo"]
 
@@ -24,20 +23,20 @@ with logged_to(snakemake.log[0]) as log:
 
     metrics = silo_flow_metrics(
         discharge,
-        width=case["width_m"],
-        depth=case["depth_m"],
-        outlet_width=case["outlet_width_m"],
-        particle_diameter=beverloo["particle_diameter"] or case["equivalent_diameter_m"],
+        width=case.width,
+        depth=case.depth,
+        outlet_width=case.outlet_width,
+        particle_diameter=beverloo["particle_diameter"] or case.particle.equivalent_diameter,
         steady_window=tuple(analysis["steady_window"]),
         discharge_coefficient=beverloo["discharge_coefficient"],
         shape_coefficient=beverloo["shape_coefficient"],
     )
-    row = flow_table_row(case["run_id"], case["particle_model"], case["n_clumps"], metrics)
+    row = flow_table_row(case.run_id, case.particle.name, case.fill.n_clumps, metrics)
     write_flow_table(snakemake.output.table, [row])
     write_discharge_history_csv(snakemake.output.history, metrics.history)
     write_json(snakemake.output.summary, {**row, "beverloo": beverloo, "steady_window": analysis["steady_window"]})
     plot_discharge(metrics.history, metrics.fit, metrics.beverloo_rate, snakemake.output.plot,
-                   title=f"Flat-bottom silo {case['run_id']}", rate_error=metrics.mass_flow_rate_error)
+                   title=f"Flat-bottom silo {case.run_id}", rate_error=metrics.mass_flow_rate_error)
     log.info("mass flow rate %.4g +- %.2g kg/s (batch means; least-squares %.2g), Beverloo %.4g kg/s "
              "(ratio %.3f +- %.2g), bulk density %.1f +- %.2g kg/m3",
              metrics.fit.mass_flow_rate, metrics.mass_flow_rate_error, metrics.fit.standard_error,

@@ -1,6 +1,5 @@
 """Snakemake adapter: one flat-bottom silo run's front wall against the measured PIV sequence (table and plot)."""
 
-import json
 from pathlib import Path
 
 from model.record import read_run_record
@@ -15,14 +14,14 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     piv, measured = snakemake.params.piv, snakemake.params.piv["measured"]
     settings = measured_piv_settings(measured)
     fields = load_measured_piv(measured, settings, [Path(p) for p in snakemake.input.measured])
     frames = engine_named(record.engine).read_frames(run_dir, record, snakemake.params.on_damaged)
     rows, pairs = piv_comparison(
         frames, fields, read_table(snakemake.input.profiles), snakemake.params.heights, measured["windows"],
-        piv["band_diameters"] * case["equivalent_diameter_m"],
+        piv["band_diameters"] * case.particle.equivalent_diameter,
         settings.scale.scale if settings.scale is not None else measured["pixel_size"], settings.frame_rate,
         piv["fcb_fraction"], measured["min_valid_fraction"], record.open_time_s)
     write_flow_table(snakemake.output.table, rows)

@@ -1,6 +1,5 @@
 """Snakemake adapter: the synthetic PIV study of one silo run (table and plot)."""
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +14,7 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     piv = snakemake.params.piv
     frames = [f for f in engine_named(record.engine).read_frames(run_dir, record, snakemake.params.on_damaged)
               if f.step > record.open_step]
@@ -25,9 +24,9 @@ with logged_to(snakemake.log[0]) as log:
     spread = np.linspace(len(frames) // 4, 3 * len(frames) // 4, piv["frame_pairs"]).astype(int)
     chosen = [frames[i] for i in sorted(set(spread.tolist()))]
     settings = PivSettings(window_px=piv["window_px"], overlap_px=piv["overlap_px"], passes=piv["passes"],
-                           band=piv["band_diameters"] * case["equivalent_diameter_m"], blur_px=piv["blur_px"],
+                           band=piv["band_diameters"] * case.particle.equivalent_diameter, blur_px=piv["blur_px"],
                            noise=piv["noise"])
-    rows, profiles = accuracy_table(chosen, case["width_m"], piv["resolutions"], piv["frame_rates"], settings,
+    rows, profiles = accuracy_table(chosen, case.width, piv["resolutions"], piv["frame_rates"], settings,
                                     snakemake.params.heights, piv["fcb_fraction"])
     write_flow_table(snakemake.output.table, rows)
     write_flow_table(snakemake.output.profiles, profiles)

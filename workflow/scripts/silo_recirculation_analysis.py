@@ -1,6 +1,5 @@
 """Snakemake adapter: direct blending measurement, RTDs (particle ids and Eulerian) and LTI predictions of one run."""
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -36,10 +35,11 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     out = snakemake.output
     settings = snakemake.params.blending
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
+    silo = case.silo
     loaded = load_tracks(snakemake.input.tracks)
     tracks = loaded.tracks
-    bottom, top = case["domain_z"]
+    bottom, top = case.domain_z
     lti = settings["lti"]
     result = analyse_configured(tracks, bottom, top, settings)
     timing = result.timing
@@ -54,12 +54,12 @@ with logged_to(snakemake.log[0]) as log:
              tracer_transit.value, tracer_transit.std_error, transit.slow_holdup.value, transit.stagnant_clumps)
     eulerian = settings["eulerian"]
     eulerian_rtd = main_run_eulerian_rtd(
-        tracks, loaded.velocity, loaded.mass, result, case["width_m"], case["depth_m"], top, case["outlet_width_m"],
+        tracks, loaded.velocity, loaded.mass, result, silo.width, silo.depth, top, silo.outlet_width,
         eulerian["bin_size"], eulerian["integration_step"], eulerian["max_recirculations"],
         settings["tracer"]["bins"],
     )
     silo_rtd = result.rtd.silo
-    title = f"{case['flow_pattern']} ({case['run_id']})"
+    title = f"{case.pattern} ({case.run_id})"
 
     # --- tables
     write_flow_table(out.concentration, concentration_rows(result))
@@ -70,12 +70,14 @@ with logged_to(snakemake.log[0]) as log:
     write_flow_table(out.vrr_period, vrr_period_rows(result))
     low, high = settings["bulk_density_slab"]
     density = flowing_bulk_density(
-        tracks.times, tracks.position[:, :, 2], loaded.mass, case["width_m"], case["depth_m"],
-        (low * case["fill_height_m"], high * case["fill_height_m"]), tracks.times[0] + timing.residence_time,
+        tracks.times, tracks.position[:, :, 2], loaded.mass, silo.width, silo.depth,
+        (low * silo.fill_height, high * silo.fill_height), tracks.times[0] + timing.residence_time,
     )
     log.info("bulk density in the slab %s m: settled %.1f, flowing %.1f +- %.2g kg/m3, drop %.4f +- %.2g",
              density.slab, density.settled, density.flowing, density.flowing_error, density.drop, density.drop_error)
-    write_json(out.summary, {**blending_summary(case, result, eulerian_rtd, eulerian["bin_size"]), **density.summary()})
+    summary = blending_summary(result, eulerian_rtd, eulerian["bin_size"], run_id=case.run_id,
+                               flow_pattern=case.pattern, estimated_residence_time=case.estimated_residence_time)
+    write_json(out.summary, {**summary, **density.summary()})
 
     # --- plots
     plot_outlet_concentration(
@@ -122,7 +124,7 @@ with logged_to(snakemake.log[0]) as log:
              tracks.position[k, :, 2], layout.colours)
             for k in frames
         ]
-        plot_coloured_snapshots(snapshots, case["width_m"], case["outlet_width_m"], top, case["channel_length_m"],
+        plot_coloured_snapshots(snapshots, silo.width, silo.outlet_width, top, case.channel_length,
                                 Path(out.snapshots) / f"{name}.png", f"{name}, {title}")
         log.info("%s: VRR per recirculation %s, predicted %s, RMS(prediction - direct) %.3f, homogenised after Nr %s",
                  name, np.round(layout.vrr.vrr, 2).tolist(), np.round(layout.vrr_predicted.vrr, 2).tolist(),

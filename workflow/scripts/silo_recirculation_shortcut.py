@@ -1,9 +1,6 @@
 """Snakemake adapter: the study's shortcut (RTD from one residence time after the tracer is marked, LTI beyond)
 measured against the full analysis of one recirculation run."""
 
-import json
-from pathlib import Path
-
 from analysis.io.tables import write_flow_table
 from analysis.studies.silo_recirculation.rtd_plots import plot_vrr_versus_period
 from analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
@@ -14,9 +11,9 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     out = snakemake.output
     settings = snakemake.params.blending
-    case = json.loads(Path(snakemake.input.case).read_text())
+    case = snakemake.params.case
     tracks = load_tracks(snakemake.input.tracks).tracks
-    bottom, top = case["domain_z"]
+    bottom, top = case.domain_z
     tracer = settings["tracer"]
     # the full run again, without what the shortcut cannot have: a few seconds, and the analysis rule's product
     # (its tables) does not hold the arrays the comparison needs
@@ -40,5 +37,5 @@ with logged_to(snakemake.log[0]) as log:
         full.vrr_sine.period_over_tm,
         [(f"sine, full run (Nr {full.timing.recirculations:.1f})", full.vrr_sine.vrr),
          (f"sine, shortcut (Nr {short.timing.recirculations:.1f})", short.vrr_sine.vrr)],
-        out.plot, f"Shortcut vs full run, {case['flow_pattern']} ({case['run_id']})",
+        out.plot, f"Shortcut vs full run, {case.pattern} ({case.run_id})",
     )

@@ -42,14 +42,13 @@ __all__ = [
 GRAVITY_QUANTITIES = ("mass_flow_rate_kg_s", "exterior_v_z_m_s", "interior_v_z_m_s")
 
 
-def blender_summary(case: Mapping, flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics) -> dict:
+def blender_summary(flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics, *, run_id: str, configuration: str,
+                    gravity_factor: float, geometry: Mapping, mode: str, n_clumps: int,
+                    steady_window: Sequence[float]) -> dict:
     """The summary of one blender run (``blender.json``).
 
     Parameters
     ----------
-    case : mapping
-        The run's case record: ``run_id``, ``configuration``, ``gravity_factor`` [-], ``geometry`` (the insert
-        summary [m]), ``mode``, ``n_clumps`` [-] and ``steady_window`` ([start, end] [s]).
     flow : mapping
         The run's flow record: ``mass_flow_rate_standard_error_kg_s`` [kg/s] and the history
         ``time_since_open_s`` [s], ``discharged_mass_kg`` [kg], ``mean_v_z_m_s`` [m/s].
@@ -57,19 +56,34 @@ def blender_summary(case: Mapping, flow: Mapping, study: BlenderStudy, metrics: 
         The study of the run (:func:`analysis.studies.blender.study.analyse_blender`).
     metrics : BlenderMetrics
         Its figures of merit (:func:`analysis.studies.blender.study.study_metrics`).
+    run_id : str
+        The run's id.
+    configuration : str
+        Its insert configuration.
+    gravity_factor : float
+        Its gravity multiple [-].
+    geometry : mapping
+        The insert summary (:func:`model.cases.blender_passages.geometry_summary`) [m, degrees].
+    mode : str
+        ``"continuous"`` or ``"batch"``.
+    n_clumps : int
+        Clumps of the fill [-].
+    steady_window : sequence of float
+        (start, end) of the steady window after opening [s].
 
     Returns
     -------
     dict
-        The case keys, ``mass_flow_rate_standard_error_kg_s``, the keys of
+        ``run_id``, ``configuration``, ``gravity_factor``, ``geometry``, ``mode``, ``n_clumps``,
+        ``steady_window_s`` (a list), ``mass_flow_rate_standard_error_kg_s``, the keys of
         :func:`~analysis.studies.blender.study.study_summary`, ``rtd_curve`` (the RTD as
         :func:`~analysis.studies.blender.study.rtd_summary`, which
         :func:`~analysis.studies.blender.study.rtd_from_summary` reads back) and ``flow_history``.
     """
     return {
-        "run_id": case["run_id"], "configuration": case["configuration"], "gravity_factor": case["gravity_factor"],
-        "geometry": case["geometry"], "mode": case["mode"], "n_clumps": case["n_clumps"],
-        "steady_window_s": case["steady_window"], "mass_flow_rate_standard_error_kg_s":
+        "run_id": run_id, "configuration": configuration, "gravity_factor": gravity_factor,
+        "geometry": geometry, "mode": mode, "n_clumps": n_clumps,
+        "steady_window_s": list(steady_window), "mass_flow_rate_standard_error_kg_s":
             flow["mass_flow_rate_standard_error_kg_s"],
         **study_summary(study, metrics),
         "rtd_curve": rtd_summary(study.rtd.rtd),

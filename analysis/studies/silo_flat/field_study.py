@@ -2,7 +2,7 @@
 
 :func:`analyse_silo_fields` takes the clump frames since the outlet opened, the contacts of the settled fill
 (None for a run that saved none: what needs them is then left out), the silo's dimensions
-(:class:`SiloDimensions`, from the case summary) and the ``silo_flat.fields`` settings (:class:`SiloFieldOptions`)
+(:class:`SiloDimensions`, from the run's silo case) and the ``silo_flat.fields`` settings (:class:`SiloFieldOptions`)
 and returns a :class:`SiloFieldStudy`: the coarse-grained fields and their time
 average, the velocity profiles, flow channel boundaries and kinematic constant, the centreline velocity, the
 profile flow rates, the Janssen comparison and the force-chain segments, with the standard errors of B(z), of
@@ -27,6 +27,7 @@ import numpy as np
 from model.checks import number_or_nan
 from model.contacts import ContactFrame
 from model.frames import ClumpFrame
+from model.cases.silo_flat import SiloCase
 from model.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.flow import column_surface_heights
@@ -114,15 +115,26 @@ class SiloDimensions:
     clump_mass: float
 
     @classmethod
-    def from_case_summary(cls, case: Mapping) -> "SiloDimensions":
-        """From the case summary (``case.json``: ``width_m``, ``depth_m``, ``outlet_width_m``,
-        ``equivalent_diameter_m``, ``clump_mass_kg``)."""
+    def from_case(cls, case: SiloCase) -> "SiloDimensions":
+        """From the silo case the run was made of (the same numbers its ``case.json`` holds as ``width_m``,
+        ``depth_m``, ``outlet_width_m``, ``equivalent_diameter_m`` and ``clump_mass_kg``).
+
+        Parameters
+        ----------
+        case : model.cases.silo_flat.SiloCase
+            The run's silo: ``width``, ``depth``, ``outlet_width`` [m] and its particle's ``equivalent_diameter``
+            [m] and ``mass`` [kg].
+
+        Returns
+        -------
+        SiloDimensions
+        """
         return cls(
-            width=case["width_m"],
-            depth=case["depth_m"],
-            outlet_width=case["outlet_width_m"],
-            particle_radius=0.5 * case["equivalent_diameter_m"],
-            clump_mass=case["clump_mass_kg"],
+            width=case.width,
+            depth=case.depth,
+            outlet_width=case.outlet_width,
+            particle_radius=0.5 * case.particle.equivalent_diameter,
+            clump_mass=case.particle.mass,
         )
 
 

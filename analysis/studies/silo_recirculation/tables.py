@@ -249,20 +249,25 @@ def clumps_per_window(result: BlendingResult) -> float:
     return result.timing.throughput * result.window
 
 
-def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float,
-                     factor: float = CEILING_FACTOR, k: float = 2.0) -> dict:
+def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float, *, run_id: str,
+                     flow_pattern: str, estimated_residence_time: float, factor: float = CEILING_FACTOR,
+                     k: float = 2.0) -> dict:
     """The summary of one recirculation run (``blending.json``).
 
     Parameters
     ----------
-    case : mapping
-        The run's case record: ``run_id``, ``flow_pattern`` and ``estimated_residence_time_s`` [s].
     result : BlendingResult
         The study of the run.
     eulerian_rtd : analysis.numerics.rtd.RTD
         Its Eulerian RTD.
     eulerian_bin_size : float
         Bin edge of the Eulerian RTD's velocity field [m].
+    run_id : str
+        The run's id.
+    flow_pattern : str
+        Its flow-pattern preset.
+    estimated_residence_time : float
+        The a-priori residence time the run was sized with [s].
     factor : float, optional
         A measured VRR at or above ``vrr_sampling_limit / factor`` is flagged as at the ceiling, >= 1 [-].
     k : float, optional
@@ -306,9 +311,9 @@ def blending_summary(case: Mapping, result: BlendingResult, eulerian_rtd: RTD, e
     transit = transit_summary(result, k)
     transit_tracer = transit.pop("rtd_particle_ids")
     return {
-        "run_id": case["run_id"], "flow_pattern": case["flow_pattern"],
+        "run_id": run_id, "flow_pattern": flow_pattern,
         "residence_time_s": timing.residence_time, "residence_time_s_error": timing.residence_time_error,
-        "estimated_residence_time_s": case["estimated_residence_time_s"],
+        "estimated_residence_time_s": estimated_residence_time,
         "holdup_clumps": timing.holdup, "holdup_clumps_error": timing.holdup_error,
         "throughput_clumps_per_s": timing.throughput, "throughput_clumps_per_s_error": timing.throughput_error,
         "frame_interval_s": timing.frame_interval, "recirculations": timing.recirculations, "window_s": result.window,
@@ -446,15 +451,15 @@ def mean_comparison(particles: Mapping, eulerian: Mapping, k: float = 2.0) -> di
             "mean_difference_significance": significance.value, "means_agree": agree}
 
 
-def verification_summary(case: Mapping, result: VerificationResult, k: float = 2.0) -> dict:
+def verification_summary(result: VerificationResult, *, run_id: str, k: float = 2.0) -> dict:
     """The summary of the Eulerian RTD verification (``verification.json``).
 
     Parameters
     ----------
-    case : mapping
-        The run's case record (its ``run_id``).
     result : VerificationResult
         Particle tracks against Eulerian pathlines.
+    run_id : str
+        The verification run's id.
     k : float, optional
         Coverage factor of the agreement of the means (:func:`mean_comparison`), > 0 [-].
 
@@ -474,7 +479,7 @@ def verification_summary(case: Mapping, result: VerificationResult, k: float = 2
     for bin_size, times in result.eulerian_residence.items():
         summary = residence_summary(times)
         eulerian[f"{1000 * bin_size:g} mm"] = {**summary, **mean_comparison(particles, summary, k)}
-    return {"run_id": case["run_id"], "residence_time_s": result.timing.residence_time,
+    return {"run_id": run_id, "residence_time_s": result.timing.residence_time,
             "residence_time_s_error": result.timing.residence_time_error,
             "n_tracers": int(np.asarray(result.particle_residence).size), "coverage_factor": float(k),
             "particles": particles, "eulerian": eulerian}
