@@ -50,6 +50,23 @@ def processor_grid(domain: dict) -> list[int]:
     return [0 if extent >= SPLIT_EXTENT_FRACTION * widest else 1 for extent in extents] + [1]
 
 
+#: A one-sphere particle model's second sphere, concentric, this fraction of its radius (-): LIGGGHTS 3.8's
+#: ``particletemplate/multisphere`` refuses fewer than two spheres, and every siloflow deck integrates clumps.
+#: Lying 0.99 r inside the surface, the inner sphere touches no neighbour and no wall unless an overlap reached
+#: 0.99 r, and it adds nothing to the clump's volume (the template's Monte Carlo mass and inertia are the sphere's).
+INNER_SPHERE_FRACTION = 0.01
+
+
+def template_spheres(positions, radii) -> list[list[float]]:
+    """The spheres of a clump template as the deck writes them, ``[[x, y, z, r], ...]`` (m): the model's, and for a
+    one-sphere model a concentric inner sphere (:data:`INNER_SPHERE_FRACTION`)."""
+    spheres = [[*map(float, position), float(radius)] for position, radius in zip(positions, radii)]
+    if len(spheres) == 1:
+        x, y, z, radius = spheres[0]
+        spheres.append([x, y, z, INNER_SPHERE_FRACTION * radius])
+    return spheres
+
+
 def flat_matrix(matrix) -> list[float]:
     return [float(value) for row in matrix for value in row]
 
@@ -58,7 +75,7 @@ def common_context(case) -> dict:
     table = case.materials
     moduli = table.youngs_modulus
     particle = case.particle
-    spheres = [[*map(float, position), float(radius)] for position, radius in zip(particle.sphere_positions, particle.sphere_radii)]
+    spheres = template_spheres(particle.sphere_positions, particle.sphere_radii)
     return {
         "materials": {
             "n_types": len(table.names),

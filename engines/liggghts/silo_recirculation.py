@@ -34,7 +34,8 @@ def recirculation_deck_context(case: RecirculationCase) -> dict:
     context["feeder"] = {
         "zone": list(case.feeder_zone),
         "velocity": case.feeder_velocity,
-        "spheres_per_clump": case.silo.spheres_per_clump,
+        # the atoms of one clump as the deck inserts them (a one-sphere model's has an inner sphere)
+        "spheres_per_clump": len(context["particle"]["spheres"]),
     }
     return context
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts.inputs import processor_grid
+from engines.liggghts.inputs import INNER_SPHERE_FRACTION, processor_grid, template_spheres
 from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
 from model.cases.silo_flat import build_silo_case
 from engines.templating import (
@@ -153,3 +153,11 @@ def test_ranks_split_the_wide_horizontal_axes_and_never_gravity():
 def test_the_silo_deck_names_its_processor_grid_before_the_box(tiny_config):
     deck = render_silo_deck(build_silo_case(tiny_config))
     assert deck.index("\nprocessors * 1 1\n") < deck.index("\ncreate_box ")
+
+
+def test_a_one_sphere_template_gets_a_concentric_inner_sphere_and_others_are_as_modelled():
+    assert template_spheres([(0.001, 0.0, -0.002)], [0.002]) == [[0.001, 0.0, -0.002, 0.002],
+                                                               [0.001, 0.0, -0.002, INNER_SPHERE_FRACTION * 0.002]]
+    assert INNER_SPHERE_FRACTION == 0.01
+    two = template_spheres([(0.0, 0.0, -0.001), (0.0, 0.0, 0.001)], [0.0015, 0.0015])
+    assert two == [[0.0, 0.0, -0.001, 0.0015], [0.0, 0.0, 0.001, 0.0015]]
