@@ -247,15 +247,25 @@ class JenikeCase(ChosenTimestep):
 
 LID_KINDS = ("rigid", "servo")
 POINT_KEYS = ("shape", "test", "sliding_friction", "rolling_friction", "restitution", "rotation_blocked")
+#: A wall test's particle-particle sliding friction, where a point sets it (a joint calibration varies it with the
+#: wall friction); without it, ``jenike.sweep.wall_test_particle_friction``.
+PARTICLE_FRICTION_KEY = "particle_sliding_friction"
 
 
 def _check_point(point: dict) -> dict:
-    """The point with exactly :data:`POINT_KEYS`, numbers as floats. Its values come from the validated
-    ``jenike.sweep`` section (:func:`model.cases.jenike_sweep.sweep_points`): the schema is their one validator."""
+    """The point with exactly :data:`POINT_KEYS` (and a wall test's optional :data:`PARTICLE_FRICTION_KEY`), numbers
+    as floats. Its values come from the validated ``jenike.sweep`` section (:func:`model.cases.jenike_sweep.sweep_points`)
+    or a calibration's design: the schema and the design's bounds are their validators."""
     missing = [key for key in POINT_KEYS if key not in point]
-    extra = sorted(set(point) - set(POINT_KEYS))
+    extra = sorted(set(point) - set(POINT_KEYS) - {PARTICLE_FRICTION_KEY})
     if missing or extra:
         raise ValueError(f"jenike point: missing keys {missing}, unknown keys {extra}; expected {list(POINT_KEYS)}")
+    optional = {}
+    if PARTICLE_FRICTION_KEY in point:
+        if point["test"] == "internal":
+            raise ValueError(f"jenike point: {PARTICLE_FRICTION_KEY} is a wall test's; an internal test's particle "
+                             "friction is its sliding_friction")
+        optional[PARTICLE_FRICTION_KEY] = float(point[PARTICLE_FRICTION_KEY])
     return {
         "shape": point["shape"],
         "test": point["test"],
@@ -263,6 +273,7 @@ def _check_point(point: dict) -> dict:
         "rolling_friction": float(point["rolling_friction"]),
         "restitution": float(point["restitution"]),
         "rotation_blocked": bool(point["rotation_blocked"]),
+        **optional,
     }
 
 
@@ -286,7 +297,8 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     """Contact matrices while filling and while testing.
 
     Testing: internal test, particle-particle sliding = point value; wall test, particle-plate sliding =
-    point value and particle-particle sliding = ``jenike.sweep.wall_test_particle_friction``;
+    point value and particle-particle sliding = the point's :data:`PARTICLE_FRICTION_KEY` or else
+    ``jenike.sweep.wall_test_particle_friction``;
     particle-ring and particle-lid sliding from ``contacts``; rolling friction = point value for every
     particle contact (particles, rings, plate, lid); restitution = point value for every particle contact.
     Filling: every particle sliding friction = ``jenike.fill.sliding_friction``, rolling =
@@ -298,7 +310,8 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     lid = _contact(config, particle, jenike["lid_material"])
     types = list(range(1, n_types + 1))
     wall_test = point["test"] != "internal"
-    particle_particle = jenike["sweep"]["wall_test_particle_friction"] if wall_test else point["sliding_friction"]
+    particle_particle = (point.get(PARTICLE_FRICTION_KEY, jenike["sweep"]["wall_test_particle_friction"]) if wall_test
+                         else point["sliding_friction"])
     sliding = {PARTICLE_TYPE: particle_particle, RING_TYPE: ring["sliding_friction"], LID_TYPE: lid["sliding_friction"]}
     if wall_test:
         sliding[PLATE_TYPE] = point["sliding_friction"]

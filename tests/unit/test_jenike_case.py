@@ -223,6 +223,19 @@ def test_wall_test_contact_matrices_give_the_plate_its_own_type():
     assert case.fill_contacts.sliding_friction[p] == (0.1,) * 4
 
 
+def test_a_wall_point_may_set_its_particle_friction_and_an_internal_one_may_not():
+    wall = {"test": "aluminium", "sliding_friction": 0.3, "rolling_friction": 0.05, "restitution": 0.6}
+    case = _case({**wall, "particle_sliding_friction": 0.42})
+    p = PARTICLE_TYPE - 1
+    assert case.test_contacts.sliding_friction[p] == (0.42, 0.17, 1.0, 0.3)
+    assert case.sweep_point["particle_sliding_friction"] == 0.42
+    assert case.run_id != _case(wall).run_id
+    # a point without it keeps the run id it always had
+    assert "particle_sliding_friction" not in _case(wall).sweep_point
+    with pytest.raises(ValueError, match="particle_sliding_friction is a wall test's"):
+        _case({"particle_sliding_friction": 0.42})
+
+
 def test_run_id_names_shape_and_test_and_hashes_every_defining_parameter():
     case = _case()
     assert re.fullmatch(r"sphere2-internal-[0-9a-f]{10}", case.run_id)
