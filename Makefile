@@ -8,7 +8,7 @@ SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES := liggghts openmpi-bin
 YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 
-.PHONY: install install-system install-python run verify validate validate-status test test-physics test-unit test-integration dry-run bench estimate docs
+.PHONY: install install-system install-python run verify bayesian validate validate-status test test-physics test-unit test-integration dry-run bench estimate docs
 
 install: install-system install-python
 
@@ -63,6 +63,13 @@ verify: install
 		--cores $(CORES)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
 		--report $(abspath $(RUN_DIR))/results/report.html
+
+# The joint Bayesian calibration (calibration.bayesian, its own target): per engine, Jenike runs placed by the
+# posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it.
+bayesian: install
+	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
+	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
+		--cores $(CORES)
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
 # (make estimate CONFIG=config/validation.yaml prints its cost, per group and part). It works in results/validation/

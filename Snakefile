@@ -24,6 +24,7 @@ for _kind in CASE_KINDS.values():
 
 
 include: "workflow/rules/existing_runs.smk"
+include: "workflow/rules/bayesian_calibration.smk"
 include: "workflow/rules/fill_balance.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/verification.smk"

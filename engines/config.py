@@ -439,9 +439,39 @@ def _check_references(config: dict) -> None:
         _check_case_materials(config, section, seen)
     for section in inheriting_sections():
         _check_outlet(config[section], section)
+    _check_bayesian(config)
     for kind in CASE_KINDS.values():
         if kind.check_config is not None:
             kind.check_config(config, seen)
+
+
+def _check_bayesian(config: Mapping) -> None:
+    """The Bayesian calibration's priors have a box with their mean inside, both or neither of mean and sd; its
+    walkers are at least twice its parameters; its budget holds the first design, its replicates and the predictive
+    draws; its engines are engines siloflow has."""
+    settings = config["calibration"]["bayesian"]
+    key = "calibration.bayesian"
+    for name, prior in settings["priors"].items():
+        if not prior["lower"] < prior["upper"]:
+            raise ConfigError(f"config key '{key}.priors.{name}': lower ({prior['lower']}) must be below upper "
+                              f"({prior['upper']})")
+        if (prior["mean"] is None) != (prior["sd"] is None):
+            raise ConfigError(f"config key '{key}.priors.{name}': give both mean and sd (a Gaussian prior) or neither "
+                              "(a uniform one)")
+        if prior["mean"] is not None and not prior["lower"] <= prior["mean"] <= prior["upper"]:
+            raise ConfigError(f"config key '{key}.priors.{name}.mean': {prior['mean']} lies outside the bounds "
+                              f"[{prior['lower']}, {prior['upper']}]")
+    walls = [test for test in config["calibration"]["targets_deg"]
+             if test != "internal" and test in config["jenike"]["sweep"]["tests"]]
+    parameters = 2 + len(walls)
+    if settings["walkers"] < 2 * parameters:
+        raise ConfigError(f"config key '{key}.walkers': {settings['walkers']} walkers for {parameters} parameters; "
+                          f"the ensemble sampler needs at least {2 * parameters}")
+    least = settings["initial_sets"] + settings["replicates"] - 1 + settings["predictive_draws"]
+    if settings["max_sets"] < least:
+        raise ConfigError(f"config key '{key}.max_sets': {settings['max_sets']} parameter sets cannot hold the first "
+                          f"design ({settings['initial_sets']}), its replicates ({settings['replicates'] - 1} more) and "
+                          f"the predictive draws ({settings['predictive_draws']}): at least {least}")
 
 
 def _check_outlet(silo: Mapping, section: str) -> None:

@@ -25,7 +25,7 @@ from model.cases.kinds import case_kind
 
 __all__ = ["RESULTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
            "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "CALIBRATION_DIR", "CALIBRATED_PARAMETERS",
-           "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
+           "BAYESIAN_DIR", "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
@@ -45,6 +45,9 @@ CALIBRATION_DIR = f"{RESULTS}/calibration"
 SUMMARY_DIR = f"{RESULTS}/summary"
 VERIFICATION_DIR = f"{RESULTS}/verification"
 CROSS_ENGINE_DIR = f"{RESULTS}/cross_engine"
+#: The joint Bayesian calibration: ``<engine>/iteration_<k>/`` (design, posterior), ``<engine>/runs/<run id>/``,
+#: ``<engine>/predictive/`` and ``<engine>/`` (the final posterior, its plots and the comparison with the chart).
+BAYESIAN_DIR = f"{CALIBRATION_DIR}/bayesian"
 
 #: The calibration's chosen parameters, which a silo run with calibrated parameters reads.
 CALIBRATED_PARAMETERS = f"{CALIBRATION_DIR}/parameters.yaml"

@@ -23,7 +23,10 @@ Choices, and why:
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
+from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Matern
 
@@ -127,7 +130,11 @@ class Surrogate:
         self.gp = GaussianProcessRegressor(kernel=self._kernel(), alpha=np.maximum(noise / scale, _JITTER),
                                            normalize_y=True, n_restarts_optimizer=self.n_restarts,
                                            random_state=self.seed)
-        self.gp.fit(to_unit(theta, self.lower, self.upper), values)
+        with warnings.catch_warnings():
+            # a length scale at its upper bound says the observable hardly depends on that parameter (the wall angle
+            # on the rolling friction): an answer, not a failure of the fit
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            self.gp.fit(to_unit(theta, self.lower, self.upper), values)
         return self
 
     def predict(self, theta) -> tuple[np.ndarray, np.ndarray]:

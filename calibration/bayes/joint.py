@@ -1,0 +1,240 @@
+"""One joint Bayesian calibration from a validated configuration: its parameters and targets, the Jenike points of a
+parameter set, and each iteration's step from the runs done to the posterior and the next parameter sets.
+
+Pure computation on arrays and plain data; the workflow reads the runs' bulk friction and writes the designs and
+posteriors (``workflow/rules/bayesian_calibration.smk``).
+
+The parameters (friction coefficients, -): ``sliding_friction`` and ``rolling_friction`` of the particle-particle
+contacts (the rolling friction also of the particle-wall contacts, as the chart sweep sets it) and
+``wall_sliding_friction.<material>`` for every wall target. Every parameter set runs one Jenike test per target: the
+internal test at its particle friction, each wall test at its wall friction with its particle friction. The
+observables are the bulk friction angles of those tests (deg).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from calibration.bayes.design import posterior_design, space_filling_design
+from calibration.bayes.noise import seed_noise
+from calibration.bayes.posterior import (PosteriorSample, Prior, log_posterior, posterior_summary,
+                                         sample_posterior)
+from calibration.bayes.stopping import posterior_moved
+from calibration.bayes.surrogate import Surrogate
+from model.cases.jenike import PARTICLE_FRICTION_KEY
+
+__all__ = ["Calibration", "IterationResult", "calibration_of", "first_design", "iterate", "next_sets", "points_of_set",
+           "predictive_sets"]
+
+INTERNAL = "internal"
+WALL_PARAMETER = "wall_sliding_friction"
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """What one Bayesian calibration calibrates, against what.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The parameters, in order (``sliding_friction``, ``rolling_friction``, ``wall_sliding_friction.<material>``).
+    prior : Prior
+        Their prior (bounds, optional truncated Gaussians).
+    tests : tuple of str
+        The Jenike tests, one per target (``internal`` and wall materials), in order.
+    targets_deg : ndarray
+        The measured bulk friction angle of each test (deg).
+    target_sd_deg : float
+        Their uncertainty (deg), one standard deviation.
+    shape : str
+        The particle model of the runs.
+    restitution : float
+        The restitution of the runs (-).
+    settings : Mapping
+        ``calibration.bayesian``.
+    """
+
+    names: tuple[str, ...]
+    prior: Prior
+    tests: tuple[str, ...]
+    targets_deg: np.ndarray
+    target_sd_deg: float
+    shape: str
+    restitution: float
+    settings: Mapping
+
+    @property
+    def lower(self) -> np.ndarray:
+        return self.prior.lower
+
+    @property
+    def upper(self) -> np.ndarray:
+        return self.prior.upper
+
+
+def calibration_of(config: Mapping) -> Calibration:
+    """The Bayesian calibration a validated configuration defines: the targets of ``calibration.targets_deg`` whose
+    test is in ``jenike.sweep.tests`` (the internal one first, then the walls in the targets' order)."""
+    settings = config["calibration"]["bayesian"]
+    priors = settings["priors"]
+    sweep_tests = config["jenike"]["sweep"]["tests"]
+    targets = {test: angle for test, angle in config["calibration"]["targets_deg"].items() if test in sweep_tests}
+    tests = tuple(sorted(targets, key=lambda test: test != INTERNAL))
+    walls = [test for test in tests if test != INTERNAL]
+    names = ("sliding_friction", "rolling_friction", *(f"{WALL_PARAMETER}.{wall}" for wall in walls))
+    chosen = [priors["sliding_friction"], priors["rolling_friction"], *([priors[WALL_PARAMETER]] * len(walls))]
+    mean = np.array([np.nan if p["mean"] is None else p["mean"] for p in chosen])
+    sd = np.array([np.nan if p["sd"] is None else p["sd"] for p in chosen])
+    prior = Prior(np.array([p["lower"] for p in chosen], dtype=float), np.array([p["upper"] for p in chosen], dtype=float),
+                  mean, sd)
+    return Calibration(names, prior, tests, np.array([targets[test] for test in tests], dtype=float),
+                       float(config["calibration"]["tolerance_deg"]), config["calibration"]["shape"],
+                       float(config["jenike"]["sweep"]["restitution"]), settings)
+
+
+def points_of_set(calibration: Calibration, theta: Sequence[float], replicate: int = 0) -> list[dict]:
+    """The Jenike points of one parameter set, one per test (:func:`model.cases.jenike.build_jenike_case`); a
+    replicate ``k`` > 0 adds k to the seed."""
+    values = dict(zip(calibration.names, map(float, theta)))
+    common = {"shape": calibration.shape, "rolling_friction": values["rolling_friction"],
+              "restitution": calibration.restitution, "rotation_blocked": False}
+    points = []
+    for test in calibration.tests:
+        if test == INTERNAL:
+            point = {**common, "test": INTERNAL, "sliding_friction": values["sliding_friction"]}
+        else:
+            point = {**common, "test": test, "sliding_friction": values[f"{WALL_PARAMETER}.{test}"],
+                     PARTICLE_FRICTION_KEY: values["sliding_friction"]}
+        points.append({**point, **({"replicate": replicate} if replicate else {})})
+    return points
+
+
+def first_design(calibration: Calibration) -> list[dict]:
+    """The first iteration's parameter sets: a Latin hypercube of ``initial_sets`` over the prior box, the first
+    set run ``replicates`` times (seeds + 0, 1, ...), whose spread is the seed noise.
+
+    Returns
+    -------
+    list of dict
+        ``{"theta": [...], "replicate": k}`` per set.
+    """
+    settings = calibration.settings
+    design = space_filling_design(calibration.lower, calibration.upper, settings["initial_sets"], settings["seed"])
+    sets = [{"theta": row.tolist(), "replicate": 0} for row in design]
+    sets += [{"theta": design[0].tolist(), "replicate": k} for k in range(1, settings["replicates"])]
+    return sets
+
+
+@dataclass(frozen=True)
+class IterationResult:
+    """One iteration's posterior.
+
+    Attributes
+    ----------
+    sample : PosteriorSample
+        The posterior samples on the surrogates, with the sampler's diagnostics.
+    seed_sd_deg : ndarray
+        The DEM's seed noise of each test's angle (deg), from the replicates, and its degrees of freedom.
+    seed_dof : int
+    shift : float or None
+        How far the posterior moved from the previous iteration's (:func:`calibration.bayes.stopping.posterior_moved`);
+        None at the first.
+    moved : bool
+        Whether it moved by more than ``stop_shift`` (True at the first).
+    surrogates : list of Surrogate
+        One per test.
+    """
+
+    sample: PosteriorSample
+    seed_sd_deg: np.ndarray
+    seed_dof: int
+    shift: float | None
+    moved: bool
+    surrogates: list
+
+    def summary(self, calibration: Calibration) -> dict:
+        """Plain data: the posterior summary, the seed noise, the sampler's diagnostics, the shift."""
+        return {
+            **posterior_summary(self.sample.samples, calibration.names).to_dict(),
+            "seed_sd_deg": dict(zip(calibration.tests, self.seed_sd_deg.tolist())),
+            "seed_noise_degrees_of_freedom": self.seed_dof,
+            "acceptance_fraction": self.sample.acceptance_fraction,
+            "autocorrelation_time": self.sample.autocorrelation_time.tolist(),
+            "effective_sample_size": self.sample.effective_sample_size.tolist(),
+            "shift": self.shift,
+            "moved": self.moved,
+        }
+
+
+def _replicate_groups(theta: np.ndarray, angles: np.ndarray) -> list[np.ndarray]:
+    """The angles of the runs at each parameter set, grouped by identical parameters."""
+    _, inverse = np.unique(theta, axis=0, return_inverse=True)
+    return [angles[inverse.reshape(-1) == group] for group in range(inverse.max() + 1)]
+
+
+def iterate(calibration: Calibration, theta, angles_deg, angle_errors_deg, previous_samples=None) -> IterationResult:
+    """Fit a surrogate of each test's angle to the runs done, sample the posterior on them and compare it with the
+    previous iteration's.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    theta : array_like, shape (n, d)
+        The parameter set of each run set (replicates repeat a row).
+    angles_deg, angle_errors_deg : array_like, shape (n, k)
+        Each run set's bulk friction angle per test and its standard error (deg).
+    previous_samples : ndarray, optional
+        The previous iteration's posterior samples.
+
+    Returns
+    -------
+    IterationResult
+    """
+    theta = np.asarray(theta, dtype=float)
+    angles = np.asarray(angles_deg, dtype=float)
+    errors = np.asarray(angle_errors_deg, dtype=float)
+    variance, dof = seed_noise(_replicate_groups(theta, angles))
+    seed_variance = np.atleast_1d(np.asarray(variance, dtype=float))
+    settings = calibration.settings
+    surrogates = []
+    for column in range(len(calibration.tests)):
+        # a run's scatter about the mean over seeds is the seed noise, or its own window's error where that is larger
+        noise = np.maximum(errors[:, column] ** 2, seed_variance[column])
+        surrogates.append(Surrogate(calibration.lower, calibration.upper, seed=settings["seed"]).fit(
+            theta, angles[:, column], noise))
+    seed_sd = np.sqrt(seed_variance)
+    log_probability = log_posterior(calibration.prior, surrogates, calibration.targets_deg,
+                                    np.full(len(calibration.tests), calibration.target_sd_deg), seed_sd)
+    sample = sample_posterior(log_probability, calibration.lower, calibration.upper, settings["walkers"],
+                              settings["steps"], settings["seed"],
+                              initial=calibration.prior.sample(settings["walkers"], settings["seed"]))
+    if previous_samples is None:
+        return IterationResult(sample, seed_sd, int(dof), None, True, surrogates)
+    moved, shift = posterior_moved(previous_samples, sample.samples, settings["stop_shift"])
+    return IterationResult(sample, seed_sd, int(dof), float(shift), bool(moved), surrogates)
+
+
+def next_sets(calibration: Calibration, samples, done_theta, sets_done: int, iteration: int) -> list[dict]:
+    """The next iteration's parameter sets: ``sets_per_iteration`` where the posterior has mass, away from the runs
+    done, within what the budget (``max_sets``, less the predictive draws) leaves."""
+    settings = calibration.settings
+    left = settings["max_sets"] - settings["predictive_draws"] - sets_done
+    n = min(settings["sets_per_iteration"], left)
+    if n <= 0:
+        return []
+    chosen = posterior_design(samples, n, calibration.lower, calibration.upper, settings["seed"] + iteration,
+                              existing=np.asarray(done_theta, dtype=float))
+    return [{"theta": row.tolist(), "replicate": 0} for row in chosen]
+
+
+def predictive_sets(calibration: Calibration, samples) -> list[dict]:
+    """``predictive_draws`` parameter sets drawn from the posterior samples (without replacement), for the
+    posterior predictive check."""
+    samples = np.asarray(samples, dtype=float)
+    rng = np.random.default_rng(calibration.settings["seed"] + 1000)
+    count = min(calibration.settings["predictive_draws"], len(samples))
+    rows = rng.choice(len(samples), size=count, replace=False)
+    return [{"theta": samples[row].tolist(), "replicate": 0} for row in rows]

@@ -1,0 +1,80 @@
+"""The joint Bayesian calibration with the real engines, tiny: one target (the internal angle), two parameters
+(particle sliding and rolling friction), single spheres in a 40 mm cell; a first design of three sets with one
+replicate, one further iteration of one set, one posterior draw run for the predictive check, on LIGGGHTS and on
+YADE. The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
+iterations, the posterior and the report come out of `snakemake bayesian_calibration`, that the seed noise is measured
+from the replicate, and that both engines give a posterior.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts, require_yade, run_snakemake
+
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(200)]
+
+TINY_BAYESIAN = {
+    "jenike": {**TINY_JENIKE_SWEEP, "sweep": {**TINY_JENIKE_SWEEP["sweep"], "shapes": ["sphere"]}},
+    "calibration": {
+        "targets_deg": {"internal": 24.0}, "tolerance_deg": 1.0, "shape": "sphere", "rolling_friction": 0.1,
+        "bayesian": {"engines": ["liggghts", "yade"], "initial_sets": 3, "replicates": 2, "sets_per_iteration": 1,
+                     "max_iterations": 1, "max_sets": 6, "predictive_draws": 1, "walkers": 8, "steps": 400,
+                     "stop_shift": 0.001, "compare_with_chart": False,
+                     "priors": {"sliding_friction": {"lower": 0.1, "upper": 0.6},
+                                "rolling_friction": {"lower": 0.0, "upper": 0.2}}},
+    },
+    "silo_flat": SMALL_SILO,
+    "silo_recirculation": NO_BLENDING,
+    "blender": NO_BLENDER,
+    "verification": NO_VERIFICATION,
+}
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    require_liggghts()
+    require_yade()
+    workdir = tmp_path_factory.mktemp("bayesian")
+    config_path = workdir / "bayesian.yaml"
+    config_path.write_text(yaml.safe_dump(TINY_BAYESIAN))
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=("bayesian_calibration",))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    return workdir / "results" / "calibration" / "bayesian"
+
+
+@pytest.mark.parametrize("engine", ["liggghts", "yade"])
+def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(calibrated, engine):
+    folder = calibrated / engine
+    first = json.loads((folder / "iteration_0" / "design.json").read_text())
+    assert len(first["sets"]) == 4 and [s["replicate"] for s in first["sets"]] == [0, 0, 0, 1]
+    assert first["sets"][3]["theta"] == first["sets"][0]["theta"]
+    second = json.loads((folder / "iteration_1" / "design.json").read_text())
+    assert len(second["sets"]) == 1  # the budget: 6 sets less the predictive draw, 4 done
+    stopped = json.loads((folder / "iteration_2" / "design.json").read_text())
+    assert stopped["stopped"] and stopped["sets"] == []
+    posterior = json.loads((folder / "posterior.json").read_text())
+    assert posterior["iteration"] == 1 and posterior["sets"] == 5
+    assert posterior["seed_noise_degrees_of_freedom"] == 1 and posterior["seed_sd_deg"]["internal"] >= 0
+    assert set(posterior["parameters"]) == {"sliding_friction", "rolling_friction"}
+    for name, bounds in (("sliding_friction", (0.1, 0.6)), ("rolling_friction", (0.0, 0.2))):
+        value = posterior["parameters"][name]
+        assert bounds[0] <= value["q05"] <= value["mean"] <= value["q95"] <= bounds[1] and value["sd"] > 0
+    samples = np.load(folder / "iteration_1" / "posterior.npz")["samples"]
+    assert samples.shape == (8 * 200, 2)
+    with open(folder / "predictive.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 1 and rows[0]["test"] == "internal" and float(rows[0]["target_deg"]) == 24.0
+    for name in ("corner.png", "predictive.png", "intervals.csv"):
+        assert (folder / name).stat().st_size > 0
+
+
+def test_the_engines_posteriors_stand_side_by_side(calibrated):
+    with open(calibrated / "engines.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert {row["parameter"] for row in rows} >= {"sliding_friction", "rolling_friction"}

@@ -1,0 +1,72 @@
+"""Snakemake adapter: the report of the Bayesian calibration on one engine (calibration.bayes.report): the final
+posterior with its credible intervals, the posterior predictive check, the chart inversion's answer beside it, the
+corner plot and the predictive check's figure."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from analysis.io.tables import write_flow_table, write_json, write_text
+from calibration.bayes.joint import calibration_of
+from calibration.bayes.plots import plot_corner, plot_predictive
+from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, interval_rows,
+                                      predictive_columns, predictive_rows, predictive_verdict)
+from engines.logs import logged_to
+
+
+def sets_of(paths):
+    return [chosen for path in paths for chosen in json.loads(Path(path).read_text())["sets"]]
+
+
+def summaries_of(paths):
+    return {summary["run_id"]: summary for summary in (json.loads(Path(path).read_text()) for path in paths)}
+
+
+with logged_to(snakemake.log[0]) as log:
+    calibration = calibration_of(snakemake.config)
+    engine = snakemake.wildcards.engine
+    summary = json.loads(Path(snakemake.input.summary).read_text())
+    samples = np.load(snakemake.input.samples)["samples"]
+    sets = sets_of(snakemake.input.designs)
+    predictive_sets = sets_of([snakemake.input.predictive_design])
+
+    intervals = interval_rows(summary, samples, calibration.names)
+    write_flow_table(snakemake.output.intervals, intervals)
+
+    predictive = predictive_rows(calibration, predictive_sets, summaries_of(snakemake.input.predictive),
+                                 summary["seed_sd_deg"])
+    verdict = predictive_verdict(predictive)
+    if predictive:
+        write_flow_table(snakemake.output.predictive, predictive)
+    else:
+        write_text(snakemake.output.predictive, ",".join(predictive_columns(calibration)) + "\n")
+        log.info("no predictive runs (calibration.bayesian.predictive_draws is 0): header only")
+    plot_predictive(predictive, snakemake.output.predictive_plot)
+    log.info("predictive check on %s: %d of %d runs within 2 sd of their target", engine, verdict["within"],
+             verdict["rows"])
+
+    chart = None
+    if snakemake.input.chart:
+        chart_parameters = yaml.safe_load(Path(snakemake.input.chart[0]).read_text())
+        comparison = chart_comparison_rows(calibration, samples, chart_parameters)
+        write_flow_table(snakemake.output.comparison, comparison)
+        chart = {row["parameter"]: row["chart_value"] for row in comparison}
+        for row in comparison:
+            log.info("%s: chart %s, posterior %.4g +- %.4g (90 %% interval %.4g-%.4g): %s", row["parameter"],
+                     row["chart_value"], row["posterior_mean"], row["posterior_sd"], row["interval_lower"],
+                     row["interval_upper"], row["note"])
+    else:
+        write_text(snakemake.output.comparison, ",".join(CHART_COMPARISON_COLUMNS) + "\n")
+        log.info("the chart comparison was not asked for (calibration.bayesian.compare_with_chart): header only")
+    plot_corner(samples, calibration.names, snakemake.output.corner, chart=chart)
+
+    final_iteration = len(snakemake.input.designs) - 1
+    write_json(snakemake.output.posterior, {**summary, "engine": engine, "intervals": intervals,
+                                            "predictive": verdict, "final_iteration": final_iteration,
+                                            "sets": len(sets), "runs": len(snakemake.input.runs),
+                                            "predictive_sets": len(predictive_sets),
+                                            "predictive_runs": len(snakemake.input.predictive)})
+    log.info("posterior on %s after iteration %d: %d sets, %d runs; %s", engine, final_iteration, len(sets),
+             len(snakemake.input.runs), {row["parameter"]: round(row["mean"], 4) for row in intervals})
