@@ -13,7 +13,7 @@ observables are the bulk friction angles of those tests (deg).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -26,8 +26,11 @@ from calibration.bayes.stopping import posterior_moved
 from calibration.bayes.surrogate import Surrogate
 from model.cases.jenike import PARTICLE_FRICTION_KEY
 
-__all__ = ["Calibration", "IterationResult", "calibration_of", "first_design", "iterate", "next_sets", "points_of_set",
-           "predictive_sets"]
+__all__ = ["Calibration", "IterationResult", "TWIN_SEED_OFFSET", "calibration_of", "first_design", "iterate", "next_sets",
+           "points_of_set", "predictive_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
+
+#: The twin experiment's runs at the truth take seeds from jenike.seed + this on, apart from the design's replicates.
+TWIN_SEED_OFFSET = 100
 
 INTERNAL = "internal"
 WALL_PARAMETER = "wall_sliding_friction"
@@ -93,6 +96,42 @@ def calibration_of(config: Mapping) -> Calibration:
     return Calibration(names, prior, tests, np.array([targets[test] for test in tests], dtype=float),
                        float(config["calibration"]["tolerance_deg"]), config["calibration"]["shape"],
                        float(config["jenike"]["sweep"]["restitution"]), settings)
+
+
+def with_targets(calibration: Calibration, targets_deg: Mapping[str, float]) -> Calibration:
+    """The calibration against other targets (deg) of the same tests (a twin experiment's)."""
+    missing = [test for test in calibration.tests if test not in targets_deg]
+    if missing:
+        raise ValueError(f"no target for the tests {missing}")
+    return replace(calibration, targets_deg=np.array([targets_deg[test] for test in calibration.tests], dtype=float))
+
+
+def twin_truth(calibration: Calibration) -> np.ndarray:
+    """The twin experiment's known parameters (``calibration.bayesian.twin.truth``), in the calibration's order."""
+    truth = calibration.settings["twin"]["truth"]
+    return np.array([truth[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name]
+                     for name in calibration.names], dtype=float)
+
+
+def twin_sets(calibration: Calibration) -> list[dict]:
+    """The twin experiment's runs at the truth: ``twin.replicates`` sets, seeds apart from the design's."""
+    theta = twin_truth(calibration).tolist()
+    return [{"theta": theta, "replicate": TWIN_SEED_OFFSET + k} for k in range(calibration.settings["twin"]["replicates"])]
+
+
+def twin_targets(calibration: Calibration, angles_deg) -> dict:
+    """The twin experiment's targets: the mean angle of the runs at the truth per test (deg), with its standard error
+    (deg; None from one run).
+
+    Parameters
+    ----------
+    angles_deg : array_like, shape (n, k)
+        The truth runs' angles, one row per run, one column per test.
+    """
+    angles = np.atleast_2d(np.asarray(angles_deg, dtype=float))
+    error = angles.std(axis=0, ddof=1) / np.sqrt(len(angles)) if len(angles) > 1 else [None] * len(calibration.tests)
+    return {"targets_deg": dict(zip(calibration.tests, angles.mean(axis=0).tolist())),
+            "standard_error_deg": dict(zip(calibration.tests, [None if e is None else float(e) for e in error]))}
 
 
 def points_of_set(calibration: Calibration, theta: Sequence[float], replicate: int = 0) -> list[dict]:

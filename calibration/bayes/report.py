@@ -16,9 +16,9 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from calibration.bayes.joint import WALL_PARAMETER, Calibration
-from calibration.bayes.posterior import credible_interval
+from calibration.bayes.posterior import credible_interval, in_credible_region
 
-__all__ = ["CHART_COMPARISON_COLUMNS", "chart_comparison_rows", "engines_rows", "interval_rows",
+__all__ = ["CHART_COMPARISON_COLUMNS", "chart_comparison_rows", "engines_rows", "interval_rows", "twin_verdict",
            "predictive_columns", "predictive_rows", "predictive_verdict"]
 
 #: How many combined standard deviations a predictive run may lie from its target and still be within (-).
@@ -345,3 +345,37 @@ def engines_rows(posteriors: Mapping[str, Mapping]) -> list[dict]:
             row[f"{second}_minus_{first}_in_sd"] = difference / combined if combined else None
         rows.append(row)
     return rows
+
+
+def twin_verdict(names: Sequence[str], samples, truth, level: float = 0.9) -> dict:
+    """Whether a twin experiment brought its known parameters back.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The parameters, in the samples' order.
+    samples : array_like, shape (n, d)
+        The posterior samples (-).
+    truth : array_like, shape (d,)
+        The parameters the engine made the targets with (-).
+    level : float
+        The credible level (0.9: the 90 % region).
+
+    Returns
+    -------
+    dict
+        ``truth`` by name; ``inside_credible_region``: whether the truth lies inside the joint region at ``level``
+        (:func:`calibration.bayes.posterior.in_credible_region`, a Gaussian approximation of the posterior);
+        ``marginals``: per parameter the equal-tailed interval at ``level`` and whether it holds the truth.
+    """
+    samples = np.asarray(samples, dtype=float)
+    truth = np.asarray(truth, dtype=float)
+    intervals = credible_interval(samples, level)
+    return {
+        "level": level,
+        "truth": dict(zip(names, truth.tolist())),
+        "inside_credible_region": bool(in_credible_region(samples, truth, level)),
+        "marginals": {name: {"truth": float(truth[i]), "lower": float(intervals[i][0]), "upper": float(intervals[i][1]),
+                             "inside": bool(intervals[i][0] <= truth[i] <= intervals[i][1])}
+                      for i, name in enumerate(names)},
+    }

@@ -1,7 +1,7 @@
 """The joint Bayesian calibration with the real engines, tiny: one target (the internal angle), two parameters
 (particle sliding and rolling friction), single spheres in a 40 mm cell; a first design of three sets with one
 replicate, one further iteration of one set, one posterior draw run for the predictive check, on LIGGGHTS and on
-YADE. The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
+YADE, as a twin experiment (the targets are each engine's own mean angle of two runs at known parameters). The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
 iterations, the posterior and the report come out of `snakemake bayesian_calibration`, that the seed noise is measured
 from the replicate, and that both engines give a posterior.
 """
@@ -26,6 +26,8 @@ TINY_BAYESIAN = {
         "bayesian": {"engines": ["liggghts", "yade"], "initial_sets": 3, "replicates": 2, "sets_per_iteration": 1,
                      "max_iterations": 1, "max_sets": 6, "predictive_draws": 1, "walkers": 8, "steps": 400,
                      "stop_shift": 0.001, "compare_with_chart": False,
+                     "twin": {"enabled": True, "truth": {"sliding_friction": 0.3, "rolling_friction": 0.1},
+                              "replicates": 2},
                      "priors": {"sliding_friction": {"lower": 0.1, "upper": 0.6},
                                 "rolling_friction": {"lower": 0.0, "upper": 0.2}}},
     },
@@ -67,9 +69,16 @@ def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(calibrated, eng
         assert bounds[0] <= value["q05"] <= value["mean"] <= value["q95"] <= bounds[1] and value["sd"] > 0
     samples = np.load(folder / "iteration_1" / "posterior.npz")["samples"]
     assert samples.shape == (8 * 200, 2)
+    twin = json.loads((folder / "twin" / "targets.json").read_text())
+    assert twin["truth"] == {"sliding_friction": 0.3, "rolling_friction": 0.1} and twin["runs"] == 2
+    target = twin["targets_deg"]["internal"]
+    assert 5.0 < target < 60.0 and twin["standard_error_deg"]["internal"] >= 0
+    assert posterior["targets_deg"] == {"internal": target}
+    assert set(posterior["twin"]["marginals"]) == {"sliding_friction", "rolling_friction"}
+    assert isinstance(posterior["twin"]["inside_credible_region"], bool)
     with open(folder / "predictive.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
-    assert len(rows) == 1 and rows[0]["test"] == "internal" and float(rows[0]["target_deg"]) == 24.0
+    assert len(rows) == 1 and rows[0]["test"] == "internal" and float(rows[0]["target_deg"]) == pytest.approx(target)
     for name in ("corner.png", "predictive.png", "intervals.csv"):
         assert (folder / name).stat().st_size > 0
 

@@ -11,7 +11,7 @@ import pytest
 from threadpoolctl import threadpool_limits
 
 from calibration.bayes.joint import (calibration_of, first_design, iterate, next_sets, points_of_set,
-                                     predictive_sets)
+                                     predictive_sets, twin_sets, twin_targets, twin_truth, with_targets)
 from calibration.bayes.posterior import in_credible_region
 from engines.config import validate_config
 from model.cases.jenike import build_jenike_case
@@ -106,3 +106,18 @@ def test_a_twin_calibration_brings_back_the_parameters_that_made_its_targets():
     assert len(next_sets(calibration, second.sample.samples, theta, 17, iteration=2)) == 1
     draws = predictive_sets(calibration, second.sample.samples)
     assert len(draws) == 2 and all(np.all(np.isin(d["theta"], second.sample.samples)) for d in draws)
+
+
+def test_a_twin_experiment_runs_the_truth_with_seeds_apart_and_takes_their_mean_as_targets():
+    config = _config(twin={"enabled": True, "truth": {"sliding_friction": 0.35, "rolling_friction": 0.12,
+                                                       "wall_sliding_friction": 0.3}, "replicates": 2})
+    calibration = calibration_of(config)
+    assert twin_truth(calibration).tolist() == [0.35, 0.12, 0.3]
+    sets = twin_sets(calibration)
+    assert sets == [{"theta": [0.35, 0.12, 0.3], "replicate": 100}, {"theta": [0.35, 0.12, 0.3], "replicate": 101}]
+    made = twin_targets(calibration, [[28.0, 9.0], [30.0, 10.0]])
+    assert made == {"targets_deg": {"internal": 29.0, "aluminium": 9.5},
+                    "standard_error_deg": {"internal": 1.0, "aluminium": 0.5}}
+    assert with_targets(calibration, made["targets_deg"]).targets_deg.tolist() == [29.0, 9.5]
+    with pytest.raises(ValueError, match=r"no target for the tests \['aluminium'\]"):
+        with_targets(calibration, {"internal": 29.0})

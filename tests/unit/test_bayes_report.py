@@ -15,7 +15,7 @@ from calibration.bayes.joint import Calibration
 from calibration.bayes.plots import CHART_COLOR, plot_corner, plot_predictive
 from calibration.bayes.posterior import Prior
 from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
-                                      predictive_columns, predictive_rows, predictive_verdict)
+                                      predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 NAMES = ("sliding_friction", "rolling_friction", "wall_sliding_friction.aluminium")
@@ -276,3 +276,15 @@ def test_plot_predictive_writes_a_png_with_a_panel_per_test(tmp_path):
     empty = tmp_path / "empty" / "predictive.png"
     plot_predictive([], empty)
     assert empty.read_bytes().startswith(PNG_SIGNATURE)
+
+
+def test_the_twin_verdict_says_whether_the_truth_came_back():
+    rng = np.random.default_rng(3)
+    samples = rng.normal([0.3, 0.1], [0.02, 0.01], size=(20000, 2))
+    inside = twin_verdict(["sliding_friction", "rolling_friction"], samples, [0.31, 0.1])
+    assert inside["inside_credible_region"] and inside["truth"] == {"sliding_friction": 0.31, "rolling_friction": 0.1}
+    assert inside["marginals"]["sliding_friction"]["inside"]
+    assert inside["marginals"]["sliding_friction"]["lower"] == pytest.approx(0.3 - 1.645 * 0.02, abs=1e-3)
+    outside = twin_verdict(["sliding_friction", "rolling_friction"], samples, [0.4, 0.1])
+    assert not outside["inside_credible_region"] and not outside["marginals"]["sliding_friction"]["inside"]
+    assert outside["marginals"]["rolling_friction"]["inside"]

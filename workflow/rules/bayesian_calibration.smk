@@ -5,7 +5,7 @@
 
 import json
 
-from calibration.bayes.joint import calibration_of, first_design
+from calibration.bayes.joint import calibration_of, first_design, twin_sets
 from calibration.bayes.runs import cases_of_sets, with_runs
 from engines.layout import BAYESIAN_DIR
 
@@ -18,6 +18,12 @@ try:
             engine_named(_engine).check_case(_case)
 except (CaseNotSupported, ValueError) as error:
     raise WorkflowError(f"The Bayesian calibration's runs cannot be built or run on their engines: {error}") from None
+
+
+#: The twin experiment's runs at the known parameters, per engine (calibration.bayesian.twin): its targets.
+BAYES_TWIN = BAYES_SETTINGS["twin"]["enabled"]
+TWIN_SETS = {engine: with_runs(config, BAYES, twin_sets(BAYES), engine) if BAYES_TWIN else []
+             for engine in BAYES_SETTINGS["engines"]}
 
 
 def bayes_folder(engine="{engine}"):
@@ -48,9 +54,11 @@ def bayes_summaries(sets, engine):
 
 
 def bayes_case(engine, run):
-    """The case of a run of a design written on ``engine`` (its iterations' and the predictive check's)."""
-    for path in sorted(Path(bayes_folder(engine)).glob("*/design.json")):
-        sets = [chosen for chosen in json.loads(path.read_text())["sets"] if run in chosen["runs"].values()]
+    """The case of a run of a design written on ``engine`` (its iterations' and the predictive check's) or of the twin
+    experiment's truth."""
+    designs = [json.loads(path.read_text())["sets"] for path in sorted(Path(bayes_folder(engine)).glob("*/design.json"))]
+    for found in (TWIN_SETS.get(engine, []), *designs):
+        sets = [chosen for chosen in found if run in chosen["runs"].values()]
         if sets:
             return cases_of_sets(config, engine, sets[:1])[run]
     raise WorkflowError(f"no design of the Bayesian calibration on {engine} has the run {run}")
@@ -62,6 +70,26 @@ def bayes_final_iteration(engine):
     while not bayes_design(engine, iteration)["stopped"]:
         iteration += 1
     return iteration - 1
+
+
+def bayes_targets(wildcards):
+    """The twin experiment's targets, made by the engine at the truth; none when the targets are measured ones."""
+    return [f"{bayes_folder(wildcards.engine)}/twin/targets.json"] if BAYES_TWIN else []
+
+
+rule bayes_twin_targets:
+    input:
+        summaries=lambda wildcards: bayes_summaries(TWIN_SETS[wildcards.engine], wildcards.engine),
+    output:
+        targets=f"{bayes_folder()}/twin/targets.json",
+    params:
+        sets=lambda wildcards: TWIN_SETS[wildcards.engine],
+    wildcard_constraints:
+        engine="|".join(ENGINE_KINDS),
+    log:
+        f"{bayes_folder()}/twin/logs/targets.log",
+    script:
+        "../scripts/bayes_twin_targets.py"
 
 
 def bayes_previous(wildcards):
@@ -132,6 +160,7 @@ rule bayes_posterior:
                                                     wildcards.engine),
         previous=lambda wildcards: [] if int(wildcards.iteration) == 0 else [
             bayes_iteration_file("posterior.npz", wildcards.engine, int(wildcards.iteration) - 1)],
+        targets=bayes_targets,
     output:
         samples=bayes_iteration_file("posterior.npz"),
         summary=bayes_iteration_file("posterior.json"),
@@ -176,6 +205,7 @@ rule bayes_report:
         predictive_design=f"{bayes_folder()}/predictive/design.json",
         predictive=lambda wildcards: bayes_summaries(bayes_predictive_sets(wildcards.engine), wildcards.engine),
         chart=[CALIBRATED_PARAMETERS] if BAYES_SETTINGS["compare_with_chart"] else [],
+        targets=bayes_targets,
     output:
         posterior=f"{bayes_folder()}/posterior.json",
         intervals=f"{bayes_folder()}/intervals.csv",

@@ -8,12 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from analysis.io.tables import write_json
-from calibration.bayes.joint import calibration_of, iterate
+from calibration.bayes.joint import calibration_of, iterate, with_targets
 from calibration.bayes.runs import observations
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     calibration = calibration_of(snakemake.config)
+    if snakemake.input.targets:  # a twin experiment: the engine's own angles at the truth
+        calibration = with_targets(calibration, json.loads(Path(snakemake.input.targets[0]).read_text())["targets_deg"])
     sets = [chosen for path in snakemake.input.designs for chosen in json.loads(Path(path).read_text())["sets"]]
     summaries = {summary["run_id"]: summary
                  for summary in (json.loads(Path(path).read_text()) for path in snakemake.input.summaries)}

@@ -9,10 +9,10 @@ import numpy as np
 import yaml
 
 from analysis.io.tables import write_flow_table, write_json, write_text
-from calibration.bayes.joint import calibration_of
+from calibration.bayes.joint import calibration_of, twin_truth, with_targets
 from calibration.bayes.plots import plot_corner, plot_predictive
 from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, interval_rows,
-                                      predictive_columns, predictive_rows, predictive_verdict)
+                                      predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
 from engines.logs import logged_to
 
 
@@ -26,6 +26,9 @@ def summaries_of(paths):
 
 with logged_to(snakemake.log[0]) as log:
     calibration = calibration_of(snakemake.config)
+    twin = None
+    if snakemake.input.targets:  # a twin experiment: the engine's own angles at the truth
+        calibration = with_targets(calibration, json.loads(Path(snakemake.input.targets[0]).read_text())["targets_deg"])
     engine = snakemake.wildcards.engine
     summary = json.loads(Path(snakemake.input.summary).read_text())
     samples = np.load(snakemake.input.samples)["samples"]
@@ -60,13 +63,21 @@ with logged_to(snakemake.log[0]) as log:
     else:
         write_text(snakemake.output.comparison, ",".join(CHART_COMPARISON_COLUMNS) + "\n")
         log.info("the chart comparison was not asked for (calibration.bayesian.compare_with_chart): header only")
-    plot_corner(samples, calibration.names, snakemake.output.corner, chart=chart)
+    truths = None
+    if snakemake.input.targets:
+        twin = twin_verdict(calibration.names, samples, twin_truth(calibration))
+        truths = twin["truth"]
+        log.info("twin experiment on %s: the truth %s is %s the 90 %% credible region", engine, twin["truth"],
+                 "inside" if twin["inside_credible_region"] else "outside")
+    plot_corner(samples, calibration.names, snakemake.output.corner, truths=truths, chart=chart)
 
     final_iteration = len(snakemake.input.designs) - 1
     write_json(snakemake.output.posterior, {**summary, "engine": engine, "intervals": intervals,
                                             "predictive": verdict, "final_iteration": final_iteration,
                                             "sets": len(sets), "runs": len(snakemake.input.runs),
                                             "predictive_sets": len(predictive_sets),
-                                            "predictive_runs": len(snakemake.input.predictive)})
+                                            "predictive_runs": len(snakemake.input.predictive),
+                                            "targets_deg": dict(zip(calibration.tests, calibration.targets_deg.tolist())),
+                                            "twin": twin})
     log.info("posterior on %s after iteration %d: %d sets, %d runs; %s", engine, final_iteration, len(sets),
              len(snakemake.input.runs), {row["parameter"]: round(row["mean"], 4) for row in intervals})
