@@ -9,7 +9,9 @@ import yaml
 
 from model.cases import cases_of
 from model.cases.silo_flat import build_silo_case
-from engines.config import SCHEMA_PATH, ConfigError, load_config, load_schema, validate_config
+from snakemake.utils import update_config
+
+from engines.config import SCHEMA_PATH, ConfigError, load_config, load_config_file, load_schema, validate_config
 from engines.interface import CaseNotSupported, engine_for
 
 
@@ -207,3 +209,20 @@ def test_an_outlet_as_wide_as_its_silo_is_refused_in_every_silo_type_section(sec
                                           rf"{section}.width \(0.1 m\)$"):
         validate_config(raw)
     validate_config({section: {"width": 0.1, "outlet_width": 0.099}})
+
+
+def update_config_copy(base: dict, layer: dict) -> dict:
+    """``layer`` over ``base`` as Snakemake merges two --configfile files."""
+    merged = copy.deepcopy(base)
+    update_config(merged, layer)
+    return merged
+
+
+def test_the_bayesian_twin_configuration_layers_over_the_default_one():
+    raw = load_config_file(SCHEMA_PATH.parents[2] / "config" / "config.yaml")
+    twin = load_config_file(SCHEMA_PATH.parents[2] / "config" / "bayesian_twin.yaml")
+    config = validate_config(update_config_copy(raw, twin))
+    bayesian = config["calibration"]["bayesian"]
+    assert bayesian["twin"]["enabled"] and bayesian["engines"] == ["liggghts"]
+    assert config["jenike"]["sweep"]["tests"] == ["internal", "aluminium"]
+    assert config["jenike"]["cell"]["inner_diameter"] == 0.04

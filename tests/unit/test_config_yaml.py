@@ -95,7 +95,8 @@ def test_a_file_larger_than_a_configuration_and_what_is_not_a_mapping_are_refuse
 
 
 def test_the_shipped_configurations_read_as_before():
-    for name in ("config/config.yaml", "config/validation.yaml", "config/thesis.yaml", "config/checks.yaml"):
+    for name in ("config/config.yaml", "config/validation.yaml", "config/thesis.yaml", "config/checks.yaml",
+                 "config/bayesian_twin.yaml"):
         with open(name, encoding="utf-8") as handle:
             assert read_config_file(name) == yaml.safe_load(handle), name
 
