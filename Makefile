@@ -65,11 +65,14 @@ verify: install
 		--report $(abspath $(RUN_DIR))/results/report.html
 
 # The joint Bayesian calibration (calibration.bayesian, its own target): per engine, Jenike runs placed by the
-# posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it.
+# posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it;
+# its report is RUN_DIR/results/report-bayesian.html.
 bayesian: install
 	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
 	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
 		--cores $(CORES)
+	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
+		--report $(abspath $(RUN_DIR))/results/report-bayesian.html
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
 # (make estimate CONFIG=config/validation.yaml prints its cost, per group and part). It works in results/validation/
