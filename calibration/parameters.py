@@ -59,12 +59,18 @@ def apply_calibrated_parameters(config: dict, parameters: dict, particle_materia
     return calibrated
 
 
-def calibrated_config(config: dict, parameters_path) -> dict:
-    """The configuration a silo run uses: as given, or with ``parameters: calibrated`` the calibration's choice.
+#: The ``silo_flat.parameters`` that take a calibration's choice: the chart inversion's (``calibrated``) or the joint
+#: Bayesian calibration's posterior mean on the silo's engine (``bayesian``); both files have the same layout.
+CALIBRATED_SOURCES = ("calibrated", "bayesian")
 
-    Reads ``parameters_path`` (YAML) only when ``silo_flat.parameters`` is ``calibrated``.
+
+def calibrated_config(config: dict, parameters_path) -> dict:
+    """The configuration a silo run uses: as given, or with ``parameters: calibrated`` (or ``bayesian``) the
+    calibration's choice.
+
+    Reads ``parameters_path`` (YAML) only when ``silo_flat.parameters`` is one of :data:`CALIBRATED_SOURCES`.
     """
-    if config["silo_flat"]["parameters"] != "calibrated":
+    if config["silo_flat"]["parameters"] not in CALIBRATED_SOURCES:
         return config
     with open(parameters_path, encoding="utf-8") as handle:
         parameters = yaml.safe_load(handle)

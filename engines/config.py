@@ -467,6 +467,10 @@ def _check_bayesian(config: Mapping) -> None:
     if settings["walkers"] < 2 * parameters:
         raise ConfigError(f"config key '{key}.walkers': {settings['walkers']} walkers for {parameters} parameters; "
                           f"the ensemble sampler needs at least {2 * parameters}")
+    silo_engine = config["silo_flat"].get("engine") or config["engine"]["kind"]
+    if config["silo_flat"]["parameters"] == "bayesian" and silo_engine not in settings["engines"]:
+        raise ConfigError(f"config key 'silo_flat.parameters': bayesian takes the posterior on the silo's engine "
+                          f"({silo_engine}), which {key}.engines {settings['engines']} does not calibrate")
     least = settings["initial_sets"] + settings["replicates"] - 1 + settings["predictive_draws"]
     if settings["max_sets"] < least:
         raise ConfigError(f"config key '{key}.max_sets': {settings['max_sets']} parameter sets cannot hold the first "

@@ -27,7 +27,7 @@ from calibration.bayes.surrogate import Surrogate
 from model.cases.jenike import PARTICLE_FRICTION_KEY
 
 __all__ = ["Calibration", "IterationResult", "TWIN_SEED_OFFSET", "calibration_of", "first_design", "iterate", "next_sets",
-           "points_of_set", "predictive_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
+           "point_estimate", "points_of_set", "predictive_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
 
 #: The twin experiment's runs at the truth take seeds from jenike.seed + this on, apart from the design's replicates.
 TWIN_SEED_OFFSET = 100
@@ -277,3 +277,31 @@ def predictive_sets(calibration: Calibration, samples) -> list[dict]:
     count = min(calibration.settings["predictive_draws"], len(samples))
     rows = rng.choice(len(samples), size=count, replace=False)
     return [{"theta": samples[row].tolist(), "replicate": 0} for row in rows]
+
+
+def point_estimate(calibration: Calibration, summary: Mapping, engine: str) -> dict:
+    """The posterior mean as the parameters a silo takes (``silo_flat.parameters: bayesian``), in the layout of the
+    chart inversion's ``parameters.yaml`` (:func:`calibration.parameters.apply_calibrated_parameters`), each value
+    with its posterior sd as ``<key>_error``.
+
+    Parameters
+    ----------
+    summary : Mapping
+        The final posterior's summary (``posterior.json``: ``parameters.<name>.mean`` and ``.sd``).
+    engine : str
+        The engine the posterior is of.
+    """
+    values = summary["parameters"]
+
+    def estimate(name: str) -> dict:
+        return {"sliding_friction": float(values[name]["mean"]), "sliding_friction_error": float(values[name]["sd"])}
+
+    walls = [name.split(".", 1)[1] for name in calibration.names if name.startswith(f"{WALL_PARAMETER}.")]
+    return {
+        "source": f"the joint Bayesian calibration's posterior mean on {engine}",
+        "shape": calibration.shape,
+        "rolling_friction": float(values["rolling_friction"]["mean"]),
+        "rolling_friction_error": float(values["rolling_friction"]["sd"]),
+        "particle_particle": estimate("sliding_friction"),
+        "particle_wall": {wall: estimate(f"{WALL_PARAMETER}.{wall}") for wall in walls},
+    }

@@ -11,7 +11,9 @@ import pytest
 from threadpoolctl import threadpool_limits
 
 from calibration.bayes.joint import (calibration_of, first_design, iterate, next_sets, points_of_set,
-                                     predictive_sets, twin_sets, twin_targets, twin_truth, with_targets)
+                                     point_estimate, predictive_sets, twin_sets, twin_targets, twin_truth,
+                                     with_targets)
+from calibration.parameters import apply_calibrated_parameters
 from calibration.bayes.posterior import in_credible_region
 from engines.config import validate_config
 from model.cases.jenike import build_jenike_case
@@ -121,3 +123,22 @@ def test_a_twin_experiment_runs_the_truth_with_seeds_apart_and_takes_their_mean_
     assert with_targets(calibration, made["targets_deg"]).targets_deg.tolist() == [29.0, 9.5]
     with pytest.raises(ValueError, match=r"no target for the tests \['aluminium'\]"):
         with_targets(calibration, {"internal": 29.0})
+
+
+def test_a_silo_takes_the_posterior_mean_in_the_layout_of_the_chart_inversion():
+    config = _config()
+    calibration = calibration_of(config)
+    summary = {"parameters": {"sliding_friction": {"mean": 0.31, "sd": 0.04},
+                              "rolling_friction": {"mean": 0.12, "sd": 0.02},
+                              "wall_sliding_friction.aluminium": {"mean": 0.22, "sd": 0.03}}}
+    parameters = point_estimate(calibration, summary, "yade")
+    assert parameters == {
+        "source": "the joint Bayesian calibration's posterior mean on yade", "shape": "sphere2",
+        "rolling_friction": 0.12, "rolling_friction_error": 0.02,
+        "particle_particle": {"sliding_friction": 0.31, "sliding_friction_error": 0.04},
+        "particle_wall": {"aluminium": {"sliding_friction": 0.22, "sliding_friction_error": 0.03}},
+    }
+    silo = apply_calibrated_parameters(config, parameters, "hdpe")
+    pairs = {tuple(sorted(c["materials"])): c for c in silo["contacts"]}
+    assert (pairs[("hdpe", "hdpe")]["sliding_friction"], pairs[("hdpe", "hdpe")]["rolling_friction"]) == (0.31, 0.12)
+    assert pairs[("aluminium", "hdpe")]["sliding_friction"] == 0.22

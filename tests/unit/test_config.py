@@ -226,3 +226,11 @@ def test_the_bayesian_twin_configuration_layers_over_the_default_one():
     assert bayesian["twin"]["enabled"] and bayesian["engines"] == ["liggghts"]
     assert config["jenike"]["sweep"]["tests"] == ["internal", "aluminium"]
     assert config["jenike"]["cell"]["inner_diameter"] == 0.04
+
+
+def test_a_silo_on_the_posterior_needs_its_engine_calibrated():
+    with pytest.raises(ConfigError, match=r"^config key 'silo_flat.parameters': bayesian takes the posterior on the "
+                                          r"silo's engine \(yade\), which calibration.bayesian.engines \['liggghts'\] "
+                                          r"does not calibrate$"):
+        validate_config({"silo_flat": {"parameters": "bayesian", "engine": "yade"}})
+    assert validate_config({"silo_flat": {"parameters": "bayesian"}})["silo_flat"]["parameters"] == "bayesian"

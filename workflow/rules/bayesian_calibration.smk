@@ -227,6 +227,19 @@ rule bayes_report:
         "../scripts/bayes_report.py"
 
 
+checkpoint bayes_parameters:
+    input:
+        posterior=f"{bayes_folder()}/posterior.json",
+    output:
+        parameters=f"{bayes_folder()}/parameters.yaml",
+    wildcard_constraints:
+        engine="|".join(ENGINE_KINDS),
+    log:
+        f"{bayes_folder()}/logs/parameters.log",
+    script:
+        "../scripts/bayes_parameters.py"
+
+
 rule bayesian_calibration:
     input:
         posteriors=[f"{bayes_folder(engine)}/posterior.json" for engine in BAYES_SETTINGS["engines"]],

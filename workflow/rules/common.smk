@@ -8,7 +8,8 @@ from pathlib import Path
 sys.path.insert(0, workflow.basedir)
 
 from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
-from calibration.parameters import calibrated_config
+from calibration.parameters import CALIBRATED_SOURCES, calibrated_config
+from model.cases.common import engine_kind
 from model.cases import cases_of
 from model.cases.kinds import CASE_KINDS
 from model.cases.silo_flat import build_silo_case, parametric_variants
@@ -88,13 +89,16 @@ def check_disk_for_pending_runs():
 
 
 def uses_calibrated_parameters():
-    return config["silo_flat"]["parameters"] == "calibrated"
+    return config["silo_flat"]["parameters"] in CALIBRATED_SOURCES
 
 
 def calibrated_parameters_file(wildcards=None):
-    """The calibration's parameters.yaml when the silo uses it (waits for the checkpoint), else nothing."""
+    """The calibration's parameters.yaml when the silo uses it (waits for its checkpoint), else nothing: the chart
+    inversion's, or the Bayesian posterior's on the silo's engine."""
     if not uses_calibrated_parameters():
         return []
+    if config["silo_flat"]["parameters"] == "bayesian":
+        return checkpoints.bayes_parameters.get(engine=engine_kind(config, "silo_flat")).output.parameters
     return checkpoints.calibration_parameters.get().output.parameters
 
 
