@@ -48,7 +48,7 @@ def test_the_configuration_names_the_parameters_and_targets_of_the_tests_it_runs
     assert calibration.names == ("sliding_friction", "rolling_friction", "wall_sliding_friction.aluminium")
     assert calibration.tests == ("internal", "aluminium")  # perspex is no test of the sweep
     assert calibration.targets_deg.tolist() == [30.0, 9.5]
-    assert calibration.lower.tolist() == [0.05, 0.0, 0.05] and calibration.upper.tolist() == [0.8, 0.3, 0.8]
+    assert calibration.lower.tolist() == [0.05, 0.0, 0.05] and calibration.upper.tolist() == [0.6, 0.2, 0.6]
 
 
 def test_a_parameter_set_runs_one_point_per_test_and_its_replicates_other_seeds():
