@@ -570,6 +570,27 @@ def combined_window_method(methods) -> str:
     return STEADY if all(method == STEADY for method in methods) else SECOND_HALF
 
 
+def shear_test_summary(point: dict, run_id: str, n_clumps: int, friction: BulkFriction, window_method: str) -> dict:
+    """The record of one Jenike shear test (``metrics/bulk_friction.json``): its point (shape, test, wall material,
+    rolling friction, restitution, rotation, lid, particle friction, shear velocity in m/s), the bulk friction
+    figures of :func:`bulk_friction_summary` and the clumps sheared."""
+    test = "internal" if point["test"] == "internal" else "wall"
+    return {
+        "run_id": run_id,
+        "shape": point["shape"],
+        "test": test,
+        "wall_material": "" if test == "internal" else point["test"],
+        "rolling_friction": point["rolling_friction"],
+        "restitution": point["restitution"],
+        "rotation_blocked": point["rotation_blocked"],
+        "lid": point["lid"],
+        "particle_friction": point["sliding_friction"],
+        "shear_velocity": point["shear_velocity"],
+        **bulk_friction_summary(friction, window_method),
+        "n_clumps": n_clumps,
+    }
+
+
 def bulk_friction_summary(friction: BulkFriction, window_method: str) -> dict:
     """The bulk friction figures of one shear test as a flat record (``metrics/bulk_friction.json``).
 

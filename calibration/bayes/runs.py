@@ -16,7 +16,7 @@ import numpy as np
 from calibration.bayes.joint import Calibration, points_of_set
 from model.cases.jenike import JenikeCase, build_jenike_case
 
-__all__ = ["cases_of_sets", "engine_config", "observations", "with_runs"]
+__all__ = ["cases_of_sets", "completed_sets", "engine_config", "failed_runs", "observations", "with_runs"]
 
 
 def engine_config(config: Mapping, engine: str) -> dict:
@@ -51,10 +51,31 @@ def cases_of_sets(config: Mapping, engine: str, sets: Sequence[Mapping]) -> dict
     return cases
 
 
+def failed_runs(sets: Sequence[Mapping], summaries: Mapping[str, Mapping]) -> list[dict]:
+    """The runs of ``sets`` that failed (their summary says ``failed``): set, test, run id and the engine's error."""
+    return [{"theta": list(chosen["theta"]), "replicate": chosen["replicate"], "test": test, "run_id": run,
+             "error": summaries[run]["error"]}
+            for chosen in sets for test, run in chosen["runs"].items() if summaries[run].get("failed")]
+
+
+def completed_sets(sets: Sequence[Mapping], summaries: Mapping[str, Mapping]) -> list[Mapping]:
+    """The sets all of whose runs completed (a set with a failed run is left out of the posterior)."""
+    return [chosen for chosen in sets if not any(summaries[run].get("failed") for run in chosen["runs"].values())]
+
+
 def observations(calibration: Calibration, sets: Sequence[Mapping],
                  summaries: Mapping[str, Mapping]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(theta (n, d), angles (n, k), errors (n, k))`` of the sets: each test's bulk friction angle and its standard
-    error (deg), from the runs' bulk friction summaries (``metrics/bulk_friction.json``) by run id."""
+    error (deg), from the runs' bulk friction summaries (``metrics/bulk_friction.json``) by run id.
+
+    Raises
+    ------
+    ValueError
+        Naming a run that failed (take :func:`completed_sets` first).
+    """
+    failed = failed_runs(sets, summaries)
+    if failed:
+        raise ValueError(f"the run {failed[0]['run_id']} failed: {failed[0]['error']}")
     theta = np.array([chosen["theta"] for chosen in sets], dtype=float)
     angles = np.array([[summaries[chosen["runs"][test]]["bulk_friction_angle_deg"] for test in calibration.tests]
                        for chosen in sets], dtype=float)

@@ -13,6 +13,7 @@ from threadpoolctl import threadpool_limits
 from calibration.bayes.joint import (calibration_of, first_design, iterate, next_sets, points_of_set,
                                      point_estimate, predictive_sets, twin_sets, twin_targets, twin_truth,
                                      with_targets)
+from calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
 from calibration.parameters import apply_calibrated_parameters
 from calibration.bayes.posterior import in_credible_region
 from engines.config import validate_config
@@ -142,3 +143,23 @@ def test_a_silo_takes_the_posterior_mean_in_the_layout_of_the_chart_inversion():
     pairs = {tuple(sorted(c["materials"])): c for c in silo["contacts"]}
     assert (pairs[("hdpe", "hdpe")]["sliding_friction"], pairs[("hdpe", "hdpe")]["rolling_friction"]) == (0.31, 0.12)
     assert pairs[("aluminium", "hdpe")]["sliding_friction"] == 0.22
+
+
+def test_a_set_with_a_failed_run_is_left_out_and_named():
+    config = _config()
+    calibration = calibration_of(config)
+    sets = with_runs(config, calibration, [{"theta": [0.3, 0.1, 0.4], "replicate": 0},
+                                           {"theta": [0.5, 0.15, 0.2], "replicate": 0}], "liggghts")
+    good, bad = sets
+    summaries = {run: {"run_id": run, "bulk_friction_angle_deg": 25.0, "bulk_friction_angle_deg_error": 0.2}
+                 for run in good["runs"].values()}
+    summaries[bad["runs"]["internal"]] = {"run_id": bad["runs"]["internal"], "bulk_friction_angle_deg": 30.0,
+                                          "bulk_friction_angle_deg_error": 0.3}
+    summaries[bad["runs"]["aluminium"]] = {"run_id": bad["runs"]["aluminium"], "failed": True, "error": "Lost atoms"}
+    assert failed_runs(sets, summaries) == [{"theta": [0.5, 0.15, 0.2], "replicate": 0, "test": "aluminium",
+                                             "run_id": bad["runs"]["aluminium"], "error": "Lost atoms"}]
+    assert completed_sets(sets, summaries) == [good]
+    theta, angles, errors = observations(calibration, completed_sets(sets, summaries), summaries)
+    assert theta.tolist() == [[0.3, 0.1, 0.4]] and angles.tolist() == [[25.0, 25.0]] and errors.tolist() == [[0.2, 0.2]]
+    with pytest.raises(ValueError, match=f"the run {bad['runs']['aluminium']} failed: Lost atoms"):
+        observations(calibration, sets, summaries)

@@ -9,7 +9,7 @@ import numpy as np
 
 from analysis.io.tables import write_json
 from calibration.bayes.joint import calibration_of, iterate, with_targets
-from calibration.bayes.runs import observations
+from calibration.bayes.runs import completed_sets, failed_runs, observations
 from engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
@@ -19,12 +19,16 @@ with logged_to(snakemake.log[0]) as log:
     sets = [chosen for path in snakemake.input.designs for chosen in json.loads(Path(path).read_text())["sets"]]
     summaries = {summary["run_id"]: summary
                  for summary in (json.loads(Path(path).read_text()) for path in snakemake.input.summaries)}
+    failed = failed_runs(sets, summaries)
+    for run in failed:
+        log.warning("left out: the set %s, whose %s run %s failed", run["theta"], run["test"], run["run_id"])
+    sets = completed_sets(sets, summaries)
     theta, angles, errors = observations(calibration, sets, summaries)
     previous = np.load(snakemake.input.previous[0])["samples"] if snakemake.input.previous else None
     result = iterate(calibration, theta, angles, errors, previous)
     np.savez(snakemake.output.samples, samples=result.sample.samples, log_probability=result.sample.log_probability)
     summary = {"iteration": int(snakemake.wildcards.iteration), "sets": len(sets),
-               "runs": len(sets) * len(calibration.tests), **result.summary(calibration)}
+               "runs": len(sets) * len(calibration.tests), "failed_runs": failed, **result.summary(calibration)}
     write_json(snakemake.output.summary, summary)
     log.info("iteration %s: %d sets; posterior means %s; seed noise %s deg; moved %s (shift %s)",
              snakemake.wildcards.iteration, len(sets),

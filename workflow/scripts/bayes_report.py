@@ -11,6 +11,7 @@ import yaml
 from analysis.io.tables import write_flow_table, write_json, write_text
 from calibration.bayes.joint import calibration_of, twin_truth, with_targets
 from calibration.bayes.plots import plot_corner, plot_predictive
+from calibration.bayes.runs import completed_sets, failed_runs
 from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, interval_rows,
                                       predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
 from engines.logs import logged_to
@@ -38,9 +39,13 @@ with logged_to(snakemake.log[0]) as log:
     intervals = interval_rows(summary, samples, calibration.names)
     write_flow_table(snakemake.output.intervals, intervals)
 
-    predictive = predictive_rows(calibration, predictive_sets, summaries_of(snakemake.input.predictive),
-                                 summary["seed_sd_deg"])
-    verdict = predictive_verdict(predictive)
+    predictive_summaries = summaries_of(snakemake.input.predictive)
+    predictive_failed = failed_runs(predictive_sets, predictive_summaries)
+    for run in predictive_failed:
+        log.warning("predictive draw %s: its %s run %s failed", run["theta"], run["test"], run["run_id"])
+    predictive = predictive_rows(calibration, completed_sets(predictive_sets, predictive_summaries),
+                                 predictive_summaries, summary["seed_sd_deg"])
+    verdict = {**predictive_verdict(predictive), "failed_runs": predictive_failed}
     if predictive:
         write_flow_table(snakemake.output.predictive, predictive)
     else:

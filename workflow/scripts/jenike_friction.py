@@ -4,7 +4,7 @@ from pathlib import Path
 
 from analysis.io.tables import write_json
 from calibration.charts import plot_force_history
-from calibration.friction import bulk_friction_of_shear, bulk_friction_summary
+from calibration.friction import bulk_friction_of_shear, shear_test_summary
 from model.record import read_run_record
 from calibration.shear import shear_signals
 from engines.interface import engine_named
@@ -17,22 +17,7 @@ with logged_to(snakemake.log[0]) as log:
     history = engine_named(record.engine).wall_forces(run_dir, record)
     signals = shear_signals(history, record.labels["shear_start_s"], record.labels["shear_end_s"])
     friction, window_method = bulk_friction_of_shear(signals)
-    test = "internal" if point["test"] == "internal" else "wall"
-    summary = {
-        "run_id": record.run_id,
-        "shape": point["shape"],
-        "test": test,
-        "wall_material": "" if test == "internal" else point["test"],
-        "rolling_friction": point["rolling_friction"],
-        "restitution": point["restitution"],
-        "rotation_blocked": point["rotation_blocked"],
-        "lid": point["lid"],
-        "particle_friction": point["sliding_friction"],
-        "shear_velocity": point["shear_velocity"],
-        **bulk_friction_summary(friction, window_method),
-        "n_clumps": record.n_clumps,
-    }
-    write_json(snakemake.output.summary, summary)
+    write_json(snakemake.output.summary, shear_test_summary(point, record.run_id, record.n_clumps, friction, window_method))
     plot_force_history(signals, friction, snakemake.output.plot,
                        title=f"{point['shape']} {point['test']}: mu = {point['sliding_friction']}, mu_r = {point['rolling_friction']}")
     log.info("bulk friction %.4f +- %.4f (%s window), bottom side %.4f", friction.coefficient,
