@@ -27,7 +27,7 @@ from calibration.bayes.surrogate import Surrogate
 from model.cases.jenike import PARTICLE_FRICTION_KEY
 
 __all__ = ["Calibration", "IterationResult", "TWIN_SEED_OFFSET", "calibration_of", "first_design", "iterate", "next_sets",
-           "point_estimate", "points_of_set", "predictive_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
+           "point_estimate", "points_of_set", "predictive_sets", "ridge_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
 
 #: The twin experiment's runs at the truth take seeds from jenike.seed + this on, apart from the design's replicates.
 TWIN_SEED_OFFSET = 100
@@ -205,7 +205,55 @@ class IterationResult:
             "effective_sample_size": self.sample.effective_sample_size.tolist(),
             "shift": self.shift,
             "moved": self.moved,
+            "ridge": ridge_sets(calibration, self.sample.samples, self.sample.log_probability, self.surrogates),
         }
+
+
+def ridge_sets(calibration: Calibration, samples, log_probability, surrogates, count: int = 7) -> list[dict]:
+    """Parameter sets along the posterior's ridge, which reproduce the targets about equally well.
+
+    The samples are ordered along the posterior's longest axis (the first principal component of the samples scaled
+    by the prior box) and cut into ``count`` bins between its 5 % and 95 % quantiles; from each bin the sample of the
+    highest posterior density is taken, with each test's angle its surrogates predict there (deg, mean and sd).
+
+    Parameters
+    ----------
+    samples : array_like, shape (n, d)
+        Posterior samples (-).
+    log_probability : array_like, shape (n,)
+        Their log posterior.
+    surrogates : sequence
+        One per test, ``predict(theta) -> (mean, std)`` (deg).
+    count : int
+        Sets to return (fewer when bins are empty).
+
+    Returns
+    -------
+    list of dict
+        ``{"position": p, <parameter>: value, ..., "predicted_deg": {test: [mean, sd]}}``, ``p`` the bin centre along
+        the axis as a fraction of the 5-95 % span (0 to 1).
+    """
+    samples = np.asarray(samples, dtype=float)
+    log_probability = np.asarray(log_probability, dtype=float)
+    scaled = (samples - calibration.lower) / (calibration.upper - calibration.lower)
+    centred = scaled - scaled.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    along = centred @ axis
+    low, high = np.quantile(along, [0.05, 0.95])
+    edges = np.linspace(low, high, count + 1)
+    chosen = []
+    for index in range(count):
+        inside = np.flatnonzero((along >= edges[index]) & (along <= edges[index + 1]))
+        if inside.size == 0:
+            continue
+        best = inside[np.argmax(log_probability[inside])]
+        theta = samples[best]
+        predicted = {test: [float(v) for v in (mean[0], std[0])]
+                     for test, (mean, std) in zip(calibration.tests,
+                                                 (surrogate.predict(theta[np.newaxis, :]) for surrogate in surrogates))}
+        chosen.append({"position": (index + 0.5) / count, **dict(zip(calibration.names, theta.tolist())),
+                       "predicted_deg": predicted})
+    return chosen
 
 
 def _replicate_groups(theta: np.ndarray, angles: np.ndarray) -> list[np.ndarray]:

@@ -81,6 +81,9 @@ def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(calibrated, eng
     assert len(rows) == 1 and rows[0]["test"] == "internal" and float(rows[0]["target_deg"]) == pytest.approx(target)
     for name in ("corner.png", "predictive.png", "intervals.csv"):
         assert (folder / name).stat().st_size > 0
+    with open(folder / "ridge.csv", newline="") as handle:
+        ridge = list(csv.DictReader(handle))
+    assert 1 <= len(ridge) <= 7 and all(float(row["predicted_internal_deg"]) > 0 for row in ridge)
 
 
 def test_the_engines_posteriors_stand_side_by_side(calibrated):

@@ -11,7 +11,7 @@ import pytest
 from threadpoolctl import threadpool_limits
 
 from calibration.bayes.joint import (calibration_of, first_design, iterate, next_sets, points_of_set,
-                                     point_estimate, predictive_sets, twin_sets, twin_targets, twin_truth,
+                                     point_estimate, predictive_sets, ridge_sets, twin_sets, twin_targets, twin_truth,
                                      with_targets)
 from calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
 from calibration.parameters import apply_calibrated_parameters
@@ -163,3 +163,30 @@ def test_a_set_with_a_failed_run_is_left_out_and_named():
     assert theta.tolist() == [[0.3, 0.1, 0.4]] and angles.tolist() == [[25.0, 25.0]] and errors.tolist() == [[0.2, 0.2]]
     with pytest.raises(ValueError, match=f"the run {bad['runs']['aluminium']} failed: Lost atoms"):
         observations(calibration, sets, summaries)
+
+
+class _Line:
+    """A surrogate whose angle is 20 + 10 (sliding + rolling) deg, sd 0.5 deg."""
+
+    def predict(self, theta):
+        theta = np.atleast_2d(theta)
+        return 20.0 + 10.0 * (theta[:, 0] + theta[:, 1]), np.full(len(theta), 0.5)
+
+
+def test_the_ridge_runs_along_the_posterior_and_each_set_reproduces_the_target():
+    config = _config()
+    config["jenike"]["sweep"]["tests"] = ["internal"]
+    calibration = calibration_of(config)
+    rng = np.random.default_rng(1)
+    # a ridge sliding + rolling = 0.4: every set on it gives the same angle, 24 deg
+    sliding = rng.uniform(0.25, 0.4, 4000)
+    samples = np.column_stack([sliding, 0.4 - sliding + rng.normal(0, 0.002, 4000)])
+    log_probability = -((samples.sum(axis=1) - 0.4) / 0.002) ** 2
+    ridge = ridge_sets(calibration, samples, log_probability, [_Line()], count=5)
+    assert [row["position"] for row in ridge] == [0.1, 0.3, 0.5, 0.7, 0.9]
+    slidings = [row["sliding_friction"] for row in ridge]
+    assert slidings == sorted(slidings) or slidings == sorted(slidings, reverse=True)
+    assert max(slidings) - min(slidings) > 0.1  # it spans the ridge
+    for row in ridge:
+        assert row["sliding_friction"] + row["rolling_friction"] == pytest.approx(0.4, abs=0.002)
+        assert row["predicted_deg"]["internal"] == pytest.approx([24.0, 0.5], abs=0.02)

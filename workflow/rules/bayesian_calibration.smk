@@ -213,6 +213,8 @@ rule bayes_report:
                          category="1 Calibration", subcategory="Bayesian", labels={"figure": "intervals {engine}"}),
         predictive=report(f"{bayes_folder()}/predictive.csv", caption="../report/bayes_predictive.rst",
                           category="1 Calibration", subcategory="Bayesian", labels={"figure": "predictive table {engine}"}),
+        ridge=report(f"{bayes_folder()}/ridge.csv", caption="../report/bayes_ridge.rst", category="1 Calibration",
+                     subcategory="Bayesian", labels={"figure": "ridge {engine}"}),
         comparison=report(f"{bayes_folder()}/chart_comparison.csv", caption="../report/bayes_chart.rst",
                           category="1 Calibration", subcategory="Bayesian", labels={"figure": "chart beside posterior {engine}"}),
         corner=report(f"{bayes_folder()}/corner.png", caption="../report/bayes_corner.rst", category="1 Calibration",

@@ -38,6 +38,11 @@ with logged_to(snakemake.log[0]) as log:
 
     intervals = interval_rows(summary, samples, calibration.names)
     write_flow_table(snakemake.output.intervals, intervals)
+    ridge = [{key: value for key, value in row.items() if key != "predicted_deg"}
+             | {f"predicted_{test}_{name}": value for test, (mean, sd) in row["predicted_deg"].items()
+                for name, value in (("deg", mean), ("sd_deg", sd))}
+             for row in summary["ridge"]]
+    write_flow_table(snakemake.output.ridge, ridge)
 
     predictive_summaries = summaries_of(snakemake.input.predictive)
     predictive_failed = failed_runs(predictive_sets, predictive_summaries)
