@@ -463,7 +463,11 @@ def _check_bayesian(config: Mapping) -> None:
                               f"[{prior['lower']}, {prior['upper']}]")
     walls = [test for test in config["calibration"]["targets_deg"]
              if test != "internal" and test in config["jenike"]["sweep"]["tests"]]
-    parameters = 2 + len(walls)
+    held = settings["fixed"]
+    parameters = ((held["sliding_friction"] is None) + (held["rolling_friction"] is None)
+                  + (len(walls) if held["wall_sliding_friction"] is None else 0))
+    if parameters == 0:
+        raise ConfigError(f"config key '{key}.fixed': every parameter is held fixed; leave at least one to calibrate")
     if settings["walkers"] < 2 * parameters:
         raise ConfigError(f"config key '{key}.walkers': {settings['walkers']} walkers for {parameters} parameters; "
                           f"the ensemble sampler needs at least {2 * parameters}")

@@ -13,7 +13,7 @@ observables are the bulk friction angles of those tests (deg).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -58,6 +58,9 @@ class Calibration:
         The restitution of the runs (-).
     settings : Mapping
         ``calibration.bayesian``.
+    fixed : Mapping
+        The parameters the user holds at a value instead of calibrating them (``calibration.bayesian.fixed``), by
+        name (-); every run takes them, the posterior has no dimension for them.
     """
 
     names: tuple[str, ...]
@@ -68,6 +71,7 @@ class Calibration:
     shape: str
     restitution: float
     settings: Mapping
+    fixed: Mapping = field(default_factory=dict)
 
     @property
     def lower(self) -> np.ndarray:
@@ -87,15 +91,20 @@ def calibration_of(config: Mapping) -> Calibration:
     targets = {test: angle for test, angle in config["calibration"]["targets_deg"].items() if test in sweep_tests}
     tests = tuple(sorted(targets, key=lambda test: test != INTERNAL))
     walls = [test for test in tests if test != INTERNAL]
-    names = ("sliding_friction", "rolling_friction", *(f"{WALL_PARAMETER}.{wall}" for wall in walls))
-    chosen = [priors["sliding_friction"], priors["rolling_friction"], *([priors[WALL_PARAMETER]] * len(walls))]
+    every = {"sliding_friction": priors["sliding_friction"], "rolling_friction": priors["rolling_friction"],
+             **{f"{WALL_PARAMETER}.{wall}": priors[WALL_PARAMETER] for wall in walls}}
+    held = settings["fixed"]
+    fixed = {name: float(held[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name]) for name in every
+             if held[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name] is not None}
+    names = tuple(name for name in every if name not in fixed)
+    chosen = [every[name] for name in names]
     mean = np.array([np.nan if p["mean"] is None else p["mean"] for p in chosen])
     sd = np.array([np.nan if p["sd"] is None else p["sd"] for p in chosen])
     prior = Prior(np.array([p["lower"] for p in chosen], dtype=float), np.array([p["upper"] for p in chosen], dtype=float),
                   mean, sd)
     return Calibration(names, prior, tests, np.array([targets[test] for test in tests], dtype=float),
                        float(config["calibration"]["tolerance_deg"]), config["calibration"]["shape"],
-                       float(config["jenike"]["sweep"]["restitution"]), settings)
+                       float(config["jenike"]["sweep"]["restitution"]), settings, fixed)
 
 
 def with_targets(calibration: Calibration, targets_deg: Mapping[str, float]) -> Calibration:
@@ -137,7 +146,7 @@ def twin_targets(calibration: Calibration, angles_deg) -> dict:
 def points_of_set(calibration: Calibration, theta: Sequence[float], replicate: int = 0) -> list[dict]:
     """The Jenike points of one parameter set, one per test (:func:`model.cases.jenike.build_jenike_case`); a
     replicate ``k`` > 0 adds k to the seed."""
-    values = dict(zip(calibration.names, map(float, theta)))
+    values = {**calibration.fixed, **dict(zip(calibration.names, map(float, theta)))}
     common = {"shape": calibration.shape, "rolling_friction": values["rolling_friction"],
               "restitution": calibration.restitution, "rotation_blocked": False}
     points = []
@@ -339,12 +348,13 @@ def point_estimate(calibration: Calibration, summary: Mapping, engine: str) -> d
     engine : str
         The engine the posterior is of.
     """
-    values = summary["parameters"]
+    # a parameter held fixed has its value and no spread
+    values = {**{name: {"mean": value, "sd": 0.0} for name, value in calibration.fixed.items()}, **summary["parameters"]}
 
     def estimate(name: str) -> dict:
         return {"sliding_friction": float(values[name]["mean"]), "sliding_friction_error": float(values[name]["sd"])}
 
-    walls = [name.split(".", 1)[1] for name in calibration.names if name.startswith(f"{WALL_PARAMETER}.")]
+    walls = [name.split(".", 1)[1] for name in values if name.startswith(f"{WALL_PARAMETER}.")]
     return {
         "source": f"the joint Bayesian calibration's posterior mean on {engine}",
         "shape": calibration.shape,

@@ -267,7 +267,10 @@ def chart_comparison_rows(calibration: Calibration, samples, chart_parameters: M
     rolling = float(chart_parameters["rolling_friction"])
     interval = np.atleast_2d(credible_interval(values, level))
     mean, sd = values.mean(axis=0), values.std(axis=0, ddof=1)
-    near = np.abs(values[:, names.index(ROLLING)] - rolling) <= window
+    if ROLLING in names:
+        near = np.abs(values[:, names.index(ROLLING)] - rolling) <= window
+    else:  # held fixed in the Bayesian calibration: every sample has the same rolling friction
+        near = np.full(len(values), abs(calibration.fixed[ROLLING] - rolling) <= window)
     count = int(near.sum())
     enough = count >= min_samples
     conditional_mean = values[near].mean(axis=0) if enough else None

@@ -16,7 +16,7 @@ from calibration.bayes.joint import (calibration_of, first_design, iterate, next
 from calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
 from calibration.parameters import apply_calibrated_parameters
 from calibration.bayes.posterior import in_credible_region
-from engines.config import validate_config
+from engines.config import ConfigError, validate_config
 from model.cases.jenike import build_jenike_case
 
 
@@ -190,3 +190,21 @@ def test_the_ridge_runs_along_the_posterior_and_each_set_reproduces_the_target()
     for row in ridge:
         assert row["sliding_friction"] + row["rolling_friction"] == pytest.approx(0.4, abs=0.002)
         assert row["predicted_deg"]["internal"] == pytest.approx([24.0, 0.5], abs=0.02)
+
+
+def test_a_parameter_held_fixed_has_no_dimension_and_every_run_takes_it():
+    config = _config(fixed={"rolling_friction": 0.1})
+    calibration = calibration_of(config)
+    assert calibration.names == ("sliding_friction", "wall_sliding_friction.aluminium")
+    assert calibration.fixed == {"rolling_friction": 0.1}
+    assert calibration.lower.tolist() == [0.05, 0.05] and calibration.upper.tolist() == [0.6, 0.6]
+    internal, wall = points_of_set(calibration, [0.3, 0.4])
+    assert (internal["sliding_friction"], internal["rolling_friction"]) == (0.3, 0.1)
+    assert (wall["sliding_friction"], wall["rolling_friction"], wall["particle_sliding_friction"]) == (0.4, 0.1, 0.3)
+    summary = {"parameters": {"sliding_friction": {"mean": 0.31, "sd": 0.04},
+                              "wall_sliding_friction.aluminium": {"mean": 0.22, "sd": 0.03}}}
+    estimate = point_estimate(calibration, summary, "liggghts")
+    assert (estimate["rolling_friction"], estimate["rolling_friction_error"]) == (0.1, 0.0)
+    assert estimate["particle_wall"] == {"aluminium": {"sliding_friction": 0.22, "sliding_friction_error": 0.03}}
+    with pytest.raises(ConfigError, match="every parameter is held fixed"):
+        _config(fixed={"rolling_friction": 0.1, "sliding_friction": 0.3, "wall_sliding_friction": 0.2})

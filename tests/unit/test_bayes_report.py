@@ -11,7 +11,8 @@ import pytest
 from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
 
-from calibration.bayes.joint import Calibration
+from calibration.bayes.joint import Calibration, calibration_of
+from engines.config import validate_config
 from calibration.bayes.plots import CHART_COLOR, plot_corner, plot_predictive
 from calibration.bayes.posterior import Prior
 from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
@@ -288,3 +289,16 @@ def test_the_twin_verdict_says_whether_the_truth_came_back():
     outside = twin_verdict(["sliding_friction", "rolling_friction"], samples, [0.4, 0.1])
     assert not outside["inside_credible_region"] and not outside["marginals"]["sliding_friction"]["inside"]
     assert outside["marginals"]["rolling_friction"]["inside"]
+
+
+def test_the_chart_comparison_of_a_calibration_with_its_rolling_friction_held_fixed():
+    config = validate_config({"calibration": {"targets_deg": {"internal": 30.0}, "rolling_friction": 0.1,
+                                              "bayesian": {"fixed": {"rolling_friction": 0.1}}},
+                              "jenike": {"sweep": {"tests": ["internal"]}}})
+    calibration = calibration_of(config)
+    samples = np.linspace(0.2, 0.4, 101)[:, np.newaxis]
+    chart = {"shape": "sphere2", "rolling_friction": 0.1,
+             "particle_particle": {"sliding_friction": 0.3, "sliding_friction_error": 0.01}}
+    (row,) = chart_comparison_rows(calibration, samples, chart)
+    assert row["parameter"] == "sliding_friction" and row["chart_inside"]
+    assert row["conditional_samples"] == 101 and row["conditional_mean"] == pytest.approx(0.3)
