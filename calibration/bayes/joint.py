@@ -82,6 +82,12 @@ class Calibration:
         return self.prior.upper
 
 
+def _setting(name: str) -> str:
+    """The key of ``calibration.bayesian``'s ``priors``, ``fixed`` and ``twin.truth`` that sets parameter ``name``:
+    one ``wall_sliding_friction`` serves every wall material's."""
+    return WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name
+
+
 def calibration_of(config: Mapping) -> Calibration:
     """The Bayesian calibration a validated configuration defines: the targets of ``calibration.targets_deg`` whose
     test is in ``jenike.sweep.tests`` (the internal one first, then the walls in the targets' order)."""
@@ -91,13 +97,11 @@ def calibration_of(config: Mapping) -> Calibration:
     targets = {test: angle for test, angle in config["calibration"]["targets_deg"].items() if test in sweep_tests}
     tests = tuple(sorted(targets, key=lambda test: test != INTERNAL))
     walls = [test for test in tests if test != INTERNAL]
-    every = {"sliding_friction": priors["sliding_friction"], "rolling_friction": priors["rolling_friction"],
-             **{f"{WALL_PARAMETER}.{wall}": priors[WALL_PARAMETER] for wall in walls}}
+    every = ("sliding_friction", "rolling_friction", *(f"{WALL_PARAMETER}.{wall}" for wall in walls))
     held = settings["fixed"]
-    fixed = {name: float(held[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name]) for name in every
-             if held[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name] is not None}
+    fixed = {name: float(held[_setting(name)]) for name in every if held[_setting(name)] is not None}
     names = tuple(name for name in every if name not in fixed)
-    chosen = [every[name] for name in names]
+    chosen = [priors[_setting(name)] for name in names]
     mean = np.array([np.nan if p["mean"] is None else p["mean"] for p in chosen])
     sd = np.array([np.nan if p["sd"] is None else p["sd"] for p in chosen])
     prior = Prior(np.array([p["lower"] for p in chosen], dtype=float), np.array([p["upper"] for p in chosen], dtype=float),
@@ -118,8 +122,7 @@ def with_targets(calibration: Calibration, targets_deg: Mapping[str, float]) -> 
 def twin_truth(calibration: Calibration) -> np.ndarray:
     """The twin experiment's known parameters (``calibration.bayesian.twin.truth``), in the calibration's order."""
     truth = calibration.settings["twin"]["truth"]
-    return np.array([truth[WALL_PARAMETER if name.startswith(f"{WALL_PARAMETER}.") else name]
-                     for name in calibration.names], dtype=float)
+    return np.array([truth[_setting(name)] for name in calibration.names], dtype=float)
 
 
 def twin_sets(calibration: Calibration) -> list[dict]:

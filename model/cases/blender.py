@@ -350,14 +350,6 @@ def blender_cases(config: dict) -> dict[str, BlenderCase]:
     return {case.run_id: case for case in cases}
 
 
-def blender_case_for_run(config: dict, run: str) -> BlenderCase:
-    """The case of run id ``run``; an error names the runs the config does define."""
-    cases = blender_cases(config)
-    if run not in cases:
-        raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
-    return cases[run]
-
-
 #: The gate over the outlet, removed when the outlet opens.
 GATE = "outlet_gate"
 #: Longest outline edge of a wall mesh (m): keeps triangles from being extremely elongated.

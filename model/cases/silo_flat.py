@@ -295,11 +295,3 @@ def silo_cases(config: dict) -> dict[str, SiloCase]:
         case = build_silo_case(run_config)
         cases[case.run_id] = case
     return cases
-
-
-def silo_case_for_run(config: dict, run: str) -> SiloCase:
-    """The case of run id ``run`` in ``config``; an error names the runs the config does define."""
-    cases = silo_cases(config)
-    if run not in cases:
-        raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
-    return cases[run]

@@ -266,14 +266,6 @@ def recirculation_cases(config: dict) -> dict[str, RecirculationCase]:
     return {case.run_id: case for case in cases}
 
 
-def recirculation_case_for_run(config: dict, run: str) -> RecirculationCase:
-    """The case of run id ``run``; an error names the runs the config does define."""
-    cases = recirculation_cases(config)
-    if run not in cases:
-        raise KeyError(f"run '{run}' is not defined by this configuration; it defines: {', '.join(sorted(cases))}")
-    return cases[run]
-
-
 def check_recirculation_config(config: Mapping, contact_pairs: Mapping) -> None:
     """The recirculating silo's own checks: its flow patterns name presets, its layouts have distinct names, its
     bulk density slab is an increasing pair. Its outlet is checked with every silo-type

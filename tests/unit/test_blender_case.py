@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from model.cases import case_for_run
 from model.cases.blender import (
-    blender_case_for_run, blender_cases, blender_mesh_set, build_blender_case, fill_cross_section_area,
+    blender_cases, blender_mesh_set, build_blender_case, fill_cross_section_area,
 )
 from model.cases.blender_geometry import blender_geometry
 from model.cases.blender_meshes import is_watertight
@@ -158,9 +159,9 @@ def test_runs_are_configurations_times_gravity_factors_and_analysis_keys_do_not_
     run = build_blender_case(golden_config, "straight").run_id
     tweaked = changed(golden_config, lambda b: (b.update(bin_size=0.02), b["rtd"].update(bins=10)))
     assert build_blender_case(tweaked, "straight").run_id == run
-    assert blender_case_for_run(golden_config, run).configuration == "straight"
+    assert case_for_run(golden_config, "blender", run).configuration == "straight"
     with pytest.raises(KeyError, match="defines"):
-        blender_case_for_run(golden_config, "straight-g1-0000000000")
+        case_for_run(golden_config, "blender", "straight-g1-0000000000")
     disabled = changed(golden_config, lambda b: b.update(enabled=False))
     assert blender_cases(disabled) == {}
 

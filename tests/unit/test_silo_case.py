@@ -9,7 +9,8 @@ import pytest
 
 from engines.config import validate_config
 from model.cases.common import material_table, run_id
-from model.cases.silo_flat import build_silo_case, silo_case_for_run
+from model.cases import case_for_run
+from model.cases.silo_flat import build_silo_case
 
 
 def test_clump_count_follows_the_fill_height(tiny_config):
@@ -135,7 +136,7 @@ def test_run_id_hash_by_hand():
 
 def test_unknown_run_is_reported_with_the_defined_ones(tiny_config):
     with pytest.raises(KeyError, match="defines: sphere2-"):
-        silo_case_for_run(tiny_config, "sphere2-0000000000")
+        case_for_run(tiny_config, "silo_flat", "sphere2-0000000000")
 
 
 @pytest.mark.parametrize(

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from model.cases import case_for_run
 from model.cases.silo_recirculation import (
     apply_flow_pattern,
     build_recirculation_case,
     estimated_residence_time,
-    recirculation_case_for_run,
     recirculation_cases,
 )
 from model.cases.physics import steps_for
@@ -109,7 +109,7 @@ def test_runs_are_keyed_by_pattern_and_role(golden_config):
     thin = next(case for case in cases.values() if case.role == "verification")
     assert thin.silo.depth == raw["silo_recirculation"]["verification"]["depth"]
     with pytest.raises(KeyError, match="it defines"):
-        recirculation_case_for_run(raw, "internal_flow-0000000000")
+        case_for_run(raw, "silo_recirculation", "internal_flow-0000000000")
     raw["silo_recirculation"]["enabled"] = False
     assert recirculation_cases(raw) == {}
 

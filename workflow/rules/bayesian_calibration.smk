@@ -38,10 +38,20 @@ def bayes_run_file(name, engine="{engine}", run="{run}"):
     return f"{bayes_folder(engine)}/runs/{run}/{name}"
 
 
+#: Each design file as read, by path and version: the DAG asks for the same designs once per job.
+_DESIGNS = {}
+
+
+def read_design(path):
+    version = (str(path), Path(path).stat().st_mtime_ns)
+    if version not in _DESIGNS:
+        _DESIGNS[version] = json.loads(Path(path).read_text())
+    return _DESIGNS[version]
+
+
 def bayes_design(engine, iteration):
     """The sets of iteration ``iteration``'s design on ``engine`` (waits for its checkpoint)."""
-    path = checkpoints.bayes_design.get(engine=engine, iteration=str(iteration)).output.design
-    return json.loads(Path(path).read_text())
+    return read_design(checkpoints.bayes_design.get(engine=engine, iteration=str(iteration)).output.design)
 
 
 def bayes_sets_upto(engine, iteration):
@@ -56,7 +66,7 @@ def bayes_summaries(sets, engine):
 def bayes_case(engine, run):
     """The case of a run of a design written on ``engine`` (its iterations' and the predictive check's) or of the twin
     experiment's truth."""
-    designs = [json.loads(path.read_text())["sets"] for path in sorted(Path(bayes_folder(engine)).glob("*/design.json"))]
+    designs = [read_design(path)["sets"] for path in sorted(Path(bayes_folder(engine)).glob("*/design.json"))]
     for found in (TWIN_SETS.get(engine, []), *designs):
         sets = [chosen for chosen in found if run in chosen["runs"].values()]
         if sets:
@@ -189,8 +199,7 @@ checkpoint bayes_predictive_design:
 
 
 def bayes_predictive_sets(engine):
-    path = checkpoints.bayes_predictive_design.get(engine=engine).output.design
-    return json.loads(Path(path).read_text())["sets"]
+    return read_design(checkpoints.bayes_predictive_design.get(engine=engine).output.design)["sets"]
 
 
 rule bayes_report:
