@@ -75,3 +75,11 @@ def calibrated_config(config: dict, parameters_path) -> dict:
     with open(parameters_path, encoding="utf-8") as handle:
         parameters = yaml.safe_load(handle)
     return apply_calibrated_parameters(config, parameters, config["silo_flat"]["particle_material"])
+
+
+def posterior_draw_configs(config: dict, draws: list[dict]) -> list[tuple[str, dict]]:
+    """The configurations of a silo run at each posterior draw (``silo_flat.posterior_draws``): ``[(label, config)]``,
+    labelled ``draw 0``, ``draw 1``, ..., each ``config`` with one draw's parameters (the layout of
+    ``parameters.yaml``, :func:`calibration.bayes.joint.draw_estimates`) in place of its contacts'."""
+    material = config["silo_flat"]["particle_material"]
+    return [(f"draw {number}", apply_calibrated_parameters(config, draw, material)) for number, draw in enumerate(draws)]

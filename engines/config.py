@@ -475,6 +475,9 @@ def _check_bayesian(config: Mapping) -> None:
     if config["silo_flat"]["parameters"] == "bayesian" and silo_engine not in settings["engines"]:
         raise ConfigError(f"config key 'silo_flat.parameters': bayesian takes the posterior on the silo's engine "
                           f"({silo_engine}), which {key}.engines {settings['engines']} does not calibrate")
+    if config["silo_flat"]["posterior_draws"] and config["silo_flat"]["parameters"] != "bayesian":
+        raise ConfigError("config key 'silo_flat.posterior_draws': the silo runs at posterior draws only with "
+                          f"silo_flat.parameters: bayesian (it is {config['silo_flat']['parameters']!r})")
     least = settings["initial_sets"] + settings["replicates"] - 1 + settings["predictive_draws"]
     if settings["max_sets"] < least:
         raise ConfigError(f"config key '{key}.max_sets': {settings['max_sets']} parameter sets cannot hold the first "

@@ -26,8 +26,9 @@ from calibration.bayes.stopping import posterior_moved
 from calibration.bayes.surrogate import Surrogate
 from model.cases.jenike import PARTICLE_FRICTION_KEY
 
-__all__ = ["Calibration", "IterationResult", "TWIN_SEED_OFFSET", "calibration_of", "first_design", "iterate", "next_sets",
-           "point_estimate", "points_of_set", "predictive_sets", "ridge_sets", "twin_sets", "twin_targets", "twin_truth", "with_targets"]
+__all__ = ["Calibration", "IterationResult", "TWIN_SEED_OFFSET", "calibration_of", "draw_estimates", "first_design",
+           "iterate", "next_sets", "point_estimate", "points_of_set", "predictive_sets", "ridge_sets", "twin_sets",
+           "twin_targets", "twin_truth", "with_targets"]
 
 #: The twin experiment's runs at the truth take seeds from jenike.seed + this on, apart from the design's replicates.
 TWIN_SEED_OFFSET = 100
@@ -351,15 +352,40 @@ def point_estimate(calibration: Calibration, summary: Mapping, engine: str) -> d
     engine : str
         The engine the posterior is of.
     """
+    return _silo_parameters(calibration, summary["parameters"],
+                            f"the joint Bayesian calibration's posterior mean on {engine}")
+
+
+def draw_estimates(calibration: Calibration, sets: Sequence[Mapping], engine: str) -> list[dict]:
+    """The posterior draws of the predictive check (``predictive/design.json``'s sets) as parameters a silo takes, in
+    the layout of :func:`point_estimate`, so that silo runs at them (``silo_flat.posterior_draws``) give the flow
+    rate and the stresses an error bar from the calibration. A draw is one value: every ``<key>_error`` is 0.
+
+    Parameters
+    ----------
+    sets : sequence of Mapping
+        The drawn sets, each with ``theta`` in the calibration's parameter order (-).
+    engine : str
+        The engine the posterior is of.
+    """
+    return [_silo_parameters(calibration, {name: {"mean": value, "sd": 0.0}
+                                           for name, value in zip(calibration.names, chosen["theta"], strict=True)},
+                             f"posterior draw {number} of the joint Bayesian calibration on {engine}")
+            for number, chosen in enumerate(sets)]
+
+
+def _silo_parameters(calibration: Calibration, parameters: Mapping, source: str) -> dict:
+    """``parameters`` (``{name: {"mean", "sd"}}`` of the free parameters) with the fixed ones, in the layout of the
+    chart inversion's ``parameters.yaml``."""
     # a parameter held fixed has its value and no spread
-    values = {**{name: {"mean": value, "sd": 0.0} for name, value in calibration.fixed.items()}, **summary["parameters"]}
+    values = {**{name: {"mean": value, "sd": 0.0} for name, value in calibration.fixed.items()}, **parameters}
 
     def estimate(name: str) -> dict:
         return {"sliding_friction": float(values[name]["mean"]), "sliding_friction_error": float(values[name]["sd"])}
 
     walls = [name.split(".", 1)[1] for name in values if name.startswith(f"{WALL_PARAMETER}.")]
     return {
-        "source": f"the joint Bayesian calibration's posterior mean on {engine}",
+        "source": source,
         "shape": calibration.shape,
         "rolling_friction": float(values["rolling_friction"]["mean"]),
         "rolling_friction_error": float(values["rolling_friction"]["sd"]),

@@ -32,7 +32,7 @@ CASE_NAME = "silo_flat"
 #: Keys that do not define a run: analysis settings, the replicate count (each replicate is its own run, defined
 #: by its seed), and the runs siloflow did not make, which it only analyses.
 ANALYSIS_ONLY_KEYS = ("steady_window", "beverloo", "fields", "parametric", "replicates", "reference_replicates", "piv",
-                      "existing_runs")
+                      "existing_runs", "posterior_draws")
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 replicate, one further iteration of one set, one posterior draw run for the predictive check, on LIGGGHTS and on
 YADE, as a twin experiment (the targets are each engine's own mean angle of two runs at known parameters). The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
 iterations, the posterior and the report come out of `snakemake bayesian_calibration`, that the seed noise is measured
-from the replicate, and that both engines give a posterior.
+from the replicate, and that both engines give a posterior; then that a small silo on LIGGGHTS runs at the posterior
+mean and at the posterior draw (``silo_flat.posterior_draws``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import yaml
 
 from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts, require_yade, run_snakemake
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(200)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(280)]
 
 TINY_BAYESIAN = {
     "jenike": {**TINY_JENIKE_SWEEP, "sweep": {**TINY_JENIKE_SWEEP["sweep"], "shapes": ["sphere"]}},
@@ -90,3 +91,29 @@ def test_the_engines_posteriors_stand_side_by_side(calibrated):
     with open(calibrated / "engines.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert {row["parameter"] for row in rows} >= {"sliding_friction", "rolling_friction"}
+
+
+def test_the_silo_runs_at_the_posterior_mean_and_at_each_draw(calibrated):
+    workdir = calibrated.parents[2]
+    config_path = workdir / "silo_draws.yaml"
+    config_path.write_text(yaml.safe_dump({**TINY_BAYESIAN, "silo_flat": {**SMALL_SILO, "parameters": "bayesian",
+                                                                          "posterior_draws": True}}))
+    summary_path = workdir / "results" / "silo_flat" / "posterior_draws" / "summary.json"
+    result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path),
+                           targets=(str(summary_path.relative_to(workdir)),))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    summary = json.loads(summary_path.read_text())
+    mean, draw = summary["runs"]
+    posterior = json.loads((calibrated / "liggghts" / "posterior.json").read_text())["parameters"]
+    assert mean["label"] == "posterior mean" and draw["label"] == "draw 0" and mean["run_id"] != draw["run_id"]
+    assert mean["sliding_friction"] == pytest.approx(posterior["sliding_friction"]["mean"])
+    predictive = json.loads((calibrated / "liggghts" / "predictive" / "design.json").read_text())["sets"]
+    assert [draw["sliding_friction"], draw["rolling_friction"]] == pytest.approx(predictive[0]["theta"])
+    for run in (mean, draw):
+        flow = json.loads((workdir / "results" / "silo_flat" / run["run_id"] / "metrics" / "flow.json").read_text())
+        assert run["mass_flow_rate_kg_s"] == flow["mass_flow_rate_kg_s"] > 0
+        assert run["base_vertical_stress_Pa"] > 0 and run["base_vertical_stress_Pa_error"] >= 0
+    # one draw: no spread between draws, so no calibration error bar and no verdict
+    assert [row["draws"] for row in summary["spread"]] == [1, 1]
+    assert all(row["spread_exceeds_run_error"] is None for row in summary["spread"])
+    assert (workdir / "results" / "silo_flat" / "posterior_draws" / "draws.png").stat().st_size > 0

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from calibration.bayes.joint import (calibration_of, first_design, iterate, next_sets, points_of_set,
+from calibration.bayes.joint import (calibration_of, draw_estimates, first_design, iterate, next_sets, points_of_set,
                                      point_estimate, predictive_sets, ridge_sets, twin_sets, twin_targets, twin_truth,
                                      with_targets)
 from calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
-from calibration.parameters import apply_calibrated_parameters
+from calibration.parameters import apply_calibrated_parameters, posterior_draw_configs
 from calibration.bayes.posterior import in_credible_region
 from engines.config import ConfigError, validate_config
 from model.cases.jenike import build_jenike_case
@@ -208,3 +208,32 @@ def test_a_parameter_held_fixed_has_no_dimension_and_every_run_takes_it():
     assert estimate["particle_wall"] == {"aluminium": {"sliding_friction": 0.22, "sliding_friction_error": 0.03}}
     with pytest.raises(ConfigError, match="every parameter is held fixed"):
         _config(fixed={"rolling_friction": 0.1, "sliding_friction": 0.3, "wall_sliding_friction": 0.2})
+
+
+def test_the_posterior_draws_reach_a_silo_each_as_one_parameter_set_with_the_fixed_ones():
+    config = _config(fixed={"rolling_friction": 0.07})
+    calibration = calibration_of(config)
+    assert calibration.names == ("sliding_friction", "wall_sliding_friction.aluminium")
+    draws = draw_estimates(calibration, [{"theta": [0.31, 0.22], "replicate": 0},
+                                         {"theta": [0.45, 0.18], "replicate": 0}], "liggghts")
+    assert draws[1] == {
+        "source": "posterior draw 1 of the joint Bayesian calibration on liggghts", "shape": "sphere2",
+        "rolling_friction": 0.07, "rolling_friction_error": 0.0,
+        "particle_particle": {"sliding_friction": 0.45, "sliding_friction_error": 0.0},
+        "particle_wall": {"aluminium": {"sliding_friction": 0.18, "sliding_friction_error": 0.0}},
+    }
+    configs = posterior_draw_configs(config, draws)
+    assert [label for label, _ in configs] == ["draw 0", "draw 1"]
+    for (_, silo), (mu, mu_wall) in zip(configs, [(0.31, 0.22), (0.45, 0.18)]):
+        pairs = {tuple(sorted(c["materials"])): c for c in silo["contacts"]}
+        assert (pairs[("hdpe", "hdpe")]["sliding_friction"], pairs[("hdpe", "hdpe")]["rolling_friction"]) == (mu, 0.07)
+        assert pairs[("aluminium", "hdpe")]["sliding_friction"] == mu_wall
+    with pytest.raises(ValueError, match="one value per parameter|zip"):
+        draw_estimates(calibration, [{"theta": [0.3], "replicate": 0}], "liggghts")
+
+
+def test_silo_runs_at_posterior_draws_need_the_bayesian_parameters():
+    with pytest.raises(ConfigError, match="silo_flat.posterior_draws.*parameters: bayesian"):
+        validate_config({"silo_flat": {"posterior_draws": True}})
+    assert validate_config({"silo_flat": {"posterior_draws": True, "parameters": "bayesian"},
+                            "calibration": {"bayesian": {"engines": ["liggghts"]}}})["silo_flat"]["posterior_draws"]

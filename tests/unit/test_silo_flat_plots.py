@@ -23,6 +23,7 @@ from analysis.studies.silo_flat.plots import (
     plot_kinematic_horizontal_velocity,
     plot_measured_comparison,
     plot_parametric_study,
+    plot_posterior_draws,
     plot_profiles_over_silo,
     plot_velocity_contour,
 )
@@ -256,3 +257,20 @@ def test_plot_discharge_states_the_given_flow_rate_error_in_its_legend(tmp_path,
     figure = written(plot_discharge(history, fit, None, path, "discharge", rate_error=0.0021), path)
     labels = [line.get_label() for line in figure.axes[0].get_lines()]
     assert "fit: 0.1 ± 0.0021 kg/s" in labels  # the batch-means error, not the fit's 1e-06
+
+
+def test_plot_posterior_draws_marks_each_run_with_its_error_and_the_calibration_band(tmp_path, written):
+    rows = [{"label": label, "mass_flow_rate_kg_s": flow, "mass_flow_rate_kg_s_error": 0.01,
+             "base_vertical_stress_Pa": stress, "base_vertical_stress_Pa_error": 2.0}
+            for label, flow, stress in (("posterior mean", 0.11, 240.0), ("draw 0", 0.1, 230.0), ("draw 1", 0.13, 250.0))]
+    spread = [{"figure": "mass_flow_rate_kg_s", "unit": "kg/s", "posterior_mean": 0.11, "calibration_sd": 0.02},
+              {"figure": "base_vertical_stress_Pa", "unit": "Pa", "posterior_mean": 240.0, "calibration_sd": float("nan")}]
+    path = tmp_path / "draws.png"
+    figure = written(plot_posterior_draws(rows, spread, path, "draws"), path)
+    flow, stress = figure.axes
+    np.testing.assert_allclose(flow.get_lines()[0].get_xydata(), [[0, 0.11], [1, 0.1], [2, 0.13]])
+    assert [label.get_text() for label in flow.get_xticklabels()] == ["posterior mean", "draw 0", "draw 1"]
+    assert flow.get_ylabel() == "mass flow rate kg s [kg/s]"
+    band = flow.patches[0]
+    assert band.get_y() == pytest.approx(0.09) and band.get_y() + band.get_height() == pytest.approx(0.13)
+    assert not stress.patches  # no calibration band without a spread

@@ -242,8 +242,10 @@ rule bayes_report:
 checkpoint bayes_parameters:
     input:
         posterior=f"{bayes_folder()}/posterior.json",
+        predictive_design=f"{bayes_folder()}/predictive/design.json",
     output:
         parameters=f"{bayes_folder()}/parameters.yaml",
+        draws=f"{bayes_folder()}/draws.yaml",
     wildcard_constraints:
         engine="|".join(ENGINE_KINDS),
     log:

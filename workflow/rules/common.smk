@@ -7,8 +7,10 @@ from pathlib import Path
 
 sys.path.insert(0, workflow.basedir)
 
+import yaml
+
 from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
-from calibration.parameters import CALIBRATED_SOURCES, calibrated_config
+from calibration.parameters import CALIBRATED_SOURCES, calibrated_config, posterior_draw_configs
 from model.cases.common import engine_kind
 from model.cases import cases_of
 from model.cases.kinds import CASE_KINDS
@@ -63,9 +65,25 @@ def cases(kind):
         path = calibrated_parameters_file()
         version = (path, Path(path).stat().st_mtime_ns)
         if version not in _CALIBRATED_CASES:
-            _CALIBRATED_CASES[version] = cases_of(silo_config(), kind)
+            drawn = {case.run_id: case for case in (build_silo_case(c) for _, c in posterior_draw_configs_of_silo())}
+            _CALIBRATED_CASES[version] = {**cases_of(silo_config(), kind), **drawn}
         return _CALIBRATED_CASES[version]
     return CASES[kind]
+
+
+def posterior_draw_configs_of_silo():
+    """``[(label, config)]`` of the silo at each of the Bayesian posterior's draws (``silo_flat.posterior_draws``;
+    waits for the calibration), none without."""
+    if not config["silo_flat"]["posterior_draws"]:
+        return []
+    path = checkpoints.bayes_parameters.get(engine=engine_kind(config, "silo_flat")).output.draws
+    return posterior_draw_configs(config, yaml.safe_load(Path(path).read_text(encoding="utf-8")))
+
+
+def posterior_draw_runs():
+    """``[(label, run id)]`` of the silo at the posterior mean then at each posterior draw (``silo_flat.posterior_draws``)."""
+    return [("posterior mean", build_silo_case(silo_config()).run_id),
+            *((label, build_silo_case(c).run_id) for label, c in posterior_draw_configs_of_silo())]
 
 
 def typed_case(kind):

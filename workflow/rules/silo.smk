@@ -46,9 +46,17 @@ def parametric_targets(wildcards=None):
     ]
 
 
+def posterior_draw_targets(wildcards=None):
+    if not config["silo_flat"]["posterior_draws"]:
+        return []
+    return [f"{case_root('silo_flat')}/posterior_draws/{name}" for name in ("runs.csv", "spread.csv", "summary.json",
+                                                                            "draws.png")]
+
+
 def silo_flat_products(wildcards=None, runs=None):
-    """The flat-bottom silo's products: its runs' (``runs``: these run ids only), with the parametric studies when all."""
-    return silo_flat_targets(runs=runs) + (parametric_targets() if runs is None else [])
+    """The flat-bottom silo's products: its runs' (``runs``: these run ids only), with the parametric studies and the
+    runs at the posterior's draws when all."""
+    return silo_flat_targets(runs=runs) + (parametric_targets() + posterior_draw_targets() if runs is None else [])
 
 
 CASE_TARGETS["silo_flat"] = silo_flat_products
@@ -221,3 +229,24 @@ rule silo_parametric:
         f"{case_root('silo_flat')}/parametric/logs/{{study}}.log",
     script:
         "../scripts/silo_parametric.py"
+
+
+rule silo_posterior_draws:
+    input:
+        parameters=calibrated_parameters_file,
+        draws=lambda wildcards: checkpoints.bayes_parameters.get(engine=engine_kind(config, "silo_flat")).output.draws,
+        flows=lambda wildcards: [run_path("silo_flat", "metrics/flow.json", run) for _, run in posterior_draw_runs()],
+        janssen=lambda wildcards: [run_path("silo_flat", "metrics/janssen.csv", run) for _, run in posterior_draw_runs()],
+    output:
+        table=f"{case_root('silo_flat')}/posterior_draws/runs.csv",
+        spread=report(f"{case_root('silo_flat')}/posterior_draws/spread.csv", caption="../report/silo_posterior_draws.rst", category="2 Silo validation", subcategory="Calibration uncertainty", labels={"figure": "calibration error bars"}),
+        summary=f"{case_root('silo_flat')}/posterior_draws/summary.json",
+        plot=report(f"{case_root('silo_flat')}/posterior_draws/draws.png", caption="../report/silo_posterior_draws.rst", category="2 Silo validation", subcategory="Calibration uncertainty", labels={"figure": "runs at posterior draws"}),
+    params:
+        labels=lambda wildcards: [label for label, _ in posterior_draw_runs()],
+        runs=lambda wildcards: [run for _, run in posterior_draw_runs()],
+        engine=engine_kind(config, "silo_flat"),
+    log:
+        f"{case_root('silo_flat')}/posterior_draws/logs/draws.log",
+    script:
+        "../scripts/silo_posterior_draws.py"

@@ -308,3 +308,30 @@ def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Figure:
     finally:
         plt.close(figure)
     return figure
+
+
+def plot_posterior_draws(rows, spread, path, title: str) -> Figure:
+    """Each figure of the silo at the posterior mean and at each posterior draw, with each run's standard error and
+    the calibration's error bar (``spread``: :func:`analysis.studies.silo_flat.posterior_draws.calibration_spread`) as
+    a band about the posterior mean's value."""
+    figure, axes = plt.subplots(1, len(spread), figsize=(4.5 * len(spread), 3.8), squeeze=False)
+    try:
+        positions = np.arange(len(rows))
+        labels = [row["label"] for row in rows]
+        for axis, summary in zip(axes[0], spread):
+            name = summary["figure"]
+            axis.errorbar(positions, [row[name] for row in rows], yerr=[row[f"{name}_error"] for row in rows],
+                          fmt="o", capsize=3, color="tab:blue", label="run ± its standard error")
+            centre, band = summary["posterior_mean"], summary["calibration_sd"]
+            if np.isfinite(centre) and np.isfinite(band):
+                axis.axhspan(centre - band, centre + band, color="tab:orange", alpha=0.25,
+                             label="posterior mean ± calibration sd")
+            axis.set_xticks(positions, labels, rotation=30, ha="right", fontsize=8)
+            axis.set_ylabel(f"{name.replace('_', ' ')} [{summary['unit']}]")
+            axis.grid(alpha=0.3, axis="y")
+            axis.legend(fontsize=7)
+        figure.suptitle(title)
+        save_png(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
