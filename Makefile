@@ -121,7 +121,7 @@ validate-status: install-python
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 test: install
-	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests siloflow analysis/numerics
 
 test-physics: install
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m physics tests

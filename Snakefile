@@ -1,7 +1,12 @@
 # siloflow: DEM calibration, validation and blending of pellets in silos.
 # Thin entry point: validate the config, include one rule file per stage, declare the final targets.
 
+import os
+
 from snakemake.utils import min_version
+
+# Plots are drawn headless: the jobs' scripts inherit this (no siloflow module chooses a matplotlib backend).
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 min_version("9.0")
 
@@ -26,6 +31,7 @@ for _kind in CASE_KINDS.values():
 include: "workflow/rules/existing_runs.smk"
 include: "workflow/rules/bayesian_calibration.smk"
 include: "workflow/rules/fill_balance.smk"
+include: "workflow/rules/paraview.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/verification.smk"
 include: "workflow/rules/cross_engine.smk"

@@ -1,7 +1,7 @@
-"""Calibration charts and polar diagnostics (PNG, matplotlib Agg backend, no display needed).
+"""Calibration charts and polar diagnostics (PNG, PDF or SVG; no display needed).
 
-Every writer draws a figure and saves it atomically (via
-:func:`analysis.io.plots.save_png`): a reader never sees a half-written PNG
+Every writer draws a figure and saves it atomically in the format of its file name (via
+:func:`analysis.io.plots.save_figure`): a reader never sees a half-written plot
 and a failed write leaves no temporary file behind. It returns that figure,
 already closed (let go by pyplot, so a caller that ignores it leaks nothing):
 its artists still hold the plotted data, which is what the tests check.
@@ -12,16 +12,12 @@ from __future__ import annotations
 import math
 import os
 
-import matplotlib
+import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
+import numpy as np
 
-matplotlib.use("Agg")  # headless: runs on clusters and in CI
-
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-import numpy as np  # noqa: E402
-
-from analysis.io.plots import save_png  # noqa: E402
-from calibration.inversion import CalibrationCurve  # noqa: E402
+from analysis.io.plots import save_figure
+from calibration.inversion import CalibrationCurve
 
 __all__ = ["plot_calibration_chart", "plot_polar_histogram"]
 
@@ -66,7 +62,7 @@ def plot_calibration_chart(
     curves : list of calibration.inversion.CalibrationCurve
         Curves to draw (at least one).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     target_angle_deg : float, optional
@@ -135,7 +131,7 @@ def plot_calibration_chart(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="best", fontsize="small")
         figure.tight_layout()
-        save_png(figure, path)
+        save_figure(figure, path)
     finally:
         plt.close(figure)
     return figure
@@ -153,7 +149,7 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
     counts : array_like, shape (m,)
         Count (or weight) per sector, >= 0.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -186,7 +182,7 @@ def plot_polar_histogram(edges_rad, counts, path: str | os.PathLike, title: str)
         )
         axes.set_title(title)
         figure.tight_layout()
-        save_png(figure, path)
+        save_figure(figure, path)
     finally:
         plt.close(figure)
     return figure
@@ -203,7 +199,7 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
     friction : calibration.friction.BulkFriction
         The bulk friction and its window.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     """
@@ -225,7 +221,7 @@ def plot_force_history(signals, friction, path: str | os.PathLike, title: str) -
                   transform=axes.transAxes, va="top", fontsize=9)
         axes.legend(loc="lower right", fontsize=8)
         axes.grid(alpha=0.3)
-        save_png(figure, path)
+        save_figure(figure, path)
     finally:
         plt.close(figure)
     return figure
@@ -250,7 +246,7 @@ def plot_lid_comparison(rows: list[dict], path: str | os.PathLike, title: str) -
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        save_png(figure, path)
+        save_figure(figure, path)
     finally:
         plt.close(figure)
     return figure

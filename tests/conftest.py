@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import copy
 import importlib.util
+import os
 import shutil
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+# The tests draw headless, as the workflow does (the Snakefile sets the same): no library module of siloflow chooses a
+# backend. Set before anything imports matplotlib, which reads it then; the pipelines the tests start inherit it.
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 import pytest
 

@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from analysis.io.plots import save_png
+from analysis.io.plots import save_figure
 
 
 def saved_figures(monkeypatch, *modules) -> list:
-    """The list that each figure saved through ``save_png`` of ``modules`` is appended to (after it is written)."""
+    """The list that each figure saved through ``save_figure`` of ``modules`` is appended to (after it is written)."""
     saved = []
 
     def keep(figure, path, tight=False):
         saved.append(figure)
-        return save_png(figure, path, tight=tight)
+        return save_figure(figure, path, tight=tight)
 
     for module in modules:
-        monkeypatch.setattr(module, "save_png", keep)
+        monkeypatch.setattr(module, "save_figure", keep)
     return saved

@@ -4,7 +4,8 @@
   through :class:`pyvista.ImageData` and pyvista's ``XMLImageDataWriter``; :func:`write_pvd` writes the
   ParaView collection that makes a time series of them.
 - :func:`read_fields_vti` reads such a file back through :func:`pyvista.read` (used to check the files in
-  the tests; ParaView is the usual reader).
+  the tests; ParaView is the usual reader). :func:`read_pvd` reads a .pvd's entries back (time, file), through
+  :class:`pyvista.PVDReader`.
 - :func:`save_fields_npz` / :func:`load_fields_npz` store the exact arrays (float64, lossless) as a compact
   compressed .npz, the cache the analysis reads back (``averaged.npz`` of the silo workflow).
 
@@ -16,7 +17,7 @@ Why the two small hand-made parts
 * The .vti is written in VTK's *appended raw* mode (UInt64 headers) rather than with
   :meth:`pyvista.DataObject.save`, whose inline base64 makes the file a third larger (measured: 302 kB
   against 228 kB for the 25 x 10 x 10 test field, zlib in both) for no gain; it is three setter calls on the
-  VTK writer that pyvista wraps.
+  VTK writer that pyvista wraps (:func:`analysis.io.vtk_xml.write_vtk_xml`, which every VTK file goes through).
 * The .pvd index is written here with :mod:`xml.etree.ElementTree`: pyvista only reads PVD
   (:class:`pyvista.PVDReader`), meshio writes time series as XDMF only, and VTK's PVD writer
   (``vtkXMLPVDWriter``) ships with ParaView, not VTK.
@@ -52,6 +53,7 @@ import numpy as np
 import pyvista
 
 from analysis.io.tables import atomic_output
+from analysis.io.vtk_xml import checked_array_name, write_vtk_xml
 from analysis.numerics.grid import Fields, Grid
 
 __all__ = [
@@ -59,6 +61,7 @@ __all__ = [
     "fields_image",
     "write_fields_vti",
     "write_pvd",
+    "read_pvd",
     "read_fields_vti",
     "save_fields_npz",
     "load_fields_npz",
@@ -68,7 +71,6 @@ NPZ_FORMAT = "siloflow.fields/1"
 """Value of the ``format`` entry of a fields .npz file."""
 
 _VTK_DTYPES = (np.dtype(np.float64), np.dtype(np.float32), np.dtype(np.uint8), np.dtype(np.int32), np.dtype(np.int64))
-_XML_SPECIAL = "<>&\"'"
 
 
 # --------------------------------------------------------------------------- helpers
@@ -93,12 +95,6 @@ def _grid_shape_of(array, shape: tuple[int, int, int], name: str) -> np.ndarray:
     if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must contain only finite numbers")
     return array
-
-
-def _checked_array_name(name) -> str:
-    if not isinstance(name, str) or not name or name.strip() != name or any(ch in name for ch in _XML_SPECIAL):
-        raise ValueError(f"extra_arrays: invalid array name {name!r} (VTK writes names into the XML unescaped)")
-    return name
 
 
 # --------------------------------------------------------------------------- VTK writers
@@ -127,7 +123,7 @@ def fields_image(
         "mask": fields.mask.astype(np.uint8),
     }
     for name, values in (extra_arrays or {}).items():
-        if _checked_array_name(name) in arrays:
+        if checked_array_name(name, "extra_arrays") in arrays:
             raise ValueError(f"extra_arrays: the name {name!r} is already used by a standard array")
         arrays[name] = _grid_shape_of(values, shape, f"extra_arrays[{name!r}]")
     if time is not None:
@@ -190,25 +186,7 @@ def write_fields_vti(
     pathlib.Path
         The written path.
     """
-    image = fields_image(grid, fields, time, extra_arrays, cell_data)
-    with atomic_output(path) as temporary:
-        # pyvista picks the writer by the file's extension, so write to a .vti first.
-        staged = temporary.with_name(temporary.name + ".vti")
-        try:
-            writer = pyvista.XMLImageDataWriter(staged, image)
-            vtk_writer = writer.writer
-            vtk_writer.SetDataModeToAppended()
-            vtk_writer.EncodeAppendedDataOff()  # raw bytes, not base64 (see the module notes)
-            vtk_writer.SetHeaderTypeToUInt64()
-            if compress:
-                vtk_writer.SetCompressorTypeToZLib()
-            else:
-                vtk_writer.SetCompressorTypeToNone()
-            writer.write()
-            os.replace(staged, temporary)
-        finally:
-            staged.unlink(missing_ok=True)
-    return Path(path)
+    return write_vtk_xml(path, fields_image(grid, fields, time, extra_arrays, cell_data), compress)
 
 
 def write_pvd(path: str | os.PathLike, entries: Sequence[tuple[float, str | os.PathLike]]) -> Path:
@@ -255,6 +233,24 @@ def write_pvd(path: str | os.PathLike, entries: Sequence[tuple[float, str | os.P
     with atomic_output(path) as temporary:
         ElementTree.ElementTree(root).write(temporary, encoding="utf-8", xml_declaration=True)
     return Path(path)
+
+
+def read_pvd(path: str | os.PathLike) -> list[tuple[float, Path]]:
+    """The entries of a ParaView collection (.pvd), read through :class:`pyvista.PVDReader`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A .pvd file, e.g. one :func:`write_pvd` wrote.
+
+    Returns
+    -------
+    list of (float, pathlib.Path)
+        ``(time [s], file)`` per data set in the file's order; each file as the .pvd names it, joined to the
+        .pvd's folder.
+    """
+    folder = Path(path).parent
+    return [(float(entry.time), folder / entry.path) for entry in pyvista.PVDReader(str(path)).datasets]
 
 
 def read_fields_vti(path: str | os.PathLike) -> Fields:

@@ -1,10 +1,14 @@
-"""What every plot writer shares: the headless backend, atomic PNG output, the silo outline and argument checks.
+"""What every plot writer shares: the figure writer (PNG, PDF or SVG, atomic), the silo outline and argument checks.
 
 The study plots (:mod:`analysis.studies.silo_flat.plots`, :mod:`analysis.studies.silo_recirculation.plots`,
 :mod:`analysis.studies.silo_recirculation.rtd_plots`, :mod:`analysis.studies.blender.plots`,
-:mod:`calibration.charts`) draw with matplotlib's Agg backend (no display needed) and save through
-:func:`save_png`. Lengths drawn in the x-z plane follow the project convention: x across the width with
-x = 0 on the silo axis, z up with the floor and outlet plane at z = 0.
+:mod:`calibration.charts`, :mod:`calibration.bayes.plots`) save through :func:`save_figure`, which takes the format
+from the file name's suffix (:data:`PLOT_FORMATS`; the workflow names its plots after ``plots.format``). No module
+of siloflow chooses a matplotlib backend: importing one leaves a notebook's backend as it was. Each writer draws on a
+figure of its own and lets pyplot go of it once saved (or never hands it to pyplot), so it shows no window whatever
+the backend; the workflow, its scripts and the tests run with ``MPLBACKEND=Agg`` (set by the Snakefile and by
+tests/conftest.py), where matplotlib would otherwise look for a display first. Lengths drawn in the x-z plane follow the project convention: x across the width
+with x = 0 on the silo axis, z up with the floor and outlet plane at z = 0.
 """
 
 from __future__ import annotations
@@ -13,16 +17,16 @@ import os
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")  # headless: runs on clusters and in CI
-
-import numpy as np  # noqa: E402
-
-from model.checks import finite_array  # noqa: E402
-from analysis.io.tables import atomic_output  # noqa: E402
+from model.checks import finite_array
+from analysis.io.tables import atomic_output
 
 __all__ = [
-    "save_png",
+    "PLOT_FORMATS",
+    "PLOT_DPI",
+    "plot_format",
+    "save_figure",
     "silo_outline",
     "non_empty_list",
     "tuple_entry",
@@ -31,12 +35,59 @@ __all__ = [
     "positive_finite_points",
 ]
 
+#: The formats a plot is written in, by file name suffix: PNG (raster) for the report and the validation record's
+#: page, PDF and SVG (vector) for papers. The configuration's ``plots.format`` takes one of them.
+PLOT_FORMATS = ("png", "pdf", "svg")
+#: Resolution of a PNG (dots per inch): a 6.4 x 4.8 in figure is 960 x 720 px. A PDF or SVG is vector; this is then
+#: only the resolution of what is drawn as an image in it (a rasterised field).
+PLOT_DPI = 150
+#: Settings of a vector file: TrueType fonts embedded in a PDF (matplotlib's default Type 3 fonts are refused by
+#: journals' submission checks).
+_VECTOR_SETTINGS = {"pdf.fonttype": 42}
 
-def save_png(figure, path: str | os.PathLike, tight: bool = False) -> Path:
-    """Save a figure as a 150 dpi PNG, atomically: a reader never sees a half-written file."""
-    with atomic_output(path) as temporary:
-        # The temporary name has no .png suffix, so give the format explicitly.
-        figure.savefig(temporary, dpi=150, format="png", bbox_inches="tight" if tight else None)
+
+def plot_format(path: str | os.PathLike) -> str:
+    """The format of a plot file, from its name's suffix (one of :data:`PLOT_FORMATS`).
+
+    Raises
+    ------
+    ValueError
+        When the suffix is none of :data:`PLOT_FORMATS`, naming the path.
+    """
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in PLOT_FORMATS:
+        raise ValueError(f"{os.fspath(path)}: a plot is written as {', '.join(f'.{f}' for f in PLOT_FORMATS)}; "
+                         f"the suffix {Path(path).suffix or '(none)'!r} is none of them")
+    return suffix
+
+
+def save_figure(figure, path: str | os.PathLike, tight: bool = False) -> Path:
+    """Save a figure in the format its file name says, atomically: a reader never sees a half-written file.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure, drawn; any backend (a figure saves through the canvas of the file's format).
+    path : str or os.PathLike
+        Destination; its suffix chooses the format (:func:`plot_format`): ``.png`` at :data:`PLOT_DPI` dpi,
+        ``.pdf`` or ``.svg`` vector. The parent folder is created if needed.
+    tight : bool, optional
+        Crop the page to what is drawn (titles or labels reaching past the figure's edge stay in).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        For a suffix that is none of :data:`PLOT_FORMATS`; nothing is written.
+    """
+    file_format = plot_format(path)
+    with atomic_output(path) as temporary, matplotlib.rc_context(_VECTOR_SETTINGS):
+        # The temporary name has no suffix, so give the format explicitly.
+        figure.savefig(temporary, dpi=PLOT_DPI, format=file_format, bbox_inches="tight" if tight else None)
     return Path(path)
 
 

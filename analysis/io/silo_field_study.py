@@ -53,8 +53,9 @@ def write_silo_field_study(outputs: Mapping[str, str | os.PathLike], study: Silo
         ``centreline``, the CSV tables of the depth-averaged and front-wall velocity profiles, the flow channel
         boundary, the kinematic constant B(z), the instantaneous profiles and the centreline velocity (SI units, as
         their columns say); ``summary``, the JSON summary; ``profile_plot``, ``contour_plot``, ``kinematic_plot``,
-        ``kinematic_u_plot`` and ``centreline_plot``, the PNG plots of the time-averaged profiles over the silo, the
-        depth-averaged v_z, B(z), the horizontal velocity against the kinematic model's and the centreline velocity.
+        ``kinematic_u_plot`` and ``centreline_plot``, the plots (PNG, PDF or SVG, as each suffix says) of the
+        time-averaged profiles over the silo, the depth-averaged v_z, B(z), the horizontal velocity against the
+        kinematic model's and the centreline velocity.
     study : SiloFieldStudy
         The study (:func:`analysis.studies.silo_flat.field_study.analyse_silo_fields`).
     vtk_every : int

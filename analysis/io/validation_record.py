@@ -1,5 +1,12 @@
 """Reader and writer of the validation record's files (``docs/validation/<group>/``): ``table.csv``, ``runs.csv``, the
-group's plots and, for a group whose runs another group reads, those runs' products (``products/``). The record itself (its columns, its page) is :mod:`analysis.studies.validation.record`."""
+group's plots and, for a group whose runs another group reads, those runs' products (``products/``). The record itself
+(its columns, its page) is :mod:`analysis.studies.validation.record`.
+
+The record keeps PNG plots (:data:`RECORD_PLOT_FORMAT`): small, and shown on its page. A workflow whose
+``plots.format`` is ``pdf`` or ``svg`` cannot make it: the record refuses such plots (:func:`check_plot_format`,
+before anything runs where the workflow asks for a record) rather than converting them, which would need a PDF or
+SVG renderer. The validation scale's configuration, config/validation.yaml, keeps the default format, png.
+"""
 
 from __future__ import annotations
 
@@ -15,14 +22,25 @@ from analysis.io.tables import write_flow_table
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from analysis.studies.validation.rows import COLUMNS
 
-__all__ = ["TABLE", "RUNS", "PRODUCTS", "benchmark_wall_time", "read_validation_rows", "write_group_record",
-           "read_group_record", "read_record", "restore_products"]
+__all__ = ["TABLE", "RUNS", "PRODUCTS", "RECORD_PLOT_FORMAT", "check_plot_format", "benchmark_wall_time",
+           "read_validation_rows", "write_group_record", "read_group_record", "read_record", "restore_products"]
 
 #: A group's table rows and its runs' provenance, in its folder.
 TABLE, RUNS = "table.csv", "runs.csv"
 #: The folder of a group's record that keeps the products of its runs another group reads, each under its path in the
 #: workflow's working directory (``products/results/...``).
 PRODUCTS = "products"
+#: The format of a record's plots, their file name suffix (see the module's notes).
+RECORD_PLOT_FORMAT = "png"
+
+
+def check_plot_format(plot_format: str) -> None:
+    """Refuse (ValueError) to make a record from plots of ``plot_format`` (the configuration's ``plots.format``, or
+    a plot file's suffix without the dot) unless it is :data:`RECORD_PLOT_FORMAT`, saying what to set."""
+    if plot_format != RECORD_PLOT_FORMAT:
+        raise ValueError(f"the validation record keeps {RECORD_PLOT_FORMAT} plots (small, shown on its page in "
+                         f"docs/validation/), not {plot_format or 'files without a suffix'}: make it with plots.format: "
+                         f"{RECORD_PLOT_FORMAT} (the default, as config/validation.yaml has it)")
 
 
 def _product_path(name: str) -> Path:
@@ -44,15 +62,17 @@ def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], ru
     if not rows or not runs:
         raise ValueError(f"a group's record needs rows and runs; got {len(rows)} rows and {len(runs)} runs")
     products = {_product_path(name): Path(source) for name, source in (products or {}).items()}
+    for name, source in plots.items():
+        if Path(name).name != name or Path(name).suffix != f".{RECORD_PLOT_FORMAT}":
+            raise ValueError(f"a record plot is a {RECORD_PLOT_FORMAT.upper()} file name without a folder, got {name!r}")
+        check_plot_format(Path(source).suffix.lstrip("."))
     directory.mkdir(parents=True, exist_ok=True)
     write_flow_table(directory / TABLE, [{column: row[column] for column in COLUMNS} for row in rows])
     write_flow_table(directory / RUNS, [{column: run[column] for column in RUN_COLUMNS} for run in runs])
-    for stale in directory.glob("*.png"):
+    for stale in directory.glob(f"*.{RECORD_PLOT_FORMAT}"):
         if stale.name not in plots:
             stale.unlink()
     for name, source in plots.items():
-        if Path(name).name != name or not name.endswith(".png"):
-            raise ValueError(f"a record plot is a PNG file name without a folder, got {name!r}")
         shutil.copyfile(source, directory / name)
     kept = directory / PRODUCTS
     # read whole before the folder is replaced: the sources may be the previous record's own products
@@ -106,8 +126,8 @@ def read_group_record(directory: str | os.PathLike) -> GroupRecord:
     rows = read_validation_rows(directory / TABLE) if (directory / TABLE).is_file() else []
     kept = directory / PRODUCTS
     products = sorted(path.relative_to(kept).as_posix() for path in kept.rglob("*") if path.is_file())
-    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=sorted(p.name for p in directory.glob("*.png")),
-                       products=products)
+    plots = sorted(p.name for p in directory.glob(f"*.{RECORD_PLOT_FORMAT}"))
+    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=plots, products=products)
 
 
 def read_record(record_dir: str | os.PathLike, groups: Iterable[str]) -> dict[str, GroupRecord]:

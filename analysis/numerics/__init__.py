@@ -7,6 +7,8 @@
 - ``profiles``: velocity profiles at a height, flow channel boundary, flow rate, comparison with measurements.
 - ``kinematic``: the kinematic model fitted to a profile. ``janssen``: Janssen's vertical stress.
 - ``flow``: discharge (bulk density, discharged mass, steady mass flow rate, Beverloo).
+- ``clump_tracks``: clump centres, velocities and masses over a run's frames, one column per clump;
+  ``exit_times``: when the clumps cross an outlet plane, re-enter through a periodic boundary, and their passes.
 - ``rtd``: residence time distributions from exit times, moments, models. ``lti``: convolution with the RTD,
   VRR, recirculation (imports ``rtd``, never the reverse).
 - ``pathlines``: virtual tracers integrated through velocity fields; ``tracer_seeds``: where they start;

@@ -1,9 +1,10 @@
-"""Figures of a Bayesian calibration: the posterior's corner plot and the posterior predictive check (PNG).
+"""Figures of a Bayesian calibration: the posterior's corner plot and the posterior predictive check (PNG, PDF or SVG).
 
 Each writer draws on its own :class:`matplotlib.figure.Figure` (no pyplot figure manager, no global state, no
-backend chosen at import: a Figure saves its PNG through the Agg canvas whatever the backend), saves it atomically
-at 150 dpi as :func:`analysis.io.plots.save_png` does (a reader never sees a half-written PNG; a failed write leaves
-no temporary file) and returns it: its artists still hold the plotted data, which is what the tests check.
+backend chosen at import: a Figure saves through the canvas of its file's format whatever the backend), saves it
+atomically with :func:`analysis.io.plots.save_figure`, cropped to what is drawn (a corner plot's titles may reach past
+its edge), in the format of the path's suffix (a reader never sees a half-written plot; a failed write leaves no
+temporary file), and returns it: its artists still hold the plotted data, which is what the tests check.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from analysis.io.tables import atomic_output
+from analysis.io.plots import save_figure
 
 __all__ = ["plot_corner", "plot_predictive"]
 
@@ -24,14 +25,6 @@ CHART_COLOR = "tab:red"
 TRUTH_COLOR = "#4682b4"
 #: The quantiles drawn on each marginal and given in its title (-): the 90 % equal-tailed interval and the median.
 QUANTILES = [0.05, 0.5, 0.95]
-
-
-def _save(figure: Figure, path: str | os.PathLike) -> None:
-    """Save a figure as a 150 dpi PNG, atomically, cropped to what is drawn (a corner plot's titles may reach past
-    its edge)."""
-    with atomic_output(path) as temporary:
-        # the temporary name has no .png suffix, so give the format explicitly
-        figure.savefig(temporary, dpi=150, format="png", bbox_inches="tight")
 
 
 def _by_name(values, names: Sequence[str], what: str) -> list[float | None]:
@@ -62,7 +55,7 @@ def plot_corner(samples, names: Sequence[str], path: str | os.PathLike, truths=N
         The parameters, used as the axes' labels ("[-]" appended); each marginal's title gives its median and the
         distances to its 5 and 95 % quantiles (a wall parameter named by its material alone).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     truths : Mapping of str to float, or sequence of float, optional
         Known true values (-) to mark (squares and lines, steel blue), e.g. of a synthetic twin calibration; None
         (or NaN) for a parameter leaves it unmarked.
@@ -95,7 +88,7 @@ def plot_corner(samples, names: Sequence[str], path: str | os.PathLike, truths=N
         pairs = [[np.nan if value is None else value for value in marked_chart]]
         corner.overplot_points(figure, pairs, color=CHART_COLOR, marker="o", markersize=4)
         figure.text(0.98, 0.98, "dashed red: the chart's values", ha="right", va="top", fontsize=9, color=CHART_COLOR)
-    _save(figure, path)
+    save_figure(figure, path, tight=True)
     return figure
 
 
@@ -116,7 +109,7 @@ def plot_predictive(rows: Sequence[Mapping], path: str | os.PathLike) -> Figure:
         Rows of :func:`calibration.bayes.report.predictive_rows` (``test``, ``set``, ``target_deg``,
         ``allowed_sd_deg``, ``angle_deg``, ``angle_error_deg``, ``within``; deg).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
 
     Returns
     -------
@@ -128,7 +121,7 @@ def plot_predictive(rows: Sequence[Mapping], path: str | os.PathLike) -> Figure:
         figure = Figure(figsize=(4.2, 2.0))
         figure.text(0.5, 0.5, "no predictive runs\n(calibration.bayesian.predictive_draws = 0)", ha="center",
                     va="center")
-        _save(figure, path)
+        save_figure(figure, path, tight=True)
         return figure
     tests = list(dict.fromkeys(row["test"] for row in rows))
     figure = Figure(figsize=(4.2 * len(tests), 4.0), layout="constrained")
@@ -157,5 +150,5 @@ def plot_predictive(rows: Sequence[Mapping], path: str | os.PathLike) -> Figure:
         axes.set_ylabel("bulk friction angle [deg]")
         axes.grid(alpha=0.3)
         axes.legend(fontsize=7, loc="best")
-    _save(figure, path)
+    save_figure(figure, path, tight=True)
     return figure

@@ -3,7 +3,8 @@
 A :class:`CaseKind` holds what siloflow knows of one kind of case: its config section and that section's schema
 fragment, the function that builds its runs from a validated configuration, whether the section inherits the shared
 keys of ``defaults`` and runs replicates, the folder of its runs under ``results/``, the stages its decks run, its
-cost model, whether its settled fill's force balance is checked, its own configuration checks and its rule file.
+cost model, whether its settled fill's force balance is checked, its own configuration checks, its rule file and its
+wall meshes (which a run's ParaView files draw).
 :data:`CASE_KINDS` maps each kind's name to its entry; :func:`register_case_kind` adds one. The configuration
 schema, the config checks, the results layout, the estimates, the engines' adapters, the run record and the workflow
 all take the kinds from here.
@@ -19,13 +20,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Mapping
 
-from model.cases.blender import BlenderCase, blender_cases, check_blender_config
+from model.cases.blender import BlenderCase, blender_cases, blender_mesh_set, check_blender_config
 from model.cases.jenike import JenikeCase, jenike_cases
 from model.cases.jenike_cost import estimate_jenike_case
 from model.cases.jenike_sweep import check_jenike_config, jenike_run_role
 from model.cases.silo_cost import estimate_blender_case, estimate_recirculation_case, estimate_silo_case
-from model.cases.silo_flat import SiloCase, silo_cases
-from model.cases.silo_recirculation import RecirculationCase, check_recirculation_config, recirculation_cases
+from model.cases.silo_flat import SiloCase, silo_cases, silo_meshes
+from model.cases.silo_recirculation import (RecirculationCase, check_recirculation_config, recirculation_cases,
+                                            recirculation_meshes)
 from model.cases.verification import VerificationCase
 
 __all__ = ["CASE_KINDS", "CaseKind", "SCHEMA_FRAGMENTS", "case_kind", "configured_kinds", "kind_of_case",
@@ -72,6 +74,9 @@ class CaseKind:
         the reference configuration's runs are ``reference`` and the others ``variant``.
     rules : str or None
         Its rule file under ``workflow/rules/``, which defines its rules and adds its targets to ``CASE_TARGETS``.
+    walls : callable or None
+        ``walls(case) -> {name: TriangleMesh}``: the wall meshes of a run (vertices in m), as the engines build their
+        walls from them; a run's ParaView files draw them (``workflow/rules/paraview.smk``). None: none drawn.
     """
 
     name: str
@@ -87,6 +92,7 @@ class CaseKind:
     check_config: Callable[[Mapping, Mapping], None] | None = None
     run_role: Callable[[Mapping, object], str] | None = None
     rules: str | None = None
+    walls: Callable[[object], dict] | None = None
 
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or not self.name.islower():
@@ -140,14 +146,14 @@ register_case_kind(CaseKind(
 register_case_kind(CaseKind(
     "silo_flat", SiloCase, "silo_flat", ("fill", "settle", "open", "discharge"), silo_cases, estimate_silo_case,
     SCHEMA_FRAGMENTS / "silo_flat.schema.yaml", inherits_defaults=True, replicated=True, fill_balance=True,
-    rules="silo.smk"))
+    rules="silo.smk", walls=silo_meshes))
 register_case_kind(CaseKind(
     "silo_recirculation", RecirculationCase, "silo_recirculation", ("fill", "settle", "open", "recirculate"),
     recirculation_cases, estimate_recirculation_case, SCHEMA_FRAGMENTS / "silo_recirculation.schema.yaml",
     inherits_defaults=True, replicated=True, fill_balance=True, check_config=check_recirculation_config,
-    rules="silo_recirculation.smk"))
+    rules="silo_recirculation.smk", walls=recirculation_meshes))
 register_case_kind(CaseKind(
     "blender", BlenderCase, "blender", ("fill", "settle", "open", "discharge"), blender_cases, estimate_blender_case,
     SCHEMA_FRAGMENTS / "blender.schema.yaml", inherits_defaults=True, replicated=True, fill_balance=True,
-    check_config=check_blender_config, rules="blender.smk"))
+    check_config=check_blender_config, rules="blender.smk", walls=blender_mesh_set))
 register_case_kind(CaseKind("verification", VerificationCase, "verification", ("release",)))

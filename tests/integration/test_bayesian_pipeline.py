@@ -112,7 +112,10 @@ def test_the_silo_runs_at_the_posterior_mean_and_at_each_draw(calibrated):
     for run in (mean, draw):
         flow = json.loads((workdir / "results" / "silo_flat" / run["run_id"] / "metrics" / "flow.json").read_text())
         assert run["mass_flow_rate_kg_s"] == flow["mass_flow_rate_kg_s"] > 0
-        assert run["base_vertical_stress_Pa"] > 0 and run["base_vertical_stress_Pa_error"] >= 0
+        janssen = (workdir / "results" / "silo_flat" / run["run_id"] / "metrics" / "janssen.csv").read_text().splitlines()
+        assert run["base_vertical_stress_Pa"] == pytest.approx(float(janssen[-1].split(",")[2])) > 0
+        # the small silo's fill holds one Janssen bin, which has no neighbour to pair with for an error
+        assert run["base_vertical_stress_Pa_error"] is None or run["base_vertical_stress_Pa_error"] >= 0
     # one draw: no spread between draws, so no calibration error bar and no verdict
     assert [row["draws"] for row in summary["spread"]] == [1, 1]
     assert all(row["spread_exceeds_run_error"] is None for row in summary["spread"])

@@ -19,7 +19,8 @@ import pytest
 import yaml
 
 from model.record import read_run_record
-from analysis.studies.silo_recirculation.tracks import recirculation_events, recirculation_tracks
+from analysis.numerics.clump_tracks import tracks_from_frames
+from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.validation.blending import blender_rows, gravity_rows
 from analysis.studies.validation.rows import Criteria
 from model.cases.blender import blender_cases
@@ -81,7 +82,7 @@ def _tracks(run: Path):
     """The run's case, record, clump tracks and the clumps that left through the outlet."""
     case = json.loads((run / "deck" / "case.json").read_text())
     record = read_run_record(run / "run.json")
-    tracks = recirculation_tracks(liggghts().read_frames(run, record), record.domain_z).tracks
+    tracks = tracks_from_frames(liggghts().read_frames(run, record), record.domain_z).tracks
     events = recirculation_events(tracks, 0.0, *case["domain_z"])
     return case, record, tracks, np.unique(events.exit_clump_index)
 

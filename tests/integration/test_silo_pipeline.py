@@ -34,8 +34,9 @@ from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
 from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
                             liggghts, require_liggghts, run_snakemake, validation_record_cli)
+from tests.notebooks import execute_notebook, figures
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(240)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(250)]
 
 
 
@@ -275,6 +276,13 @@ def test_silo_flow_metrics_and_plots_are_written(tiny_pipeline):
     for name in ("profiles", "vz_contour", "kinematic_B", "kinematic_u", "centreline_velocity", "janssen",
                  "force_chains"):
         assert (run_dir / "plots" / f"{name}.png").read_bytes()[:4] == b"\x89PNG", name
+
+
+def test_the_silo_flat_notebook_runs_on_the_tiny_run_and_its_checks_hold(tiny_pipeline, tmp_path):
+    _, run_dir, _ = tiny_pipeline
+    notebook = execute_notebook("silo_flat.ipynb", run_dir, tmp_path)  # a failed assert cell raises, naming it
+    shown = figures(notebook)
+    assert len(shown) == 3 and all(png.startswith(b"\x89PNG") for png in shown)
 
 
 def test_synthetic_piv_of_the_front_wall_recovers_the_dem_profile_at_one_height(tiny_pipeline):

@@ -28,8 +28,9 @@ from model.record import read_run_record
 from engines.config import validate_config
 from engines.layout import case_root, run_dir, run_path
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.notebooks import execute_notebook, figures
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(170)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(180)]
 
 CONFIG = {
     "silo_recirculation": TINY_BLENDING,
@@ -218,6 +219,13 @@ def test_thin_silo_compares_tracks_with_three_bin_sizes(thin_silo):
         assert 0.3 * particle_mean < stats["mean_s"] < 3.0 * particle_mean
     for name in ("paths.png", "residence_times.png"):
         assert (verification / name).read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_recirculation_notebook_runs_on_the_tiny_run_and_its_checks_hold(blending_pipeline, tmp_path):
+    _, runs, _ = blending_pipeline
+    notebook = execute_notebook("silo_recirculation.ipynb", runs["blending"], tmp_path)  # a failed assert raises
+    shown = figures(notebook)
+    assert len(shown) == 3 and all(png.startswith(b"\x89PNG") for png in shown)
 
 
 def test_validation_rows_of_the_real_run_carry_errors_and_a_verdict(blending_pipeline):

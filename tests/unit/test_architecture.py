@@ -3,7 +3,8 @@ package and templates know LIGGGHTS (its code, file names and formats).
 
 Layers (../shared/design/ARCHITECTURE.md): workflow -> engines, analysis, calibration; calibration -> analysis;
 engines and analysis -> the neutral model (``model``), which imports nothing else of siloflow; engines import nothing
-of analysis, analysis nothing of engines.
+of analysis, analysis nothing of engines. The notebook API (the package ``siloflow``) is the top layer: it may import
+every other package, and none imports it.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import pytest
 from engines.config import REPO_ROOT
 from engines.interface import ENGINE_KINDS, engine_named
 
-PACKAGES = ("model", "engines", "analysis", "calibration")
+PACKAGES = ("model", "engines", "analysis", "calibration", "siloflow")
 
 
 def _module_name(path: Path) -> str:
@@ -111,7 +112,15 @@ def test_layers_point_one_way():
                 wrong.append(f"{module} -> {target} (calibration may use analysis and the model only)")
             if top == "engines" and other not in ("engines", "model"):
                 wrong.append(f"{module} -> {target} (engines take only the neutral model)")
+            if other == "siloflow" and top != "siloflow":
+                wrong.append(f"{module} -> {target} (the notebook API is the top layer: nothing imports it)")
     assert not wrong, "\n".join(sorted(wrong))
+
+
+def test_the_workflow_does_not_go_through_the_notebook_api():
+    found = [f"{path.relative_to(REPO_ROOT)}:{line} imports {module}" for path in _python_files("workflow/scripts")
+             for line, module in _imports(path)[0] if module.split(".")[0] == "siloflow"]
+    assert not found, "the workflow calls the library, not the notebook API built on it:\n" + "\n".join(found)
 
 
 def test_no_import_circles():
@@ -165,7 +174,7 @@ ENGINE_NAMES = {"liggghts": (LIGGGHTS_NAMES, ("engines", "liggghts")), "yade": (
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_NAMES))
-@pytest.mark.parametrize("folder", ["engines", "analysis", "calibration", "workflow", "Snakefile"])
+@pytest.mark.parametrize("folder", ["engines", "analysis", "calibration", "siloflow", "workflow", "Snakefile"])
 def test_only_an_engines_package_names_its_files_and_formats(folder, engine):
     pattern, package = ENGINE_NAMES[engine]
     root = REPO_ROOT / folder

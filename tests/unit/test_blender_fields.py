@@ -18,7 +18,7 @@ from analysis.studies.blender.window_fields_io import (
     write_frame_fields,
     write_planar_fields,
 )
-from analysis.studies.silo_recirculation.tracks import ClumpTracks
+from analysis.numerics.clump_tracks import ClumpTracks
 from analysis.numerics.eulerian_rtd import silo_bins
 
 

@@ -234,3 +234,14 @@ def test_a_silo_on_the_posterior_needs_its_engine_calibrated():
                                           r"does not calibrate$"):
         validate_config({"silo_flat": {"parameters": "bayesian", "engine": "yade"}})
     assert validate_config({"silo_flat": {"parameters": "bayesian"}})["silo_flat"]["parameters"] == "bayesian"
+
+
+@pytest.mark.parametrize("given, expected", [({}, "png"), ({"format": "pdf"}, "pdf"), ({"format": "svg"}, "svg")])
+def test_every_plot_takes_the_configured_format_png_by_default(given, expected):
+    assert validate_config({"plots": given})["plots"] == {"format": expected}
+    assert validate_config({})["plots"] == {"format": "png"}
+
+
+def test_a_plot_format_of_none_of_the_writers_is_refused_naming_the_key():
+    with pytest.raises(ConfigError, match=r"^config key 'plots.format': 'jpg' is not one of \['png', 'pdf', 'svg'\]"):
+        validate_config({"plots": {"format": "jpg"}})

@@ -107,9 +107,9 @@ DOC_GLOBS = ("README.md", "docs/**/*.md")
 GENERATED_DOCS = ("docs/validation/README.md", "docs/validation/*/**/*.md")
 
 #: The project's Python packages: a dotted name starting with one of them is imported.
-PACKAGES = ("model", "engines", "analysis", "calibration")
+PACKAGES = ("model", "engines", "analysis", "calibration", "siloflow")
 #: A span that starts with one of these (or is one of the root files) is a path into the repository.
-PATH_ROOTS = (*PACKAGES, "workflow", "templates", "tests", "config", "docs", "profiles")
+PATH_ROOTS = (*PACKAGES, "workflow", "templates", "tests", "config", "docs", "profiles", "examples")
 ROOT_FILES = ("Makefile", "Snakefile", "pyproject.toml", "mkdocs.yml")
 #: Bare file names of these kinds (`case_deck.py`, `macros.j2`) name a file somewhere in the repository.
 SOURCE_SUFFIXES = ("py", "smk", "j2")

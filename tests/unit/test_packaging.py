@@ -37,7 +37,7 @@ def _pipeline_imports() -> dict[str, set[str]]:
     """``{top-level module: {file, ...}}`` of every import in the pipeline's modules, function bodies included (an
     import there runs when the function does)."""
     found: dict[str, set[str]] = {}
-    files = [path for folder in ("model", "engines", "analysis", "calibration", "workflow/scripts")
+    files = [path for folder in ("model", "engines", "analysis", "calibration", "siloflow", "workflow/scripts")
              for path in (REPO_ROOT / folder).rglob("*.py") if "__pycache__" not in path.parts]
     for path in files:
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):

@@ -29,6 +29,12 @@ def test_the_base_stress_is_the_deepest_row_of_the_janssen_profile():
             {"depth_below_surface_m": 0.07, "sigma_v_dem_Pa": 247.0, "sigma_v_dem_Pa_error": 5.5},
             {"depth_below_surface_m": 0.01, "sigma_v_dem_Pa": 40.0, "sigma_v_dem_Pa_error": 1.0}]
     assert base_vertical_stress(rows) == (247.0, 5.5)
+    # the deepest bin has no neighbour to pair with for its error: the deepest with one stands for the base
+    unpaired = [*rows, {"depth_below_surface_m": 0.08, "sigma_v_dem_Pa": 260.0, "sigma_v_dem_Pa_error": None}]
+    assert base_vertical_stress(unpaired) == (247.0, 5.5)
+    value, error = base_vertical_stress([{"depth_below_surface_m": 0.08, "sigma_v_dem_Pa": 260.0,
+                                          "sigma_v_dem_Pa_error": ""}])
+    assert value == 260.0 and math.isnan(error)
     with pytest.raises(ValueError, match="no rows"):
         base_vertical_stress([])
 
@@ -72,3 +78,10 @@ def test_runs_without_error_leave_every_spread_to_the_parameters():
     assert flow["spread_ratio"] == math.inf and flow["spread_exceeds_run_error"] is True
     assert flow["calibration_sd"] == pytest.approx(math.sqrt(0.5))
     assert math.isnan(stress["spread_ratio"]) and stress["spread_exceeds_run_error"] is None
+
+
+def test_the_runs_own_error_leaves_out_the_unknown_ones():
+    flow, stress = calibration_spread(_rows([1.0, 1.0, 2.0], [0.0, 0.3, float("nan")], [5.0, 5.0, 6.0],
+                                            [0.0, float("nan"), float("nan")]))
+    assert flow["run_error"] == pytest.approx(0.3)
+    assert math.isnan(stress["run_error"]) and stress["spread_exceeds_run_error"] is None

@@ -22,14 +22,8 @@ from analysis.studies.silo_recirculation.concentration import (
     predicted_concentration_from_first_pass,
 )
 from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_count, tracer_passes
-from analysis.studies.silo_recirculation.tracks import (
-    ClumpTracks,
-    RecirculationEvents,
-    clump_tracks,
-    clumps_above_outlet,
-    recirculation_events,
-    recirculation_tracks,
-)
+from analysis.numerics.clump_tracks import ClumpTracks, clump_tracks, tracks_from_frames
+from analysis.studies.silo_recirculation.tracks import RecirculationEvents, clumps_above_outlet, recirculation_events
 from analysis.studies.silo_recirculation.vrr import (
     RecirculationVRR,
     holdup_residence_time,
@@ -560,7 +554,7 @@ def _spheres(time, clump_id, position, velocity, mass):
                          radius=np.full(n, 0.001), mass=mass)
 
 
-def test_recirculation_tracks_join_straddling_clumps_and_lay_out_velocities_and_masses():
+def test_tracks_from_frames_join_straddling_clumps_and_lay_out_velocities_and_masses():
     # Domain periodic in z over [-0.25, 0.75) (L = 1 m). Clump 5 has two spheres; at t = 1 s it straddles the
     # periodic boundary (spheres at z = 0.74 and -0.24, i.e. 0.76 unwrapped): its centre is 0.75 -> wrapped to
     # -0.25. Clump 9 is a single sphere, absent from the last frame.
@@ -571,7 +565,7 @@ def test_recirculation_tracks_join_straddling_clumps_and_lay_out_velocities_and_
                  [[0.0, 0.0, -0.5], [0.0, 0.0, -2.0], [0.0, 0.0, -2.0]], [1.0, 2.0, 2.0]),
         _spheres(2.0, [5, 5], [[0.0, 0.0, 0.3], [0.0, 0.0, 0.4]], [[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]], [2.0, 2.0]),
     ]
-    result = recirculation_tracks(frames, (BOTTOM, TOP))
+    result = tracks_from_frames(frames, (BOTTOM, TOP))
     np.testing.assert_array_equal(result.tracks.times, [0.0, 1.0, 2.0])
     np.testing.assert_array_equal(result.tracks.clump_id, [5, 9])
     np.testing.assert_allclose(result.tracks.z[:, 0], [0.11, -0.25, 0.35], atol=1e-12)
@@ -583,13 +577,13 @@ def test_recirculation_tracks_join_straddling_clumps_and_lay_out_velocities_and_
     np.testing.assert_array_equal(result.mass, [2.0, 1.0])
 
 
-def test_recirculation_tracks_take_clump_frames_as_they_are_and_need_two_frames():
+def test_tracks_from_frames_take_clump_frames_as_they_are_and_need_two_frames():
     clumps = [ClumpFrame(time=t, step=k, clump_id=[3], position=[[0.0, 0.0, z]], velocity=[[0.0, 0.0, -0.1]],
                          mass=[0.5], n_spheres=[4]) for k, (t, z) in enumerate([(0.0, 0.2), (0.5, 0.15)])]
-    result = recirculation_tracks(iter(clumps), (BOTTOM, TOP))
+    result = tracks_from_frames(iter(clumps), (BOTTOM, TOP))
     np.testing.assert_array_equal(result.tracks.z[:, 0], [0.2, 0.15])
     np.testing.assert_array_equal(result.mass, [0.5])
     with pytest.raises(ValueError, match="at least 2 frames, got 1"):
-        recirculation_tracks(clumps[:1], (BOTTOM, TOP))
+        tracks_from_frames(clumps[:1], (BOTTOM, TOP))
     with pytest.raises(ValueError, match="domain_z must be"):
-        recirculation_tracks(clumps, (TOP, BOTTOM))
+        tracks_from_frames(clumps, (TOP, BOTTOM))

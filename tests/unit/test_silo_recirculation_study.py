@@ -21,7 +21,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationEvents, recirculation_events
+from analysis.numerics.clump_tracks import ClumpTracks
+from analysis.studies.silo_recirculation.tracks import RecirculationEvents, recirculation_events
 from analysis.studies.silo_recirculation.study import (
     residence_summary,
     BlendingResult,

@@ -26,7 +26,8 @@ import pytest
 from analysis.numerics.residence_statistics import mean_residence_time
 from analysis.studies.silo_recirculation.study import loop_timing, transit_timing
 from analysis.studies.silo_recirculation.tracers import tracer_passes
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events
+from analysis.numerics.clump_tracks import ClumpTracks
+from analysis.studies.silo_recirculation.tracks import recirculation_events
 from analysis.studies.silo_recirculation.transit import (
     passes_in_progress,
     stagnant_clumps,

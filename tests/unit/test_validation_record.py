@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
+import yaml
 
 from model.record import RunRecord, RunRecordError
 from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            read_validation_rows, restore_products, write_group_record)
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time
 from analysis.studies.validation.rows import COLUMNS, row
-from engines.config import REPO_ROOT
+from engines.config import REPO_ROOT, load_config_file
 from tests.conftest import validation_record_cli
 
 CLI = validation_record_cli()
@@ -69,6 +71,24 @@ def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
         write_group_record(folder, _rows(), runs, {"../x.png": plot})
     with pytest.raises(ValueError, match="needs rows and runs"):
         write_group_record(folder, [], runs, {})
+
+
+def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_runs(tmp_path, capsys):
+    """A workflow with plots.format pdf or svg cannot make the record, whose page shows PNG plots: the writer refuses
+    such a plot and writes nothing, and `make validate GROUP=<name>` refuses such a configuration first."""
+    plot = tmp_path / "profiles.pdf"
+    plot.write_bytes(b"%PDF-1.4")
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    message = r"the validation record keeps png plots .*, not pdf: make it with plots.format: png"
+    with pytest.raises(ValueError, match=message):
+        write_group_record(tmp_path / "silo", _rows(), runs, {"profiles.png": plot})
+    assert not (tmp_path / "silo").exists()
+    raw = load_config_file(REPO_ROOT / "config" / "validation.yaml")
+    config = tmp_path / "validation_pdf.yaml"
+    config.write_text(yaml.safe_dump({**raw, "plots": {"format": "pdf"}}, sort_keys=False))
+    assert CLI.main(["check", "blending_1", str(config), str(tmp_path)]) == 2
+    assert re.search(message, capsys.readouterr().err)
+    assert CLI.main(["check", "blending_1", str(REPO_ROOT / "config" / "validation.yaml"), str(tmp_path)]) == 0
 
 
 def test_a_table_without_the_validation_columns_is_refused(tmp_path):

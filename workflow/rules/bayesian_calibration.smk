@@ -226,9 +226,9 @@ rule bayes_report:
                      subcategory="Bayesian", labels={"figure": "ridge {engine}"}),
         comparison=report(f"{bayes_folder()}/chart_comparison.csv", caption="../report/bayes_chart.rst",
                           category="1 Calibration", subcategory="Bayesian", labels={"figure": "chart beside posterior {engine}"}),
-        corner=report(f"{bayes_folder()}/corner.png", caption="../report/bayes_corner.rst", category="1 Calibration",
+        corner=report(plot_file(f"{bayes_folder()}/corner"), caption="../report/bayes_corner.rst", category="1 Calibration",
                       subcategory="Bayesian", labels={"figure": "posterior {engine}"}),
-        predictive_plot=report(f"{bayes_folder()}/predictive.png", caption="../report/bayes_predictive.rst",
+        predictive_plot=report(plot_file(f"{bayes_folder()}/predictive"), caption="../report/bayes_predictive.rst",
                                category="1 Calibration", subcategory="Bayesian",
                                labels={"figure": "predictive check {engine}"}),
     wildcard_constraints:

@@ -14,17 +14,18 @@ def blender_targets(wildcards=None, runs=None):
     targets = [
         run_path("blender", name, run)
         for run in chosen
-        for name in ("metrics/blender.json", "metrics/fill_balance.json", "plots/profiles.png",
-                     "plots/insert_velocities.png", "plots/flow_channel.png", "plots/pathlines.png", "plots/rtd.png",
-                     "plots/discontinuous.png", "plots/vrr_period.png")
+        for name in ("metrics/blender.json", "metrics/fill_balance.json",
+                     *(plot_file(f"plots/{plot}") for plot in ("profiles", "insert_velocities", "flow_channel",
+                                                               "pathlines", "rtd", "discontinuous", "vrr_period")))
     ]
     if runs is not None:
         return targets
     if chosen:
         targets += [f"{case_root('blender')}/comparison/{name}"
-                    for name in ("configurations.csv", "significance.csv", "configurations.md", "configurations.png", "rtd.png")]
+                    for name in ("configurations.csv", "significance.csv", "configurations.md", plot_file("configurations"),
+                                 plot_file("rtd"))]
     if len(config["blender"]["gravity_factors"]) > 1:
-        targets += [f"{case_root('blender')}/gravity/scaling.csv", f"{case_root('blender')}/gravity/scaling.png"]
+        targets += [f"{case_root('blender')}/gravity/scaling.csv", plot_file(f"{case_root('blender')}/gravity/scaling")]
     return targets
 
 
@@ -99,13 +100,13 @@ rule blender_analysis:
         residence=f"{run_dir('blender')}/metrics/residence_across_width.csv",
         rtd=f"{run_dir('blender')}/metrics/rtd.csv",
         vrr=f"{run_dir('blender')}/metrics/vrr_period.csv",
-        profiles_plot=report(f"{run_dir('blender')}/plots/profiles.png", caption="../report/blender_profiles.rst", category="4 Blender", subcategory="{run}", labels={"figure": "profiles"}),
-        distribution_plot=report(f"{run_dir('blender')}/plots/insert_velocities.png", caption="../report/blender_insert.rst", category="4 Blender", subcategory="{run}", labels={"figure": "insert velocities"}),
-        fcb_plot=report(f"{run_dir('blender')}/plots/flow_channel.png", caption="../report/blender_fcb.rst", category="4 Blender", subcategory="{run}", labels={"figure": "flow channel"}),
-        pathlines_plot=report(f"{run_dir('blender')}/plots/pathlines.png", caption="../report/blender_pathlines.rst", category="4 Blender", subcategory="{run}", labels={"figure": "pathlines"}),
-        rtd_plot=report(f"{run_dir('blender')}/plots/rtd.png", caption="../report/blender_rtd.rst", category="4 Blender", subcategory="{run}", labels={"figure": "RTD"}),
-        discontinuous_plot=report(f"{run_dir('blender')}/plots/discontinuous.png", caption="../report/blender_discontinuous.rst", category="4 Blender", subcategory="{run}", labels={"figure": "discontinuous"}),
-        vrr_plot=report(f"{run_dir('blender')}/plots/vrr_period.png", caption="../report/blender_vrr.rst", category="4 Blender", subcategory="{run}", labels={"figure": "VRR vs period"}),
+        profiles_plot=report(plot_file(f"{run_dir('blender')}/plots/profiles"), caption="../report/blender_profiles.rst", category="4 Blender", subcategory="{run}", labels={"figure": "profiles"}),
+        distribution_plot=report(plot_file(f"{run_dir('blender')}/plots/insert_velocities"), caption="../report/blender_insert.rst", category="4 Blender", subcategory="{run}", labels={"figure": "insert velocities"}),
+        fcb_plot=report(plot_file(f"{run_dir('blender')}/plots/flow_channel"), caption="../report/blender_fcb.rst", category="4 Blender", subcategory="{run}", labels={"figure": "flow channel"}),
+        pathlines_plot=report(plot_file(f"{run_dir('blender')}/plots/pathlines"), caption="../report/blender_pathlines.rst", category="4 Blender", subcategory="{run}", labels={"figure": "pathlines"}),
+        rtd_plot=report(plot_file(f"{run_dir('blender')}/plots/rtd"), caption="../report/blender_rtd.rst", category="4 Blender", subcategory="{run}", labels={"figure": "RTD"}),
+        discontinuous_plot=report(plot_file(f"{run_dir('blender')}/plots/discontinuous"), caption="../report/blender_discontinuous.rst", category="4 Blender", subcategory="{run}", labels={"figure": "discontinuous"}),
+        vrr_plot=report(plot_file(f"{run_dir('blender')}/plots/vrr_period"), caption="../report/blender_vrr.rst", category="4 Blender", subcategory="{run}", labels={"figure": "VRR vs period"}),
     params:
         case=typed_case("blender"),
         blender=lambda wildcards: {key: config["blender"][key] for key in (
@@ -123,8 +124,8 @@ rule blender_comparison:
         table=f"{case_root('blender')}/comparison/configurations.csv",
         markdown=f"{case_root('blender')}/comparison/configurations.md",
         significance=f"{case_root('blender')}/comparison/significance.csv",
-        plot=report(f"{case_root('blender')}/comparison/configurations.png", caption="../report/blender_comparison.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "configurations"}),
-        rtd_plot=report(f"{case_root('blender')}/comparison/rtd.png", caption="../report/blender_comparison_rtd.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "RTDs"}),
+        plot=report(plot_file(f"{case_root('blender')}/comparison/configurations"), caption="../report/blender_comparison.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "configurations"}),
+        rtd_plot=report(plot_file(f"{case_root('blender')}/comparison/rtd"), caption="../report/blender_comparison_rtd.rst", category="4 Blender", subcategory="Comparison", labels={"figure": "RTDs"}),
     params:
         runs=lambda wildcards: blender_runs(),
         tolerance=config["blender"]["discontinuous"]["tolerance"],
@@ -139,7 +140,7 @@ rule blender_gravity:
         summaries=lambda wildcards: [f"{run_dir('blender', run)}/metrics/blender.json" for run in blender_runs()],
     output:
         table=f"{case_root('blender')}/gravity/scaling.csv",
-        plot=report(f"{case_root('blender')}/gravity/scaling.png", caption="../report/blender_gravity.rst", category="4 Blender", subcategory="Gravity scaling", labels={"figure": "gravity"}),
+        plot=report(plot_file(f"{case_root('blender')}/gravity/scaling"), caption="../report/blender_gravity.rst", category="4 Blender", subcategory="Gravity scaling", labels={"figure": "gravity"}),
     params:
         runs=lambda wildcards: blender_runs(),
     log:

@@ -51,7 +51,7 @@ def lid_comparison_targets():
     sweep = config["jenike"]["sweep"]
     if not (sweep["lid_comparison"] and "internal" in sweep["tests"]):
         return []
-    return [f"{CALIBRATION_DIR}/lid_comparison.csv", f"{CALIBRATION_DIR}/charts/lid_comparison.png"]
+    return [f"{CALIBRATION_DIR}/lid_comparison.csv", plot_file(f"{CALIBRATION_DIR}/charts/lid_comparison")]
 
 
 def diagnostic_targets(runs=None):
@@ -59,7 +59,7 @@ def diagnostic_targets(runs=None):
     points = diagnostic_points([case.sweep_point for case in JENIKE_CASES.values()], config["jenike"]["sweep"],
                                config["jenike"]["lid"])
     chosen = [run for run in (JENIKE_CASES if runs is None else runs) if JENIKE_CASES[run].sweep_point in points]
-    return [run_path("jenike", f"plots/{name}.png", run) for run in chosen for name in ("mobilised_friction", "angular_velocity")]
+    return [run_path("jenike", plot_file(f"plots/{name}"), run) for run in chosen for name in ("mobilised_friction", "angular_velocity")]
 
 
 def calibration_targets(wildcards=None, runs=None):
@@ -72,7 +72,7 @@ def calibration_targets(wildcards=None, runs=None):
         *diagnostic_targets(),
         f"{CALIBRATION_DIR}/bulk_friction.csv",
         CALIBRATED_PARAMETERS,
-        *[f"{CALIBRATION_DIR}/charts/{name}.png" for name in calibration_chart_names()],
+        *[plot_file(f"{CALIBRATION_DIR}/charts/{name}") for name in calibration_chart_names()],
         *lid_comparison_targets(),
         *[run_path("jenike", "metrics/fill_balance.json", run) for run in JENIKE_CASES],
     ]
@@ -120,7 +120,7 @@ rule jenike_friction:
         case=rules.jenike_deck.output.case,
     output:
         summary=run_path("jenike", "metrics/bulk_friction.json"),
-        plot=report(run_path("jenike", "plots/forces.png"), caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{run}"}),
+        plot=report(run_path("jenike", plot_file("plots/forces")), caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{run}"}),
     params:
         point=lambda wildcards: jenike_point(wildcards.run),
     log:
@@ -144,7 +144,7 @@ rule calibration_chart:
     input:
         summaries=lambda wildcards: summaries_of(chart_runs(wildcards.chart)),
     output:
-        chart=report(f"{CALIBRATION_DIR}/charts/{{chart}}.png", caption="../report/calibration_chart.rst",
+        chart=report(plot_file(f"{CALIBRATION_DIR}/charts/{{chart}}"), caption="../report/calibration_chart.rst",
                      category="1 Calibration", subcategory="Charts", labels={"figure": "{chart}"}),
     wildcard_constraints:
         chart="|".join(calibration_chart_names()) or "no chart",
@@ -180,7 +180,7 @@ rule lid_comparison:
         summaries=summaries_of(lid_comparison_runs()),
     output:
         table=f"{CALIBRATION_DIR}/lid_comparison.csv",
-        plot=report(f"{CALIBRATION_DIR}/charts/lid_comparison.png", caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
+        plot=report(plot_file(f"{CALIBRATION_DIR}/charts/lid_comparison"), caption="../report/lid_comparison.rst", category="1 Calibration", subcategory="Charts", labels={"figure": "lid comparison"}),
     params:
         base_restitution=config["jenike"]["sweep"]["restitution"],
         shear_velocity=config["jenike"]["shear"]["velocity"],
@@ -195,8 +195,8 @@ rule jenike_diagnostics:
         case=rules.jenike_deck.output.case,
         record=rules.jenike_run.output.record,
     output:
-        friction=report(run_path("jenike", "plots/mobilised_friction.png"), caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
-        rotation=report(run_path("jenike", "plots/angular_velocity.png"), caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
+        friction=report(run_path("jenike", plot_file("plots/mobilised_friction")), caption="../report/mobilised_friction.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
+        rotation=report(run_path("jenike", plot_file("plots/angular_velocity")), caption="../report/angular_velocity.rst", category="1 Calibration", subcategory="Diagnostics", labels={"figure": "{run}"}),
         summary=run_path("jenike", "metrics/diagnostics.json"),
     params:
         case=typed_case("jenike"),

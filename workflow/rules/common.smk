@@ -39,6 +39,16 @@ except (PreflightError, MeasuredInputError) as error:
 # In place, so that scripts see the defaults through snakemake.config too.
 config.update(PREFLIGHT.config)
 
+#: The format of every plot the workflow writes, its file name suffix (plots.format: png, pdf or svg); the writer
+#: (analysis.io.plots.save_figure) takes the format from the suffix.
+PLOT_FORMAT = config["plots"]["format"]
+
+
+def plot_file(stem):
+    """The plot ``stem`` (its path without a suffix; wildcards allowed) in the configured format (plots.format)."""
+    return f"{stem}.{PLOT_FORMAT}"
+
+
 #: Every case the validated configuration defines (the flat-bottom silo's as configured, before calibration).
 CASES = PREFLIGHT.cases
 
@@ -138,8 +148,11 @@ def among(found, runs):
 
 
 def print_result_locations():
+    """Where the products of the runs are, those that exist: a call for one target (``bayesian_calibration``, a
+    validation group) makes only some of them."""
     for path in [*(path for targets in CASE_TARGETS.values() for path in targets()), *existing_runs_targets()]:
-        print(f"siloflow result: {Path(path).resolve()}")
+        if Path(path).exists():
+            print(f"siloflow result: {Path(path).resolve()}")
 
 
 # The deck and run steps of every case: the engine writes deck/case.json last, and run.json last of a run.

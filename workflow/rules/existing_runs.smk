@@ -42,7 +42,7 @@ rule existing_silo_metrics:
         table=existing_run_path("silo_flat", "metrics/flow.csv"),
         history=existing_run_path("silo_flat", "metrics/discharge.csv"),
         summary=existing_run_path("silo_flat", "metrics/flow.json"),
-        plot=existing_run_path("silo_flat", "plots/discharge.png"),
+        plot=existing_run_path("silo_flat", plot_file("plots/discharge")),
     params:
         run=existing_description,
         analysis=lambda wildcards: {
@@ -70,11 +70,11 @@ rule existing_silo_fields:
         centreline=existing_run_path("silo_flat", "metrics/centreline_velocity.csv"),
         summary=existing_run_path("silo_flat", "metrics/fields.json"),
         analyses=existing_run_path("silo_flat", "metrics/analyses.json"),
-        profile_plot=existing_run_path("silo_flat", "plots/profiles.png"),
-        contour_plot=existing_run_path("silo_flat", "plots/vz_contour.png"),
-        kinematic_plot=existing_run_path("silo_flat", "plots/kinematic_B.png"),
-        kinematic_u_plot=existing_run_path("silo_flat", "plots/kinematic_u.png"),
-        centreline_plot=existing_run_path("silo_flat", "plots/centreline_velocity.png"),
+        profile_plot=existing_run_path("silo_flat", plot_file("plots/profiles")),
+        contour_plot=existing_run_path("silo_flat", plot_file("plots/vz_contour")),
+        kinematic_plot=existing_run_path("silo_flat", plot_file("plots/kinematic_B")),
+        kinematic_u_plot=existing_run_path("silo_flat", plot_file("plots/kinematic_u")),
+        centreline_plot=existing_run_path("silo_flat", plot_file("plots/centreline_velocity")),
     params:
         run=existing_description,
         settings=lambda wildcards: config["silo_flat"]["fields"],

@@ -9,8 +9,8 @@ def silo_flat_targets(wildcards=None, runs=None):
     return [
         run_path("silo_flat", name, run)
         for run in (run_ids("silo_flat") if runs is None else runs)
-        for name in ("metrics/flow.csv", "plots/discharge.png", "fields/fields.pvd", "metrics/profiles.csv",
-                     "plots/profiles.png", "metrics/fill_balance.json", *measured_comparison_names(),
+        for name in ("metrics/flow.csv", plot_file("plots/discharge"), "fields/fields.pvd", "metrics/profiles.csv",
+                     plot_file("plots/profiles"), "metrics/fill_balance.json", *measured_comparison_names(),
                      *piv_names())
     ]
 
@@ -18,16 +18,16 @@ def silo_flat_targets(wildcards=None, runs=None):
 def piv_names():
     names = []
     if config["silo_flat"]["piv"]["enabled"]:
-        names += ["metrics/piv_accuracy.csv", "plots/piv_accuracy.png"]
+        names += ["metrics/piv_accuracy.csv", plot_file("plots/piv_accuracy")]
     if MEASURED_PIV_FILES:
-        names += ["metrics/piv_comparison.csv", "plots/piv_comparison.png"]
+        names += ["metrics/piv_comparison.csv", plot_file("plots/piv_comparison")]
     return names
 
 
 def measured_comparison_names():
     if config["silo_flat"]["fields"]["measured_profiles"] is None:
         return []
-    return ["metrics/measured_comparison.csv", "plots/measured_comparison.png"]
+    return ["metrics/measured_comparison.csv", plot_file("plots/measured_comparison")]
 
 
 def parametric_studies():
@@ -41,16 +41,15 @@ def parametric_studies():
 
 
 def parametric_targets(wildcards=None):
-    return [
-        f"{case_root('silo_flat')}/parametric/{study}.{ext}" for study in parametric_studies() for ext in ("csv", "png")
-    ]
+    folder = f"{case_root('silo_flat')}/parametric"
+    return [path for study in parametric_studies() for path in (f"{folder}/{study}.csv", plot_file(f"{folder}/{study}"))]
 
 
 def posterior_draw_targets(wildcards=None):
     if not config["silo_flat"]["posterior_draws"]:
         return []
     return [f"{case_root('silo_flat')}/posterior_draws/{name}" for name in ("runs.csv", "spread.csv", "summary.json",
-                                                                            "draws.png")]
+                                                                            plot_file("draws"))]
 
 
 def silo_flat_products(wildcards=None, runs=None):
@@ -110,7 +109,7 @@ rule silo_metrics:
         table=f"{run_dir('silo_flat')}/metrics/flow.csv",
         history=f"{run_dir('silo_flat')}/metrics/discharge.csv",
         summary=f"{run_dir('silo_flat')}/metrics/flow.json",
-        plot=report(f"{run_dir('silo_flat')}/plots/discharge.png", caption="../report/silo_discharge.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "discharge"}),
+        plot=report(plot_file(f"{run_dir('silo_flat')}/plots/discharge"), caption="../report/silo_discharge.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "discharge"}),
     params:
         case=typed_case("silo_flat"),
         analysis=lambda wildcards: {
@@ -139,13 +138,13 @@ rule silo_fields:
         centreline=f"{run_dir('silo_flat')}/metrics/centreline_velocity.csv",
         janssen=f"{run_dir('silo_flat')}/metrics/janssen.csv",
         summary=f"{run_dir('silo_flat')}/metrics/fields.json",
-        profile_plot=report(f"{run_dir('silo_flat')}/plots/profiles.png", caption="../report/silo_profiles.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "velocity profiles"}),
-        contour_plot=report(f"{run_dir('silo_flat')}/plots/vz_contour.png", caption="../report/silo_contour.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "v_z field"}),
-        kinematic_plot=report(f"{run_dir('silo_flat')}/plots/kinematic_B.png", caption="../report/silo_kinematic_b.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic B"}),
-        kinematic_u_plot=report(f"{run_dir('silo_flat')}/plots/kinematic_u.png", caption="../report/silo_kinematic_u.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic u"}),
-        centreline_plot=report(f"{run_dir('silo_flat')}/plots/centreline_velocity.png", caption="../report/silo_centreline.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "centreline"}),
-        janssen_plot=report(f"{run_dir('silo_flat')}/plots/janssen.png", caption="../report/silo_janssen.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "Janssen"}),
-        force_chain_plot=report(f"{run_dir('silo_flat')}/plots/force_chains.png", caption="../report/silo_force_chains.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "force chains"}),
+        profile_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/profiles"), caption="../report/silo_profiles.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "velocity profiles"}),
+        contour_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/vz_contour"), caption="../report/silo_contour.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "v_z field"}),
+        kinematic_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/kinematic_B"), caption="../report/silo_kinematic_b.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic B"}),
+        kinematic_u_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/kinematic_u"), caption="../report/silo_kinematic_u.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "kinematic u"}),
+        centreline_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/centreline_velocity"), caption="../report/silo_centreline.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "centreline"}),
+        janssen_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/janssen"), caption="../report/silo_janssen.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "Janssen"}),
+        force_chain_plot=report(plot_file(f"{run_dir('silo_flat')}/plots/force_chains"), caption="../report/silo_force_chains.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "force chains"}),
     params:
         case=typed_case("silo_flat"),
         settings=lambda wildcards: config["silo_flat"]["fields"],
@@ -163,7 +162,7 @@ rule silo_piv_synthetic:
     output:
         table=f"{run_dir('silo_flat')}/metrics/piv_accuracy.csv",
         profiles=f"{run_dir('silo_flat')}/metrics/piv_accuracy_profiles.csv",
-        plot=report(f"{run_dir('silo_flat')}/plots/piv_accuracy.png", caption="../report/silo_piv_accuracy.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV accuracy"}),
+        plot=report(plot_file(f"{run_dir('silo_flat')}/plots/piv_accuracy"), caption="../report/silo_piv_accuracy.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV accuracy"}),
     params:
         case=typed_case("silo_flat"),
         piv=config["silo_flat"]["piv"],
@@ -183,7 +182,7 @@ rule silo_piv_compare:
         measured=lambda wildcards: [str(p) for p in MEASURED_PIV_FILES],
     output:
         table=f"{run_dir('silo_flat')}/metrics/piv_comparison.csv",
-        plot=report(f"{run_dir('silo_flat')}/plots/piv_comparison.png", caption="../report/silo_piv_comparison.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV comparison"}),
+        plot=report(plot_file(f"{run_dir('silo_flat')}/plots/piv_comparison"), caption="../report/silo_piv_comparison.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "PIV comparison"}),
     params:
         case=typed_case("silo_flat"),
         piv=config["silo_flat"]["piv"],
@@ -201,7 +200,7 @@ rule silo_measured_comparison:
         measured=lambda wildcards: config["silo_flat"]["fields"]["measured_profiles"],
     output:
         table=f"{run_dir('silo_flat')}/metrics/measured_comparison.csv",
-        plot=report(f"{run_dir('silo_flat')}/plots/measured_comparison.png", caption="../report/silo_measured.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "measured"}),
+        plot=report(plot_file(f"{run_dir('silo_flat')}/plots/measured_comparison"), caption="../report/silo_measured.rst", category="2 Silo validation", subcategory="{run}", labels={"figure": "measured"}),
     params:
         plane=config["silo_flat"]["fields"]["measured_plane"],
     log:
@@ -220,7 +219,7 @@ rule silo_parametric:
         fields=lambda wildcards: [run_path("silo_flat", "fields/averaged.npz", run) for _, run in _study_runs(wildcards)],
     output:
         table=f"{case_root('silo_flat')}/parametric/{{study}}.csv",
-        plot=report(f"{case_root('silo_flat')}/parametric/{{study}}.png", caption="../report/silo_parametric.rst", category="2 Silo validation", subcategory="Parametric studies", labels={"figure": "{study}"}),
+        plot=report(plot_file(f"{case_root('silo_flat')}/parametric/{{study}}"), caption="../report/silo_parametric.rst", category="2 Silo validation", subcategory="Parametric studies", labels={"figure": "{study}"}),
     params:
         labels=lambda wildcards: [label for label, _ in _study_runs(wildcards)],
         runs=lambda wildcards: [run for _, run in _study_runs(wildcards)],
@@ -241,7 +240,7 @@ rule silo_posterior_draws:
         table=f"{case_root('silo_flat')}/posterior_draws/runs.csv",
         spread=report(f"{case_root('silo_flat')}/posterior_draws/spread.csv", caption="../report/silo_posterior_draws.rst", category="2 Silo validation", subcategory="Calibration uncertainty", labels={"figure": "calibration error bars"}),
         summary=f"{case_root('silo_flat')}/posterior_draws/summary.json",
-        plot=report(f"{case_root('silo_flat')}/posterior_draws/draws.png", caption="../report/silo_posterior_draws.rst", category="2 Silo validation", subcategory="Calibration uncertainty", labels={"figure": "runs at posterior draws"}),
+        plot=report(plot_file(f"{case_root('silo_flat')}/posterior_draws/draws"), caption="../report/silo_posterior_draws.rst", category="2 Silo validation", subcategory="Calibration uncertainty", labels={"figure": "runs at posterior draws"}),
     params:
         labels=lambda wildcards: [label for label, _ in posterior_draw_runs()],
         runs=lambda wildcards: [run for _, run in posterior_draw_runs()],

@@ -20,19 +20,21 @@ def recirculation_targets(wildcards=None, runs=None):
     targets = [
         run_path(RECIRCULATION, name, run)
         for run in blending
-        for name in ("metrics/blending.json", "metrics/fill_balance.json", "plots/concentration.png", "plots/vrr.png",
-                     "plots/rtd.png", "plots/lti.png", "plots/vrr_period.png", "plots/recirculation_model.png",
+        for name in ("metrics/blending.json", "metrics/fill_balance.json",
+                     *(plot_file(f"plots/{plot}") for plot in ("concentration", "vrr", "rtd", "lti", "vrr_period",
+                                                               "recirculation_model")),
                      "plots/snapshots")
     ]
     if shortcut_measured():
-        targets += [run_path(RECIRCULATION, name, run) for run in blending for name in ("metrics/shortcut.csv", "plots/shortcut.png")]
+        targets += [run_path(RECIRCULATION, name, run) for run in blending
+                    for name in ("metrics/shortcut.csv", plot_file("plots/shortcut"))]
     if runs is None and blending:
-        targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", f"{case_root(RECIRCULATION)}/summary/vrr.png"]
+        targets += [f"{case_root(RECIRCULATION)}/summary/blending.csv", plot_file(f"{case_root(RECIRCULATION)}/summary/vrr")]
     verification = among(recirculation_runs("verification"), runs)
     targets += [
         run_path(RECIRCULATION, f"verification/{name}", run)
         for run in verification
-        for name in ("verification.json", "paths.png", "residence_times.png")
+        for name in ("verification.json", plot_file("paths"), plot_file("residence_times"))
     ]
     targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in verification]
     return targets
@@ -103,18 +105,20 @@ rule silo_recirculation_analysis:
         rtd=f"{run_dir(RECIRCULATION)}/metrics/rtd.csv",
         vrr_period=f"{run_dir(RECIRCULATION)}/metrics/vrr_period.csv",
         model=f"{run_dir(RECIRCULATION)}/metrics/recirculation_model.csv",
-        concentration_plot=report(f"{run_dir(RECIRCULATION)}/plots/concentration.png", caption="../report/silo_recirculation_concentration.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "concentration"}),
-        vrr_plot=report(f"{run_dir(RECIRCULATION)}/plots/vrr.png", caption="../report/silo_recirculation_vrr.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR"}),
-        rtd_plot=report(f"{run_dir(RECIRCULATION)}/plots/rtd.png", caption="../report/silo_recirculation_rtd.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "RTD"}),
-        lti_plot=report(f"{run_dir(RECIRCULATION)}/plots/lti.png", caption="../report/silo_recirculation_lti.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "LTI"}),
-        vrr_period_plot=report(f"{run_dir(RECIRCULATION)}/plots/vrr_period.png", caption="../report/silo_recirculation_vrr_period.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR vs period"}),
-        model_plot=report(f"{run_dir(RECIRCULATION)}/plots/recirculation_model.png", caption="../report/silo_recirculation_model.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "recirculation model"}),
-        snapshots=report(directory(f"{run_dir(RECIRCULATION)}/plots/snapshots"), patterns=["{layout}.png"],
+        concentration_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/concentration"), caption="../report/silo_recirculation_concentration.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "concentration"}),
+        vrr_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/vrr"), caption="../report/silo_recirculation_vrr.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR"}),
+        rtd_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/rtd"), caption="../report/silo_recirculation_rtd.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "RTD"}),
+        lti_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/lti"), caption="../report/silo_recirculation_lti.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "LTI"}),
+        vrr_period_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/vrr_period"), caption="../report/silo_recirculation_vrr_period.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "VRR vs period"}),
+        model_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/recirculation_model"), caption="../report/silo_recirculation_model.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "recirculation model"}),
+        snapshots=report(directory(f"{run_dir(RECIRCULATION)}/plots/snapshots"), patterns=[plot_file("{layout}")],
                          caption="../report/silo_recirculation_snapshots.rst", category="3 Recirculating silo", subcategory="{run}",
                          labels={"figure": "snapshots {layout}"}),
         per_layout=directory(f"{run_dir(RECIRCULATION)}/plots/layouts"),
     params:
         case=typed_case(RECIRCULATION),
+        # of the plots in plots/snapshots/ and plots/layouts/, which the script names
+        plot_format=PLOT_FORMAT,
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
                                     ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer",
                                      "eulerian", "snapshots", "bulk_density_slab")},
@@ -130,7 +134,7 @@ rule silo_recirculation_shortcut:
         tracks=rules.silo_recirculation_tracks.output.tracks,
     output:
         table=report(f"{run_dir(RECIRCULATION)}/metrics/shortcut.csv", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut table"}),
-        plot=report(f"{run_dir(RECIRCULATION)}/plots/shortcut.png", caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut"}),
+        plot=report(plot_file(f"{run_dir(RECIRCULATION)}/plots/shortcut"), caption="../report/silo_recirculation_shortcut.rst", category="3 Recirculating silo", subcategory="{run}", labels={"figure": "shortcut"}),
     params:
         case=typed_case(RECIRCULATION),
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in
@@ -149,8 +153,8 @@ rule silo_recirculation_verification:
     output:
         table=f"{run_dir(RECIRCULATION)}/verification/residence_times.csv",
         summary=f"{run_dir(RECIRCULATION)}/verification/verification.json",
-        paths_plot=report(f"{run_dir(RECIRCULATION)}/verification/paths.png", caption="../report/silo_recirculation_paths.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "paths"}),
-        residence_plot=report(f"{run_dir(RECIRCULATION)}/verification/residence_times.png", caption="../report/silo_recirculation_residence.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "residence times"}),
+        paths_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/verification/paths"), caption="../report/silo_recirculation_paths.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "paths"}),
+        residence_plot=report(plot_file(f"{run_dir(RECIRCULATION)}/verification/residence_times"), caption="../report/silo_recirculation_residence.rst", category="3 Recirculating silo", subcategory="Verification", labels={"figure": "residence times"}),
     params:
         case=typed_case(RECIRCULATION),
         blending=lambda wildcards: {key: config[RECIRCULATION][key] for key in ("verification", "tracer", "eulerian")},
@@ -166,7 +170,7 @@ rule silo_recirculation_summary:
         vrr=lambda wildcards: [f"{run_dir(RECIRCULATION, run)}/metrics/vrr.csv" for run in recirculation_runs()],
     output:
         table=f"{case_root(RECIRCULATION)}/summary/blending.csv",
-        vrr_plot=report(f"{case_root(RECIRCULATION)}/summary/vrr.png", caption="../report/silo_recirculation_summary.rst", category="3 Recirculating silo", subcategory="Summary", labels={"figure": "VRR all"}),
+        vrr_plot=report(plot_file(f"{case_root(RECIRCULATION)}/summary/vrr"), caption="../report/silo_recirculation_summary.rst", category="3 Recirculating silo", subcategory="Summary", labels={"figure": "VRR all"}),
     params:
         runs=lambda wildcards: recirculation_runs(),
     log:

@@ -2,6 +2,7 @@
 # page), each row with its uncertainty and whether the scale shows its physics. It reads the products of every
 # stage and runs no engine; config/validation.yaml (`make validate`) is the scale at which the rows are shown.
 
+from analysis.io.validation_record import RECORD_PLOT_FORMAT, check_plot_format
 from model.cases import REFERENCE, VARIANT, run_roles
 from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, SUMMARY_DIR, VALIDATION_RECORD
@@ -194,27 +195,37 @@ for _part in (part for group_parts in PARTS.values() if len(group_parts) > 1 for
 def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
     profiles and Janssen comparison with the front-wall series, VRR against Nr, the blender's passage velocities
-    and gravity series."""
+    and gravity series. The record keeps PNG plots (analysis.io.validation_record): with another plots.format a
+    group's record is refused here, before anything runs."""
+    try:
+        check_plot_format(PLOT_FORMAT)
+    except ValueError as error:
+        raise WorkflowError(str(error)) from None
+    return {f"{name}.{RECORD_PLOT_FORMAT}": plot for name, plot in record_plot_sources(group).items()}
+
+
+def record_plot_sources(group):
+    """:func:`record_plots` by name in the record without its suffix."""
     kind = GROUPS[group].kind
     if kind == "jenike":
-        plots = {f"{name}.png": f"{CALIBRATION_DIR}/charts/{name}.png" for name in calibration_chart_names(group_made(group))}
+        plots = {name: plot_file(f"{CALIBRATION_DIR}/charts/{name}") for name in calibration_chart_names(group_made(group))}
         if GROUPS[group].makes(kind, CHECK):
-            plots.update({"lid_comparison.png": path for path in lid_comparison_targets() if path.endswith(".png")})
+            plots.update({"lid_comparison": path for path in lid_comparison_targets() if path.endswith(f".{PLOT_FORMAT}")})
         return plots
     if kind == "silo_flat":
         plots = {}
         if GROUPS[group].makes(kind, REFERENCE):
             base = run_ids("silo_flat")[0]
-            plots.update({f"{name}.png": run_path("silo_flat", f"plots/{name}.png", base) for name in ("profiles", "janssen")})
+            plots.update({name: run_path("silo_flat", plot_file(f"plots/{name}"), base) for name in ("profiles", "janssen")})
         if GROUPS[group].makes(kind, VARIANT):
-            plots.update({f"{study}.png": f"{case_root('silo_flat')}/parametric/{study}.png" for study in parametric_studies()})
+            plots.update({study: plot_file(f"{case_root('silo_flat')}/parametric/{study}") for study in parametric_studies()})
         return plots
     if kind == RECIRCULATION:
-        return {"vrr.png": f"{case_root(RECIRCULATION)}/summary/vrr.png"}
-    plots = {f"insert_velocities_{cases('blender')[run].configuration}_g{cases('blender')[run].gravity_factor:g}.png":
-             run_path("blender", "plots/insert_velocities.png", run) for run in blender_runs()}
+        return {"vrr": plot_file(f"{case_root(RECIRCULATION)}/summary/vrr")}
+    plots = {f"insert_velocities_{cases('blender')[run].configuration}_g{cases('blender')[run].gravity_factor:g}":
+             run_path("blender", plot_file("plots/insert_velocities"), run) for run in blender_runs()}
     if len(config["blender"]["gravity_factors"]) > 1:
-        plots["gravity_scaling.png"] = f"{case_root('blender')}/gravity/scaling.png"
+        plots["gravity_scaling"] = plot_file(f"{case_root('blender')}/gravity/scaling")
     return plots
 
 

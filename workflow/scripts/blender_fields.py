@@ -14,7 +14,7 @@ from analysis.studies.blender.window_fields import (
 )
 from analysis.studies.blender.window_fields_io import write_frame_fields, write_planar_fields
 from model.record import read_run_record
-from analysis.studies.silo_recirculation.tracks import recirculation_tracks
+from analysis.numerics.clump_tracks import tracks_from_frames
 from analysis.numerics.eulerian_rtd import silo_bins
 from analysis.numerics.flow import steady_flow_rate
 from analysis.io.tables import write_json
@@ -27,7 +27,7 @@ with logged_to(snakemake.log[0]) as log:
     case = snakemake.params.case
     silo = case.silo
     frames = engine_named(record.engine).read_frames(run_dir, record, on_damaged=snakemake.params.on_damaged)
-    recorded = recirculation_tracks(frames, record.domain_z)
+    recorded = tracks_from_frames(frames, record.domain_z)
     tracks = recorded.tracks
     since_open = tracks.times - record.open_time_s
     grid = silo_bins(silo.width, silo.depth, silo.fill_height, snakemake.params.bin_size)

@@ -36,6 +36,7 @@ with logged_to(snakemake.log[0]) as log:
     out = snakemake.output
     settings = snakemake.params.blending
     case = snakemake.params.case
+    plot_format = snakemake.params.plot_format  # plots.format, the suffix of the plots named here
     silo = case.silo
     loaded = load_tracks(snakemake.input.tracks)
     tracks = loaded.tracks
@@ -109,11 +110,12 @@ with logged_to(snakemake.log[0]) as log:
                   ("renewal prediction, measured loop RTD", layout.predicted, "predicted"),
                   ("renewal prediction, Johanson RTD", layout.predicted_johanson, "predicted"),
                   ("first exits of the initial fill", layout.first_pass.concentration, "first pass")]
-        lti_paths = [Path(out.per_layout) / f"lti_{name}.png"] + ([Path(out.lti_plot)] if index == 0 else [])
+        lti_paths = [Path(out.per_layout) / f"lti_{name}.{plot_format}"] + ([Path(out.lti_plot)] if index == 0 else [])
         for path in lti_paths:
             plot_lti_comparison(layout.recirculation_number, series, path, f"{name}: direct vs LTI, {title}",
                                 blue_fraction=layout.layout.blue_fraction, x_label="Nr [-]")
-        model_paths = [Path(out.per_layout) / f"model_{name}.png"] + ([Path(out.model_plot)] if index == 0 else [])
+        model_paths = ([Path(out.per_layout) / f"model_{name}.{plot_format}"]
+                       + ([Path(out.model_plot)] if index == 0 else []))
         for path in model_paths:
             plot_recirculation_model(layout.model_time_nr, layout.model_concentration, layout.layout.blue_fraction,
                                      layout.model_homogenised_after, path,
@@ -125,7 +127,7 @@ with logged_to(snakemake.log[0]) as log:
             for k in frames
         ]
         plot_coloured_snapshots(snapshots, silo.width, silo.outlet_width, top, case.channel_length,
-                                Path(out.snapshots) / f"{name}.png", f"{name}, {title}")
+                                Path(out.snapshots) / f"{name}.{plot_format}", f"{name}, {title}")
         log.info("%s: VRR per recirculation %s, predicted %s, RMS(prediction - direct) %.3f, homogenised after Nr %s",
                  name, np.round(layout.vrr.vrr, 2).tolist(), np.round(layout.vrr_predicted.vrr, 2).tolist(),
                  layout.prediction_rms_error(), layout.homogenised_after)

@@ -7,11 +7,12 @@ complete, stale or missing against the runs ``CONFIG`` plans (:func:`engines.val
 ``publish WORKDIR RECORD_DIR [GROUP]`` copies the records a `make validate` wrote in ``WORKDIR`` into ``RECORD_DIR``;
 ``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
 (:func:`analysis.studies.validation.record.record_page`); ``check GROUP CONFIG RECORD_DIR`` refuses, before anything
-runs, an unknown group or part, a group that runs in parts (naming them), or one whose rows compare against a group
-not yet complete in the record; ``restore GROUP CONFIG RECORD_DIR WORKDIR`` checks as ``check`` does, then copies
-into WORKDIR the products of the runs of the groups GROUP reads that their records keep and WORKDIR lacks (so that
-a group reads the runs another session made instead of making them again); ``finished CONFIG WORKDIR [GROUP]`` prints the groups (of GROUP's only) whose every
-run has finished in WORKDIR, whose record `make validate` then writes.
+runs, an unknown group or part, a group that runs in parts (naming them), one whose rows compare against a group
+not yet complete in the record, or a configuration whose plots are not PNG, which the record keeps
+(``plots.format``); ``restore GROUP CONFIG RECORD_DIR WORKDIR`` checks as ``check`` does, then copies into WORKDIR
+the products of the runs of the groups GROUP reads that their records keep and WORKDIR lacks (so that a group reads
+the runs another session made instead of making them again); ``finished CONFIG WORKDIR [GROUP]`` prints the groups
+(of GROUP's only) whose every run has finished in WORKDIR, whose record `make validate` then writes.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from pathlib import Path
 from typing import Sequence
 
 from analysis.io.tables import write_text
-from analysis.io.validation_record import PRODUCTS, read_group_record, read_record, restore_products, write_group_record
+from analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_record, restore_products,
+                                           write_group_record)
 from analysis.studies.validation.record import record_page
 from engines.config import load_config
 from engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
@@ -76,9 +78,13 @@ def measured_wall_times(record: dict, cores: int) -> dict[str, dict[str, float]]
     return walls
 
 
-def _plan(config_path: str) -> tuple[list, dict[str, list]]:
-    """A configuration's run estimates and the runs each group makes of them (:func:`engines.planning.group_runs`)."""
+def _plan(config_path: str, record: bool = False) -> tuple[list, dict[str, list]]:
+    """A configuration's run estimates and the runs each group makes of them (:func:`engines.planning.group_runs`).
+    With ``record``, the configuration is to write the record from: refused (ValueError) when its plots are not in the
+    record's format (:func:`analysis.io.validation_record.check_plot_format`)."""
     config = load_config(config_path)
+    if record:
+        check_plot_format(config["plots"]["format"])
     estimates = config_estimates(config)
     return estimates, group_runs(config, estimates)
 
@@ -94,15 +100,16 @@ def _check(name: str, made: dict[str, list], record_dir: str | Path) -> None:
 
 def check(name: str, config_path: str, record_dir: str | Path) -> None:
     """`make validate GROUP=<name>`'s check before anything runs: ``name`` is a group or a part of one that
-    ``config_path`` plans, and the groups its rows compare against are complete in the record (ValueError)."""
-    _check(name, _plan(config_path)[1], record_dir)
+    ``config_path`` plans, its plots are in the record's format, and the groups its rows compare against are complete
+    in the record (ValueError)."""
+    _check(name, _plan(config_path, record=True)[1], record_dir)
 
 
 def restore(name: str, config_path: str, record_dir: str | Path, workdir: str | Path) -> dict[str, int]:
     """:func:`check` group or part ``name``, then copy into ``workdir`` the products of the runs of the groups it
     reads that their records in ``record_dir`` keep and ``workdir`` lacks
     (:func:`analysis.io.validation_record.restore_products`). Returns ``{group read: files copied}``."""
-    made = _plan(config_path)[1]
+    made = _plan(config_path, record=True)[1]
     _check(name, made, record_dir)
     reads = GROUPS[group_of_part(name)].reads
     restored = {other: len(restore_products(Path(record_dir) / other, workdir)) for other in reads}

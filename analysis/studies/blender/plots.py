@@ -1,7 +1,8 @@
 """Plots of the multi-flow blender analysis (the modules of :mod:`analysis.studies.blender`).
 
 Each writer takes the results of the blender analysis (or plain arrays), a path and a title, draws one figure
-and saves it atomically as a 150 dpi PNG with :func:`analysis.io.plots.save_png`; nothing is read from files.
+and saves it atomically with :func:`analysis.io.plots.save_figure` (PNG, PDF or SVG, as the path's suffix says);
+nothing is read from files.
 Lengths are given in m and drawn in mm; x = 0 is the silo axis and z = 0 the outlet plane. The RTD and the
 discontinuous mode are drawn by the writers of :mod:`analysis.studies.silo_recirculation.rtd_plots`.
 """
@@ -13,22 +14,18 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from model.checks import finite_array, number_or_nan, positive_number  # noqa: E402
-from analysis.io.plots import non_empty_list, positive_finite_points, save_png, tuple_entry  # noqa: E402
-from analysis.numerics.rtd import RTD  # noqa: E402
-from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity  # noqa: E402
-from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode  # noqa: E402
-from analysis.studies.blender.profiles import ChannelBoundary, PassageVelocities, ProfilesOverTime  # noqa: E402
-from analysis.studies.blender.steady_field import BlenderField  # noqa: E402
-from analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD  # noqa: E402
-from analysis.studies.silo_recirculation.rtd_plots import plot_recirculation_model, plot_rtd_comparison  # noqa: E402
+from model.checks import finite_array, number_or_nan, positive_number
+from analysis.io.plots import non_empty_list, positive_finite_points, save_figure, tuple_entry
+from analysis.numerics.rtd import RTD
+from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity
+from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode
+from analysis.studies.blender.profiles import ChannelBoundary, PassageVelocities, ProfilesOverTime
+from analysis.studies.blender.steady_field import BlenderField
+from analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD
+from analysis.studies.silo_recirculation.rtd_plots import plot_recirculation_model, plot_rtd_comparison
 
 __all__ = [
     "plot_profiles_over_time",
@@ -74,7 +71,7 @@ def plot_profiles_over_time(profiles: ProfilesOverTime, path: str | os.PathLike,
     profiles : analysis.studies.blender.profiles.ProfilesOverTime
         Profiles at key heights for several windows.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -104,7 +101,7 @@ def plot_profiles_over_time(profiles: ProfilesOverTime, path: str | os.PathLike,
             axes.set_ylabel("v_z / cross-section mean [-]")
         axes_grid.flat[0].legend(fontsize=7)
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -121,7 +118,7 @@ def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelociti
     inlet, outlet : analysis.studies.blender.profiles.PassageVelocities
         Profiles and passage means at the two heights.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -153,7 +150,7 @@ def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelociti
             axes.legend(fontsize=7)
         axes_pair[0].set_ylabel("v_z [m/s]")
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -168,7 +165,7 @@ def plot_channel_boundary(field: BlenderField, boundary: ChannelBoundary, path: 
     boundary : analysis.studies.blender.profiles.ChannelBoundary
         Boundary per row (:func:`analysis.studies.blender.profiles.flow_channel_boundary_over_height` of ``field``).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -201,7 +198,7 @@ def plot_channel_boundary(field: BlenderField, boundary: ChannelBoundary, path: 
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.legend(loc="upper center", fontsize=7)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -220,7 +217,7 @@ def plot_tracer_pathlines(pathlines: TracerPathlines, path: str | os.PathLike, t
     pathlines : analysis.studies.blender.tracers.TracerPathlines
         Released tracers and their paths.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -249,7 +246,7 @@ def plot_tracer_pathlines(pathlines: TracerPathlines, path: str | os.PathLike, t
         right.grid(alpha=0.3)
         right.legend(fontsize=8)
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -264,7 +261,7 @@ def plot_rtd_theta(rtds: Mapping, path: str | os.PathLike, title: str) -> Path:
     rtds : mapping label -> RTD or VirtualTracerRTD
         One RTD per configuration.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -290,7 +287,7 @@ def plot_discontinuous_mode(result: DiscontinuousMode, path: str | os.PathLike, 
     result : analysis.studies.blender.modes.DiscontinuousMode
         The recirculated two-layer fill.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -315,7 +312,7 @@ def plot_continuous_mode(results: Mapping, path: str | os.PathLike, title: str) 
     results : mapping label -> analysis.studies.blender.modes.ContinuousMode
         One result per configuration.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -349,7 +346,7 @@ def plot_continuous_mode(results: Mapping, path: str | os.PathLike, title: str) 
         right.set_ylim(bottom=0.0)
         right.grid(alpha=0.3, which="both")
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -367,7 +364,7 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         ``(label, gravity_factor, time, velocity)``: factor ``g_run / g`` (> 0), times [s] (finite) and a
         velocity [m/s] of the same length (NaN is a gap).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     quantity : str, optional
@@ -397,7 +394,7 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -414,7 +411,7 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
         Metric columns to draw, each a key of every row; NaN values leave the bar out. A column whose rows carry
         ``<column>_error`` gets error bars of one standard error (none where the error is NaN or missing).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     best : str, optional
@@ -464,6 +461,6 @@ def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str |
             axes.grid(alpha=0.3, axis="y")
         figure.suptitle(title if best is None else f"{title} (best: {best})")
         figure.tight_layout()
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)

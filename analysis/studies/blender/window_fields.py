@@ -1,6 +1,6 @@
 """Window-averaged planar fields and the discharge history of a blender run, from clump tracks.
 
-Pure functions on numpy arrays; no file I/O (:func:`analysis.studies.silo_recirculation.tracks.recirculation_tracks`
+Pure functions on numpy arrays; no file I/O (:func:`analysis.numerics.clump_tracks.tracks_from_frames`
 builds the tracks from the engine's frames, :mod:`analysis.studies.blender.window_fields_io` stores the
 fields). SI units: positions in m, velocities in m/s, masses in kg, times in s.
 
@@ -24,7 +24,8 @@ import numpy as np
 from model.checks import finite_number, positive_number
 from analysis.numerics.eulerian_rtd import bin_sums
 from analysis.numerics.grid import Grid
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, recirculation_events
+from analysis.numerics.clump_tracks import ClumpTracks
+from analysis.studies.silo_recirculation.tracks import recirculation_events
 
 __all__ = ["PlanarField", "window_average_field", "frame_fields", "discharged_mass_history", "frames_in_window",
            "mean_velocity_history"]

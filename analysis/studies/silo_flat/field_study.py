@@ -31,7 +31,6 @@ from model.cases.silo_flat import SiloCase
 from model.constants import GRAVITY
 from analysis.numerics.field_ops import depth_average, front_wall_slice
 from analysis.numerics.flow import column_surface_heights
-from analysis.numerics.coarse_graining import kernel_support_radius
 from analysis.numerics.force_chains import ForceChainSegments, force_chain_segments
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.profiles import profile_flow_rate, velocity_profile
@@ -43,8 +42,7 @@ from analysis.studies.silo_flat.fields import (
     analyse_profiles,
     centreline_velocity,
     clump_fields,
-    compare_janssen,
-    contact_stress_field,
+    janssen_from_contacts,
     profile_mass_flow_rate,
     profile_uncertainty,
     silo_grid,
@@ -135,6 +133,37 @@ class SiloDimensions:
             outlet_width=case.outlet_width,
             particle_radius=0.5 * case.particle.equivalent_diameter,
             clump_mass=case.particle.mass,
+        )
+
+    @classmethod
+    def from_summary(cls, summary: Mapping) -> "SiloDimensions":
+        """From a run's case summary (``deck/case.json``), which every silo-type case writes: the flat-bottom
+        silo, the recirculating silo and the blender.
+
+        Parameters
+        ----------
+        summary : mapping
+            ``width_m``, ``depth_m``, ``outlet_width_m``, ``equivalent_diameter_m`` [m] and ``clump_mass_kg`` [kg].
+
+        Returns
+        -------
+        SiloDimensions
+
+        Raises
+        ------
+        KeyError
+            Naming the missing key, for the summary of a case that is no silo (a Jenike cell).
+        """
+        missing = [key for key in ("width_m", "depth_m", "outlet_width_m", "equivalent_diameter_m", "clump_mass_kg")
+                   if key not in summary]
+        if missing:
+            raise KeyError(f"the case summary has no {', '.join(missing)}: it is no silo's")
+        return cls(
+            width=float(summary["width_m"]),
+            depth=float(summary["depth_m"]),
+            outlet_width=float(summary["outlet_width_m"]),
+            particle_radius=0.5 * float(summary["equivalent_diameter_m"]),
+            clump_mass=float(summary["clump_mass_kg"]),
         )
 
 
@@ -411,14 +440,10 @@ def _contact_analyses(contacts: ContactFrame, grid: Grid, settings: FieldSetting
     """The settled fill's contact stress on the grid (Pa), its Janssen comparison and its force chains."""
     # Janssen: mean vertical contact stress of the settled fill against the formula, below the lowest point of
     # the surface.
-    stress = contact_stress_field(contacts, grid, settings)
-    janssen = compare_janssen(
-        stress, grid, float(np.nanmin(surface)), bulk_density, silo.width, silo.depth,
-        math.tan(math.radians(options.side_wall_friction_angle_deg)),
-        math.tan(math.radians(options.front_wall_friction_angle_deg)),
-        options.internal_friction_angle_deg, margin=settings.cutoff * settings.width,
-        bin_width=2.0 * kernel_support_radius(settings.width, settings.cutoff, settings.kernel),
-        bulk_density_error=number_or_nan(bulk_density_error))
+    stress, janssen = janssen_from_contacts(
+        contacts, grid, settings, float(np.nanmin(surface)), bulk_density, silo.width, silo.depth,
+        options.internal_friction_angle_deg, options.side_wall_friction_angle_deg,
+        options.front_wall_friction_angle_deg, bulk_density_error=number_or_nan(bulk_density_error))
     segments = force_chain_segments(contacts, 0.5 * silo.depth, options.force_chain_slice,
                                     cap=force_chain_cap(silo.clump_mass))
     return stress, janssen, segments

@@ -15,7 +15,7 @@ import numpy as np
 
 from analysis.numerics.grid import Fields, Grid
 from analysis.numerics.field_ops import average_fields, depth_average
-from analysis.numerics.coarse_graining import coarse_grain
+from analysis.numerics.coarse_graining import coarse_grain, kernel_support_radius
 from model.constants import GRAVITY
 from analysis.numerics.contact_stress import contact_stress
 from analysis.numerics.janssen import janssen_vertical_stress
@@ -452,6 +452,60 @@ def compare_janssen(
         hydrostatic=hydrostatic, hydrostatic_error=gravity * h * float(bulk_density_error),
         bin_pairs=max(pairs, 0),
     )
+
+
+def janssen_from_contacts(
+    contacts,
+    grid: Grid,
+    settings: FieldSettings,
+    surface_height: float,
+    bulk_density: float,
+    width: float,
+    depth: float,
+    internal_friction_angle_deg: float,
+    side_wall_friction_angle_deg: float,
+    front_wall_friction_angle_deg: float,
+    bulk_density_error: float = math.nan,
+) -> tuple[np.ndarray, JanssenComparison]:
+    """The contact stress of a settled fill on the grid and its comparison with Janssen's formula.
+
+    The stress is :func:`contact_stress_field`; the comparison :func:`compare_janssen` with the rows within the
+    kernel's reach (``cutoff`` widths) of the floor and of the surface left out and the error from mirror bins as
+    wide as the kernel's support, so that neighbouring bins share few contacts.
+
+    Parameters
+    ----------
+    contacts : model.contacts.ContactFrame
+        Pair contacts of the settled fill (positions in m, forces in N).
+    grid : Grid
+        Grid of the fields, tiling the silo.
+    settings : FieldSettings
+        The kernel: its width (m), cut-off (-) and kind.
+    surface_height : float
+        Fill surface height H the depths are measured from (m); the study takes the lowest point of the surface.
+    bulk_density : float
+        Bulk density rho_b of the fill (kg/m3).
+    width, depth : float
+        Silo width W and depth T (m).
+    internal_friction_angle_deg, side_wall_friction_angle_deg, front_wall_friction_angle_deg : float
+        Bulk friction angles of Janssen's formula (degrees): internal, side walls, front and back walls.
+    bulk_density_error : float, optional
+        Standard error of ``bulk_density`` (kg/m3), for the hydrostatic stress's error; NaN (default): unknown.
+
+    Returns
+    -------
+    stress : numpy.ndarray, shape grid.shape + (3, 3)
+        Contact stress (Pa, compression positive).
+    comparison : JanssenComparison
+    """
+    stress = contact_stress_field(contacts, grid, settings)
+    comparison = compare_janssen(
+        stress, grid, surface_height, bulk_density, width, depth,
+        math.tan(math.radians(side_wall_friction_angle_deg)), math.tan(math.radians(front_wall_friction_angle_deg)),
+        internal_friction_angle_deg, margin=settings.cutoff * settings.width,
+        bin_width=2.0 * kernel_support_radius(settings.width, settings.cutoff, settings.kernel),
+        bulk_density_error=bulk_density_error)
+    return stress, comparison
 
 
 def _in_window(fields: Sequence[Fields], times: np.ndarray, window: tuple[float, float]) -> list[Fields]:

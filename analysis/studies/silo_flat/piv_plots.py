@@ -7,13 +7,10 @@ import os
 from pathlib import Path
 
 import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # headless: runs on clusters and in CI
-
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from analysis.io.plots import save_png  # noqa: E402
+from analysis.io.plots import save_figure
 
 __all__ = ["plot_piv_accuracy"]
 
@@ -56,7 +53,7 @@ def plot_piv_accuracy(rows: list[dict], path: str | os.PathLike, title: str = "S
         axes.grid(alpha=0.3)
         axes.legend(fontsize="x-small")
     figure.suptitle(title)
-    return save_png(figure, path, tight=True)
+    return save_figure(figure, path, tight=True)
 
 
 def plot_piv_comparison(pairs, path: str | os.PathLike, title: str = "DEM front wall vs measured PIV") -> Path:
@@ -87,4 +84,4 @@ def plot_piv_comparison(pairs, path: str | os.PathLike, title: str = "DEM front 
     panels[0].set_ylabel("v_z (m/s)")
     panels[0].legend(fontsize="x-small")
     figure.suptitle(title)
-    return save_png(figure, path, tight=True)
+    return save_figure(figure, path, tight=True)

@@ -1,24 +1,21 @@
 """Plots of the flat-bottom silo flow in the study's style: discharge, velocity profiles and fields, stresses.
 
-Each writer takes arrays or dataclasses and a path, draws one figure and saves it atomically as a 150 dpi
-PNG (:func:`analysis.io.plots.save_png`). It returns that figure, already closed (let go by pyplot, so a
-caller that ignores it leaks nothing): its artists still hold the plotted data, which is what the tests check."""
+Each writer takes arrays or dataclasses and a path, draws one figure and saves it atomically in the format of the
+path's suffix, PNG, PDF or SVG (:func:`analysis.io.plots.save_figure`). It returns that figure, already closed (let go
+by pyplot, so a caller that ignores it leaks nothing): its artists still hold the plotted data, which is what the
+tests check."""
 
 from __future__ import annotations
 
 import os
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from analysis.io.plots import save_png, silo_outline  # noqa: E402
-from analysis.numerics.flow import DischargeHistory, FlowRateFit  # noqa: E402
+from analysis.io.plots import save_figure, silo_outline
+from analysis.numerics.flow import DischargeHistory, FlowRateFit
 
 
 def plot_discharge(
@@ -44,7 +41,7 @@ def plot_discharge(
     beverloo_rate : float or None
         Beverloo mass flow rate [kg/s]; None to omit the line.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     rate_error : float, optional
@@ -92,7 +89,7 @@ def plot_discharge(
         axes.grid(True, alpha=0.3)
         axes.legend(loc="upper left", fontsize="small")
         figure.tight_layout()
-        save_png(figure, path)
+        save_figure(figure, path)
     finally:
         plt.close(figure)
     return figure
@@ -135,7 +132,7 @@ def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: fl
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.legend(loc="upper center", fontsize=8)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -154,7 +151,7 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -173,7 +170,7 @@ def plot_kinematic_constant(heights, B, path, title: str, B_error=None) -> Figur
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.grid(alpha=0.3)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -196,7 +193,7 @@ def plot_janssen(comparison, path, title: str) -> Figure:
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -213,7 +210,7 @@ def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Fi
         axes.set_title(title)
         axes.legend(fontsize=8)
         axes.grid(alpha=0.3)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -235,7 +232,7 @@ def plot_force_chains(segments, width: float, outlet_width: float, top: float, p
         axes.set_xlabel("x [mm]")
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -262,7 +259,7 @@ def plot_measured_comparison(comparisons, path, title: str) -> Figure:
         axes_list[-1, 0].set_xlabel("x [mm]")
         axes_list[0, 0].legend(fontsize=8)
         figure.suptitle(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -284,7 +281,7 @@ def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, 
         right.set_ylabel("steady mass flow rate [kg/s]")
         right.grid(alpha=0.3, axis="y")
         figure.suptitle(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -304,7 +301,7 @@ def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Figure:
         axes_list[0, 0].legend(fontsize=8)
         axes_list[-1, 0].set_xlabel("x [mm]")
         figure.suptitle(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure
@@ -331,7 +328,7 @@ def plot_posterior_draws(rows, spread, path, title: str) -> Figure:
             axis.grid(alpha=0.3, axis="y")
             axis.legend(fontsize=7)
         figure.suptitle(title)
-        save_png(figure, path, tight=True)
+        save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
     return figure

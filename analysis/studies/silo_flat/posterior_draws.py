@@ -25,12 +25,23 @@ SPREAD_LEVEL = 0.95
 
 
 def base_vertical_stress(janssen_rows: Sequence[Mapping]) -> tuple[float, float]:
-    """The DEM's vertical stress at the base of the settled fill and its standard error (Pa): the row of
-    ``metrics/janssen.csv`` deepest below the surface (its ``sigma_v_dem_Pa`` and ``sigma_v_dem_Pa_error``)."""
+    """The DEM's vertical stress at the base of the settled fill and its standard error (Pa): ``sigma_v_dem_Pa`` and
+    ``sigma_v_dem_Pa_error`` of the row of ``metrics/janssen.csv`` deepest below the surface among those with a
+    standard error (a bin without a neighbour to pair with has none); NaN as the error when no row has one."""
     if not janssen_rows:
         raise ValueError("the Janssen profile has no rows: the settled fill gave no vertical stress")
-    deepest = max(janssen_rows, key=lambda row: float(row["depth_below_surface_m"]))
-    return float(deepest["sigma_v_dem_Pa"]), float(deepest["sigma_v_dem_Pa_error"])
+    known = [row for row in janssen_rows if _number(row.get("sigma_v_dem_Pa_error")) is not None]
+    deepest = max(known or janssen_rows, key=lambda row: float(row["depth_below_surface_m"]))
+    error = _number(deepest.get("sigma_v_dem_Pa_error"))
+    return float(deepest["sigma_v_dem_Pa"]), math.nan if error is None else error
+
+
+def _number(value) -> float | None:
+    """``value`` as a finite float, None when it is empty, null or NaN."""
+    if value is None or value == "":
+        return None
+    number = float(value)
+    return number if math.isfinite(number) else None
 
 
 def posterior_draw_rows(labels: Sequence[str], runs: Sequence[str], parameters: Sequence[Mapping],
@@ -67,7 +78,7 @@ def calibration_spread(rows: Sequence[Mapping]) -> list[dict]:
     """Per figure, the calibration's error bar from the draws beside the runs' own error.
 
     For the draws (every row but the posterior mean's) with values :math:`v_i` and standard errors :math:`e_i`:
-    the spread :math:`s` (sample standard deviation, ddof 1), the runs' own error :math:`e` (root mean square of the
+    the spread :math:`s` (sample standard deviation, ddof 1), the runs' own error :math:`e` (root mean square of the known
     :math:`e_i`), and the calibration's part :math:`\\sqrt{\\max(s^2 - e^2, 0)}`. Were the parameters of no
     consequence, :math:`(n - 1) s^2 / e^2` would follow a chi-square law with :math:`n - 1` degrees of freedom; the
     spread counts as larger than the runs' own error when it exceeds that law's quantile at :data:`SPREAD_LEVEL`.
@@ -88,7 +99,8 @@ def calibration_spread(rows: Sequence[Mapping]) -> list[dict]:
         errors = np.array([row[f"{figure}_error"] for row in draws], dtype=float)
         count = len(values)
         spread = float(np.std(values, ddof=1)) if count >= 2 else math.nan
-        run_error = float(np.sqrt(np.mean(errors ** 2))) if count else math.nan
+        known = errors[np.isfinite(errors)]
+        run_error = float(np.sqrt(np.mean(known ** 2))) if len(known) else math.nan
         if count < 2 or math.isnan(run_error):
             ratio = math.nan
         elif run_error > 0:

@@ -1,7 +1,8 @@
 """The blending study in the recirculating silo.
 
-- ``tracks``: clump tracks from the engine's frames, outlet crossings, re-entries and passes;
-  ``tracks_io``: their ``.npz`` store.
+- ``tracks``: the outlet crossings, re-entries and passes of the clump tracks (those of
+  :mod:`analysis.numerics.exit_times`, on the tracks of :mod:`analysis.numerics.clump_tracks`) with what the study
+  adds to them, and the holdup; ``tracks_io``: the tracks' ``.npz`` store.
 - ``concentration``: batch layers, outlet concentration measured and predicted (renewal equation).
 - ``vrr``: recirculation number, holdup residence time, VRR per recirculation.
 - ``tracers``: the tracer passes of the particle RTD. ``validation``: argument checks they share.

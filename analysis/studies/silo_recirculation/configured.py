@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from analysis.studies.silo_recirculation.study import BlendingResult, Layout, analyse_blending
-from analysis.studies.silo_recirculation.tracks import ClumpTracks
+from analysis.numerics.clump_tracks import ClumpTracks
 
 #: The keys of the section that :func:`analyse_configured` reads.
 SETTINGS_KEYS = ("layouts", "lti", "concentration_window", "concentration_window_target_vrr", "tracer")

@@ -1,7 +1,8 @@
 """Plots of blending in the recirculating planar silo in the study's style: what the run shows.
 
 Each writer takes arrays (or lists of labelled arrays), a path and a title, draws one figure and saves
-it atomically as a 150 dpi PNG with :func:`analysis.io.plots.save_png`; nothing is read from files.
+it atomically with :func:`analysis.io.plots.save_figure` (PNG, PDF or SVG, as the path's suffix says); nothing is
+read from files.
 The RTD and LTI model curves are drawn by :mod:`analysis.studies.silo_recirculation.rtd_plots`.
 
 Geometry (as in :mod:`analysis.studies.silo_flat.plots`): width W along x with walls at x = +-W/2, floor and outlet
@@ -20,24 +21,20 @@ import math
 import os
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from model.checks import finite_array, positive_number  # noqa: E402
-from analysis.io.plots import (  # noqa: E402
+from model.checks import finite_array, positive_number
+from analysis.io.plots import (
     finite_abscissa,
     matching_ordinate,
     non_empty_list,
-    save_png,
+    save_figure,
     silo_outline,
     tuple_entry,
 )
-from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling  # noqa: E402
-from analysis.studies.silo_recirculation.rtd_plots import BLUE, tolerance_band  # noqa: E402
+from analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling
+from analysis.studies.silo_recirculation.rtd_plots import BLUE, tolerance_band
 
 __all__ = [
     "plot_outlet_concentration",
@@ -79,7 +76,7 @@ def plot_outlet_concentration(curves, blue_fraction: float, path: str | os.PathL
     blue_fraction : float
         Blue fraction of the whole inventory [-] (> 0): the homogeneous value, drawn dashed.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     tolerance : float, optional
@@ -110,7 +107,7 @@ def plot_outlet_concentration(curves, blue_fraction: float, path: str | os.PathL
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -162,7 +159,7 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         the counting-noise ceiling of that curve's VRR [-] (> 0; None or absent: ``noise_limit``) and the
         standard error of each VRR [-] (same length, >= 0; NaN: no bar; None or absent: no bars).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     noise_limit : float or None, optional
@@ -229,7 +226,7 @@ def plot_vrr_versus_recirculations(curves, path: str | os.PathLike, title: str, 
         axes.set_title(title)
         axes.grid(alpha=0.3, which="both")
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -254,7 +251,7 @@ def plot_coloured_snapshots(snapshots, width: float, outlet_width: float, top: f
     channel_length : float
         Length of the channel below the outlet [m]; it ends at z = -channel_length.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -306,7 +303,7 @@ def plot_coloured_snapshots(snapshots, width: float, outlet_width: float, top: f
         for axes in axes_grid[:, 0]:
             axes.set_ylabel("z [mm]")
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -329,7 +326,7 @@ def plot_paths_comparison(particle_paths, pathlines, width: float, outlet_width:
     top : float
         Height up to which the walls are drawn [m].
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -375,6 +372,6 @@ def plot_paths_comparison(particle_paths, pathlines, width: float, outlet_width:
         axes.set_ylabel("z [mm]")
         axes.set_title(title)
         axes.legend(loc="upper center", fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)

@@ -1,10 +1,10 @@
 """Plots of residence time distributions and of the LTI (RTD convolution) model of blending.
 
 Shared by the recirculating silo and the blender (:mod:`analysis.studies.blender.plots`). Each writer takes
-arrays (or lists of labelled arrays), a path and a title, draws one figure and saves it atomically as a
-150 dpi PNG with :func:`analysis.io.plots.save_png`; nothing is read from files. "Concentration" is the
-blue (tracer) fraction [-]; tolerance bands are relative, ``blue_fraction * (1 +- tolerance)``, as in
-:func:`analysis.numerics.lti.recirculations_to_homogenise`.
+arrays (or lists of labelled arrays), a path and a title, draws one figure and saves it atomically with
+:func:`analysis.io.plots.save_figure` (PNG, PDF or SVG, as the path's suffix says); nothing is read from files.
+"Concentration" is the blue (tracer) fraction [-]; tolerance bands are relative, ``blue_fraction * (1 +- tolerance)``,
+as in :func:`analysis.numerics.lti.recirculations_to_homogenise`.
 """
 
 from __future__ import annotations
@@ -13,20 +13,16 @@ import math
 import os
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from model.checks import positive_number  # noqa: E402
-from analysis.io.plots import (  # noqa: E402
+from model.checks import positive_number
+from analysis.io.plots import (
     finite_abscissa,
     matching_ordinate,
     non_empty_list,
     positive_finite_points,
-    save_png,
+    save_figure,
     tuple_entry,
 )
 
@@ -68,7 +64,7 @@ def plot_rtd_comparison(curves, path: str | os.PathLike, title: str, dimensionle
         ``(label, t, E, t_mean)``: bin centres t [s] (finite), RTD E(t) [1/s] (same length) and the
         mean residence time t_m [s] (> 0), which the legend shows.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     dimensionless : bool, optional
@@ -107,7 +103,7 @@ def plot_rtd_comparison(curves, path: str | os.PathLike, title: str, dimensionle
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -125,7 +121,7 @@ def plot_lti_comparison(time, series, path: str | os.PathLike, title: str, blue_
         drawn as a gap) and a style hint: ``"direct"`` (solid), ``"predicted"`` (dashed),
         ``"first pass"`` (dotted), ``"input"`` (thin grey); any other hint gives a thin solid line.
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     blue_fraction : float or None, optional
@@ -165,7 +161,7 @@ def plot_lti_comparison(time, series, path: str | os.PathLike, title: str, blue_
         axes.set_title(title)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -183,7 +179,7 @@ def plot_vrr_versus_period(period_fraction, curves, path: str | os.PathLike, tit
         ``(label, VRR)``: variance reduction ratio [-] at each period (same length as
         ``period_fraction``).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -218,7 +214,7 @@ def plot_vrr_versus_period(period_fraction, curves, path: str | os.PathLike, tit
         axes.set_title(title)
         axes.grid(alpha=0.3, which="both")
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -239,7 +235,7 @@ def plot_recirculation_model(time_in_passes, concentration, blue_fraction: float
         Recirculations after which the concentration stays within the band [-], drawn as a vertical
         line; NaN when it is never reached (then the plot says "not within band").
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
     tolerance : float, optional
@@ -282,7 +278,7 @@ def plot_recirculation_model(time_in_passes, concentration, blue_fraction: float
         axes.set_title(title)
         axes.grid(alpha=0.3, axis="y")
         axes.legend(fontsize=8)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)
 
@@ -299,7 +295,7 @@ def plot_residence_time_comparison(samples, path: str | os.PathLike, title: str)
         ``(label, residence_times)``: 1-D residence times [s]; each sample needs at least one finite
         value (infinite values are not allowed).
     path : str or os.PathLike
-        Destination PNG file (written atomically, 150 dpi).
+        Destination plot file, written atomically in the format of its suffix (:func:`analysis.io.plots.save_figure`).
     title : str
         Figure title.
 
@@ -346,6 +342,6 @@ def plot_residence_time_comparison(samples, path: str | os.PathLike, title: str)
         right.set_ylim(0.0, 1.02)
         right.grid(alpha=0.3)
         figure.suptitle(title)
-        return save_png(figure, path, tight=True)
+        return save_figure(figure, path, tight=True)
     finally:
         plt.close(figure)

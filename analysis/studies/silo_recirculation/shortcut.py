@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from analysis.studies.silo_recirculation.study import BlendingResult
-from analysis.studies.silo_recirculation.tracks import ClumpTracks
+from analysis.numerics.clump_tracks import ClumpTracks
 
 
 def tracks_until(tracks: ClumpTracks, t_end: float) -> ClumpTracks:

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analysis.numerics.clump_tracks import ClumpTracks
 from analysis.numerics.eulerian_rtd import eulerian_residence_times, silo_bins
 from analysis.numerics.lti import VRRTable, recirculate, recirculations_to_homogenise, vrr_versus_period
 from analysis.numerics.rtd import RTD, johanson_rtd, rtd_from_exit_times
@@ -53,12 +54,7 @@ from analysis.studies.silo_recirculation.concentration import (
 )
 from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_passes
 from analysis.studies.silo_recirculation.transit import TransitLittlesLaw, transit_horizon, transit_littles_law
-from analysis.studies.silo_recirculation.tracks import (
-    ClumpTracks,
-    RecirculationEvents,
-    clumps_above_outlet,
-    recirculation_events,
-)
+from analysis.studies.silo_recirculation.tracks import RecirculationEvents, clumps_above_outlet, recirculation_events
 from analysis.studies.silo_recirculation.vrr import (
     RecirculationVRR,
     littles_law,

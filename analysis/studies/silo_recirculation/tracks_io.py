@@ -1,7 +1,7 @@
 """Reader and writer of the recirculation study's clump tracks as ``.npz``.
 
 The only place the recirculation analysis touches files; the tracks themselves are built from the engine's
-frames by :func:`analysis.studies.silo_recirculation.tracks.recirculation_tracks`, and the other modules
+frames by :func:`analysis.numerics.clump_tracks.tracks_from_frames`, and the other modules
 of :mod:`analysis.studies.silo_recirculation` compute on the arrays.
 """
 
@@ -13,12 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from analysis.io.tables import atomic_output
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationTracks
+from analysis.numerics.clump_tracks import ClumpTracks, TrackedClumps
 
 __all__ = ["write_tracks", "load_tracks"]
 
 
-def write_tracks(tracks: RecirculationTracks, path: str | os.PathLike) -> Path:
+def write_tracks(tracks: TrackedClumps, path: str | os.PathLike) -> Path:
     """Save tracks as a compressed ``.npz`` (atomically); positions and velocities as float32."""
     with atomic_output(path) as temporary:
         with open(temporary, "wb") as handle:
@@ -30,9 +30,9 @@ def write_tracks(tracks: RecirculationTracks, path: str | os.PathLike) -> Path:
     return Path(path)
 
 
-def load_tracks(path: str | os.PathLike) -> RecirculationTracks:
+def load_tracks(path: str | os.PathLike) -> TrackedClumps:
     """Load tracks written by :func:`write_tracks` (positions and velocities back in float64)."""
     with np.load(path) as data:
         tracks = ClumpTracks(times=data["times"], clump_id=data["clump_id"],
                              position=data["position"].astype(np.float64))
-        return RecirculationTracks(tracks=tracks, velocity=data["velocity"].astype(np.float64), mass=data["mass"])
+        return TrackedClumps(tracks=tracks, velocity=data["velocity"].astype(np.float64), mass=data["mass"])

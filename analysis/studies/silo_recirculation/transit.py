@@ -38,7 +38,8 @@ import numpy as np
 
 from model.checks import finite_array, finite_number, increasing_times, integer_at_least, positive_number
 from analysis.numerics.uncertainty import Estimate, batch_means, proportion_error
-from analysis.studies.silo_recirculation.tracks import ClumpTracks, RecirculationEvents, above_outlet
+from analysis.numerics.clump_tracks import ClumpTracks
+from analysis.studies.silo_recirculation.tracks import RecirculationEvents, above_outlet
 from analysis.studies.silo_recirculation.validation import event_times
 from analysis.studies.silo_recirculation.vrr import LittlesLaw, littles_law
 
