@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 
 import nbformat
+from jupyter_client.manager import KernelManager
 from nbclient import NotebookClient
 
 from engines.config import REPO_ROOT
@@ -29,9 +30,13 @@ def execute_notebook(name: str, run_dir: str | os.PathLike, workdir: str | os.Pa
     """
     notebook = nbformat.read(EXAMPLES / name, as_version=4)
     path = os.pathsep.join(part for part in (str(REPO_ROOT), os.environ.get("PYTHONPATH", "")) if part)
-    client = NotebookClient(notebook, timeout=CELL_TIMEOUT_S, kernel_name="python3",
+    # the kernel talks to the client over local files (ipc), so that the tests open no network port
+    kernel = KernelManager(kernel_name="python3", transport="ipc", ip=str(Path(workdir) / "kernel"))
+    client = NotebookClient(notebook, km=kernel, timeout=CELL_TIMEOUT_S, kernel_name="python3",
                             resources={"metadata": {"path": str(workdir)}})
-    client.execute(env={**os.environ, "SILOFLOW_RUN": str(Path(run_dir)), "PYTHONPATH": path})
+    # the kernel's own (inline) backend shows the figures: the headless one the tests set would show none
+    env = {key: value for key, value in os.environ.items() if key != "MPLBACKEND"}
+    client.execute(env={**env, "SILOFLOW_RUN": str(Path(run_dir)), "PYTHONPATH": path})
     return notebook
 
 

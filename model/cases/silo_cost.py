@@ -124,6 +124,7 @@ def _estimate_silo_deck(
         mpi_ranks=mpi_ranks,
         model=model,
         contact_frames=SILO_CONTACT_SNAPSHOTS,
+        paraview_frames=dump_frames(silo.discharge_steps, silo.dump_every),
         stages=stages,
     )
 

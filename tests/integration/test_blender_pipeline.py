@@ -26,6 +26,7 @@ from analysis.studies.validation.rows import Criteria
 from model.cases.blender import blender_cases
 from engines.config import validate_config
 from engines.layout import case_root, run_dir
+from tests.paraview_checks import check_paraview_folder
 from tests.conftest import (FAST_POUR, NO_BLENDING, STAGE_TIMESTEP_FRACTION, TINY_BLENDER, TINY_SILO, liggghts,
                             require_liggghts, run_snakemake)
 
@@ -160,3 +161,10 @@ def test_validation_rows_of_the_real_runs_normalise_passages_and_scale_with_grav
     assert len(scaled) == 2 and all(row["value_error"] > 0.0 for row in scaled)
     (flow,) = [row for row in scaled if row["figure"].startswith("Mass flow rate")]
     assert flow["value"] == pytest.approx(1.0, abs=0.1)  # the 4 g flow rate is 2x the 1 g one, as asserted above
+
+
+def test_each_blender_run_opens_in_paraview_with_its_pathlines(blender_pipeline, tmp_path):
+    _, runs = blender_pipeline
+    for run in runs.values():
+        record = read_run_record(run / "run.json")
+        check_paraview_folder(run, liggghts().read_frames(run, record), lines=("pathlines",), workdir=tmp_path)

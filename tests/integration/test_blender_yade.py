@@ -12,6 +12,7 @@ import pytest
 from model.frames import clumps_from_frame
 from engines.config import validate_config
 from tests.conftest import FAST_POUR, require_yade, run_first_case
+from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(65)]
 
@@ -68,3 +69,9 @@ def test_clumps_leaving_below_the_outlet_reenter_at_the_top_at_a_steady_rate(run
     # the second half of the discharge passes clumps as fast as the first (within counting noise): a steady flow
     first, second = crossings[: len(crossings) // 2].sum(), crossings[len(crossings) // 2:].sum()
     assert abs(first - second) <= 3.0 * np.sqrt(first + second)
+
+
+def test_the_yade_run_opens_in_paraview_on_its_simulated_clock(run, tmp_path):
+    case, engine, run_dir, record = run
+    frames = write_engine_paraview_files("blender", case, engine, run_dir, record)
+    check_paraview_folder(run_dir, frames, fields=False, workdir=tmp_path)

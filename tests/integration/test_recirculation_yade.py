@@ -11,6 +11,7 @@ import pytest
 from model.frames import clumps_from_frame
 from engines.config import validate_config
 from tests.conftest import FAST_POUR, TINY_SETTLE, require_yade, run_first_case
+from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(90)]
 
@@ -74,3 +75,9 @@ def test_clumps_leaving_the_channel_bottom_reenter_at_the_top(run):
     assert reentered > 10
     lowest = min(frame.position[:, 2].min() for frame in frames)
     assert lowest >= -case.channel_length - 0.01  # none falls far below the channel before it re-enters
+
+
+def test_the_yade_run_opens_in_paraview_on_its_simulated_clock(run, tmp_path):
+    case, engine, run_dir, record = run
+    frames = write_engine_paraview_files("silo_recirculation", case, engine, run_dir, record)
+    check_paraview_folder(run_dir, frames, fields=False, workdir=tmp_path)

@@ -32,6 +32,7 @@ from engines.layout import READ_PRODUCTS
 from engines.layout import run_dir as layout_run_dir
 from engines.liggghts.cost import calibrate_cost_model
 from engines.planning import config_estimates, measured_cost_model, run_directory
+from tests.paraview_checks import check_paraview_folder
 from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
                             liggghts, require_liggghts, run_snakemake, validation_record_cli)
 from tests.notebooks import execute_notebook, figures
@@ -433,3 +434,9 @@ def test_mass_is_conserved_inserted_equals_in_silo_plus_discharged(tiny_pipeline
     discharged = sum(mass_of[clump] for clump in discharged_ids)
     assert last.mass[in_silo].sum() + discharged == pytest.approx(opening.mass.sum(), rel=1e-9)
     assert last.mass[in_silo].sum() + discharged == pytest.approx(inserted, rel=5e-3)
+
+
+def test_the_run_opens_in_paraview_on_its_simulated_clock(tiny_pipeline, tmp_path):
+    _, run_dir, _ = tiny_pipeline
+    record = read_run_record(run_dir / "run.json")
+    check_paraview_folder(run_dir, liggghts().read_frames(run_dir, record), workdir=tmp_path)

@@ -27,7 +27,8 @@ from model.cases.silo_recirculation import recirculation_cases
 from model.record import read_run_record
 from engines.config import validate_config
 from engines.layout import case_root, run_dir, run_path
-from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, require_liggghts, run_snakemake
+from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, liggghts, require_liggghts, run_snakemake
+from tests.paraview_checks import check_paraview_folder
 from tests.notebooks import execute_notebook, figures
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(180)]
@@ -263,3 +264,10 @@ def test_the_shortcut_is_measured_against_the_whole_run(blending_pipeline_at_the
     assert row["t_mean_shortcut_s"] < row["t_mean_full_s"] + 3.0 * error
     assert math.isfinite(row["model_rms_difference"]) and math.isfinite(rows[-1]["vrr_largest_relative_difference"])
     assert (runs["blending"] / "plots" / "shortcut.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_blending_run_opens_in_paraview_with_its_tracks(blending_pipeline, tmp_path):
+    _, runs, _ = blending_pipeline
+    run = runs["blending"]
+    record = read_run_record(run / "run.json")
+    check_paraview_folder(run, liggghts().read_frames(run, record), lines=("tracks",), workdir=tmp_path)

@@ -22,6 +22,7 @@ from engines.config import load_config_file, validate_config
 from engines.interface import EngineOptions, EngineRunError, engine_for
 from engines.yade.run import restart_files
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
+from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(45)]
 
@@ -147,3 +148,9 @@ def test_wall_forces_span_the_run_and_the_settled_fill_balances(micro_run):
     # walls + floor carry the weight (the fill is at rest)
     assert balance.support_ratio == pytest.approx(1.0, abs=0.01)
     assert sum(balance.wall_support.values()) / balance.weight == pytest.approx(balance.support_ratio, abs=1e-6)
+
+
+def test_the_yade_run_opens_in_paraview_on_its_simulated_clock(micro_run, tmp_path):
+    case, engine, run_dir, record, _, _ = micro_run
+    frames = write_engine_paraview_files("silo_flat", case, engine, run_dir, record)
+    check_paraview_folder(run_dir, frames, fields=False, workdir=tmp_path)

@@ -374,8 +374,8 @@ def test_hand_made_silo_case_exact_numbers():
     assert discharge == pytest.approx(SILO_LIKE_DISCHARGE, rel=1e-12)
     assert 0.5 < discharge / (200 * 2000) < 0.8  # it drains: 30 clumps/s for about 1.94 s out of the 100
     assert estimate.wall_time_s == pytest.approx((SILO_LIKE_FILL + 40_000 + SILO_LIKE_DISCHARGE) * 5.0e-7, rel=1e-12)
-    # 8 dumps, plus the one contact snapshot of the settled fill
-    assert estimate.dump_bytes == 8 * (1024 + 200 * 128) + (1024 + 200 * 200) == 254_016
+    # 8 dumps and their ParaView copies, plus the one contact snapshot of the settled fill
+    assert estimate.dump_bytes == 8 * (1024 + 200 * 128) + 8 * (1024 + 200 * 50) + (1024 + 200 * 200) == 342_208
     assert (estimate.run_id, estimate.kind) == ("silo-test", "silo_flat")
 
 
@@ -389,7 +389,7 @@ def test_silo_case_from_config_counts_the_settle_stage_at_its_longest(config):
     assert estimate.simulated_time_s == pytest.approx(expected_steps * case.timestep, rel=1e-12)
     assert estimate.wall_time_s == pytest.approx(estimate.sphere_steps * 5.0e-7 / 1.6, rel=1e-12)
     assert estimate.dump_frames == 1 + math.ceil(case.discharge_steps / case.dump_every)
-    frames_bytes = estimate.dump_frames * (1024 + estimate.spheres * 128)
+    frames_bytes = estimate.dump_frames * (1024 + estimate.spheres * 128 + 1024 + estimate.spheres * 50)
     assert estimate.dump_bytes == frames_bytes + 1024 + estimate.spheres * 200
     assert estimate.run_id == case.run_id and estimate.mpi_ranks == 2
 
@@ -424,7 +424,7 @@ def test_changing_a_silo_case_changes_its_estimate_exactly(config):
     assert estimate.dump_frames == 10
     assert estimate.simulated_time_s == pytest.approx(16300 * 2.0e-5, rel=1e-12)
     spheres = 500 * case.particle.n_spheres
-    assert estimate.dump_bytes == 10 * (1024 + spheres * 128) + 1024 + spheres * 200
+    assert estimate.dump_bytes == 10 * (1024 + spheres * 128) + 10 * (1024 + spheres * 50) + 1024 + spheres * 200
 
 
 def test_recirculation_cases_use_their_silo_and_their_own_run_id(config):
@@ -549,8 +549,8 @@ def test_disk_check_refuses_when_the_estimate_exceeds_the_free_space():
 def test_disk_check_of_estimated_runs_names_both_sizes():
     estimates = [estimate_silo_case(_silo_like(), model=WORST_CASE), estimate_silo_case(_silo_like(run_id="silo-2"), model=WORST_CASE)]
     required = total_dump_bytes(estimates)
-    assert required == 2 * 254_016
-    with pytest.raises(InsufficientDiskSpace, match=r"need about 508 kB .* only 500 kB are free on results/"):
+    assert required == 2 * 342_208
+    with pytest.raises(InsufficientDiskSpace, match=r"need about 684 kB .* only 500 kB are free on results/"):
         check_disk_space(required, 500_000, "results/", "of silo_flat")
 
 
@@ -604,7 +604,7 @@ def test_estimate_rows_have_stable_columns_and_a_totals_row():
     assert rows[1] == {"run": "b", "kind": "blender", "mpi_ranks": 2, "clumps": 10, "spheres": 20, "steps": 100,
                        "sphere_steps": 1500.0, "simulated_s": 0.5, "wall_time": "1 h", "core_time": "2 h",
                        "dump_frames": 7, "disk": "2 GB"}
-    assert rows[0]["disk"] == "254 kB" and rows[0]["sphere_steps"] == first.sphere_steps
+    assert rows[0]["disk"] == "342 kB" and rows[0]["sphere_steps"] == first.sphere_steps
     assert rows[0]["wall_time"] == rows[0]["core_time"] == format_duration(first.sphere_steps * 5.0e-7) == "0.23 s"
     assert rows[2] == {"run": "total (2 runs)", "kind": "", "mpi_ranks": "", "clumps": "", "spheres": "",
                        "steps": "", "sphere_steps": first.sphere_steps + 1500.0, "simulated_s": "",

@@ -3,11 +3,7 @@ so a copied run folder opens; with ParaView installed, pvpython runs it and find
 
 from __future__ import annotations
 
-import ast
-import json
-import os
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +18,7 @@ from analysis.numerics.force_chains import ForceChainSegments
 from analysis.studies.blender.window_fields import PlanarField
 from model.cases.geometry import horizontal_rectangle
 from model.frames import ParticleFrame
+from tests.paraview_checks import named_files, open_state_in_pvpython
 
 pytest.importorskip("pyvista")
 
@@ -56,14 +53,6 @@ def write_run(run: Path) -> Path:
                                        StateLines("force_chains", folder / "force_chains.vtp", "normal_force")])
 
 
-def named_files(script: Path) -> list[str]:
-    """The files the state opens: the arguments of its ``here(...)`` calls."""
-    tree = ast.parse(script.read_text(encoding="utf-8"))
-    return [node.args[0].value for node in ast.walk(tree)
-            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "here"
-            and node.args and isinstance(node.args[0], ast.Constant)]
-
-
 def test_the_state_names_exactly_the_files_of_its_run_relative_to_itself(tmp_path):
     state = write_run(tmp_path / "results" / "run")
     names = named_files(state)
@@ -92,45 +81,12 @@ def test_a_pipeline_name_must_be_a_variable_the_state_does_not_use(tmp_path, nam
                               lines=[StateLines(name, tmp_path / "chains.vtp", "normal_force")])
 
 
-#: Run inside pvpython: the state, then what ParaView made of it as JSON. Without a display ParaView cannot render,
-#: and setting the animation's time renders; that one call is stubbed then (the GUI makes it for real).
-CHECKER = """
-import json, os, sys
-import paraview.simple as simple
-
-class _Scene:
-    def UpdateAnimationUsingDataTimeSteps(self):
-        pass
-
-if not os.environ.get("DISPLAY"):
-    simple.GetAnimationScene = lambda: _Scene()
-path = sys.argv[1]
-exec(compile(open(path).read(), path, "exec"), {"__file__": path, "__name__": "__main__"})
-found = {}
-for (name, _), source in simple.GetSources().items():
-    files = source.FileName
-    found[name] = {"files": [files] if isinstance(files, str) else list(files),
-                   "times": list(getattr(source, "TimestepValues", None) or []),
-                   "point": sorted(source.PointData.keys()), "cell": sorted(source.CellData.keys()),
-                   "visible": bool(simple.GetDisplayProperties(source).Visibility)}
-print("STATE " + json.dumps(found))
-"""
-
-
 @pytest.mark.skipif(shutil.which("pvpython") is None, reason="ParaView (pvpython) is not installed")
 def test_pvpython_opens_every_file_of_a_copied_run(tmp_path):
     write_run(tmp_path / "results" / "run")
     copy = shutil.copytree(tmp_path / "results" / "run", tmp_path / "moved" / "run")
     shutil.rmtree(tmp_path / "results")  # the state must not lean on where it was written
-    checker = tmp_path / "checker.py"
-    checker.write_text(CHECKER, encoding="utf-8")
-    # ParaView's own Python and its packages: the test's Python path (another interpreter's) stays out
-    env = {key: value for key, value in os.environ.items() if key not in ("PYTHONPATH", "PYTHONHOME")}
-    done = subprocess.run([shutil.which("pvpython"), str(checker), str(copy / "paraview" / "state.py")],
-                          capture_output=True, text=True, timeout=300, cwd=tmp_path, env=env)
-    lines = [line for line in done.stdout.splitlines() if line.startswith("STATE ")]
-    assert done.returncode == 0 and lines, done.stdout[-2000:] + done.stderr[-2000:]
-    found = json.loads(lines[-1][len("STATE "):])
+    found = open_state_in_pvpython(copy / "paraview" / "state.py", tmp_path)
 
     assert set(found) == {"walls", "particles", "fields", "tracks", "force_chains"}
     opened = {Path(file).resolve() for source in found.values() for file in source["files"]}

@@ -151,4 +151,5 @@ rule blender_gravity:
 
 rule blender_all:
     input:
-        blender_targets,
+        # the kind's products as the workflow knows them at the end (ParaView's included)
+        lambda wildcards: CASE_TARGETS["blender"](wildcards),

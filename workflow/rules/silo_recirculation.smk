@@ -181,4 +181,5 @@ rule silo_recirculation_summary:
 
 rule silo_recirculation_all:
     input:
-        recirculation_targets,
+        # the kind's products as the workflow knows them at the end (ParaView's included)
+        lambda wildcards: CASE_TARGETS[RECIRCULATION](wildcards),
