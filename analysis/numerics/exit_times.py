@@ -34,11 +34,31 @@ from model.checks import finite_number
 from model.frames import ClumpFrame, ParticleFrame
 from analysis.numerics.clump_tracks import ClumpTracks, checked_tracks, tracks_from_frames
 
-__all__ = ["ExitTimes", "exit_times", "outlet_exits"]
+__all__ = ["ExitTimes", "PassTable", "exit_times", "outlet_exits"]
+
+
+class PassTable:
+    """What a table of passes (``clump_id``, ``pass_number``, ``entry_time``, ``exit_time``) tells about itself: the
+    counts and each pass's residence time."""
+
+    @property
+    def n_clumps(self) -> int:
+        """Number of clumps."""
+        return int(self.clump_id.shape[0])
+
+    @property
+    def n_passes(self) -> int:
+        """Number of passes (rows of the pass table)."""
+        return int(self.pass_number.shape[0])
+
+    @property
+    def residence_time(self) -> np.ndarray:
+        """``exit_time - entry_time`` of each pass: re-entry to outlet [s] (NaN where either is NaN)."""
+        return self.exit_time - self.entry_time
 
 
 @dataclass(frozen=True, eq=False)
-class ExitTimes:
+class ExitTimes(PassTable):
     """Outlet crossings, re-entries and passes of the clumps of a run.
 
     Pass rows are ordered by clump index, then by ``pass_number``; crossing rows by time.
@@ -87,21 +107,6 @@ class ExitTimes:
     last_frame_time: float
     outlet_z: float
     domain_z: tuple[float, float] | None
-
-    @property
-    def n_clumps(self) -> int:
-        """Number of clumps."""
-        return int(self.clump_id.shape[0])
-
-    @property
-    def n_passes(self) -> int:
-        """Number of passes (rows of the pass table)."""
-        return int(self.pass_number.shape[0])
-
-    @property
-    def residence_time(self) -> np.ndarray:
-        """``exit_time - entry_time`` of each pass: re-entry to outlet [s] (NaN where either is NaN)."""
-        return self.exit_time - self.entry_time
 
 
 def _checked_domain(outlet: float, domain_z) -> tuple[float, float] | None:

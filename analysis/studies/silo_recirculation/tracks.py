@@ -30,7 +30,7 @@ import numpy as np
 
 from model.checks import finite_number
 from analysis.numerics.clump_tracks import ClumpTracks, checked_tracks
-from analysis.numerics.exit_times import outlet_exits
+from analysis.numerics.exit_times import PassTable, outlet_exits
 
 __all__ = [
     "RecirculationEvents",
@@ -41,7 +41,7 @@ __all__ = [
 
 
 @dataclass(frozen=True, eq=False)
-class RecirculationEvents:
+class RecirculationEvents(PassTable):
     """Outlet crossings, re-entries and passes of the clumps of a recirculating silo.
 
     Pass rows are ordered by clump index, then by ``pass_number``. Crossing rows (``exit_*``) are
@@ -107,21 +107,6 @@ class RecirculationEvents:
     outlet_z: float
     domain_bottom: float
     domain_top: float
-
-    @property
-    def n_clumps(self) -> int:
-        """Number of clumps."""
-        return int(self.clump_id.shape[0])
-
-    @property
-    def n_passes(self) -> int:
-        """Number of passes (rows of the pass table)."""
-        return int(self.pass_number.shape[0])
-
-    @property
-    def residence_time(self) -> np.ndarray:
-        """``exit_time - entry_time`` of each pass: re-entry to outlet [s] (NaN where either is NaN)."""
-        return self.exit_time - self.entry_time
 
 
 def recirculation_events(tracks: ClumpTracks, outlet_z: float, domain_bottom: float, domain_top: float) -> RecirculationEvents:
