@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import ast
 import json
-import math
 import os
 import shutil
 import subprocess
@@ -21,7 +20,7 @@ from analysis.io.paraview_state import StateLines, write_paraview_state
 from analysis.io.particle_series import write_particle_series
 from analysis.io.vtk_lines import write_force_chains_vtp
 from analysis.io.vtk_walls import write_walls_vtp
-from analysis.numerics.force_chains import force_chain_segments
+from analysis.numerics.force_chains import all_force_chains
 from model.cases.kinds import case_kind
 
 #: Run inside pvpython: the state, then what ParaView made of it as JSON. Without a display ParaView cannot render,
@@ -130,7 +129,7 @@ def write_engine_paraview_files(kind: str, case, engine, run_dir: Path, record) 
     write_particle_series(folder / "particles.pvd", frames)
     write_walls_vtp(folder / "walls.vtp", case_kind(kind).walls(case))
     settled = engine.settled_fill(run_dir, record)[-1]
-    write_force_chains_vtp(folder / "force_chains.vtp", force_chain_segments(settled.contacts, 0.0, math.inf, math.inf))
+    write_force_chains_vtp(folder / "force_chains.vtp", all_force_chains(settled.contacts))
     write_paraview_state(folder / "state.py", f"{kind} run {record.run_id} ({record.engine})", folder / "particles.pvd",
                          walls=folder / "walls.vtp",
                          lines=[StateLines("force_chains", folder / "force_chains.vtp", "normal_force")])

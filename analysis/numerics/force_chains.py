@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from model.contacts import ContactFrame
 
-__all__ = ["ForceChainSegments", "force_chain_segments"]
+__all__ = ["ForceChainSegments", "all_force_chains", "force_chain_segments"]
 
 
 @dataclass(frozen=True)
@@ -46,3 +47,9 @@ def force_chain_segments(
     )
     force = np.clip(contacts.normal_force[inside], 0.0, cap)
     return ForceChainSegments(contacts.position_i[inside], contacts.position_j[inside], force, float(cap))
+
+
+def all_force_chains(contacts: ContactFrame) -> ForceChainSegments:
+    """Every contact as a segment with its normal force as computed (no slice, no cap): what a viewer that slices
+    and thresholds itself (ParaView) takes."""
+    return force_chain_segments(contacts, 0.0, math.inf, math.inf)

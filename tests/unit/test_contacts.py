@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from engines.liggghts.contacts import ContactDumpError, parse_local_dump, read_contacts
-from analysis.numerics.force_chains import force_chain_segments
+from analysis.numerics.force_chains import all_force_chains, force_chain_segments
 
 DUMP = """ITEM: TIMESTEP
 22000
@@ -34,6 +34,15 @@ def test_force_chain_slice_and_cap():
     segments = force_chain_segments(parse_local_dump(DUMP), slice_centre_y=0.005, slice_thickness=0.006, cap=1.5)
     assert len(segments.normal_force) == 1  # the second contact spans y = 0.001..0.009
     assert segments.normal_force[0] == 1.5
+
+
+def test_all_force_chains_keep_every_contact_and_its_compressive_force():
+    frame = parse_local_dump(DUMP)
+    segments = all_force_chains(frame)
+    # the first contact is in compression (2 N), the second pulls (its force counts 0), neither capped
+    np.testing.assert_allclose(segments.normal_force, [2.0, 0.0], rtol=1e-15)
+    np.testing.assert_array_equal(segments.start, frame.position_i)
+    assert segments.cap == float("inf")
 
 
 def test_truncated_dump_names_the_file(tmp_path):

@@ -64,36 +64,43 @@ RUN_PRIORITY = run_priorities(ESTIMATES)
 CASE_TARGETS = {}
 
 
-#: The flat-bottom silo's runs with calibrated parameters, built once per version of the calibration's choice.
+#: The flat-bottom silo's runs with calibrated parameters, built once per version of the calibration's choice:
+#: ``{version: (cases, [(label, run id)] of the posterior mean and draws)}``.
 _CALIBRATED_CASES = {}
+
+
+def _calibrated_silo():
+    """The silo's runs with calibrated parameters, and its runs at the posterior mean and draws
+    (``silo_flat.posterior_draws``; none without), built once per version of the calibration's files."""
+    path = calibrated_parameters_file()
+    version = (path, Path(path).stat().st_mtime_ns)
+    if version not in _CALIBRATED_CASES:
+        silo = silo_config()
+        calibrated = cases_of(silo, "silo_flat")
+        labelled = []
+        if config["silo_flat"]["posterior_draws"]:
+            # the draws are written beside the posterior mean, by the same checkpoint
+            draws = checkpoints.bayes_parameters.get(engine=engine_kind(config, "silo_flat")).output.draws
+            drawn = [(label, build_silo_case(c)) for label, c in
+                     posterior_draw_configs(config, yaml.safe_load(Path(draws).read_text(encoding="utf-8")))]
+            calibrated.update({case.run_id: case for _, case in drawn})
+            labelled = [("posterior mean", build_silo_case(silo).run_id),
+                        *((label, case.run_id) for label, case in drawn)]
+        _CALIBRATED_CASES[version] = (calibrated, labelled)
+    return _CALIBRATED_CASES[version]
 
 
 def cases(kind):
     """The runs of case ``kind``: the flat-bottom silo's with calibrated parameters applied when asked for (the only
     place they are applied)."""
     if kind == "silo_flat" and uses_calibrated_parameters():
-        path = calibrated_parameters_file()
-        version = (path, Path(path).stat().st_mtime_ns)
-        if version not in _CALIBRATED_CASES:
-            drawn = {case.run_id: case for case in (build_silo_case(c) for _, c in posterior_draw_configs_of_silo())}
-            _CALIBRATED_CASES[version] = {**cases_of(silo_config(), kind), **drawn}
-        return _CALIBRATED_CASES[version]
+        return _calibrated_silo()[0]
     return CASES[kind]
-
-
-def posterior_draw_configs_of_silo():
-    """``[(label, config)]`` of the silo at each of the Bayesian posterior's draws (``silo_flat.posterior_draws``;
-    waits for the calibration), none without."""
-    if not config["silo_flat"]["posterior_draws"]:
-        return []
-    path = checkpoints.bayes_parameters.get(engine=engine_kind(config, "silo_flat")).output.draws
-    return posterior_draw_configs(config, yaml.safe_load(Path(path).read_text(encoding="utf-8")))
 
 
 def posterior_draw_runs():
     """``[(label, run id)]`` of the silo at the posterior mean then at each posterior draw (``silo_flat.posterior_draws``)."""
-    return [("posterior mean", build_silo_case(silo_config()).run_id),
-            *((label, build_silo_case(c).run_id) for label, c in posterior_draw_configs_of_silo())]
+    return _calibrated_silo()[1]
 
 
 def typed_case(kind):

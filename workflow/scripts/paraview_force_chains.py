@@ -3,11 +3,10 @@ carrying its normal force (:func:`analysis.io.vtk_lines.write_force_chains_vtp`)
 the slice and the cap of the silo's force-chain plot are left out: an infinite slice and cap keep every contact and
 its force as computed."""
 
-import math
 from pathlib import Path
 
 from analysis.io.vtk_lines import write_force_chains_vtp
-from analysis.numerics.force_chains import force_chain_segments
+from analysis.numerics.force_chains import all_force_chains
 from engines.interface import engine_named
 from engines.logs import logged_to
 from model.record import read_run_record
@@ -16,7 +15,7 @@ with logged_to(snakemake.log[0]) as log:
     run_dir = Path(snakemake.input.record).parent
     record = read_run_record(snakemake.input.record)
     settled = engine_named(record.engine).settled_fill(run_dir, record)[-1]
-    segments = force_chain_segments(settled.contacts, 0.0, math.inf, math.inf)
+    segments = all_force_chains(settled.contacts)
     write_force_chains_vtp(snakemake.output.chains, segments)
     log.info("%s: %d contacts at step %d, normal force up to %.4g N", record.run_id, len(segments.normal_force),
              settled.contacts.step, segments.normal_force.max() if segments.normal_force.size else 0.0)
