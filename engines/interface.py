@@ -176,6 +176,13 @@ class Engine(ABC):
         its steps), from the engine's own timing of every attempt, or None when the run left no timing (not run, or
         stopped before its first stage ended)."""
 
+    @abstractmethod
+    def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
+        """Time a run's attempts before its last took (s), from the engine's own timing in their logs, up to the last
+        time each logged: those resumed in place from the run's restart files and those moved aside into
+        ``failed_attempts/`` to start afresh (:func:`engines.run_files.set_aside_attempts`); 0 for a run made in one
+        go. Snakemake's benchmark of the run step times its last attempt only."""
+
     def measured_cost(self, run_dir: str | Path) -> float | None:
         """CPU seconds per sphere-step that a run took on this machine (s), from :meth:`measured_work`, or None when
         the run left no timing."""

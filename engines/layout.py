@@ -66,7 +66,7 @@ SILO_ROW_PRODUCTS = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields"
 #: on another machine restores them instead of making those runs again.
 READ_PRODUCTS = {
     "jenike": ("metrics/bulk_friction.json", RUN_RECORD, RUN_BENCHMARK),
-    "silo_flat": (*SILO_ROW_PRODUCTS.values(), "fields/averaged.npz", RUN_RECORD, RUN_BENCHMARK),
+    "silo_flat": (*SILO_ROW_PRODUCTS.values(), "fields/depth_averaged.npz", RUN_RECORD, RUN_BENCHMARK),
 }
 
 #: The wildcard rules use for a run id.

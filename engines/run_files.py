@@ -12,7 +12,10 @@ from model.record import RunRecord
 from engines.estimates import format_bytes
 from engines.layout import RUN_RECORD, write_text_atomic
 
-__all__ = ["output_bytes", "set_aside_previous_attempt", "write_run_record"]
+__all__ = ["FAILED_ATTEMPTS", "output_bytes", "set_aside_attempts", "set_aside_previous_attempt", "write_run_record"]
+
+#: The folder of a run directory that holds its unfinished earlier attempts, one ``<UTC time>/`` folder each.
+FAILED_ATTEMPTS = "failed_attempts"
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...], patterns: tuple[str, ...] = ()) -> Path | None:
@@ -28,15 +31,21 @@ def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...], patterns
     if not leftovers:
         return None
     stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
-    target = run_dir / "failed_attempts" / stamp
+    target = run_dir / FAILED_ATTEMPTS / stamp
     attempt = 1
     while target.exists():
         attempt += 1
-        target = run_dir / "failed_attempts" / f"{stamp}-{attempt}"
+        target = run_dir / FAILED_ATTEMPTS / f"{stamp}-{attempt}"
     target.mkdir(parents=True)
     for path in leftovers:
         shutil.move(str(path), str(target / path.name))
     return target
+
+
+def set_aside_attempts(run_dir: str | Path) -> list[Path]:
+    """The folders of a run's earlier attempts that :func:`set_aside_previous_attempt` moved aside, oldest first."""
+    folder = Path(run_dir) / FAILED_ATTEMPTS
+    return sorted(path for path in folder.iterdir() if path.is_dir()) if folder.is_dir() else []
 
 
 def write_run_record(run_dir: Path, record: RunRecord) -> Path:

@@ -11,7 +11,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from model.cost import CostModel, MeasuredWork
 from engines.liggghts.thermo import ThermoProgress
 
-__all__ = ["StageCost", "TimedRun", "calibrate_cost_model", "measured_work", "stage_costs", "timed_runs"]
+__all__ = ["StageCost", "TimedRun", "calibrate_cost_model", "elapsed_seconds", "measured_work", "stage_costs", "timed_runs"]
 
 _LOOP_TIME = re.compile(
     r"Loop time of\s+([-+0-9.eE]+)\s+on\s+(\d+)\s+procs\s+for\s+(\d+)\s+steps\s+with\s+(\d+)\s+atoms"
@@ -90,6 +90,41 @@ def timed_runs(log_text: str) -> Iterator[TimedRun]:
             events = []
         first = last = None
         integral = 0.0
+
+
+def elapsed_seconds(log_text: str) -> float:
+    """Wall time the ``run`` commands of one attempt's log took (s), also when the attempt was cut off.
+
+    A ``run`` that finished counts its ``Loop time`` (the wall time LIGGGHTS measures for it); a ``run`` cut off
+    before its ``Loop time`` line (a killed attempt) counts the ``cpu`` column of its last thermo row, the wall time
+    since that ``run`` began, so the time after its last row is missing. The set-up between runs (reading the data,
+    building the neighbour lists) is not timed by LIGGGHTS and is not counted.
+
+    Parameters
+    ----------
+    log_text : str
+        The text of one attempt's log or screen output (decks whose thermo rows carry ``cpu``).
+
+    Returns
+    -------
+    float
+        Seconds; 0 for a log with no timed run.
+    """
+    progress = ThermoProgress()
+    total = unfinished = 0.0
+    for line in log_text.splitlines():
+        for row in progress.feed(line + "\n"):
+            if row.cpu is not None and math.isfinite(row.cpu):
+                unfinished = row.cpu
+        match = _LOOP_TIME.search(line)
+        if match:
+            try:
+                seconds = float(match.group(1))
+            except ValueError:  # a garbled number: the run's last row is the best left
+                seconds = unfinished
+            total += seconds if math.isfinite(seconds) and seconds >= 0 else unfinished
+            unfinished = 0.0
+    return total + unfinished
 
 
 def measured_work(log_texts: Iterable[str]) -> MeasuredWork | None:

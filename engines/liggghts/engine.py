@@ -8,6 +8,7 @@ reads the engine's files back into the neutral objects of :mod:`model`. Its temp
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -22,6 +23,7 @@ from model.cases.verification import VerificationCase
 from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, DumpFile, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
+from engines.run_files import set_aside_attempts
 from model.cases.blender import GATE
 from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
@@ -39,7 +41,7 @@ from engines.liggghts.jenike import (
     run_jenike,
     write_jenike_inputs,
 )
-from engines.liggghts.cost import measured_work as work_from_logs
+from engines.liggghts.cost import elapsed_seconds, measured_work as work_from_logs
 from engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs, check_programs
 from engines.liggghts.settled import read_settled_fill
 from model.cases.silo_flat import FLOOR_MESHES
@@ -166,6 +168,11 @@ class LiggghtsEngine(Engine):
 
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
         return work_from_logs(path.read_text(errors="replace") for path in attempt_logs(run_dir))
+
+    def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
+        logs = [*(path for attempt in set_aside_attempts(run_dir) for path in attempt_logs(attempt)),
+                *attempt_logs(run_dir)[:-1]]
+        return math.fsum(elapsed_seconds(path.read_text(errors="replace")) for path in logs)
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return list(read_frames(Path(run_dir) / "dumps", DUMP_PREFIX, record.timestep_s, on_damaged=on_damaged))

@@ -10,7 +10,27 @@ from pathlib import Path
 from model.cost import MeasuredWork
 from engines.markers import parse_markers
 
-__all__ = ["measured_seconds_per_sphere_step", "measured_work"]
+__all__ = ["elapsed_cpu_seconds", "measured_seconds_per_sphere_step", "measured_work"]
+
+
+def elapsed_cpu_seconds(logs: list[Path]) -> float:
+    """CPU time of a run's attempts up to each one's last timed marker (s), also when an attempt was cut off.
+
+    Each attempt is its own single-threaded process, so its CPU time is its wall time less the waits; the time
+    after its last marker is missing. 0 when no attempt reached a timed marker.
+
+    Parameters
+    ----------
+    logs : list of Path
+        The log of each attempt (the first and its resumptions).
+    """
+    total = 0.0
+    for path in logs:
+        timed = [m.values["cpu_s"] for m in parse_markers(Path(path).read_text(encoding="utf-8", errors="replace"))
+                 if isinstance(m.values.get("cpu_s"), float) and math.isfinite(m.values["cpu_s"])
+                 and m.values["cpu_s"] >= 0]
+        total += timed[-1] if timed else 0.0
+    return total
 
 
 def measured_work(logs: list[Path]) -> MeasuredWork | None:

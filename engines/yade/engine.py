@@ -8,6 +8,7 @@ from the LIGGGHTS decks' (:mod:`engines.yade.inputs` says how).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -24,7 +25,8 @@ from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.layout import CASE_SUMMARY
-from engines.yade.cost import measured_work as work_from_logs
+from engines.run_files import set_aside_attempts
+from engines.yade.cost import elapsed_cpu_seconds, measured_work as work_from_logs
 from engines.yade.blender import run_blender, write_blender_inputs
 from engines.yade.inputs import ENGINE_NAME
 from engines.yade.jenike import FORCES_NAME, check_jenike_case, jenike_contacts, run_jenike, write_jenike_inputs
@@ -109,6 +111,11 @@ class YadeEngine(Engine):
 
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
         return work_from_logs(attempt_logs(run_dir))
+
+    def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
+        logs = [*(path for attempt in set_aside_attempts(run_dir) for path in attempt_logs(attempt)),
+                *attempt_logs(run_dir)[:-1]]
+        return elapsed_cpu_seconds(logs)
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return read_frames(run_dir, DUMP_PREFIX, on_damaged)

@@ -142,6 +142,7 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
         if case.run_id == run_dir.name).seeds))
     assert base["engine"] == "liggghts" and base["engine_version"] == liggghts().installed_version() != "unknown"
     assert float(base["wall_time_s"]) > 0.0 and base["cores"] == "1" and len(base["commit"]) >= 40
+    assert float(base["earlier_attempts_s"]) == 0.0  # started once: no earlier attempt set aside
     assert float(base["simulated_time_s"]) == pytest.approx(max(
         stage["time"] for stage in read_run_record(run_dir / "run.json").stages.values() if "time" in stage))
     assert {row["group"] for row in record.rows} == {"Flat-bottom silo"}

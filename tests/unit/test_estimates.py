@@ -45,7 +45,11 @@ from engines.estimates import (
 )
 from model.cases.kinds import CASE_KINDS, configured_kinds
 from model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
-from engines.liggghts.cost import StageCost, TimedRun, calibrate_cost_model, measured_work, stage_costs, timed_runs
+from engines.liggghts.cost import (StageCost, TimedRun, calibrate_cost_model, elapsed_seconds, measured_work, stage_costs,
+                                   timed_runs)
+from engines.interface import engine_named
+from engines.liggghts.run import LOG_NAME, RESUME_STEM
+from engines.run_files import FAILED_ATTEMPTS
 from model.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
@@ -202,6 +206,41 @@ def test_measured_work_adds_the_attempts():
     # rows of the run that never finished count for nothing
     cut = POUR_AND_DRAIN_LOG + _thermo([(1600, 200), (1700, 200)])
     assert measured_work([cut + resumed]) == work
+
+
+def _timed_thermo(cpus) -> str:
+    """A thermo block whose rows carry the given ``cpu`` column (s since its ``run`` began), 100 steps apart."""
+    lines = ["    Step    Atoms           Time       n_clumps       ke_per_c            CPU"]
+    lines += [f"{100 * i:8d} {200:8d} {i * 1e-3:14.8g} {100:14d} {1e-9:14.8g} {cpu:14.8g}" for i, cpu in enumerate(cpus)]
+    return "\n".join(lines) + "\n"
+
+
+def test_the_elapsed_time_of_a_cut_off_attempt_counts_its_last_row():
+    finished = _timed_thermo([0.0, 1.5, 3.9]) + "Loop time of 4 on 2 procs for 200 steps with 200 atoms\n"
+    # a finished run counts its Loop time (wall time, not times the ranks); the run cut off its last row's cpu
+    assert elapsed_seconds(finished) == 4.0
+    assert elapsed_seconds(finished + _timed_thermo([0.0, 2.25]) + "ERROR: killed\n") == 6.25
+    # a garbled Loop time falls back on the run's last row
+    assert elapsed_seconds(_timed_thermo([0.0, 0.75]) + "Loop time of 1.2.3 on 1 procs for 100 steps with 200 atoms\n") == 0.75
+    assert elapsed_seconds("no thermo\n") == 0.0
+
+
+def test_a_run_s_attempts_before_its_last_add_up(tmp_path):
+    engine = engine_named("liggghts")
+    (tmp_path / LOG_NAME).write_text(_timed_thermo([0.0, 99.0]) + "Loop time of 99.5 on 1 procs for 100 steps with 200 atoms\n")
+    assert engine.earlier_attempts_seconds(tmp_path) == 0.0  # made in one go: the benchmark timed it all
+    # two attempts set aside to start afresh, the second with a resumption of its own
+    first, second = tmp_path / FAILED_ATTEMPTS / "20261129T073502Z", tmp_path / FAILED_ATTEMPTS / "20261129T080427Z"
+    first.mkdir(parents=True)
+    second.mkdir()
+    (first / LOG_NAME).write_text(_timed_thermo([0.0, 10.0]))
+    (second / LOG_NAME).write_text(_timed_thermo([0.0, 3.0]) + "Loop time of 3.5 on 1 procs for 100 steps with 200 atoms\n")
+    (second / f"{RESUME_STEM}1.{LOG_NAME}").write_text(_timed_thermo([0.0, 1.25]))
+    assert engine.earlier_attempts_seconds(tmp_path) == 10.0 + 3.5 + 1.25
+    # the run then resumed in place: its first attempt counts, its last (the benchmark's) does not
+    (tmp_path / LOG_NAME).write_text(_timed_thermo([0.0, 99.0]))
+    (tmp_path / f"{RESUME_STEM}1.{LOG_NAME}").write_text(_timed_thermo([0.0, 7.0]))
+    assert engine.earlier_attempts_seconds(tmp_path) == 10.0 + 3.5 + 1.25 + 99.0
 
 
 def test_measured_work_refuses_impossible_values():

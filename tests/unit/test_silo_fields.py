@@ -527,7 +527,7 @@ def test_a_measurement_of_the_simulated_linear_profile_has_no_error():
 def test_parametric_profiles_at_the_highest_height_every_run_covers():
     tall = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))  # nodes up to 57 mm
     short = silo_grid(0.06, 0.012, 0.048, (0.004, 0.004, 0.006))  # nodes up to 45 mm, 4 mm across
-    runs = [_linear_fields(tall, -1.0, -0.1), _linear_fields(short, -2.0, -0.2)]
+    runs = [depth_average(_linear_fields(tall, -1.0, -0.1)), depth_average(_linear_fields(short, -2.0, -0.2))]
     profiles = parametric_profiles(runs, 0.05)
     assert profiles.height == pytest.approx(0.039, rel=1e-12)  # the short run's second-highest row
     assert parametric_profiles(runs, 0.02).height == 0.02
@@ -548,5 +548,7 @@ def test_parametric_profiles_at_the_highest_height_every_run_covers():
     assert rows[0]["centreline_v_z_m_s"] == pytest.approx(-0.1, rel=1e-12)
     assert all(math.isnan(rows[0][key]) for key in
                ("mass_flow_rate_kg_s_error", "beverloo_ratio_error", "filling_bulk_density_kg_m3_error"))
-    with pytest.raises(ValueError, match="averaged"):
+    with pytest.raises(ValueError, match="at least one"):
         parametric_profiles([], 0.05)
+    with pytest.raises(ValueError, match=r"one node layer in y .* got \[3\]"):
+        parametric_profiles([_linear_fields(tall, -1.0, -0.1)], 0.05)

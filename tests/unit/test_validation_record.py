@@ -11,7 +11,8 @@ import yaml
 from model.record import RunRecord, RunRecordError
 from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            read_validation_rows, restore_products, write_group_record)
-from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord, provenance_row, record_page, simulated_time
+from analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, provenance_row, record_page, run_wall_time,
+                                              simulated_time)
 from analysis.studies.validation.rows import COLUMNS, row
 from engines.config import REPO_ROOT, load_config_file
 from tests.conftest import validation_record_cli
@@ -36,11 +37,14 @@ def _rows():
 
 
 def test_the_provenance_row_names_the_run_its_engine_and_its_time():
-    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, "2026-11-28")
+    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, 20.25, "2026-11-28")
     assert list(got) == list(RUN_COLUMNS)
     assert got == {"run_id": "sphere2-abc", "group": "silo", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
-                   "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5, "cores": 2,
-                   "date": "2026-11-28"}
+                   "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5,
+                   "earlier_attempts_s": 20.25, "cores": 2, "date": "2026-11-28"}
+    # the time of all its attempts; a record written before earlier attempts were timed gives the last one's only
+    assert run_wall_time(got) == 81.75
+    assert run_wall_time({key: value for key, value in got.items() if key != "earlier_attempts_s"}) == 61.5
     assert math.isnan(simulated_time(_record(stages={"fill": {"step": 3}})))
 
 
@@ -55,7 +59,7 @@ def test_a_run_record_s_names_are_matched_whole(key, value):
 def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
     plot = tmp_path / "source.png"
     plot.write_bytes(PNG)
-    runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, 0.0, "2026-11-28")]
     folder = tmp_path / "silo"
     folder.mkdir()
     (folder / "old.png").write_bytes(PNG)
@@ -78,7 +82,7 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
     such a plot and writes nothing, and `make validate GROUP=<name>` refuses such a configuration first."""
     plot = tmp_path / "profiles.pdf"
     plot.write_bytes(b"%PDF-1.4")
-    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
     message = r"the validation record keeps png plots .*, not pdf: make it with plots.format: png"
     with pytest.raises(ValueError, match=message):
         write_group_record(tmp_path / "silo", _rows(), runs, {"profiles.png": plot})
@@ -100,30 +104,35 @@ def test_a_table_without_the_validation_columns_is_refused(tmp_path):
 
 def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
     # the silo group ran in two parts: silo_1 made two runs side by side, silo_2 one
-    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, "2026-11-28"),
-            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, "2026-11-29"),
-            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, "2026-11-29")]
+    # silo_2's run was interrupted once: its attempt before the last took 900 s, which counts
+    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, 0.0, "2026-11-28"),
+            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, 0.0, "2026-11-29"),
+            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, 900.0, "2026-11-29")]
     # the series' record also lists the base run it compares against, made by the silo group
-    series = [provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, "2026-11-29"),
-              runs[0]]
+    # and its record predates the time of earlier attempts
+    series = [{key: value for key, value in
+               provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, 0.0, "2026-11-29").items()
+               if key != "earlier_attempts_s"}, runs[0]]
     groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"]),
               "silo_series": GroupRecord(rows=_rows()[:1], runs=series)}
     status = {"calibration": "missing", "silo": "stale", "silo_series": "complete"}
     wall = CLI.measured_wall_times(groups, cores=2)
-    assert wall == {"silo": {"silo_1": 5400.0, "silo_2": 900.0}, "silo_series": {"silo_series": 3600.0}}
+    assert wall == {"silo": {"silo_1": 5400.0, "silo_2": 1800.0}, "silo_series": {"silo_series": 3600.0}}
     text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, wall, 2,
                        "config/validation.yaml", "config/thesis.yaml", {"silo": ["silo_1", "silo_2"]})
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
     assert "| calibration | missing | 0 | - | - | 0 | 0 |" in lines
-    assert "| silo | stale | 3 | 2.25 h | silo_1 1.50 h, silo_2 0.25 h | 2 | 1 |" in lines
+    assert "| silo | stale | 3 | 2.50 h | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 |" in lines
     assert "| silo_series | complete | 1 | 1.00 h | 1.00 h | 1 | 1 |" in lines
     assert "Not recorded yet: `make validate GROUP=calibration`." in lines
     # the stale group runs in parts: the page names them
     assert ("**Stale**: the runs below are not those `config/validation.yaml` now plans; `make validate GROUP=silo_1`, "
             "then `make validate GROUP=silo_2` brings the record up to date.") in lines
     assert ("3 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
-            "[`silo/runs.csv`](silo/runs.csv).") in lines
+            "[`silo/runs.csv`](silo/runs.csv). 1 run(s) were interrupted and run again; their attempts before the "
+            "last took 0.25 h, counted in the group's times above.") in lines
+    assert "For 1 run(s) the record gives the time of the last attempt only." in text
     assert ("| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | 667 | yes | "
             "depth 40 mm = 12.0 particle diameters (>= 10) |") in lines
     assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | no |" in text
@@ -138,7 +147,7 @@ def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_p
     workdir, record_dir = tmp_path / "work", tmp_path / "docs"
     plot = tmp_path / "p.png"
     plot.write_bytes(PNG)
-    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
     write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs, {"janssen.png": plot})
     write_group_record(record_dir / "blender", _rows(), runs, {})
     assert publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
@@ -155,7 +164,7 @@ def test_a_record_keeps_the_products_other_groups_read_and_restores_only_what_is
     for name, text in ((summary, '{"bulk_friction": 0.5}'), (run, '{"run_id": "sphere2-abc"}')):
         (workdir / name).parent.mkdir(parents=True, exist_ok=True)
         (workdir / name).write_text(text)
-    runs = [provenance_row(_record(), "calibration", "3.8", [1], "c0ffee", 60.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "calibration", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
     source = workdir / "results" / "summary" / "record" / "calibration"
     write_group_record(source, _rows(), runs, {}, {summary: workdir / summary, run: workdir / run})
     assert read_group_record(source).products == [summary, run]

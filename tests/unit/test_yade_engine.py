@@ -22,7 +22,9 @@ from engines.config import ConfigError, load_config, validate_config
 from engines.interface import CaseNotSupported, engine_named
 from engines.templating import UnsafeDeckValue, deck_string, render_deck
 from model.cost import MeasuredWork
-from engines.yade.cost import measured_seconds_per_sphere_step, measured_work
+from engines.yade.cost import elapsed_cpu_seconds, measured_seconds_per_sphere_step, measured_work
+from engines.yade.run import LOG_NAME, RESUME_STEM
+from engines.run_files import FAILED_ATTEMPTS
 from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
 from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
 from engines.yade.progress import ScriptProgress
@@ -275,6 +277,20 @@ def test_measured_cost_sums_every_attempts_last_timing(tmp_path):
     empty.write_text("Traceback\n")
     assert measured_seconds_per_sphere_step([empty]) is None
     assert measured_work([empty]) is None
+
+
+def test_a_run_s_attempts_before_its_last_count_their_last_timed_marker(tmp_path):
+    attempt = tmp_path / FAILED_ATTEMPTS / "20261129T073502Z"
+    attempt.mkdir(parents=True)
+    (attempt / LOG_NAME).write_text("SILOFLOW filled cpu_s=10.0 sphere_steps=1000000\nSILOFLOW progress cpu_s=nan\n"
+                                    "SILOFLOW opened cpu_s=20.5 sphere_steps=4000000\nTraceback\n")
+    assert elapsed_cpu_seconds([attempt / LOG_NAME]) == 20.5
+    assert engine_named("yade").earlier_attempts_seconds(tmp_path) == 20.5
+    # then it ran afresh and resumed once in place: the first of those counts, the last does not
+    (tmp_path / LOG_NAME).write_text("SILOFLOW opened cpu_s=4.25\n")
+    (tmp_path / f"{RESUME_STEM}1.{LOG_NAME}").write_text("SILOFLOW resumed step=5\nSILOFLOW discharged cpu_s=8.0\n")
+    assert engine_named("yade").earlier_attempts_seconds(tmp_path) == 20.5 + 4.25
+    assert engine_named("yade").earlier_attempts_seconds(tmp_path / "elsewhere") == 0.0
 
 
 def test_measured_work_skips_markers_with_unusable_timing(tmp_path):

@@ -209,6 +209,17 @@ rule silo_measured_comparison:
         "../scripts/silo_measured_comparison.py"
 
 
+rule silo_depth_averaged:
+    input:
+        arrays=rules.silo_fields.output.arrays,
+    output:
+        arrays=f"{run_dir('silo_flat')}/fields/depth_averaged.npz",
+    log:
+        f"{run_dir('silo_flat')}/logs/depth_averaged.log",
+    script:
+        "../scripts/silo_depth_averaged.py"
+
+
 def _study_runs(wildcards):
     return parametric_studies()[wildcards.study]
 
@@ -216,7 +227,7 @@ def _study_runs(wildcards):
 rule silo_parametric:
     input:
         flows=lambda wildcards: [run_path("silo_flat", "metrics/flow.json", run) for _, run in _study_runs(wildcards)],
-        fields=lambda wildcards: [run_path("silo_flat", "fields/averaged.npz", run) for _, run in _study_runs(wildcards)],
+        fields=lambda wildcards: [run_path("silo_flat", "fields/depth_averaged.npz", run) for _, run in _study_runs(wildcards)],
     output:
         table=f"{case_root('silo_flat')}/parametric/{{study}}.csv",
         plot=report(plot_file(f"{case_root('silo_flat')}/parametric/{{study}}"), caption="../report/silo_parametric.rst", category="2 Silo validation", subcategory="Parametric studies", labels={"figure": "{study}"}),

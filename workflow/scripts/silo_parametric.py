@@ -1,4 +1,5 @@
-"""Snakemake adapter: one parametric silo study: v_z profiles at one height and flow rates of its runs."""
+"""Snakemake adapter: one parametric silo study: v_z profiles at one height (from each run's depth-averaged fields)
+and flow rates of its runs."""
 
 import json
 from pathlib import Path
@@ -12,8 +13,8 @@ from engines.logs import logged_to
 with logged_to(snakemake.log[0]) as log:
     labels, runs = snakemake.params.labels, snakemake.params.runs
     flows = [json.loads(Path(path).read_text()) for path in snakemake.input.flows]
-    averaged = [load_fields_npz(path) for path in snakemake.input.fields]
-    profiles = parametric_profiles(averaged, snakemake.params.profile_height)
+    depth_averaged = [load_fields_npz(path) for path in snakemake.input.fields]
+    profiles = parametric_profiles(depth_averaged, snakemake.params.profile_height)
     rows = parametric_rows(snakemake.wildcards.study, labels, runs, flows, profiles)
     write_flow_table(snakemake.output.table, rows)
     plot_parametric_study(profiles.x, profiles.v_z, labels, [r["mass_flow_rate_kg_s"] for r in rows], profiles.height,

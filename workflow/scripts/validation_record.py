@@ -32,7 +32,8 @@ with logged_to(snakemake.log[0]) as log:
             versions[record.engine] = engine_named(record.engine).installed_version()
         finished = datetime.fromtimestamp(Path(record_path).stat().st_mtime, tz=timezone.utc).date().isoformat()
         runs.append(provenance_row(record, params.made_by[record.run_id], versions[record.engine],
-                                   params.seeds[record.run_id], commit, benchmark_wall_time(benchmark), finished))
+                                   params.seeds[record.run_id], commit, benchmark_wall_time(benchmark),
+                                   engine_named(record.engine).earlier_attempts_seconds(Path(record_path).parent), finished))
     directory = write_group_record(Path(snakemake.output.runs).parent, read_validation_rows(inputs.rows), runs,
                                    dict(zip(params.plot_names, inputs.plots)),
                                    {path: path for path in inputs.products})

@@ -25,7 +25,7 @@ from typing import Sequence
 from analysis.io.tables import write_text
 from analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_record, restore_products,
                                            write_group_record)
-from analysis.studies.validation.record import record_page
+from analysis.studies.validation.record import record_page, run_wall_time
 from engines.config import load_config
 from engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
 from engines.planning import config_estimates, group_runs, run_directory
@@ -73,7 +73,7 @@ def measured_wall_times(record: dict, cores: int) -> dict[str, dict[str, float]]
         made: dict[str, list] = {}
         for run in group.runs:
             if group_of_part(run["group"]) == name:
-                made.setdefault(run["group"], []).append((float(run["wall_time_s"]), int(run["cores"])))
+                made.setdefault(run["group"], []).append((run_wall_time(run), int(run["cores"])))
         walls[name] = {part: runs_wall_time(runs, cores) for part, runs in sorted(made.items())}
     return walls
 

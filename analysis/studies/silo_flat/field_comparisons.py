@@ -88,15 +88,18 @@ class ParametricProfiles:
     v_z: list[np.ndarray]
 
 
-def parametric_profiles(averaged: Sequence[Fields], height: float) -> ParametricProfiles:
-    """v_z profiles of the depth average of each run's time-averaged fields at the study's ``height`` (m).
+def parametric_profiles(depth_averaged: Sequence[Fields], height: float) -> ParametricProfiles:
+    """v_z profiles of each run's depth-averaged, time-averaged fields at the study's ``height`` (m).
 
-    The height is lowered, if need be, to the second-highest node row of the run with the lowest grid, so that
-    every run's fields cover it with a row above.
+    Each run's fields have one node layer in y (:func:`~analysis.numerics.field_ops.depth_average`, which the
+    workflow writes per run as ``fields/depth_averaged.npz``). The height is lowered, if need be, to the
+    second-highest node row of the run with the lowest grid, so that every run's fields cover it with a row above.
     """
-    depth_averaged = [depth_average(f) for f in averaged]
     if not depth_averaged:
-        raise ValueError("averaged must hold at least one run's fields")
+        raise ValueError("depth_averaged must hold at least one run's fields")
+    layers = sorted({f.grid.shape[1] for f in depth_averaged} - {1})
+    if layers:
+        raise ValueError(f"depth_averaged fields must have one node layer in y (use depth_average), got {layers}")
     height = min([height] + [float(f.grid.z[-2]) for f in depth_averaged])
     profiles = [velocity_profile(f, height) for f in depth_averaged]
     x = profiles[0].x

@@ -18,11 +18,11 @@ from model.checks import number_or_nan
 from model.record import RunRecord
 from analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
 
-__all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "simulated_time", "record_page"]
+__all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time", "record_page"]
 
 #: The columns of a group's ``runs.csv``, in order.
 RUN_COLUMNS = ("run_id", "group", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
-               "cores", "date")
+               "earlier_attempts_s", "cores", "date")
 
 
 @dataclass(frozen=True)
@@ -55,7 +55,7 @@ def simulated_time(record: RunRecord) -> float:
 
 
 def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
-                   date: str) -> dict:
+                   earlier_attempts_s: float, date: str) -> dict:
     """One row of ``runs.csv`` for a finished run.
 
     Parameters
@@ -72,14 +72,38 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
     commit : str
         The commit of siloflow's code that wrote the record (``-dirty`` appended with uncommitted changes).
     wall_time_s : float
-        Wall time of the run step (s), Snakemake's benchmark of it.
+        Wall time of the run step (s), Snakemake's benchmark of it: its last attempt only.
+    earlier_attempts_s : float
+        Time its attempts before the last took (s): those resumed from its restart files and those set aside to
+        start afresh (:meth:`engines.interface.Engine.earlier_attempts_seconds`); 0 when it ran in one go.
     date : str
         When the run finished (ISO 8601 date).
     """
     return {"run_id": record.run_id, "group": group, "case": record.case, "engine": record.engine, "engine_version": engine_version,
             "seeds": " ".join(str(int(seed)) for seed in seeds), "commit": commit,
             "simulated_time_s": simulated_time(record), "wall_time_s": float(wall_time_s),
-            "cores": int(record.mpi_ranks), "date": date}
+            "earlier_attempts_s": float(earlier_attempts_s), "cores": int(record.mpi_ranks), "date": date}
+
+
+def run_wall_time(run: Mapping) -> float:
+    """Wall time a recorded run took over all its attempts (s): the run step's last attempt, plus those before it (a
+    record written before ``earlier_attempts_s`` existed counts the last attempt only)."""
+    earlier = number_or_nan(run.get("earlier_attempts_s"))
+    return float(run["wall_time_s"]) + (earlier if math.isfinite(earlier) else 0.0)
+
+
+def _attempts_sentence(runs: Sequence[Mapping]) -> str:
+    """What the runs' attempts before their last took, when some run was interrupted or its record does not say."""
+    earlier = [number_or_nan(run.get("earlier_attempts_s")) for run in runs]
+    unknown = sum(not math.isfinite(value) for value in earlier)
+    interrupted = [value for value in earlier if math.isfinite(value) and value > 0]
+    sentences = []
+    if interrupted:
+        sentences.append(f"{len(interrupted)} run(s) were interrupted and run again; their attempts before the last "
+                         f"took {_hours(math.fsum(interrupted))}, counted in the group's times above.")
+    if unknown:
+        sentences.append(f"For {unknown} run(s) the record gives the time of the last attempt only.")
+    return " ".join(sentences)
 
 
 def _value(row: Mapping) -> str:
@@ -143,7 +167,7 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     for name, state in status.items():
         record, part_walls = groups.get(name, GroupRecord()), wall_s.get(name, {})
         made = [run for run in record.runs if run["group"] in part_walls]
-        core = math.fsum(float(run["wall_time_s"]) * int(run["cores"]) for run in made)
+        core = math.fsum(run_wall_time(run) * int(run["cores"]) for run in made)
         shown = sum(row["scale_shows"] == YES for row in record.rows)
         wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | "
@@ -165,6 +189,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         lines.append(f"{len(record.runs)} runs on {', '.join(engines)}, {'/'.join(map(str, cores))} core(s) each, "
                      f"code {', '.join(commits)}, {dates[0]} to {dates[-1]}; run ids and seeds in "
                      f"[`{name}/runs.csv`]({name}/runs.csv)." if record.runs else "No runs recorded.")
+        attempts = _attempts_sentence(record.runs)
+        if attempts:
+            lines[-1] += " " + attempts
         lines += ["", "| table | figure | case | value | study | scale shows | evidence |",
                   "|---|---|---|---|---|---|---|"]
         for row in record.rows:
