@@ -25,7 +25,7 @@ from model.cases.kinds import case_kind
 
 __all__ = ["RESULTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
            "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "CALIBRATION_DIR", "CALIBRATED_PARAMETERS",
-           "BAYESIAN_DIR", "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
+           "BAYESIAN_DIR", "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "REPOSITORY_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
 
 #: The results folder, relative to the working directory of the workflow.
@@ -55,6 +55,8 @@ CALIBRATED_PARAMETERS = f"{CALIBRATION_DIR}/parameters.yaml"
 #: Each validation group's record as the pipeline writes it (``<group>/``), before `make validate` copies it into
 #: the repository's ``docs/validation/``.
 VALIDATION_RECORD = f"{SUMMARY_DIR}/record"
+#: Where `make validate` keeps the record in the repository (relative to its top), the Makefile's VALIDATION_RECORD.
+REPOSITORY_RECORD = "docs/validation"
 
 #: The products of a flat-bottom silo run its validation rows are read from, by the name the rows call them.
 SILO_ROW_PRODUCTS = {"case": CASE_SUMMARY, "flow": "metrics/flow.json", "fields": "metrics/fields.json",

@@ -9,16 +9,19 @@ from model.record import read_run_record
 from analysis.io.validation_record import benchmark_wall_time, read_validation_rows, write_group_record
 from analysis.studies.validation.record import provenance_row
 from engines.interface import engine_named
+from engines.layout import REPOSITORY_RECORD
 from engines.logs import logged_to
 
 
 def _commit() -> str:
-    """The commit of the code that writes the record, ``-dirty`` with uncommitted changes; ``unknown`` outside git."""
+    """The commit of the code that writes the record, ``-dirty`` with uncommitted changes to anything but the record
+    kept in the repository (which `make validate` rewrites group by group); ``unknown`` outside git."""
     where = Path(snakemake.scriptdir)
     head = subprocess.run(["git", "-C", str(where), "rev-parse", "HEAD"], capture_output=True, text=True, check=False)
     if head.returncode != 0:
         return "unknown"
-    dirty = subprocess.run(["git", "-C", str(where), "status", "--porcelain", "--untracked-files=no"],
+    dirty = subprocess.run(["git", "-C", str(where), "status", "--porcelain", "--untracked-files=no", "--", ":/",
+                            f":(top,exclude){REPOSITORY_RECORD}"],
                            capture_output=True, text=True, check=False).stdout.strip()
     return head.stdout.strip() + ("-dirty" if dirty else "")
 
