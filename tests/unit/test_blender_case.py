@@ -60,18 +60,25 @@ def test_continuous_deck_is_periodic_and_loses_no_clump_batch_deck_drains(golden
     assert opened.index("variable outlet_gate_fx equal 0.0") < opened.index("unfix outlet_gate")
 
 
-def test_gravity_factor_scales_gravity_and_flow_times_not_the_time_step(golden_config):
+def test_gravity_factor_scales_gravity_stiffness_and_times_at_the_same_steps(golden_config):
     base = build_blender_case(golden_config, "straight", 1.0)
     fast = build_blender_case(golden_config, "straight", 4.0)
     assert fast.gravity == pytest.approx(4 * 9.81)
-    assert fast.silo.timestep == base.silo.timestep
-    assert fast.silo.discharge_steps == pytest.approx(base.silo.discharge_steps / 2, abs=1)
-    assert fast.silo.dump_every == pytest.approx(base.silo.dump_every / 2, abs=1)
+    # every modulus times f: E / (rho g d) and so the overlaps stay as at 1 g, and the time step (as 1 / sqrt(E))
+    # halves with the flow times, so the run makes the same steps
+    assert fast.silo.materials.youngs_modulus == tuple(4 * e for e in base.silo.materials.youngs_modulus)
+    assert fast.silo.materials.poisson_ratio == base.silo.materials.poisson_ratio
+    assert fast.silo.timestep == pytest.approx(base.silo.timestep / 2, rel=1e-12)
+    assert fast.silo.discharge_steps == pytest.approx(base.silo.discharge_steps, abs=1)
+    assert fast.silo.dump_every == pytest.approx(base.silo.dump_every, abs=1)
     assert fast.steady_window == pytest.approx((0.25, 0.5))
     assert fast.silo.settle_threshold == pytest.approx(4 * base.silo.settle_threshold)
     assert fast.silo.fill.insertion_velocity == base.silo.fill.insertion_velocity
     assert "fix gravity all gravity 39.24 vector" in render_blender_deck(fast)
     assert fast.run_id != base.run_id and fast.run_id.startswith("straight-g4-")
+    # the factor of the moduli defines the runs it changes; those at 1 g keep their ids
+    assert fast.defining_parameters["youngs_modulus_factor"] == 4.0
+    assert "youngs_modulus_factor" not in base.defining_parameters
 
 
 def test_fill_area_of_an_empty_hopper_is_the_trapezoid_plus_the_rectangle():
