@@ -301,8 +301,9 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     ``jenike.sweep.wall_test_particle_friction``;
     particle-ring and particle-lid sliding from ``contacts``; rolling friction = point value for every
     particle contact (particles, rings, plate, lid); restitution = point value for every particle contact.
-    Filling: every particle sliding friction = ``jenike.fill.sliding_friction``, rolling =
-    ``jenike.fill.rolling_friction``, restitution as when testing. Pairs without a particle are neutral.
+    Filling: every particle sliding friction = ``jenike.fill.sliding_friction`` (null: the test's particle-particle
+    sliding friction), rolling = ``jenike.fill.rolling_friction``, restitution as when testing. Pairs without a
+    particle are neutral.
     """
     jenike = config["jenike"]
     particle = jenike["particle_material"]
@@ -317,6 +318,7 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
         sliding[PLATE_TYPE] = point["sliding_friction"]
     rolling = {t: point["rolling_friction"] for t in types}
     restitution = {t: point["restitution"] for t in types}
+    pour_friction = particle_particle if jenike["fill"]["sliding_friction"] is None else jenike["fill"]["sliding_friction"]
     restitution_matrix = _matrix(n_types, restitution, NEUTRAL_CONTACT["restitution"])
     test = ContactSet(
         sliding_friction=_matrix(n_types, sliding, NEUTRAL_CONTACT["sliding_friction"]),
@@ -324,7 +326,7 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
         restitution=restitution_matrix,
     )
     fill = ContactSet(
-        sliding_friction=_matrix(n_types, {t: jenike["fill"]["sliding_friction"] for t in types}, 0.0),
+        sliding_friction=_matrix(n_types, {t: pour_friction for t in types}, 0.0),
         rolling_friction=_matrix(n_types, {t: jenike["fill"]["rolling_friction"] for t in types}, 0.0),
         restitution=restitution_matrix,
     )

@@ -13,7 +13,7 @@ import pytest
 
 from engines.interface import CaseNotSupported, engine_named
 
-from engines.config import load_config, validate_config
+from engines.config import ConfigError, load_config, validate_config
 from model.cases.geometry import read_stl
 from model.cases.jenike import (
     FILL_SOLID_FRACTION,
@@ -221,6 +221,21 @@ def test_wall_test_contact_matrices_give_the_plate_its_own_type():
     assert test.rolling_friction[p] == (0.05,) * 4
     assert test.restitution[p] == (0.6,) * 4
     assert case.fill_contacts.sliding_friction[p] == (0.1,) * 4
+
+
+def test_a_sample_poured_at_its_own_friction_fills_with_the_test_s_particle_friction():
+    """jenike.fill.sliding_friction null: every particle contact pours with the test's particle-particle friction
+    (the internal point's own, the wall test's particle friction), and the run is another run than the dense pour's."""
+    fill = copy.deepcopy(_config()["jenike"]["fill"])
+    own = _case(fill={**fill, "sliding_friction": None})
+    p = PARTICLE_TYPE - 1
+    assert own.fill_contacts.sliding_friction[p] == (0.5, 0.5, 0.5)
+    assert own.test_contacts == _case().test_contacts and own.run_id != _case().run_id
+    wall = _case({"test": "aluminium", "sliding_friction": 0.3, "rolling_friction": 0.05, "restitution": 0.6},
+                 fill={**fill, "sliding_friction": None})
+    assert wall.fill_contacts.sliding_friction[p] == (0.35,) * 4  # wall_test_particle_friction
+    with pytest.raises(ConfigError, match="jenike.fill.sliding_friction"):
+        _case(fill={**fill, "sliding_friction": "own"})
 
 
 def test_a_wall_point_may_set_its_particle_friction_and_an_internal_one_may_not():
