@@ -25,13 +25,12 @@ REENTRY_EVERY = 10
 def blender_script_context(case: BlenderCase) -> dict:
     """The rendering context of ``templates/yade/blender.py.j2``."""
     silo = case.silo
-    context = silo_script_context(silo)
+    context = silo_script_context(silo, case.gravity)
     wall = silo.materials.type_of(silo.wall_materials["side"]) - 1
     # the meshes' outer faces are W/2 + t from the axis; a clump beyond them by its size has left the blender
     half_span = 0.5 * case.geometry.width + case.geometry.wall_thickness
     context.update({
         "title": f"siloflow-blender-{case.run_id}",
-        "gravity": case.gravity,
         "exploded_speed": exploded_speed(silo.domain_top + silo.sink_depth, silo.fill.insertion_velocity)
         * max(1.0, case.gravity_factor) ** 0.5,
         "half_width": half_span,

@@ -77,13 +77,14 @@ def principal_clump(particle) -> tuple[np.ndarray, np.ndarray]:
     return particle.sphere_positions @ axes, moments
 
 
-def materials_context(case, table, wall_density: float = 1000.0) -> dict:
+def materials_context(case, table, wall_density: float = 1000.0, gravity: float = GRAVITY) -> dict:
     """The materials of ``table``: each material's elastic constants and density, each pair's sliding friction and
-    restitution, and the one rolling law (eta, krot) of its particle contacts."""
+    restitution, and the one rolling law (eta, krot) of its particle contacts, whose stiffness is the Hertz
+    stiffness under a clump's weight at ``gravity`` (m/s^2)."""
     particle = case.particle
     rolling = rolling_friction(table, f"run {case.run_id}")
     radius = float(particle.sphere_radii.min())
-    kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * GRAVITY)
+    kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * gravity)
     n = len(table.names)
     return {
         "list": [{"youngs_modulus": float(table.youngs_modulus[i]), "poisson_ratio": float(table.poisson_ratio[i]),
@@ -95,19 +96,20 @@ def materials_context(case, table, wall_density: float = 1000.0) -> dict:
     }
 
 
-def common_context(case, table, wall_density: float = 1000.0) -> dict:
-    """The context of ``templates/yade/base.py.j2``: materials, pair contacts, rolling law, clump, time step."""
+def common_context(case, table, wall_density: float = 1000.0, gravity: float = GRAVITY) -> dict:
+    """The context of ``templates/yade/base.py.j2``: materials, pair contacts, rolling law, clump, time step and
+    gravity (m/s^2)."""
     particle = case.particle
     centres, moments = principal_clump(particle)
     return {
-        "materials": materials_context(case, table, wall_density),
+        "materials": materials_context(case, table, wall_density, gravity),
         "particle": {
             "spheres": [[*map(float, c), float(r)] for c, r in zip(centres, particle.sphere_radii)],
             "mass": float(particle.mass),
             "inertia": [float(m) for m in moments],
         },
         "timestep": case.timestep,
-        "gravity": GRAVITY,
+        "gravity": gravity,
     }
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from model.record import RunRecord
+from model.constants import GRAVITY
 from model.cases.silo_flat import SiloCase, silo_meshes
 from engines.interface import CaseNotSupported
 from engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
@@ -42,12 +43,13 @@ def check_silo_case(case: SiloCase) -> None:
         )
 
 
-def silo_script_context(case: SiloCase) -> dict:
-    """The rendering context of ``templates/yade/silo_flat.py.j2``."""
+def silo_script_context(case: SiloCase, gravity: float = GRAVITY) -> dict:
+    """The rendering context of ``templates/yade/silo_flat.py.j2``, under ``gravity`` (m/s^2; a blender's gravity
+    series runs its silo at f g)."""
     table = case.materials
     side, bottom, front_back = (table.type_of(case.wall_materials[key]) - 1 for key in ("side", "bottom", "front_back"))
     half_width = 0.5 * case.width
-    context = common_context(case, table)
+    context = common_context(case, table, gravity=gravity)
     context.update({
         "title": f"siloflow-silo_flat-{case.run_id}",
         "exploded_speed": exploded_speed(case.domain_top + case.sink_depth, case.fill.insertion_velocity),

@@ -28,7 +28,7 @@ from engines.run_files import FAILED_ATTEMPTS
 from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
 from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
 from engines.yade.progress import ScriptProgress
-from engines.yade.blender import render_blender_script
+from engines.yade.blender import blender_script_context, render_blender_script
 from engines.yade.silo_flat import render_silo_script, silo_script_context
 from engines.yade.silo_recirculation import render_recirculation_script
 from tests.golden_files import assert_matches_golden
@@ -79,6 +79,16 @@ def test_blender_script_matches_golden_file_and_is_python():
     assert_matches_golden(rendered, "blender_yade.py")
     ast.parse(rendered)
     assert ("DOMAIN_TOP - SINK_BOTTOM" in rendered) == (case.mode == "continuous")
+
+
+def test_a_blender_at_f_g_runs_its_stiffer_contacts_under_f_g():
+    """The gravity series' similarity on YADE: at 4 g the moduli are 4 times stiffer and the rolling law's stiffness,
+    the Hertz stiffness under a clump's weight, is taken under 4 g, so it is 4 times the 1 g one (E^(2/3) F^(1/3))."""
+    config = validate_config(_with_engine("blender_config.yaml", "blender"))
+    base, heavy = (blender_script_context(build_blender_case(config, "straight", f)) for f in (1.0, 4.0))
+    assert (base["gravity"], heavy["gravity"]) == (pytest.approx(9.81), pytest.approx(4 * 9.81))
+    assert heavy["materials"]["list"][0]["youngs_modulus"] == 4 * base["materials"]["list"][0]["youngs_modulus"]
+    assert heavy["materials"]["rolling_stiffness"] == pytest.approx(4 * base["materials"]["rolling_stiffness"], rel=1e-12)
 
 
 def test_the_script_never_starts_yades_launcher_and_imports_from_the_system_modules():
