@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
+import subprocess
 
 import pytest
 import yaml
@@ -15,6 +17,7 @@ from analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, proven
                                               simulated_time)
 from analysis.studies.validation.rows import COLUMNS, row
 from engines.config import REPO_ROOT, load_config_file
+from engines.layout import REPOSITORY_RECORD
 from tests.conftest import validation_record_cli
 
 CLI = validation_record_cli()
@@ -189,6 +192,18 @@ def test_a_record_keeps_the_products_other_groups_read_and_restores_only_what_is
     assert restore_products(kept, fresh) == [fresh / "results/x/metrics/a.json"]
     with pytest.raises(ValueError, match="a path inside the working directory"):
         write_group_record(kept, _rows(), runs, {}, {"../outside.json": workdir / run})
+
+
+def test_the_record_s_products_are_not_ignored_by_git():
+    """The products a record keeps sit under ``products/results/...``, as in the workflow's working directory: the
+    repository ignores only its top-level ``results/``, so that they are committed with the record."""
+    if shutil.which("git") is None or not (REPO_ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    product = f"{REPOSITORY_RECORD}/silo/{PRODUCTS}/results/silo_flat/sphere2-abc/run.json"
+    ignored = subprocess.run(["git", "-C", str(REPO_ROOT), "check-ignore", "-q", "--no-index", product], check=False)
+    assert ignored.returncode == 1, f"git ignores {product}"
+    assert subprocess.run(["git", "-C", str(REPO_ROOT), "check-ignore", "-q", "--no-index", "results/silo_flat/x/run.json"],
+                          check=False).returncode == 0
 
 
 def test_the_committed_page_is_rebuilt_from_the_committed_record(monkeypatch):
