@@ -27,8 +27,9 @@ PNG = b"\x89PNG\r\n\x1a\n" + b"\x00" * 8
 
 
 def _record(run_id="sphere2-abc", stages=None, ranks=1) -> RunRecord:
-    stages = {"fill": {"step": 10, "time": 0.25}, "discharge": {"step": 30, "time": 1.75}} if stages is None else stages
-    return RunRecord(engine="liggghts", case="silo_flat", run_id=run_id, timestep_s=1e-5, n_clumps=100, n_frames=3,
+    # a time step of 2^-10 s: step times are exact in binary
+    stages = {"fill": {"step": 256, "time": 0.25}, "discharge": {"step": 1792, "time": 1.75}} if stages is None else stages
+    return RunRecord(engine="liggghts", case="silo_flat", run_id=run_id, timestep_s=2.0**-10, n_clumps=100, n_frames=3,
                      mpi_ranks=ranks, stages=stages)
 
 
@@ -48,7 +49,12 @@ def test_the_provenance_row_names_the_run_its_engine_and_its_time():
     # the time of all its attempts; a record written before earlier attempts were timed gives the last one's only
     assert run_wall_time(got) == 81.75
     assert run_wall_time({key: value for key, value in got.items() if key != "earlier_attempts_s"}) == 61.5
-    assert math.isnan(simulated_time(_record(stages={"fill": {"step": 3}})))
+    # a run resumed from a restart file counts its steps on while LIGGGHTS' clock starts again at zero: the step
+    # decides; a stage without a step gives its time; a record with neither, NaN
+    assert simulated_time(_record(stages={"fill": {"step": 256, "time": 0.25},
+                                          "discharge": {"step": 1792, "time": 0.5}})) == 1.75
+    assert simulated_time(_record(stages={"fill": {"time": 0.25}})) == 0.25
+    assert math.isnan(simulated_time(_record(stages={"fill": {"clumps": 3}})))
 
 
 @pytest.mark.parametrize("key, value", [("run_id", "sphere2-abc\n"), ("engine", "liggghts\n")])

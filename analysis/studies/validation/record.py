@@ -49,8 +49,16 @@ class GroupRecord:
 
 
 def simulated_time(record: RunRecord) -> float:
-    """The simulated time a run reached (s): the latest ``time`` of its stages; NaN when no stage gives one."""
-    times = [float(stage["time"]) for stage in record.stages.values() if isinstance(stage.get("time"), (int, float))]
+    """The simulated time a run reached (s): its latest stage's step times its time step, or where a stage gives no
+    step, its ``time``; NaN when no stage gives either. The step comes first because a run resumed from a restart
+    file counts its steps on while LIGGGHTS starts its clock again at zero."""
+    times = []
+    for stage in record.stages.values():
+        step = stage.get("step")
+        if isinstance(step, (int, float)):
+            times.append(float(step) * record.timestep_s)
+        elif isinstance(stage.get("time"), (int, float)):
+            times.append(float(stage["time"]))
     return max(times) if times else math.nan
 
 
