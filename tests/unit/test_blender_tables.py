@@ -12,6 +12,7 @@ import json
 import math
 
 import numpy as np
+import pytest
 
 from analysis.io.tables import write_json
 from analysis.numerics.lti import VRRTable
@@ -217,6 +218,19 @@ def test_gravity_rows_scale_configurations_with_a_1g_run_and_skip_the_others():
     ])
     assert curves == [("A", 1.0, [0.0, 1.0], [0.0, -0.5]), ("A", 4.0, [0.0, 4.0], [0.0, -1.5])]
     assert skipped == [("B", [1.0]), ("C", [2.0, 8.0])]
+
+
+def test_gravity_rows_take_the_mean_of_a_replicated_factor():
+    """The reference at 1 g runs with seeds: their mean is the 1 g value, the first seed draws the curve."""
+    replicated = [run_summary("A", 1.0, 0.9, -0.1, 0.4), run_summary("A", 4.0, 2.0, -0.2, 1.0),
+                  run_summary("A", 1.0, 1.1, -0.1, 0.6)]
+    rows, curves, skipped = gravity_rows(replicated)
+    assert [(row["quantity"], row["gravity_factor"], row["value"]) for row in rows] == [
+        ("mass_flow_rate_kg_s", 1.0, pytest.approx(1.0)), ("mass_flow_rate_kg_s", 4.0, 2.0),
+        ("exterior_v_z_m_s", 1.0, pytest.approx(-0.1)), ("exterior_v_z_m_s", 4.0, -0.2),
+        ("interior_v_z_m_s", 1.0, pytest.approx(0.5)), ("interior_v_z_m_s", 4.0, 1.0)]
+    assert all(row["scales"] for row in rows)
+    assert curves == [("A", 1.0, [0.0, 1.0], [0.0, -0.4]), ("A", 4.0, [0.0, 4.0], [0.0, -1.0])] and skipped == []
 
 
 def test_gravity_rows_pass_the_tolerance_on():

@@ -241,7 +241,8 @@ def gravity_rows(summaries: Sequence[Mapping], tolerance: float = 0.1) -> tuple[
     """Gravity scaling of every configuration run at 1 g and at least one other factor (``scaling.csv``).
 
     For each configuration (in sorted order), its runs sorted by gravity factor give the quantities of
-    :data:`GRAVITY_QUANTITIES` per factor; those finite at every factor (JSON's null, a NaN written out, counts
+    :data:`GRAVITY_QUANTITIES` per factor (the mean of its seeds where a factor runs several, whose first seed gives
+    the curve); those finite at every factor (JSON's null, a NaN written out, counts
     as not finite) go to :func:`analysis.studies.blender.gravity.gravity_scaling`.
 
     Parameters
@@ -267,15 +268,20 @@ def gravity_rows(summaries: Sequence[Mapping], tolerance: float = 0.1) -> tuple[
     """
     rows, curves, skipped = [], [], []
     for configuration in sorted({s["configuration"] for s in summaries}):
-        runs = sorted((s for s in summaries if s["configuration"] == configuration), key=lambda s: s["gravity_factor"])
-        factors = [s["gravity_factor"] for s in runs]
+        by_factor: dict[float, list] = {}
+        for s in summaries:
+            if s["configuration"] == configuration:
+                by_factor.setdefault(float(s["gravity_factor"]), []).append(s)
+        factors = sorted(by_factor)
         if 1.0 not in factors or len(factors) < 2:
             skipped.append((configuration, factors))
             continue
-        quantities = {key: [number_or_nan(s["metrics"][key]) for s in runs] for key in GRAVITY_QUANTITIES}
+        # the seeds of one factor (a replicated reference) count as their mean
+        quantities = {key: [float(np.mean([number_or_nan(s["metrics"][key]) for s in by_factor[f]])) for f in factors]
+                      for key in GRAVITY_QUANTITIES}
         quantities = {k: v for k, v in quantities.items() if np.all(np.isfinite(v))}
         scaling = gravity_scaling(factors, quantities, tolerance=tolerance)
         rows += [{"configuration": configuration, **row} for row in scaling.rows]
-        curves += [(configuration, s["gravity_factor"], s["flow_history"]["time_since_open_s"],
-                    s["flow_history"]["mean_v_z_m_s"]) for s in runs]
+        curves += [(configuration, f, by_factor[f][0]["flow_history"]["time_since_open_s"],
+                    by_factor[f][0]["flow_history"]["mean_v_z_m_s"]) for f in factors]
     return rows, curves, skipped
