@@ -7,12 +7,13 @@ import logging
 import shutil
 import time
 from pathlib import Path
+from typing import Callable
 
 from model.record import RunRecord
 from engines.estimates import format_bytes
 from engines.layout import RUN_RECORD, write_text_atomic
 
-__all__ = ["FAILED_ATTEMPTS", "output_bytes", "set_aside_attempts", "set_aside_previous_attempt", "write_run_record"]
+__all__ = ["FAILED_ATTEMPTS", "earlier_attempt_logs", "output_bytes", "set_aside_attempts", "set_aside_previous_attempt", "write_run_record"]
 
 #: The folder of a run directory that holds its unfinished earlier attempts, one ``<UTC time>/`` folder each.
 FAILED_ATTEMPTS = "failed_attempts"
@@ -46,6 +47,14 @@ def set_aside_attempts(run_dir: str | Path) -> list[Path]:
     """The folders of a run's earlier attempts that :func:`set_aside_previous_attempt` moved aside, oldest first."""
     folder = Path(run_dir) / FAILED_ATTEMPTS
     return sorted(path for path in folder.iterdir() if path.is_dir()) if folder.is_dir() else []
+
+
+def earlier_attempt_logs(run_dir: str | Path, attempt_logs: Callable[[Path], list[Path]]) -> list[Path]:
+    """The logs of a run's attempts before its last: those of the attempts set aside (:func:`set_aside_attempts`),
+    then those of the run directory but its last (the attempt the run step's benchmark times). ``attempt_logs`` lists
+    an engine's logs of one directory, first attempt and resumptions in order."""
+    return [*(path for attempt in set_aside_attempts(run_dir) for path in attempt_logs(attempt)),
+            *attempt_logs(Path(run_dir))[:-1]]
 
 
 def write_run_record(run_dir: Path, record: RunRecord) -> Path:

@@ -23,7 +23,7 @@ from model.cases.verification import VerificationCase
 from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, DumpFile, Engine, EngineOptions, register
 from engines.layout import CASE_SUMMARY
-from engines.run_files import set_aside_attempts
+from engines.run_files import earlier_attempt_logs
 from model.cases.blender import GATE
 from engines.liggghts.blender import run_blender, write_blender_inputs
 from engines.liggghts.contacts import read_contacts
@@ -170,8 +170,7 @@ class LiggghtsEngine(Engine):
         return work_from_logs(path.read_text(errors="replace") for path in attempt_logs(run_dir))
 
     def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
-        logs = [*(path for attempt in set_aside_attempts(run_dir) for path in attempt_logs(attempt)),
-                *attempt_logs(run_dir)[:-1]]
+        logs = earlier_attempt_logs(run_dir, attempt_logs)
         return math.fsum(elapsed_seconds(path.read_text(errors="replace")) for path in logs)
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:

@@ -24,13 +24,7 @@ def elapsed_cpu_seconds(logs: list[Path]) -> float:
     logs : list of Path
         The log of each attempt (the first and its resumptions).
     """
-    total = 0.0
-    for path in logs:
-        timed = [m.values["cpu_s"] for m in parse_markers(Path(path).read_text(encoding="utf-8", errors="replace"))
-                 if isinstance(m.values.get("cpu_s"), float) and math.isfinite(m.values["cpu_s"])
-                 and m.values["cpu_s"] >= 0]
-        total += timed[-1] if timed else 0.0
-    return total
+    return math.fsum(timed[-1]["cpu_s"] for timed in map(_timed_markers, logs) if timed)
 
 
 def measured_work(logs: list[Path]) -> MeasuredWork | None:
@@ -51,13 +45,18 @@ def measured_work(logs: list[Path]) -> MeasuredWork | None:
     """
     cpu = steps = 0.0
     for path in logs:
-        timed = [m.values for m in parse_markers(Path(path).read_text(encoding="utf-8", errors="replace"))
-                 if all(isinstance(m.values.get(key), float) and math.isfinite(m.values[key]) and m.values[key] >= 0
-                        for key in ("cpu_s", "sphere_steps"))]
+        timed = _timed_markers(path, ("cpu_s", "sphere_steps"))
         if timed:
             cpu += timed[-1]["cpu_s"]
             steps += timed[-1]["sphere_steps"]
     return MeasuredWork(cpu, steps) if steps > 0 else None
+
+
+def _timed_markers(path: Path, keys: tuple[str, ...] = ("cpu_s",)) -> list[dict]:
+    """The values of the markers of one attempt's log that carry every one of ``keys`` as a finite number >= 0."""
+    return [m.values for m in parse_markers(Path(path).read_text(encoding="utf-8", errors="replace"))
+            if all(isinstance(m.values.get(key), float) and math.isfinite(m.values[key]) and m.values[key] >= 0
+                   for key in keys)]
 
 
 def measured_seconds_per_sphere_step(logs: list[Path]) -> float | None:

@@ -25,7 +25,7 @@ from model.cost import MeasuredWork
 from engines.interface import CaseNotSupported, Engine, EngineOptions, register
 from engines.jenike_checks import JENIKE_FLOOR_WALLS, jenike_wall_forces, read_jenike_force_history
 from engines.layout import CASE_SUMMARY
-from engines.run_files import set_aside_attempts
+from engines.run_files import earlier_attempt_logs
 from engines.yade.cost import elapsed_cpu_seconds, measured_work as work_from_logs
 from engines.yade.blender import run_blender, write_blender_inputs
 from engines.yade.inputs import ENGINE_NAME
@@ -113,8 +113,7 @@ class YadeEngine(Engine):
         return work_from_logs(attempt_logs(run_dir))
 
     def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
-        logs = [*(path for attempt in set_aside_attempts(run_dir) for path in attempt_logs(attempt)),
-                *attempt_logs(run_dir)[:-1]]
+        logs = earlier_attempt_logs(run_dir, attempt_logs)
         return elapsed_cpu_seconds(logs)
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
