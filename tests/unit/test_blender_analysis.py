@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from analysis.numerics.grid import Fields, Grid
+from analysis.numerics.replicates import combine_replicates
 from analysis.studies.blender.comparison import BlenderMetrics, best_blender, comparison_table
 from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity, gravity_scaling
 from analysis.studies.blender.modes import continuous_mode, discontinuous_mode
@@ -537,13 +538,27 @@ def test_best_blender_fewest_recirculations_then_highest_vrr_at_shortest_period(
     assert best_blender([metrics("a", 2.0, 4.0), metrics("b", 2.0, 4.0)]) == "a"
 
 
+def test_replicates_keep_a_row_each_and_rank_by_their_mean():
+    # seeds of "a" homogenise after 1 and 4 recirculations (mean 2.5): "b" with 2 is better than the best seed
+    replicated = [metrics("a", 1.0, 9.0), metrics("b", 2.0, 1.0), metrics("a", 4.0, 9.0)]
+    rows = comparison_table(replicated)
+    assert [row["configuration"] for row in rows] == ["a", "b", "a"]
+    assert [row["recirculations_to_homogenise"] for row in rows] == [1.0, 2.0, 4.0]
+    combined = combine_replicates(rows, ["configuration"])
+    assert [row["configuration"] for row in combined] == ["a", "b"]
+    assert combined[0]["recirculations_to_homogenise"] == 2.5 and combined[0]["replicates"] == 2
+    assert best_blender(replicated) == "b"
+    # equal means: VRR means break the tie (a: (3 + 5) / 2 = 4 > b: 3.5)
+    assert best_blender([metrics("a", 2.0, 3.0), metrics("b", 2.0, 3.5), metrics("a", 2.0, 5.0)]) == "a"
+    # a seed that never homogenises sends its configuration behind every one that does
+    assert best_blender([metrics("a", 1.0, 9.0), metrics("a", math.nan, 9.0), metrics("b", 5.0, 1.0)]) == "b"
+
+
 def test_comparison_rejects_inconsistent_metrics():
     other = BlenderMetrics(name="b", mass_flow_rate=0.5, exterior_v_z=0.0, interior_v_z=0.0, tube_v_z=0.0,
                            rtd_mean=1.0, rtd_spread=0.1, ts_over_td=0.5, recirculations_to_homogenise=1.0,
                            vrr_by_period={1.0: 2.0})
     with pytest.raises(ValueError, match="VRR periods"):
         comparison_table([metrics("a", 1.0, 2.0), other])
-    with pytest.raises(ValueError, match="distinct names"):
-        best_blender([metrics("a", 1.0, 2.0), metrics("a", 2.0, 2.0)])
     with pytest.raises(ValueError, match="BlenderMetrics"):
         comparison_table([])

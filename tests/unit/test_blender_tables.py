@@ -26,6 +26,7 @@ from analysis.studies.blender.tables import (
     comparison_markdown,
     gravity_rows,
     lowest_gravity_runs,
+    rtd_label,
     profile_rows,
     residence_rows,
     rtd_rows,
@@ -156,6 +157,14 @@ def test_lowest_gravity_runs_keeps_the_order_of_the_runs_at_the_lowest_factor():
     assert lowest == 1.0
     assert chosen == [summaries[1], summaries[3]]
     assert lowest_gravity_runs(summaries[2:3]) == (50.0, [summaries[2]])
+
+
+def test_rtd_label_names_the_run_of_a_replicated_configuration_only():
+    summaries = [{"configuration": "converging", "run_id": "converging-g1-aa"},
+                 {"configuration": "straight", "run_id": "straight-g1-bb"},
+                 {"configuration": "converging", "run_id": "converging-g1-cc"}]
+    assert [rtd_label(s, summaries) for s in summaries] == [
+        "converging (converging-g1-aa)", "straight", "converging (converging-g1-cc)"]
 
 
 def test_comparison_markdown_is_heading_table_and_verdict():

@@ -13,7 +13,7 @@ from analysis.studies.blender.comparison import (
 )
 from analysis.studies.blender.plots import plot_configuration_comparison, plot_rtd_theta
 from analysis.studies.blender.study import metrics_from_summary, rtd_from_summary
-from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs
+from analysis.studies.blender.tables import comparison_markdown, lowest_gravity_runs, rtd_label
 from analysis.io.tables import write_flow_table, write_text
 from analysis.numerics.reference_spread import floor_table
 from analysis.numerics.replicates import combine_replicates
@@ -37,8 +37,8 @@ with logged_to(snakemake.log[0]) as log:
         write_text(snakemake.output.significance, ",".join(SIGNIFICANCE_COLUMNS) + "\n")
     plot_configuration_comparison(rows, figure_columns(rows[0]), snakemake.output.plot,
                                   f"Insert configurations at {lowest:g} g", best=best)
-    plot_rtd_theta({s["configuration"]: rtd_from_summary(s["rtd_curve"]) for s in chosen}, snakemake.output.rtd_plot,
-                   f"RTD of the configurations at {lowest:g} g")
+    plot_rtd_theta({rtd_label(s, chosen): rtd_from_summary(s["rtd_curve"]) for s in chosen},
+                   snakemake.output.rtd_plot, f"RTD of the configurations at {lowest:g} g")
     log.info("best blender: %s; %s; significant differences: %s", best, rows,
              [(r["figure"], r["configuration_a"], r["configuration_b"]) for r in significance
               if r["significance"] == "significant"])

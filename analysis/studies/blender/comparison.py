@@ -12,6 +12,8 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from analysis.numerics.replicates import REPLICATES_KEY, SEED_STD_SUFFIX
 from model.checks import number_or_nan, positive_number
 from analysis.numerics.uncertainty import Significance, combine_independent, difference_significant
@@ -95,9 +97,6 @@ def _metrics(metrics) -> list[BlenderMetrics]:
     items = list(metrics)
     if not items or not all(isinstance(item, BlenderMetrics) for item in items):
         raise ValueError("metrics must be a non-empty sequence of BlenderMetrics")
-    names = [item.name for item in items]
-    if len(set(names)) != len(names):
-        raise ValueError(f"metrics must have distinct names, got {names}")
     periods = sorted(float(p) for p in items[0].vrr_by_period)
     for item in items:
         if sorted(float(p) for p in item.vrr_by_period) != periods:
@@ -114,7 +113,10 @@ def _known_ceiling(ceiling) -> bool:
 
 
 def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
-    """One row per configuration with a stable column order (for :func:`analysis.io.tables.write_flow_table`).
+    """One row per run with a stable column order (for :func:`analysis.io.tables.write_flow_table`).
+
+    Metrics that share a name are replicates of one configuration (other seeds): each keeps its own row, and
+    :func:`analysis.numerics.replicates.combine_replicates` on ``["configuration"]`` turns them into one.
 
     Columns: ``configuration``, then each of ``mass_flow_rate_kg_s, exterior_v_z_m_s, interior_v_z_m_s,
     tube_v_z_m_s, rtd_mean_s, rtd_spread, ts_over_td, recirculations_to_homogenise`` followed by its standard error
@@ -153,18 +155,22 @@ def comparison_table(metrics: Sequence[BlenderMetrics]) -> list[dict]:
 def best_blender(metrics: Sequence[BlenderMetrics]) -> str:
     """The best blender: fewest recirculations to homogenise, ties broken by the highest VRR at the shortest period.
 
-    A configuration that never homogenises (NaN) ranks after all that do; remaining ties keep the
-    given order. Without VRR periods only the recirculations count.
+    Replicates (metrics that share a name) count by their mean over the seeds; a configuration one of whose
+    seeds never homogenises (NaN) ranks, like one that never does, after all that do. Remaining ties keep the
+    order in which the configurations first appear. Without VRR periods only the recirculations count.
     """
     items = _metrics(metrics)
+    seeds: dict[str, list[BlenderMetrics]] = {}
+    for item in items:
+        seeds.setdefault(item.name, []).append(item)
 
-    def key(item: BlenderMetrics):
-        recirculations = float(item.recirculations_to_homogenise)
-        periods = sorted(item.vrr_by_period)
-        vrr = float(item.vrr_by_period[periods[0]]) if periods else 0.0
+    def key(name: str):
+        recirculations = float(np.mean([float(item.recirculations_to_homogenise) for item in seeds[name]]))
+        periods = sorted(seeds[name][0].vrr_by_period)
+        vrr = float(np.mean([float(item.vrr_by_period[periods[0]]) for item in seeds[name]])) if periods else 0.0
         return (recirculations if math.isfinite(recirculations) else math.inf, -vrr)
 
-    return min(items, key=key).name
+    return min(seeds, key=key)
 
 
 def figure_columns(row: Mapping) -> list[str]:

@@ -33,6 +33,7 @@ __all__ = [
     "rtd_rows",
     "vrr_period_rows",
     "lowest_gravity_runs",
+    "rtd_label",
     "comparison_markdown",
     "GRAVITY_QUANTITIES",
     "gravity_rows",
@@ -186,6 +187,14 @@ def lowest_gravity_runs(summaries: Sequence[Mapping]) -> tuple[float, list[Mappi
     """
     lowest = min(summary["gravity_factor"] for summary in summaries)
     return lowest, [summary for summary in summaries if summary["gravity_factor"] == lowest]
+
+
+def rtd_label(summary: Mapping, summaries: Sequence[Mapping]) -> str:
+    """The legend label of a run's RTD among ``summaries``: its configuration, and its run id where another run
+    of the same configuration (a replicate with another seed) is among them."""
+    configuration = summary["configuration"]
+    repeated = sum(other["configuration"] == configuration for other in summaries) > 1
+    return f"{configuration} ({summary['run_id']})" if repeated else configuration
 
 
 def _estimate_cell(row: Mapping, column: str) -> str | float:
