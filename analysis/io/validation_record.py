@@ -6,6 +6,8 @@ The record keeps PNG plots (:data:`RECORD_PLOT_FORMAT`): small, and shown on its
 ``plots.format`` is ``pdf`` or ``svg`` cannot make it: the record refuses such plots (:func:`check_plot_format`,
 before anything runs where the workflow asks for a record) rather than converting them, which would need a PDF or
 SVG renderer. The validation scale's configuration, config/validation.yaml, keeps the default format, png.
+A plot enters the record as a 256-colour PNG (:func:`write_record_plot`): a third of matplotlib's full-colour file,
+which keeps the whole record, plots included, well under 2 MB.
 """
 
 from __future__ import annotations
@@ -17,13 +19,15 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
+from PIL import Image
+
 from model.checks import number_or_nan
 from analysis.io.tables import write_flow_table
 from analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from analysis.studies.validation.rows import COLUMNS
 
-__all__ = ["TABLE", "RUNS", "PRODUCTS", "RECORD_PLOT_FORMAT", "check_plot_format", "benchmark_wall_time",
-           "read_validation_rows", "write_group_record", "read_group_record", "read_record", "restore_products"]
+__all__ = ["TABLE", "RUNS", "PRODUCTS", "RECORD_PLOT_FORMAT", "RECORD_PLOT_COLOURS", "check_plot_format", "benchmark_wall_time",
+           "read_validation_rows", "write_record_plot", "write_group_record", "read_group_record", "read_record", "restore_products"]
 
 #: A group's table rows and its runs' provenance, in its folder.
 TABLE, RUNS = "table.csv", "runs.csv"
@@ -41,6 +45,28 @@ def check_plot_format(plot_format: str) -> None:
         raise ValueError(f"the validation record keeps {RECORD_PLOT_FORMAT} plots (small, shown on its page in "
                          f"docs/validation/), not {plot_format or 'files without a suffix'}: make it with plots.format: "
                          f"{RECORD_PLOT_FORMAT} (the default, as config/validation.yaml has it)")
+
+
+#: Colours of a record plot's palette: a matplotlib plot has few distinct colours besides its antialiased edges.
+RECORD_PLOT_COLOURS = 256
+
+
+def write_record_plot(source: str | os.PathLike, destination: str | os.PathLike) -> Path:
+    """Write the PNG plot ``source`` to ``destination`` as a PNG of at most :data:`RECORD_PLOT_COLOURS` colours.
+
+    Median-cut palette without dithering (Pillow), so flat areas and lines stay flat; transparency is dropped onto
+    white, the page's background. Returns the destination.
+    """
+    with Image.open(source) as image:
+        if image.mode in ("RGBA", "LA", "PA") or (image.mode == "P" and "transparency" in image.info):
+            rgba = image.convert("RGBA")
+            rgb = Image.new("RGB", rgba.size, "white")
+            rgb.paste(rgba, mask=rgba.getchannel("A"))
+        else:
+            rgb = image.convert("RGB")
+        palette = rgb.quantize(colors=RECORD_PLOT_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+        palette.save(destination, format="PNG", optimize=True)
+    return Path(destination)
 
 
 def _product_path(name: str) -> Path:
@@ -73,7 +99,7 @@ def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], ru
         if stale.name not in plots:
             stale.unlink()
     for name, source in plots.items():
-        shutil.copyfile(source, directory / name)
+        write_record_plot(source, directory / name)
     kept = directory / PRODUCTS
     # read whole before the folder is replaced: the sources may be the previous record's own products
     contents = {name: source.read_bytes() for name, source in products.items()}

@@ -7,12 +7,15 @@ import re
 import shutil
 import subprocess
 
+import numpy as np
 import pytest
 import yaml
+from PIL import Image
 
 from model.record import RunRecord, RunRecordError
 from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
-                                           read_validation_rows, restore_products, write_group_record)
+                                           RECORD_PLOT_COLOURS, read_validation_rows, restore_products,
+                                           write_group_record, write_record_plot)
 from analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, provenance_row, record_page, run_wall_time,
                                               simulated_time)
 from analysis.studies.validation.rows import COLUMNS, row
@@ -23,7 +26,20 @@ from tests.conftest import validation_record_cli
 CLI = validation_record_cli()
 RECORD_PAGE, page, publish = CLI.RECORD_PAGE, CLI.page, CLI.publish
 
-PNG = b"\x89PNG\r\n\x1a\n" + b"\x00" * 8
+#: The pixels of a small plot: white, a red line and a blue one (row by row, RGB).
+PIXELS = [(255, 255, 255), (255, 0, 0), (0, 0, 255), (255, 255, 255)] * 3
+
+
+def _png(path):
+    image = Image.new("RGB", (4, 3))
+    image.putdata(PIXELS)
+    image.save(path)
+    return path
+
+
+def _pixels(path):
+    with Image.open(path) as image:
+        return [tuple(int(c) for c in pixel) for pixel in np.asarray(image.convert("RGB")).reshape(-1, 3)]
 
 
 def _record(run_id="sphere2-abc", stages=None, ranks=1) -> RunRecord:
@@ -66,15 +82,14 @@ def test_a_run_record_s_names_are_matched_whole(key, value):
 
 
 def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
-    plot = tmp_path / "source.png"
-    plot.write_bytes(PNG)
+    plot = _png(tmp_path / "source.png")
     runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, 0.0, "2026-11-28")]
     folder = tmp_path / "silo"
     folder.mkdir()
-    (folder / "old.png").write_bytes(PNG)
+    _png(folder / "old.png")
     write_group_record(folder, _rows(), runs, {"profiles.png": plot})
     back = read_group_record(folder)
-    assert back.plots == ["profiles.png"] and (folder / "profiles.png").read_bytes() == PNG
+    assert back.plots == ["profiles.png"] and _pixels(folder / "profiles.png") == PIXELS
     assert back.runs == [{**{k: str(v) for k, v in runs[0].items()}}]  # text: a commit of digits stays text
     assert back.rows[0] == _rows()[0]
     assert math.isnan(back.rows[1]["value"]) and back.rows[1]["study_value"] == ""
@@ -84,6 +99,28 @@ def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
         write_group_record(folder, _rows(), runs, {"../x.png": plot})
     with pytest.raises(ValueError, match="needs rows and runs"):
         write_group_record(folder, [], runs, {})
+
+
+def test_a_record_plot_is_a_palette_png_of_the_same_pixels_with_transparency_on_white(tmp_path):
+    write_record_plot(_png(tmp_path / "plot.png"), tmp_path / "record.png")
+    with Image.open(tmp_path / "record.png") as written:
+        assert written.format == "PNG" and written.mode == "P"
+    assert _pixels(tmp_path / "record.png") == PIXELS
+    # a transparent pixel lands on white, a half-transparent black one on mid grey
+    image = Image.new("RGBA", (2, 1))
+    image.putdata([(0, 0, 0, 0), (0, 0, 0, 128)])
+    image.save(tmp_path / "alpha.png")
+    write_record_plot(tmp_path / "alpha.png", tmp_path / "alpha_record.png")
+    assert _pixels(tmp_path / "alpha_record.png") == [(255, 255, 255), (127, 127, 127)]
+    # more colours than the palette holds: at most RECORD_PLOT_COLOURS remain, each pixel near its own
+    ramp = [(i % 256, i // 4, 255 - i % 256) for i in range(1024)]
+    image = Image.new("RGB", (1024, 1))
+    image.putdata(ramp)
+    image.save(tmp_path / "ramp.png")
+    write_record_plot(tmp_path / "ramp.png", tmp_path / "ramp_record.png")
+    written = _pixels(tmp_path / "ramp_record.png")
+    assert len(set(written)) <= RECORD_PLOT_COLOURS
+    assert np.abs(np.array(written) - np.array(ramp)).max() <= 16
 
 
 def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_runs(tmp_path, capsys):
@@ -154,13 +191,13 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
 
 def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_path):
     workdir, record_dir = tmp_path / "work", tmp_path / "docs"
-    plot = tmp_path / "p.png"
-    plot.write_bytes(PNG)
+    plot = _png(tmp_path / "p.png")
     runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
-    write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs, {"janssen.png": plot})
+    recorded = write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs,
+                                  {"janssen.png": plot})
     write_group_record(record_dir / "blender", _rows(), runs, {})
     assert publish(workdir, record_dir, ["calibration", "silo"]) == ["silo"]
-    assert (record_dir / "silo" / "janssen.png").read_bytes() == PNG and (record_dir / "silo" / RUNS).is_file()
+    assert (record_dir / "silo" / "janssen.png").read_bytes() == (recorded / "janssen.png").read_bytes() and (record_dir / "silo" / RUNS).is_file()
     assert (record_dir / "blender" / RUNS).is_file()
 
 
