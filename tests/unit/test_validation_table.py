@@ -124,6 +124,36 @@ def test_a_calibrated_coefficient_is_judged_on_the_points_its_band_lies_between_
     assert row_wide["scale_shows"] == NO and "steady shear window in 2 of 3 shear tests" in row_wide["evidence"]
 
 
+def test_an_unreachable_target_gives_the_chart_s_nearest_angle_and_whether_the_gap_exceeds_its_error():
+    """A curve that levels off at 0.56 (29.25 deg) never reaches the 30 deg target; a wall curve that starts at 0.299
+    (16.65 deg) lies above its 9.5 deg target. Each gives its nearest end in degrees against the target."""
+    internal = [_bulk("sphere2", 0.1, 0.44, 0.004, rolling=0.1), _bulk("sphere2", 0.3, 0.52, 0.004, rolling=0.1),
+                _bulk("sphere2", 0.5, 0.55, 0.005, rolling=0.1), _bulk("sphere2", 0.8, 0.56, 0.005, rolling=0.1)]
+    wall = [{**_bulk("sphere2", mu, bulk, 0.002, test="wall", rolling=0.1, window=window), "wall_material": "aluminium"}
+            for mu, bulk, window in ((0.3, 0.299, "steady"), (0.5, 0.44, "second half"))]
+    parameters = {"shape": "sphere2", "rolling_friction": 0.1, "tolerance_deg": 1.0,
+                  "targets_deg": {"internal": 30.0, "aluminium": 9.5}, "particle_wall": {},
+                  "unreachable": {"internal": "internal 30.0 deg is unreachable", "aluminium": "aluminium unreachable"}}
+    table = calibration_rows(internal + wall, parameters, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA,
+                             sections=("calibrated",))
+    rows = {r["figure"]: r for r in table}
+    assert sorted(rows) == ["Bulk friction angle nearest the unreachable target (particle-aluminium)",
+                            "Bulk friction angle nearest the unreachable target (particle-particle)"]
+    top = rows["Bulk friction angle nearest the unreachable target (particle-particle)"]
+    angle, error = math.degrees(math.atan(0.56)), math.degrees(0.005 / (1.0 + 0.56 ** 2))
+    assert top["value"] == pytest.approx(angle, rel=1e-15) and top["value_error"] == pytest.approx(error, rel=1e-15)
+    assert top["unit"] == "deg" and top["study_value"] == "30 deg measured; particle friction 0.35"
+    # 30 - 29.249 = 0.751 deg against 2 x 0.218 deg: resolved, on steady points in a wide cell
+    assert top["scale_shows"] == YES and "internal 30.0 deg is unreachable" in top["evidence"]
+    assert "at particle friction 0.8, lies 0.751 ± 0.22 deg below the target: resolved" in top["evidence"]
+    low = rows["Bulk friction angle nearest the unreachable target (particle-aluminium)"]
+    assert low["value"] == pytest.approx(math.degrees(math.atan(0.299)), rel=1e-15)
+    # judged on its two lowest points, one of them a transient
+    assert low["scale_shows"] == NO and "lowest point, at particle friction 0.3" in low["evidence"]
+    assert "steady shear window in 1 of 2 shear tests" in low["evidence"]
+    assert f"lies {low['value'] - 9.5:.3g} ± " in low["evidence"] and "deg above the target" in low["evidence"]
+
+
 def test_a_curve_that_falls_at_its_end_has_stopped_rising():
     """The wall test's bulk friction past its maximum (0.445 at 0.5, 0.325 at 0.8): the last step is a resolved fall,
     not a rise, so the curve shows where it stops rising."""

@@ -7,7 +7,8 @@ Rows (see :mod:`analysis.studies.validation.rows`):
   rising (its first step resolved, its last step not);
 - rotation blocked against free rotation, the other lid against the configured one, each extra restitution
   against the base one and each other shear velocity against the configured one, on the same sweep points;
-- the calibrated particle-scale friction coefficients.
+- the calibrated particle-scale friction coefficients, and for a target no swept particle friction reproduces, the
+  chart's bulk friction angle nearest it.
 
 Every row says whether the shear tests it draws on reached a steady window (``window_method`` of each point,
 :func:`calibration.friction.bulk_friction_of_shear`): a bulk friction averaged over the second half of a shear that
@@ -253,11 +254,8 @@ def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diamete
             continue
         target = parameters["targets_deg"].get(test)
         clipped = bool(result.get("band_clipped"))
-        # the chart this coefficient was read from: the calibration shape's curve of this test (a wall material's
-        # points are the test "wall" of that material), and on it the points the band lies between
-        curve = ("internal", None) if test == "internal" else ("wall", test)
-        entries = [entry for entry in chart_entries.get((shape, curve[0], float(parameters["rolling_friction"])), [])
-                   if curve[1] is None or entry.get("wall_material") == curve[1]]
+        # the chart this coefficient was read from, and on it the points the band lies between
+        entries = _curve_entries(parameters, chart_entries, test)
         cell_ok, cell_text = _judged(cell, _bracketing(entries, result["lower"], result["upper"]))
         rows.append(row(
             GROUP, f"Calibrated particle sliding friction ({'particle-particle' if test == 'internal' else 'particle-' + test})",
@@ -266,4 +264,42 @@ def _calibrated_rows(parameters: Mapping, cell_diameter: float, particle_diamete
             verdict(cell_ok, not clipped),
             f"{cell_text}; reproduces the measured {target:g} deg +- {parameters['tolerance_deg']:g} deg; band "
             f"{result['lower']:.3g} to {result['upper']:.3g}{' (clipped at the swept range)' if clipped else ''}"))
+    for test, message in sorted((parameters.get("unreachable") or {}).items()):
+        entries = _curve_entries(parameters, chart_entries, test)
+        if entries:
+            rows.append(_unreachable_row(parameters, test, message, entries, cell, criteria))
     return rows
+
+
+def _curve_entries(parameters: Mapping, chart_entries: Mapping[tuple, list], test: str) -> list[Mapping]:
+    """The points of the chart a coefficient of ``test`` (``internal`` or a wall material) is read from: the
+    calibration shape's curve of that test at the calibration's rolling friction, by particle friction."""
+    kind, material = ("internal", None) if test == "internal" else ("wall", test)
+    entries = chart_entries.get((parameters["shape"], kind, float(parameters["rolling_friction"])), [])
+    return [entry for entry in entries if material is None or entry.get("wall_material") == material]
+
+
+def _angle_deg(bulk: float, error: float) -> tuple[float, float]:
+    """The friction angle ``atan(bulk)`` [deg] and its first-order standard error ``error / (1 + bulk^2)``."""
+    return math.degrees(math.atan(bulk)), math.degrees(error / (1.0 + bulk * bulk))
+
+
+def _unreachable_row(parameters: Mapping, test: str, message: str, entries: Sequence[Mapping],
+                     cell: tuple[bool, str], criteria: Criteria) -> dict:
+    """A target no particle friction of the chart reproduces: the chart's end nearest it, in degrees, and whether
+    the gap exceeds its error. The end is judged on its two outermost points (their steadiness shows the level)."""
+    target = float(parameters["targets_deg"][test])
+    points = [_point(entry) for entry in entries]
+    above = target > max(_angle_deg(b, e)[0] for _, b, e in points)
+    end = max(points, key=lambda point: point[1]) if above else min(points, key=lambda point: point[1])
+    angle, error = _angle_deg(end[1], end[2])
+    cell_ok, cell_text = _judged(cell, entries[-2:] if above else entries[:2])
+    gap = target - angle
+    seen = resolved(gap, error, criteria.coverage_factor)
+    label = "particle-particle" if test == "internal" else "particle-" + test
+    return row(GROUP, f"Bulk friction angle nearest the unreachable target ({label})",
+               f"{parameters['shape']}, rolling {parameters['rolling_friction']:g}", angle, error, "deg",
+               f"{target:g} deg measured; particle friction {STUDY_FRICTION.get(test, '?')}", verdict(cell_ok, seen),
+               f"{cell_text}; {message}; the chart's {'highest' if above else 'lowest'} point, at particle friction "
+               f"{end[0]:g}, lies {plus_minus(abs(gap), error)} deg {'below' if above else 'above'} the target: "
+               f"{_RESOLVED[seen]} at {criteria.coverage_factor:g} standard errors")
