@@ -58,12 +58,10 @@ def write_record_plot(source: str | os.PathLike, destination: str | os.PathLike)
     white, the page's background. Returns the destination.
     """
     with Image.open(source) as image:
-        if image.mode in ("RGBA", "LA", "PA") or (image.mode == "P" and "transparency" in image.info):
-            rgba = image.convert("RGBA")
-            rgb = Image.new("RGB", rgba.size, "white")
-            rgb.paste(rgba, mask=rgba.getchannel("A"))
-        else:
-            rgb = image.convert("RGB")
+        # every mode converts to RGBA (opaque where it has no alpha), so one composite covers them all
+        rgba = image.convert("RGBA")
+        rgb = Image.new("RGB", rgba.size, "white")
+        rgb.paste(rgba, mask=rgba.getchannel("A"))
         palette = rgb.quantize(colors=RECORD_PLOT_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
         palette.save(destination, format="PNG", optimize=True)
     return Path(destination)

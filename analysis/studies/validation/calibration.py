@@ -290,8 +290,9 @@ def _unreachable_row(parameters: Mapping, test: str, message: str, entries: Sequ
     the gap exceeds its error. The end is judged on its two outermost points (their steadiness shows the level)."""
     target = float(parameters["targets_deg"][test])
     points = [_point(entry) for entry in entries]
-    above = target > max(_angle_deg(b, e)[0] for _, b, e in points)
-    end = max(points, key=lambda point: point[1]) if above else min(points, key=lambda point: point[1])
+    # atan is increasing: the target lies above the chart when its tangent exceeds the largest bulk friction
+    above = math.tan(math.radians(target)) > max(bulk for _, bulk, _ in points)
+    end = (max if above else min)(points, key=lambda point: point[1])
     angle, error = _angle_deg(end[1], end[2])
     cell_ok, cell_text = _judged(cell, entries[-2:] if above else entries[:2])
     gap = target - angle
