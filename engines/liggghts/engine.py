@@ -71,8 +71,8 @@ def _wrapped_silo_pairs(case) -> list[tuple[str, str, float, str]]:
 def _jenike_pairs(case: JenikeCase) -> list[tuple[str, str, float, str]]:
     names = case.materials.names
     found = []
-    # the sweep point sets the restitution of both contact sets: name its key first
-    for contacts, key in ((case.test_contacts, "jenike.sweep.restitution"), (case.fill_contacts, "contacts")):
+    # the sweep point sets the test's restitution and, unless jenike.fill.restitution is set, the pour's: name it first
+    for contacts, key in ((case.test_contacts, "jenike.sweep.restitution"), (case.fill_contacts, "jenike.fill.restitution")):
         for j, value in enumerate(contacts.restitution[0]):
             found.append((names[0], names[j], float(value), key))
     return found

@@ -293,6 +293,20 @@ def _matrix(n_types: int, particle_row: dict[int, float], neutral: float) -> tup
     return tuple(tuple(float(v) for v in row) for row in rows)
 
 
+#: Keys of ``jenike.fill`` whose whole effect is in the fill's contact set (``fill_contacts``, itself a defining
+#: parameter): left out of the section in the run id, so that spelling out a value that changes no contact does not
+#: rename the runs that already exist.
+FILL_CONTACT_KEYS = ("restitution",)
+
+
+def _defining_section(jenike: dict) -> dict:
+    """The ``jenike`` section as it defines a run: without its sweep (the point stands for it), the fill's checks
+    (:func:`model.cases.common.without_fill_checks`) and :data:`FILL_CONTACT_KEYS`."""
+    section = without_fill_checks({key: value for key, value in jenike.items() if key != "sweep"})
+    section["fill"] = {key: value for key, value in section["fill"].items() if key not in FILL_CONTACT_KEYS}
+    return section
+
+
 def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, ContactSet]:
     """Contact matrices while filling and while testing.
 
@@ -302,8 +316,8 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     particle-ring and particle-lid sliding from ``contacts``; rolling friction = point value for every
     particle contact (particles, rings, plate, lid); restitution = point value for every particle contact.
     Filling: every particle sliding friction = ``jenike.fill.sliding_friction`` (null: the test's particle-particle
-    sliding friction), rolling = ``jenike.fill.rolling_friction``, restitution as when testing. Pairs without a
-    particle are neutral.
+    sliding friction), rolling = ``jenike.fill.rolling_friction``, restitution = ``jenike.fill.restitution`` (null:
+    the test's). Pairs without a particle are neutral.
     """
     jenike = config["jenike"]
     particle = jenike["particle_material"]
@@ -319,16 +333,17 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     rolling = {t: point["rolling_friction"] for t in types}
     restitution = {t: point["restitution"] for t in types}
     pour_friction = particle_particle if jenike["fill"]["sliding_friction"] is None else jenike["fill"]["sliding_friction"]
-    restitution_matrix = _matrix(n_types, restitution, NEUTRAL_CONTACT["restitution"])
+    pour_restitution = jenike["fill"].get("restitution")
     test = ContactSet(
         sliding_friction=_matrix(n_types, sliding, NEUTRAL_CONTACT["sliding_friction"]),
         rolling_friction=_matrix(n_types, rolling, NEUTRAL_CONTACT["rolling_friction"]),
-        restitution=restitution_matrix,
+        restitution=_matrix(n_types, restitution, NEUTRAL_CONTACT["restitution"]),
     )
     fill = ContactSet(
         sliding_friction=_matrix(n_types, {t: pour_friction for t in types}, 0.0),
         rolling_friction=_matrix(n_types, {t: jenike["fill"]["rolling_friction"] for t in types}, 0.0),
-        restitution=restitution_matrix,
+        restitution=test.restitution if pour_restitution is None else _matrix(
+            n_types, {t: pour_restitution for t in types}, NEUTRAL_CONTACT["restitution"]),
     )
     return fill, test
 
@@ -549,7 +564,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         "particle_model": model_parameters(particle.name, config["particle_models"][particle.name]),
         "test_contacts": asdict(test_contacts),
         "fill_contacts": asdict(fill_contacts),
-        "jenike": without_fill_checks({key: value for key, value in jenike.items() if key not in ("sweep",)}),
+        "jenike": _defining_section(jenike),
     }
     return JenikeCase(
         particle=particle,

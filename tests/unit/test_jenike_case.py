@@ -238,6 +238,22 @@ def test_a_sample_poured_at_its_own_friction_fills_with_the_test_s_particle_fric
         _case(fill={**fill, "sliding_friction": "own"})
 
 
+def test_a_sample_poured_at_a_set_restitution_is_sheared_at_the_point_s_own():
+    """jenike.fill.restitution: every particle contact pours at it and tests at the point's restitution; a value
+    equal to the point's is the same run as null, and another value another run."""
+    fill = copy.deepcopy(_config()["jenike"]["fill"])
+    p = PARTICLE_TYPE - 1
+    poured = _case({"restitution": 0.6}, fill={**fill, "restitution": 0.1})
+    assert poured.fill_contacts.restitution[p] == (0.1, 0.1, 0.1)
+    assert poured.test_contacts.restitution[p] == (0.6, 0.6, 0.6)
+    assert poured.test_contacts == _case({"restitution": 0.6}).test_contacts
+    assert _case({"restitution": 0.6}).fill_contacts.restitution[p] == (0.6, 0.6, 0.6)
+    assert poured.run_id != _case({"restitution": 0.6}).run_id
+    assert _case(fill={**fill, "restitution": 0.1}).run_id == _case().run_id == _case(fill={**fill, "restitution": None}).run_id
+    with pytest.raises(ConfigError, match="jenike.fill.restitution"):
+        _case(fill={**fill, "restitution": 0.0})
+
+
 def test_a_wall_point_may_set_its_particle_friction_and_an_internal_one_may_not():
     wall = {"test": "aluminium", "sliding_friction": 0.3, "rolling_friction": 0.05, "restitution": 0.6}
     case = _case({**wall, "particle_sliding_friction": 0.42})
