@@ -296,7 +296,7 @@ def _matrix(n_types: int, particle_row: dict[int, float], neutral: float) -> tup
 #: Keys of ``jenike.fill`` whose whole effect is in the fill's contact set (``fill_contacts``, itself a defining
 #: parameter): left out of the section in the run id, so that spelling out a value that changes no contact does not
 #: rename the runs that already exist.
-FILL_CONTACT_KEYS = ("restitution",)
+FILL_CONTACT_KEYS = ("restitution", "rotation_blocked_sliding_friction")
 
 
 def _defining_section(jenike: dict) -> dict:
@@ -316,8 +316,9 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     particle-ring and particle-lid sliding from ``contacts``; rolling friction = point value for every
     particle contact (particles, rings, plate, lid); restitution = point value for every particle contact.
     Filling: every particle sliding friction = ``jenike.fill.sliding_friction`` (null: the test's particle-particle
-    sliding friction), rolling = ``jenike.fill.rolling_friction``, restitution = ``jenike.fill.restitution`` (null:
-    the test's). Pairs without a particle are neutral.
+    sliding friction; a rotation-blocked point's ``jenike.fill.rotation_blocked_sliding_friction`` where set),
+    rolling = ``jenike.fill.rolling_friction``, restitution = ``jenike.fill.restitution`` (null: the test's). Pairs
+    without a particle are neutral.
     """
     jenike = config["jenike"]
     particle = jenike["particle_material"]
@@ -333,6 +334,8 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     rolling = {t: point["rolling_friction"] for t in types}
     restitution = {t: point["restitution"] for t in types}
     pour_friction = particle_particle if jenike["fill"]["sliding_friction"] is None else jenike["fill"]["sliding_friction"]
+    if point["rotation_blocked"] and jenike["fill"].get("rotation_blocked_sliding_friction") is not None:
+        pour_friction = jenike["fill"]["rotation_blocked_sliding_friction"]
     pour_restitution = jenike["fill"].get("restitution")
     test = ContactSet(
         sliding_friction=_matrix(n_types, sliding, NEUTRAL_CONTACT["sliding_friction"]),

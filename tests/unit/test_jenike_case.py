@@ -254,6 +254,23 @@ def test_a_sample_poured_at_a_set_restitution_is_sheared_at_the_point_s_own():
         _case(fill={**fill, "restitution": 0.0})
 
 
+def test_a_rotation_blocked_sample_may_be_poured_at_a_friction_of_its_own():
+    """jenike.fill.rotation_blocked_sliding_friction: a rotation-blocked point pours at it and tests at its own
+    friction; a free point pours as sliding_friction says; unset, the run ids are those without the key."""
+    fill = {**copy.deepcopy(_config()["jenike"]["fill"]), "sliding_friction": None}
+    p = PARTICLE_TYPE - 1
+    blocked = {"rotation_blocked": True}
+    poured = _case(blocked, fill={**fill, "rotation_blocked_sliding_friction": 0.1})
+    assert poured.fill_contacts.sliding_friction[p] == (0.1, 0.1, 0.1)
+    assert poured.test_contacts.sliding_friction[p] == (0.5, 0.17, 1.0)
+    assert _case(blocked, fill=fill).fill_contacts.sliding_friction[p] == (0.5, 0.5, 0.5)
+    free = _case(fill={**fill, "rotation_blocked_sliding_friction": 0.1})
+    assert free.fill_contacts.sliding_friction[p] == (0.5, 0.5, 0.5)
+    assert free.run_id == _case(fill=fill).run_id and poured.run_id != _case(blocked, fill=fill).run_id
+    with pytest.raises(ConfigError, match="rotation_blocked_sliding_friction"):
+        _case(fill={**fill, "rotation_blocked_sliding_friction": 1.5})
+
+
 def test_a_wall_point_may_set_its_particle_friction_and_an_internal_one_may_not():
     wall = {"test": "aluminium", "sliding_friction": 0.3, "rolling_friction": 0.05, "restitution": 0.6}
     case = _case({**wall, "particle_sliding_friction": 0.42})
