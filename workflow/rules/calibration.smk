@@ -67,9 +67,11 @@ def calibration_targets(wildcards=None, runs=None):
     charts, the chosen parameters and the lid comparison."""
     if runs is not None:
         return [*(run_path("jenike", name, run) for run in runs
-                  for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json")), *diagnostic_targets(runs)]
+                  for name in ("metrics/bulk_friction.json", "metrics/fill_balance.json", plot_file("plots/forces"))),
+                *diagnostic_targets(runs)]
     return [
         *diagnostic_targets(),
+        *[run_path("jenike", plot_file("plots/forces"), run) for run in JENIKE_CASES],
         f"{CALIBRATION_DIR}/bulk_friction.csv",
         CALIBRATED_PARAMETERS,
         *[plot_file(f"{CALIBRATION_DIR}/charts/{name}") for name in calibration_chart_names()],
@@ -120,13 +122,28 @@ rule jenike_friction:
         case=rules.jenike_deck.output.case,
     output:
         summary=run_path("jenike", "metrics/bulk_friction.json"),
-        plot=report(run_path("jenike", plot_file("plots/forces")), caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{run}"}),
     params:
         point=lambda wildcards: jenike_point(wildcards.run),
     log:
         run_path("jenike", "logs/friction.log"),
     script:
-        "../scripts/jenike_friction.py"
+        "../scripts/jenike_shear_test.py"
+
+
+# apart from the bulk friction: a validation group that reads another group's runs gets their bulk friction from
+# that group's record, which keeps no plot of them
+rule jenike_forces_plot:
+    input:
+        record=rules.jenike_run.output.record,
+        case=rules.jenike_deck.output.case,
+    output:
+        plot=report(run_path("jenike", plot_file("plots/forces")), caption="../report/jenike_forces.rst", category="1 Calibration", subcategory="Shear tests", labels={"figure": "{run}"}),
+    params:
+        point=lambda wildcards: jenike_point(wildcards.run),
+    log:
+        run_path("jenike", "logs/forces_plot.log"),
+    script:
+        "../scripts/jenike_shear_test.py"
 
 
 rule calibration_table:
