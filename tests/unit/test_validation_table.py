@@ -89,10 +89,18 @@ def test_a_row_whose_shear_tests_did_not_all_reach_a_steady_window_does_not_show
     curve, lid, chosen = "Bulk friction at particle friction 0.5", "Bulk friction", "Calibrated particle sliding friction"
     assert [judged["steady"][f]["scale_shows"] for f in (curve, lid, chosen)] == [YES, YES, YES]
     assert "steady shear window in 3 of 3 shear tests" in judged["steady"][curve]["evidence"]
-    assert "steady shear window in 4 of 4 shear tests" in judged["steady"][lid]["evidence"]  # both lids' points
-    assert [judged["transient"][f]["scale_shows"] for f in (curve, lid, chosen)] == [NO, NO, NO]
+    # the lid comparison's shear tests: both lids at 0.3, the one particle friction it pairs
+    assert "steady shear window in 2 of 2 shear tests" in judged["steady"][lid]["evidence"]
+    # the transient at 0.5 is the curve's and the calibration's, not the lid comparison's, which pairs 0.3 only
+    assert [judged["transient"][f]["scale_shows"] for f in (curve, lid, chosen)] == [NO, YES, NO]
+    assert "steady shear window in 2 of 2 shear tests" in judged["transient"][lid]["evidence"]
+    transient_pair = [*steady[:3], _bulk("sphere2", 0.3, 0.60, 0.01, lid="servo", window="second half")]
+    table = calibration_rows(transient_pair, PARAMETERS, 0.095, {"sphere2": 0.004}, 0.1, "rigid", 0.03, CRITERIA)
+    (paired,) = [r for r in table if r["figure"].startswith("Bulk friction, servo lid")]
+    assert paired["scale_shows"] == NO
+    assert "steady shear window in 1 of 2 shear tests (the others a transient)" in paired["evidence"]
     assert "steady shear window in 2 of 3 shear tests (the others a transient)" in judged["transient"][curve]["evidence"]
-    assert [judged["unsaid"][f]["scale_shows"] for f in (curve, lid, chosen)] == [UNKNOWN, UNKNOWN, UNKNOWN]
+    assert [judged["unsaid"][f]["scale_shows"] for f in (curve, lid, chosen)] == [UNKNOWN, YES, UNKNOWN]
     assert "(the others do not say)" in judged["unsaid"][chosen]["evidence"]
 
 

@@ -221,8 +221,12 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, c
                             "independent of the shear speed (quasi-static)", False))
     for figure, others, study, expect in comparisons if "comparisons" in sections else ():
         for key, entries in others.items():
+            # judged on the shear tests the differences are taken from: a transient elsewhere on the chart's curve
+            # is that curve's row's to report, not this one's
+            compared = {_point(entry)[0] for entry in entries}
+            paired = [entry for entry in chart_entries.get(key, []) if _point(entry)[0] in compared]
             cell_ok, cell_text = _judged(_cell_text(cell_diameter, particle_diameters[key[0]], criteria),
-                                         [*chart_entries.get(key, []), *entries])
+                                         [*paired, *entries])
             rows += _paired_rows(figure, curves, {key: [_point(entry) for entry in entries]}, cell_ok, cell_text,
                                  criteria, study, expect)
     if "calibrated" in sections:
