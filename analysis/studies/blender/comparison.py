@@ -160,6 +160,8 @@ def best_blender(metrics: Sequence[BlenderMetrics]) -> str:
     order in which the configurations first appear. Without VRR periods only the recirculations count.
     """
     items = _metrics(metrics)
+    # grouped here rather than through combine_replicates: its mean leaves out a seed that never homogenises, which
+    # here must rank the whole configuration after those that do
     seeds: dict[str, list[BlenderMetrics]] = {}
     for item in items:
         seeds.setdefault(item.name, []).append(item)
