@@ -7,12 +7,20 @@ import pytest
 from analysis.report.summary import summary_html
 from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows, rtd_peak
 from analysis.studies.validation.calibration import calibration_rows
-from analysis.studies.validation.rows import NO, UNKNOWN, YES, Criteria, ratio, resolved, row, verdict
+from analysis.studies.validation.rows import NO, UNKNOWN, YES, Criteria, precise, ratio, resolved, row, verdict
 from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
 from analysis.studies.validation.table import page_sections, scale_limits
 from engines.config import validate_config
 
 CRITERIA = Criteria()
+
+
+def test_precise_judges_the_relative_error_against_its_limit_and_quotes_both():
+    assert precise(0.409, 0.14, CRITERIA) == (False, "relative error 34 % (at most 25 %)")
+    assert precise(-2.0, 0.5, CRITERIA) == (True, "relative error 25 % (at most 25 %)")
+    assert precise(0.0, 0.1, CRITERIA) == (False, "relative error unbounded (at most 25 %)")
+    assert precise(1.0, math.nan, CRITERIA) == (None, "relative error not known (at most 25 %)")
+    assert precise(math.nan, 0.1, Criteria(max_relative_error=0.1)) == (None, "relative error not known (at most 10 %)")
 
 
 def test_criteria_come_from_the_config_section_with_their_defaults():
@@ -65,6 +73,9 @@ def test_a_curve_that_rises_then_levels_off_in_a_wide_cell_shows_where_bulk_fric
     assert lid["value_error"] == pytest.approx(math.sqrt(4 * 1e-4) / 2, rel=1e-12) and lid["scale_shows"] == YES
     (restitution,) = [r for r in table if "restitution 0.6 - 0.1" in r["figure"]]
     assert restitution["value"] == pytest.approx(0.002, abs=1e-12) and restitution["scale_shows"] == YES
+    # sqrt(2) x 0.01 against the level 0.55: small enough to have seen a change
+    assert restitution["evidence"].endswith(
+        "not resolved at 2 standard errors; its error against the bulk friction 0.55: relative error 2.6 % (at most 25 %)")
     # the speed point stays off the chart's curve; its difference is resolved, so the speed independence is not shown
     (speed,) = [r for r in table if "shear velocity 0.015 - 0.03 m/s" in r["figure"]]
     assert speed["value"] == pytest.approx(0.03, abs=1e-12) and speed["scale_shows"] == NO
@@ -264,6 +275,8 @@ def test_recirculation_rows_judge_the_vrr_against_the_window_ceiling_and_resolve
     assert vrr5["value"] == 150.0 and vrr5["scale_shows"] == NO and "(ceiling)" in vrr5["evidence"]
     peak, ts_td, drop = table[2], table[3], table[4]
     assert peak["value"] == 0.75 and ts_td["value"] == 0.25
+    # 0.01 / 0.25: the figure that decides its verdict is in its evidence
+    assert ts_td["scale_shows"] == YES and ts_td["evidence"].endswith("200 tracer clumps; relative error 4 % (at most 25 %)")
     assert drop["value"] == 0.06 and drop["value_error"] == 0.002 and drop["scale_shows"] == YES
     assert len(table) == 5
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
-from analysis.studies.validation.rows import Criteria, plus_minus, ratio, resolved, row, verdict
+from analysis.studies.validation.rows import Criteria, plus_minus, precise, ratio, resolved, row, verdict
 
 __all__ = ["rtd_peak", "recirculation_rows", "blender_rows", "gravity_rows"]
 
@@ -84,13 +84,15 @@ def recirculation_rows(case: Mapping, summary: Mapping, rtd: Sequence[Mapping], 
     if chosen:
         theta, theta_error = rtd_peak([float(e["time_s"]) for e in chosen], [float(e["E_per_s"]) for e in chosen],
                                       float(ids["t_mean_s"]), number_or_nan(ids.get("t_mean_s_error")))
+        theta_precise, theta_text = precise(theta, theta_error, criteria)
         rows.append(row(RECIRCULATION_GROUP, "RTD peak theta = t_peak / t_mean", pattern, theta, theta_error, "-", "",
-                        verdict(depth_ok, _precise(theta, theta_error, criteria)),
-                        f"{depth_text}; {int(ids['n_tracer'])} tracer clumps, {len(chosen)} bins"))
-    rows.append(row(RECIRCULATION_GROUP, "First appearance / discharge time t_s/t_d", pattern, ids["t_s_over_t_d"],
-                    number_or_nan(ids.get("t_s_over_t_d_error")), "-", "",
-                    verdict(depth_ok, _precise(ids["t_s_over_t_d"], number_or_nan(ids.get("t_s_over_t_d_error")), criteria)),
-                    f"{depth_text}; {int(ids['n_tracer'])} tracer clumps"))
+                        verdict(depth_ok, theta_precise),
+                        f"{depth_text}; {int(ids['n_tracer'])} tracer clumps, {len(chosen)} bins; {theta_text}"))
+    first, first_error = ids["t_s_over_t_d"], number_or_nan(ids.get("t_s_over_t_d_error"))
+    first_precise, first_text = precise(first, first_error, criteria)
+    rows.append(row(RECIRCULATION_GROUP, "First appearance / discharge time t_s/t_d", pattern, first, first_error, "-",
+                    "", verdict(depth_ok, first_precise),
+                    f"{depth_text}; {int(ids['n_tracer'])} tracer clumps; {first_text}"))
     if "bulk_density_drop" in summary:
         drop, error = summary["bulk_density_drop"], number_or_nan(summary.get("bulk_density_drop_error"))
         seen = resolved(drop, error, criteria.coverage_factor)
@@ -101,12 +103,6 @@ def recirculation_rows(case: Mapping, summary: Mapping, rtd: Sequence[Mapping], 
                         f"{summary['settled_bulk_density_kg_m3']:.1f}, flowing "
                         f"{plus_minus(summary['flowing_bulk_density_kg_m3'], number_or_nan(summary.get('flowing_bulk_density_kg_m3_error')), 4)} kg/m3"))
     return rows
-
-
-def _precise(value: float, error: float, criteria: Criteria) -> bool | None:
-    if not math.isfinite(error) or not math.isfinite(value):
-        return None
-    return error <= criteria.max_relative_error * abs(value)
 
 
 def _metric(metrics: Mapping, key: str) -> tuple[float, float]:
@@ -163,10 +159,11 @@ def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteri
         mean, mean_error = _cross_section_mean(metrics, widths)
         for key, (passage, _) in _passages(widths).items():
             value = ratio(*_metric(metrics, f"{key}_v_z_m_s"), mean, mean_error)
+            value_precise, value_text = precise(*value, criteria)
             rows.append(row(BLENDER_GROUP, f"{passage.capitalize()} v_z / cross-section mean", name, *value, "-", "",
-                            verdict(scale_ok, _precise(*value, criteria)),
+                            verdict(scale_ok, value_precise),
                             f"{scale_text}; cross-section mean {plus_minus(mean, mean_error)} m/s (passages weighted by "
-                            f"their clear widths); {depth}"))
+                            f"their clear widths); {depth}; {value_text}"))
         exterior_over_tube, in_mass_flow = _in_mass_flow(metrics, widths, criteria)
         inner = "tube" if "tube" in widths else "interior annulus"
         rows.append(row(BLENDER_GROUP, f"Exterior annulus / {inner} v_z (mass flow of the insert)", name,
@@ -179,9 +176,10 @@ def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteri
         for key, label in (("rtd_mean_s", "Mean residence time"),
                            ("recirculations_to_homogenise", "Recirculations to homogenise")):
             value = _metric(metrics, key)
+            value_precise, value_text = precise(*value, criteria)
             rows.append(row(BLENDER_GROUP, label, name, *value, "s" if key.endswith("_s") else "-", "",
-                            verdict(scale_ok, _precise(*value, criteria)),
-                            f"{scale_text}; error from the run's tracer counts"))
+                            verdict(scale_ok, value_precise),
+                            f"{scale_text}; error from the run's tracer counts; {value_text}"))
     return rows
 
 
@@ -199,9 +197,10 @@ def gravity_rows(summaries: Sequence[Mapping], criteria: Criteria) -> list[dict]
                 value, error = ratio(*_metric(runs[factor], key), *_metric(runs[1.0], key))
                 scaled, scaled_error = value / math.sqrt(factor), error / math.sqrt(factor)
                 off = resolved(scaled - 1.0, scaled_error, k)
+                scaled_precise, scaled_text = precise(scaled, scaled_error, criteria)
                 rows.append(row(GRAVITY_GROUP, f"{label.capitalize()} at {factor:g} g / (1 g value x sqrt({factor:g}))",
                                 name, scaled, scaled_error, "-", "flow rate and mean velocity scale with sqrt(g)",
-                                verdict(_precise(scaled, scaled_error, criteria)),
+                                verdict(scaled_precise),
                                 f"{'does not scale' if off else 'scales' if off is False else 'unknown'} with sqrt(g) "
-                                f"at {k:g} standard errors"))
+                                f"at {k:g} standard errors; {scaled_text}"))
     return rows

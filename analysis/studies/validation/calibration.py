@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 
 from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
-from analysis.studies.validation.rows import NO, Criteria, plus_minus, resolved, row, verdict
+from analysis.studies.validation.rows import NO, Criteria, plus_minus, precise, resolved, row, verdict
 
 __all__ = ["SECTIONS", "calibration_rows"]
 
@@ -138,18 +138,20 @@ def _paired_rows(figure: str, reference: dict, other: dict, cell_ok: bool, cell_
         difference = sum(d for d, _, _ in pairs) / len(pairs)
         error = combine_independent([e for _, e, _ in pairs]) / len(pairs)
         seen = resolved(difference, error, criteria.coverage_factor)
+        resolution = f"{_RESOLVED[seen]} at {criteria.coverage_factor:g} standard errors"
         if expect_difference:
             shows = verdict(cell_ok, seen)
         else:
             # "insensitive" is shown only by an error small enough to have seen a change
             level = sum(base[mu][0] for _, _, mu in pairs) / len(pairs)
-            precise = None if not math.isfinite(error) else error <= criteria.max_relative_error * abs(level)
-            shows = verdict(cell_ok, _not(seen), precise)
+            small, small_text = precise(level, error, criteria)
+            shows = verdict(cell_ok, _not(seen), small)
+            resolution += f"; its error against the bulk friction {level:.3g}: {small_text}"
         shape, test, rolling = key
         listing = "; ".join(f"{mu:g}: {plus_minus(d, e)}" for d, e, mu in pairs)
         rows.append(row(GROUP, figure, f"{shape}, {test}, rolling {rolling:g}", difference, error, "-", study, shows,
                         f"{cell_text}; differences at particle friction {listing}; mean {plus_minus(difference, error)}"
-                        f": {_RESOLVED[seen]} at {criteria.coverage_factor:g} standard errors"))
+                        f": {resolution}"))
     return rows
 
 

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
 
-__all__ = ["YES", "NO", "UNKNOWN", "COLUMNS", "Criteria", "row", "verdict", "ratio", "resolved", "plus_minus"]
+__all__ = ["YES", "NO", "UNKNOWN", "COLUMNS", "Criteria", "row", "verdict", "ratio", "resolved", "precise",
+           "plus_minus"]
 
 YES, NO, UNKNOWN = "yes", "no", "unknown"
 
@@ -86,6 +87,18 @@ def resolved(difference: float, error: float, k: float) -> bool | None:
     if not math.isfinite(error) or not math.isfinite(difference):
         return None
     return abs(difference) > k * error
+
+
+def precise(value: float, error: float, criteria: Criteria) -> tuple[bool | None, str]:
+    """Whether a figure resolves what it measures: its standard error at most ``criteria.max_relative_error`` of
+    its magnitude (None when the value or the error is not known), and the evidence clause that says so, e.g.
+    ``relative error 34 % (at most 25 %)``."""
+    limit = f"(at most {criteria.max_relative_error * 100:g} %)"
+    if not math.isfinite(error) or not math.isfinite(value):
+        return None, f"relative error not known {limit}"
+    relative = _relative(error, value)
+    shown = f"{relative * 100:.2g} %" if math.isfinite(relative) else "unbounded"
+    return error <= criteria.max_relative_error * abs(value), f"relative error {shown} {limit}"
 
 
 def ratio(a: float, ua: float, b: float, ub: float) -> tuple[float, float]:

@@ -15,7 +15,7 @@ from collections.abc import Mapping, Sequence
 
 from model.checks import number_or_nan
 from analysis.numerics.uncertainty import combine_independent
-from analysis.studies.validation.rows import Criteria, plus_minus, ratio, resolved, row, verdict
+from analysis.studies.validation.rows import Criteria, plus_minus, precise, ratio, resolved, row, verdict
 
 __all__ = ["SiloRun", "silo_rows", "front_wall_series_rows"]
 
@@ -54,12 +54,6 @@ class SiloRun:
             f"outlet {outlet * 1000:.0f} mm = {ratio_:.1f} particle diameters (>= {criteria.min_outlet_diameters:g})")
 
 
-def _precise(value: float, error: float, criteria: Criteria) -> bool | None:
-    if not math.isfinite(error):
-        return None
-    return error <= criteria.max_relative_error * abs(value)
-
-
 def silo_rows(run: SiloRun, criteria: Criteria) -> list[dict]:
     """The base run's rows: bulk density, flow rate, Beverloo's coefficient, Janssen, B(z) and the flow channel."""
     k = criteria.coverage_factor
@@ -73,10 +67,11 @@ def silo_rows(run: SiloRun, criteria: Criteria) -> list[dict]:
     rows.append(row(GROUP, "Filling bulk density", case_name, density, density_error, "kg/m3", "667 (40 mm deep)",
                     verdict(depth_ok, balance_ok), f"{depth_text}; {balance_text}"))
     rate, rate_error = flow["mass_flow_rate_kg_s"], number_or_nan(flow.get("mass_flow_rate_kg_s_error"))
-    steady = _precise(rate, rate_error, criteria)
+    steady, steady_text = precise(rate, rate_error, criteria)
     rows.append(row(GROUP, "Steady mass flow rate", case_name, rate, rate_error, "kg/s", "",
                     verdict(depth_ok, outlet_ok, steady),
-                    f"{depth_text}; {outlet_text}; Beverloo predicts {flow['beverloo_mass_flow_rate_kg_s']:.4g} kg/s"))
+                    f"{depth_text}; {outlet_text}; {steady_text}; Beverloo predicts "
+                    f"{flow['beverloo_mass_flow_rate_kg_s']:.4g} kg/s"))
     beverloo = flow["beverloo"]
     ratio_value, ratio_error = flow["beverloo_ratio"], number_or_nan(flow.get("beverloo_ratio_error"))
     coefficient = beverloo["discharge_coefficient"]
@@ -84,14 +79,15 @@ def silo_rows(run: SiloRun, criteria: Criteria) -> list[dict]:
                     coefficient * ratio_value, coefficient * ratio_error, "-", f"{coefficient:g}",
                     verdict(depth_ok, outlet_ok, steady),
                     f"C that makes Beverloo match the measured rate: flow / Beverloo {plus_minus(ratio_value, ratio_error)};"
-                    f" {outlet_text}"))
+                    f" {outlet_text}; flow rate's {steady_text}"))
     rows += _janssen_rows(run, case_name, depth_ok, depth_text, balance_ok, k)
     for entry in run.kinematic:
         b, error = number_or_nan(entry["B_m"]), number_or_nan(entry.get("B_m_error"))
+        b_precise, b_text = precise(b, error, criteria)
         rows.append(row(GROUP, f"Kinematic constant B at z = {float(entry['z_m']) * 1000:.0f} mm", case_name,
-                        b, error, "m", "", verdict(depth_ok, math.isfinite(b) and _precise(b, error, criteria)),
+                        b, error, "m", "", verdict(depth_ok, math.isfinite(b) and b_precise),
                         f"{depth_text}; B = {b / run.diameter:.2f} particle diameters, error from "
-                        f"{int(float(entry['batches']))} time batches"))
+                        f"{int(float(entry['batches']))} time batches; {b_text}"))
     rows += _channel_rows(run, case_name, depth_ok, depth_text, k)
     return rows
 
