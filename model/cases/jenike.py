@@ -334,9 +334,9 @@ def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, C
     rolling = {t: point["rolling_friction"] for t in types}
     restitution = {t: point["restitution"] for t in types}
     pour_friction = particle_particle if jenike["fill"]["sliding_friction"] is None else jenike["fill"]["sliding_friction"]
-    if point["rotation_blocked"] and jenike["fill"].get("rotation_blocked_sliding_friction") is not None:
+    if point["rotation_blocked"] and jenike["fill"]["rotation_blocked_sliding_friction"] is not None:
         pour_friction = jenike["fill"]["rotation_blocked_sliding_friction"]
-    pour_restitution = jenike["fill"].get("restitution")
+    pour_restitution = jenike["fill"]["restitution"]
     test = ContactSet(
         sliding_friction=_matrix(n_types, sliding, NEUTRAL_CONTACT["sliding_friction"]),
         rolling_friction=_matrix(n_types, rolling, NEUTRAL_CONTACT["rolling_friction"]),
