@@ -36,9 +36,9 @@ install-system:
 install-python:
 	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test,docs]"
 
-# Snakemake goes through engines.workflow_lock: after a killed run it removes the stale Snakemake lock first, and it
+# Snakemake goes through siloflow.engines.workflow_lock: after a killed run it removes the stale Snakemake lock first, and it
 # refuses to start (unlocking nothing) while another run is live in the same directory.
-RUN_SNAKEMAKE = $(PYTHON) -m engines.workflow_lock --snakefile $(CURDIR)/Snakefile
+RUN_SNAKEMAKE = $(PYTHON) -m siloflow.engines.workflow_lock --snakefile $(CURDIR)/Snakefile
 
 # The report collects every plot with its caption and the summary page (RUN_DIR/results/report.html).
 # Reruns follow changed inputs and parameters, not changed siloflow code: an upgrade must not repeat hours of
@@ -48,7 +48,7 @@ RUN_SNAKEMAKE = $(PYTHON) -m engines.workflow_lock --snakefile $(CURDIR)/Snakefi
 RUN_DIR ?= .
 
 run: install
-	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
+	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG))
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
 		--report $(abspath $(RUN_DIR))/results/report.html
@@ -58,7 +58,7 @@ run: install
 CHECKS_CONFIG := $(CURDIR)/config/checks.yaml
 
 verify: install
-	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG)) $(CHECKS_CONFIG)
+	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG)) $(CHECKS_CONFIG)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
 		--cores $(CORES)
 	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
@@ -68,7 +68,7 @@ verify: install
 # posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it;
 # its report is RUN_DIR/results/report-bayesian.html.
 bayesian: install
-	$(PYTHON) -m engines.config_yaml $(abspath $(CONFIG))
+	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG))
 	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
 		--cores $(CORES)
 	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
@@ -78,7 +78,7 @@ bayesian: install
 # (make estimate CONFIG=config/validation.yaml prints its cost, per group and part). It works in results/validation/
 # (its own results/ and reports there, so that it never overwrites the default run's), prints the estimate of every run
 # first and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group
-# (engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series, blending,
+# (siloflow.engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series, blending,
 # blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record is written
 # and copied into docs/validation/ once all its runs have finished, whichever part finished them. A group that compares
 # against another group's runs (calibration_checks, silo_series) starts from the products of those runs that the
@@ -97,7 +97,7 @@ GROUP             ?=
 validate: install
 	@mkdir -p $(VALIDATION_DIR)/results
 	$(if $(GROUP),$(VALIDATION_RECORD_CLI) restore '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD) $(VALIDATION_DIR))
-	$(PYTHON) -m engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
+	$(PYTHON) -m siloflow.engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
 	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) $(VALIDATION_OPTIONS) --cores $(CORES) \
 		--keep-going
 	@groups="$$($(VALIDATION_RECORD_CLI) finished $(VALIDATION_CONFIG) $(VALIDATION_DIR) $(if $(GROUP),'$(GROUP)'))" || exit 1; \
@@ -121,7 +121,7 @@ validate-status: install-python
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 test: install
-	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests siloflow analysis/numerics
+	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests siloflow/api siloflow/analysis/numerics
 
 test-physics: install
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m physics tests
@@ -134,7 +134,7 @@ test-integration: install
 
 # Particle counts, steps, wall time and disk of every run of a config, before running it: make estimate CONFIG=config/thesis.yaml
 estimate: install-python
-	$(PYTHON) -m engines.planning $(CONFIG) --cores $(CORES)
+	$(PYTHON) -m siloflow.engines.planning $(CONFIG) --cores $(CORES)
 
 dry-run: install
 	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)

@@ -1,44 +1,33 @@
-"""siloflow from a notebook: open a finished run and turn its frames into the study's numbers.
+"""siloflow: DEM calibration, validation and blending of pellets in silos, from config files to plots.
 
-The calls in order (every quantity in SI units; see docs/notebooks.md):
+The package holds the neutral model (:mod:`siloflow.model`), the engines and the workflow's planning
+(:mod:`siloflow.engines`), the analysis (:mod:`siloflow.analysis`), the calibration (:mod:`siloflow.calibration`),
+the Snakemake workflow with its schemas (``siloflow/workflow/``), the engines' templates (``siloflow/templates/``),
+the command line (:mod:`siloflow.cli`) and the notebook API (:mod:`siloflow.api`).
 
-1. :func:`open_run` opens a run folder of either engine and any case kind: ``run.record``, ``run.case``,
-   ``run.frames()``, ``run.clumps()``, ``run.wall_forces()``, ``run.contacts()``.
-2. A flat-bottom silo: :func:`silo_dimensions`, :func:`discharge` (bulk density, steady flow rate, Beverloo),
-   :func:`fill_surface`, :func:`silo_grid`, :func:`coarse_grain` with a kernel of :func:`default_width`,
-   :func:`time_average`, :func:`velocity_profiles` and :func:`janssen_comparison`.
-3. A recirculating silo: :func:`exit_times` (outlet crossings, re-entries and passes of every clump),
-   :func:`residence_time_distribution` and :func:`vrr`.
-4. A Jenike shear test: :func:`bulk_friction`.
-
-Nothing here draws: the notebooks in ``examples/`` plot with matplotlib, and importing siloflow leaves matplotlib's
-backend alone.
+The notebook API's names are reachable from the package itself (``from siloflow import open_run``). They are loaded
+on first use, so that the command line and the workflow's steps, which import the subpackages, do not load the
+analysis stack (numba, pyvista) the notebook API pulls in.
 """
 
-from analysis.numerics.coarse_graining import default_width
-from analysis.numerics.exit_times import ExitTimes, exit_times
-from siloflow.fields import coarse_grain, silo_grid, time_average, velocity_profiles
-from siloflow.janssen import janssen_comparison
-from siloflow.jenike import bulk_friction
-from siloflow.residence import residence_time_distribution, vrr
-from siloflow.runs import Run, open_run
-from siloflow.silo import discharge, fill_surface, silo_dimensions
+import importlib
 
-__all__ = [
-    "ExitTimes",
-    "Run",
-    "bulk_friction",
-    "coarse_grain",
-    "default_width",
-    "discharge",
-    "exit_times",
-    "fill_surface",
-    "janssen_comparison",
-    "open_run",
-    "residence_time_distribution",
-    "silo_dimensions",
-    "silo_grid",
-    "time_average",
-    "velocity_profiles",
-    "vrr",
-]
+#: The notebook API's public names (:mod:`siloflow.api`), resolved on first access.
+_API_NAMES = frozenset({
+    "ExitTimes", "Run", "bulk_friction", "coarse_grain", "default_width", "discharge", "exit_times", "fill_surface",
+    "janssen_comparison", "open_run", "residence_time_distribution", "silo_dimensions", "silo_grid", "time_average",
+    "velocity_profiles", "vrr",
+})
+
+__all__ = sorted(_API_NAMES)
+
+
+def __getattr__(name: str):
+    # PEP 562: `from siloflow import open_run` finds the name here the first time it is asked for.
+    if name in _API_NAMES:
+        return getattr(importlib.import_module("siloflow.api"), name)
+    raise AttributeError(f"module 'siloflow' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | _API_NAMES)

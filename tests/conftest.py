@@ -17,9 +17,10 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 import pytest
 
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from model.cases import cases_of
-from engines.interface import EngineOptions, engine_for, engine_named
+from siloflow.engines.config import load_config_file, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.model.cases import cases_of
+from siloflow.engines.interface import EngineOptions, engine_for, engine_named
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
@@ -201,10 +202,10 @@ def run_snakemake(workdir, *arguments: str, targets=()) -> subprocess.CompletedP
 
 
 def validation_record_cli():
-    """The validation record's command line (workflow/scripts/validation_record_cli.py, a script of the workflow
+    """The validation record's command line (siloflow/workflow/scripts/validation_record_cli.py, a script of the workflow
     layer, not a package module), loaded as a module."""
     spec = importlib.util.spec_from_file_location("validation_record_cli",
-                                                  REPO_ROOT / "workflow" / "scripts" / "validation_record_cli.py")
+                                                  REPO_ROOT / "siloflow" / "workflow" / "scripts" / "validation_record_cli.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module

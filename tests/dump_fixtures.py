@@ -1,6 +1,6 @@
 """Synthetic LIGGGHTS particle dumps for the unit tests and the bench, written with pyvista.
 
-pyvista (VTK's own legacy writer) writes the layout LIGGGHTS writes (see :mod:`engines.liggghts.dumps`)
+pyvista (VTK's own legacy writer) writes the layout LIGGGHTS writes (see :mod:`siloflow.engines.liggghts.dumps`)
 when the arrays are added as plain point data with no active scalars: same header, float32 POINTS, one
 vertex per point, a ``FIELD FieldData`` block with ``int`` and ``double`` arrays in insertion order, big-endian
 and each array followed by a newline. Two differences remain, both accepted by the reader for a reason:

@@ -11,7 +11,7 @@ import nbformat
 from jupyter_client.manager import KernelManager
 from nbclient import NotebookClient
 
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 
 EXAMPLES = REPO_ROOT / "examples"
 #: Longest a cell may take (s): reading the frames and coarse-graining them, numba's compilation included.

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 import pyvista
 
-from analysis.io.paraview_state import StateLines, write_paraview_state
-from analysis.io.particle_series import write_particle_series
-from analysis.io.vtk_lines import write_force_chains_vtp
-from analysis.io.vtk_walls import write_walls_vtp
-from analysis.numerics.force_chains import all_force_chains
-from model.cases.kinds import case_kind
+from siloflow.analysis.io.paraview_state import StateLines, write_paraview_state
+from siloflow.analysis.io.particle_series import write_particle_series
+from siloflow.analysis.io.vtk_lines import write_force_chains_vtp
+from siloflow.analysis.io.vtk_walls import write_walls_vtp
+from siloflow.analysis.numerics.force_chains import all_force_chains
+from siloflow.model.cases.kinds import case_kind
 
 #: Run inside pvpython: the state, then what ParaView made of it as JSON. Without a display ParaView cannot render,
 #: and setting the animation's time renders; that one call is stubbed then (the GUI makes it for real).

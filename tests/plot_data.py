@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from analysis.io.plots import save_figure
+from siloflow.analysis.io.plots import save_figure
 
 
 def saved_figures(monkeypatch, *modules) -> list:

@@ -34,8 +34,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from analysis.numerics.coarse_graining import HAVE_NUMBA, coarse_grain
-from analysis.numerics.grid import Grid
+from siloflow.analysis.numerics.coarse_graining import HAVE_NUMBA, coarse_grain
+from siloflow.analysis.numerics.grid import Grid
 
 N_PARTICLES = 100_000
 N_LARGE = 500_000

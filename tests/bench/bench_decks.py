@@ -5,7 +5,7 @@ with all its outputs: wall force histories, settle checks, settled-fill snapshot
 and once from a minimal deck written by hand (``tests/bench/hand_<case>.liggghts``) with the same clumps,
 materials, walls, time step, fill, particle dumps and stage lengths: each of its stages runs exactly as many steps
 as the generated run's took (read from the generated log's ``SILOFLOW <event> step=...`` markers). Both logs are
-split into stages at their ``SILOFLOW`` markers (:func:`engines.liggghts.cost.stage_costs`) and each stage's
+split into stages at their ``SILOFLOW`` markers (:func:`siloflow.engines.liggghts.cost.stage_costs`) and each stage's
 throughput is compared.
 
 Cases
@@ -56,13 +56,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from model.cases.blender import BlenderCase, build_blender_case
-from model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
-from model.cases.jenike_sweep import sweep_points
-from model.cases.silo_flat import SiloCase
-from engines.interface import Engine, EngineOptions, engine_for
-from engines.liggghts.cost import StageCost, stage_costs
-from engines.markers import parse_markers
+from siloflow.model.cases.blender import BlenderCase, build_blender_case
+from siloflow.model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike_sweep import sweep_points
+from siloflow.model.cases.silo_flat import SiloCase
+from siloflow.engines.interface import Engine, EngineOptions, engine_for
+from siloflow.engines.liggghts.cost import StageCost, stage_costs
+from siloflow.engines.markers import parse_markers
 from tests.bench.small_silo import default_config_with, small_silo
 from tests.conftest import FAST_POUR
 

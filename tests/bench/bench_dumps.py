@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 import pyvista
 
-from model.frames import OPTIONAL_VECTORS, ParticleFrame
-from engines.liggghts.dumps import DumpFormatError, dump_step, frame_from_arrays, parse_legacy_vtk_polydata, read_frame
+from siloflow.model.frames import OPTIONAL_VECTORS, ParticleFrame
+from siloflow.engines.liggghts.dumps import DumpFormatError, dump_step, frame_from_arrays, parse_legacy_vtk_polydata, read_frame
 from tests.dump_fixtures import write_liggghts_dump
 
 N_SPHERES = 500_000

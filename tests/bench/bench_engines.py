@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from engines.interface import EngineOptions, engine_named
+from siloflow.engines.interface import EngineOptions, engine_named
 from tests.bench.bench_mpi import flow_rate
 from tests.bench.small_silo import small_silo
 from tests.conftest import MICRO_SILO

@@ -4,7 +4,7 @@ grid the deck generator chooses against LIGGGHTS' own.
 The same silo (the tiny test silo made deeper and wider, about 4,000 two-sphere clumps) runs serially, with
 ``mpirun -np 2`` on LIGGGHTS' own grid (``processors * * *``: it splits the longest axis, here the height, so the
 upper rank idles as the silo fills and again as it empties) and with ``mpirun -np 2`` on the grid the deck names
-(:func:`engines.liggghts.inputs.processor_grid`: ranks side by side across the width). Reports the wall time of
+(:func:`siloflow.engines.liggghts.inputs.processor_grid`: ranks side by side across the width). Reports the wall time of
 each, the speed-up (baseline: the serial run, measured in the same benchmark) and, to show the physics does not
 change with the rank count, the steady mass flow rate of each with its counting noise (3 sigma of the clumps
 discharged in the steady window). Prints a table and writes it as CSV (``argv[1]``, default
@@ -23,10 +23,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from model.frames import clumps_from_frame
-from analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
-from engines.interface import EngineOptions
-from engines.liggghts.inputs import DECK_NAME
+from siloflow.model.frames import clumps_from_frame
+from siloflow.analysis.numerics.flow import discharged_mass_history, mass_in_silo, steady_flow_rate
+from siloflow.engines.interface import EngineOptions
+from siloflow.engines.liggghts.inputs import DECK_NAME
 from tests.bench.small_silo import small_silo
 from tests.conftest import TINY_SILO
 

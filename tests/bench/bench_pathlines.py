@@ -8,7 +8,7 @@ cross the outlet plane z = 0 or max_time = 3 s (the slow tracers near the walls 
 
 On the same seeds and fields, in the same run, it times
 
-- siloflow's compiled integrator :func:`analysis.numerics.pathlines.integrate_pathlines` (numba; warmed up
+- siloflow's compiled integrator :func:`siloflow.analysis.numerics.pathlines.integrate_pathlines` (numba; warmed up
   first, so compilation is excluded and reported separately) on all 50,000 tracers and on the
   peer's subset,
 - the straightforward peer :func:`integrate_with_scipy`: the same scheme, stage times, clamping
@@ -40,8 +40,8 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
-from analysis.numerics.pathlines import HAVE_NUMBA, EXITED, NOT_EXITED, OUTSIDE, integrate_pathlines, time_levels
-from analysis.numerics.tracer_seeds import lattice_seeds
+from siloflow.analysis.numerics.pathlines import HAVE_NUMBA, EXITED, NOT_EXITED, OUTSIDE, integrate_pathlines, time_levels
+from siloflow.analysis.numerics.tracer_seeds import lattice_seeds
 
 SHAPE = (127, 107, 31)
 SPACING = (0.006, 0.004, 0.006)
@@ -74,7 +74,7 @@ def synthetic_fields(shape=SHAPE, spacing=SPACING, origin=ORIGIN, times=TIMES) -
 def integrate_with_scipy(seeds, t0, velocities, times, origin, spacing, dt, outlet_z, max_time, method="rk2"):
     """Reference integrator: siloflow's scheme with scipy's RegularGridInterpolator in space.
 
-    Same stage times ``t0 + n dt``, same time levels and weights (:func:`analysis.numerics.pathlines.time_levels`),
+    Same stage times ``t0 + n dt``, same time levels and weights (:func:`siloflow.analysis.numerics.pathlines.time_levels`),
     positions clamped to the hull of the cell-centre nodes before the (linear) interpolation,
     Heun or Euler, crossing time interpolated linearly within the step, NaN for seeds outside the
     box or at/below the outlet and for tracers not out within ``max_time``.

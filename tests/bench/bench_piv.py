@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.io.tables import write_flow_table
-from analysis.piv.synthetic import piv_displacements, render_particle_image
+from siloflow.analysis.io.tables import write_flow_table
+from siloflow.analysis.piv.synthetic import piv_displacements, render_particle_image
 
 WIDTH, HEIGHT = 1000, 1400
 SHIFT = np.array([3.3, -1.7])

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import copy
 
-from model.cases.silo_flat import SiloCase, build_silo_case
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.interface import Engine, engine_for
+from siloflow.model.cases.silo_flat import SiloCase, build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.engines.interface import Engine, engine_for
 
 
 def default_config_with(section: str, overrides: dict) -> dict:

@@ -33,7 +33,7 @@ EXPLODED_SPEED = 16.14847699954193
 
 # ------------------------------------------------------------------------------------------------ runtime
 def say(event, **values):
-    """A stage marker the orchestrator reads (engines.markers): SILOFLOW <event> key=value ..."""
+    """A stage marker the orchestrator reads (siloflow.engines.markers): SILOFLOW <event> key=value ..."""
     print("SILOFLOW " + event + "".join(f" {key}={value}" for key, value in values.items()), flush=True)
 
 
@@ -68,7 +68,7 @@ def set_engines(material_ids, pairs=None, rolling_friction=None, rolling_stiffne
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb(), Bo1_Wall_Aabb()]),
         InteractionLoop(
             [Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
-            # es = 1: no tangential dashpot (engines.yade.inputs: with clumps it went unstable at e = 0.1)
+            # es = 1: no tangential dashpot (siloflow.engines.yade.inputs: with clumps it went unstable at e = 0.1)
             [Ip2_FrictMat_FrictMat_MindlinPhys(frictAngle=MatchMaker(matches=friction),
                                                en=MatchMaker(matches=restitution),
                                                es=MatchMaker(matches=[(a, b, 1.0) for a, b, _ in restitution]),
@@ -428,7 +428,7 @@ def place_lid(height):
 
 
 class ForceHistory:
-    """The force history (engines.jenike_checks): every FORCE_SAMPLE_EVERY steps a sample, every OUTPUT_EVERY steps a
+    """The force history (siloflow.engines.jenike_checks): every FORCE_SAMPLE_EVERY steps a sample, every OUTPUT_EVERY steps a
     row that averages the samples since the last row (LIGGGHTS' fix ave/time averages every step)."""
 
     def __init__(self, path, lid_members, lid_body):

@@ -18,14 +18,14 @@ import numpy as np
 import pytest
 import yaml
 
-from model.record import read_run_record
-from analysis.numerics.clump_tracks import tracks_from_frames
-from analysis.studies.silo_recirculation.tracks import recirculation_events
-from analysis.studies.validation.blending import blender_rows, gravity_rows
-from analysis.studies.validation.rows import Criteria
-from model.cases.blender import blender_cases
-from engines.config import validate_config
-from engines.layout import case_root, run_dir
+from siloflow.model.record import read_run_record
+from siloflow.analysis.numerics.clump_tracks import tracks_from_frames
+from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
+from siloflow.analysis.studies.validation.blending import blender_rows, gravity_rows
+from siloflow.analysis.studies.validation.rows import Criteria
+from siloflow.model.cases.blender import blender_cases
+from siloflow.engines.config import validate_config
+from siloflow.engines.layout import case_root, run_dir
 from tests.paraview_checks import check_paraview_folder
 from tests.conftest import (FAST_POUR, NO_BLENDING, STAGE_TIMESTEP_FRACTION, TINY_BLENDER, TINY_SILO, liggghts,
                             require_liggghts, run_snakemake)

@@ -19,12 +19,12 @@ import math
 import pytest
 import yaml
 
-from calibration.friction import bulk_friction_of_shear
-from calibration.shear import shear_signals
-from model.cases import cases_of
-from model.cases.jenike import build_jenike_case
-from engines.config import validate_config
-from engines.interface import EngineOptions, engine_for
+from siloflow.calibration.friction import bulk_friction_of_shear
+from siloflow.calibration.shear import shear_signals
+from siloflow.model.cases import cases_of
+from siloflow.model.cases.jenike import build_jenike_case
+from siloflow.engines.config import validate_config
+from siloflow.engines.interface import EngineOptions, engine_for
 from tests.conftest import (NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts,
                             run_snakemake)
 

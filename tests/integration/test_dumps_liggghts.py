@@ -25,20 +25,20 @@ import numpy as np
 import pytest
 import pyvista
 
-from model.frames import ParticleFrame, clumps_from_frame
-from model.record import RunRecord
-from model.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
-from model.cases.silo_flat import SiloCase, build_silo_case
-from engines.config import load_config_file, validate_config
-from engines.interface import EngineOptions
-from engines.liggghts.dumps import (
+from siloflow.model.frames import ParticleFrame, clumps_from_frame
+from siloflow.model.record import RunRecord
+from siloflow.model.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
+from siloflow.model.cases.silo_flat import SiloCase, build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from siloflow.engines.interface import EngineOptions
+from siloflow.engines.liggghts.dumps import (
     DumpFormatError,
     dump_step,
     list_dumps,
     parse_legacy_vtk_polydata,
     read_frame,
 )
-from engines.liggghts.run import DUMP_PREFIX
+from siloflow.engines.liggghts.run import DUMP_PREFIX
 from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, liggghts
 from tests.dump_fixtures import write_liggghts_dump
 

@@ -28,13 +28,13 @@ import numpy as np
 import pytest
 import yaml
 
-from model.existing_run import ExistingSiloRun
-from analysis.io.tables import read_table
-from analysis.studies.silo_flat.existing_run import analyse_existing_run
-from analysis.studies.silo_flat.field_study import SiloFieldOptions
-from engines.config import validate_config
-from engines.existing_runs import check_existing_run, read_existing_frames
-from engines.layout import existing_run_dir
+from siloflow.model.existing_run import ExistingSiloRun
+from siloflow.analysis.io.tables import read_table
+from siloflow.analysis.studies.silo_flat.existing_run import analyse_existing_run
+from siloflow.analysis.studies.silo_flat.field_study import SiloFieldOptions
+from siloflow.engines.config import validate_config
+from siloflow.engines.existing_runs import check_existing_run, read_existing_frames
+from siloflow.engines.layout import existing_run_dir
 from tests.conftest import require_liggghts, run_snakemake
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(15)]
@@ -113,7 +113,7 @@ def user_run(tmp_path_factory) -> Path:
     (folder / "right.stl").write_text(_plate((WIDTH + OUTLET) / 2, WIDTH + 0.001))
     (folder / "post").mkdir()
     environment = dict(os.environ)
-    if os.geteuid() == 0:  # as engines/liggghts/run.py: Open MPI refuses root unless told
+    if os.geteuid() == 0:  # as siloflow/engines/liggghts/run.py: Open MPI refuses root unless told
         environment.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     result = subprocess.run(["liggghts", "-in", "in.silo", "-log", "log.liggghts"], cwd=folder, env=environment,
                             capture_output=True, text=True, check=False, timeout=300)

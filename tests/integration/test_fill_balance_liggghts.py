@@ -1,5 +1,5 @@
 """Real LIGGGHTS fills of a narrow silo, poured the old way (fast) and the new way (gentle): their settled fills are
-read back through the engine interface and their force balance (analysis.numerics.force_balance) computed from the
+read back through the engine interface and their force balance (siloflow.analysis.numerics.force_balance) computed from the
 engine's own forces.
 
 The silo is 20 mm wide, 12 mm deep and 40 mm high (about 350 two-sphere clumps): narrow, so that its walls carry a
@@ -24,11 +24,11 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
-from analysis.numerics.janssen import janssen_vertical_stress
-from model.cases.silo_flat import build_silo_case
-from engines.config import load_config_file, validate_config
-from engines.interface import EngineOptions, engine_for
+from siloflow.analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
+from siloflow.analysis.numerics.janssen import janssen_vertical_stress
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from siloflow.engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, require_liggghts
 
 # physics: two extra fills of a narrow silo (the gentle one settles for a minute) check the pours' force balance;

@@ -24,11 +24,11 @@ from concurrent.futures import ThreadPoolExecutor
 import pytest
 import scipy.stats
 
-from analysis.numerics.force_balance import settled_fill_balance
-from analysis.numerics.janssen import janssen_vertical_stress
-from model.cases.silo_flat import build_silo_case
-from engines.config import load_config_file, validate_config
-from engines.interface import EngineOptions, engine_named
+from siloflow.analysis.numerics.force_balance import settled_fill_balance
+from siloflow.analysis.numerics.janssen import janssen_vertical_stress
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from siloflow.engines.interface import EngineOptions, engine_named
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_liggghts, require_yade
 
 # physics: eight settled columns on two engines (three seeds each of the frictional one) check the walls' share of

@@ -17,22 +17,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
-from model.record import RunRecord
-from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
-from calibration.friction import BulkFriction, bulk_friction
-from calibration.shear import ShearSignals, shear_signals
-from engines.config import validate_config
-from model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
-from engines.liggghts.run import DUMP_PREFIX
-from engines.liggghts.jenike import (
+from siloflow.engines.liggghts.dumps import list_dumps, parse_legacy_vtk_polydata
+from siloflow.model.record import RunRecord
+from siloflow.analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
+from siloflow.calibration.friction import BulkFriction, bulk_friction
+from siloflow.calibration.shear import ShearSignals, shear_signals
+from siloflow.engines.config import validate_config
+from siloflow.model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from siloflow.engines.liggghts.run import DUMP_PREFIX
+from siloflow.engines.liggghts.jenike import (
     FORCES_NAME,
     PAIR_CONTACT_PREFIX,
     WALL_CONTACT_PREFIX,
     read_contact_dump,
 )
-from engines.jenike_checks import read_jenike_force_history
-from engines.interface import EngineOptions
+from siloflow.engines.jenike_checks import read_jenike_force_history
+from siloflow.engines.interface import EngineOptions
 from tests.conftest import RunsOnDemand, liggghts, require_liggghts
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(100)]

@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.record import RunRecord
-from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
-from calibration.friction import BulkFriction, bulk_friction
-from calibration.shear import ShearSignals, shear_signals
-from model.cases.jenike import JenikeCase, build_jenike_case
-from engines.config import validate_config
-from engines.interface import EngineOptions, engine_named
+from siloflow.model.record import RunRecord
+from siloflow.analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
+from siloflow.calibration.friction import BulkFriction, bulk_friction
+from siloflow.calibration.shear import ShearSignals, shear_signals
+from siloflow.model.cases.jenike import JenikeCase, build_jenike_case
+from siloflow.engines.config import validate_config
+from siloflow.engines.interface import EngineOptions, engine_named
 from tests.conftest import RunsOnDemand, require_yade
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(170)]

@@ -9,13 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
-from engines.config import validate_config
-from engines.interface import EngineOptions
-from engines.liggghts.inputs import INNER_SPHERE_FRACTION
-from engines.liggghts.jenike import PAIR_CONTACT_PREFIX, read_jenike_pair_contacts
-from engines.liggghts.dumps import list_dumps
-from model.cases.jenike import build_jenike_case
+from siloflow.analysis.numerics.force_balance import BalanceTolerances, balance_problems, settled_fill_balance
+from siloflow.engines.config import validate_config
+from siloflow.engines.interface import EngineOptions
+from siloflow.engines.liggghts.inputs import INNER_SPHERE_FRACTION
+from siloflow.engines.liggghts.jenike import PAIR_CONTACT_PREFIX, read_jenike_pair_contacts
+from siloflow.engines.liggghts.dumps import list_dumps
+from siloflow.model.cases.jenike import build_jenike_case
 from tests.conftest import liggghts, require_liggghts
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(40)]

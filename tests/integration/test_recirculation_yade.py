@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.frames import clumps_from_frame
-from engines.config import validate_config
+from siloflow.model.frames import clumps_from_frame
+from siloflow.engines.config import validate_config
 from tests.conftest import FAST_POUR, TINY_SETTLE, require_yade, run_first_case
 from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 

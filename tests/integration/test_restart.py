@@ -19,11 +19,12 @@ import time
 import pytest
 import yaml
 
-from model.record import read_run_record
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.layout import run_dir as layout_run_dir, run_path
-from engines.liggghts.run import restart_files
-from model.cases.silo_flat import build_silo_case
+from siloflow.model.record import read_run_record
+from siloflow.engines.config import load_config_file, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.engines.layout import run_dir as layout_run_dir, run_path
+from siloflow.engines.liggghts.run import restart_files
+from siloflow.model.cases.silo_flat import build_silo_case
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(100)]

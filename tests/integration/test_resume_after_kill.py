@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(90)]

@@ -16,22 +16,23 @@ import yaml
 
 import pyvista
 
-from model.frames import clumps_from_frame
-from model.record import read_run_record
-from analysis.io.tables import read_table
-from analysis.io.validation_record import read_group_record
-from analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
-from analysis.piv.front_wall import front_wall_image, front_wall_spheres
-from analysis.piv.synthetic import piv_displacements
-from analysis.studies.silo_flat.metrics import silo_flow_metrics
-from model.cases import cases_of
-from model.cases.silo_flat import build_silo_case
-from engines.config import REPO_ROOT, load_config_file, validate_config
-from engines.interface import EngineOptions, EngineRunError, engine_named
-from engines.layout import READ_PRODUCTS
-from engines.layout import run_dir as layout_run_dir
-from engines.liggghts.cost import calibrate_cost_model
-from engines.planning import config_estimates, measured_cost_model, run_directory
+from siloflow.model.frames import clumps_from_frame
+from siloflow.model.record import read_run_record
+from siloflow.analysis.io.tables import read_table
+from siloflow.analysis.io.validation_record import read_group_record
+from siloflow.analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
+from siloflow.analysis.piv.front_wall import front_wall_image, front_wall_spheres
+from siloflow.analysis.piv.synthetic import piv_displacements
+from siloflow.analysis.studies.silo_flat.metrics import silo_flow_metrics
+from siloflow.model.cases import cases_of
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.engines.interface import EngineOptions, EngineRunError, engine_named
+from siloflow.engines.layout import READ_PRODUCTS
+from siloflow.engines.layout import run_dir as layout_run_dir
+from siloflow.engines.liggghts.cost import calibrate_cost_model
+from siloflow.engines.planning import config_estimates, measured_cost_model, run_directory
 from tests.paraview_checks import check_paraview_folder
 from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
                             liggghts, require_liggghts, run_snakemake, validation_record_cli)

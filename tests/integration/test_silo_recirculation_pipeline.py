@@ -17,16 +17,16 @@ import numpy as np
 import pytest
 import yaml
 
-from analysis.io.tables import read_table
-from analysis.numerics.uncertainty import Significance, difference_significant
-from analysis.studies.validation.blending import recirculation_rows
-from analysis.studies.validation.rows import Criteria
-from analysis.studies.silo_recirculation.tracks import recirculation_events
-from analysis.studies.silo_recirculation.tracks_io import load_tracks
-from model.cases.silo_recirculation import recirculation_cases
-from model.record import read_run_record
-from engines.config import validate_config
-from engines.layout import case_root, run_dir, run_path
+from siloflow.analysis.io.tables import read_table
+from siloflow.analysis.numerics.uncertainty import Significance, difference_significant
+from siloflow.analysis.studies.validation.blending import recirculation_rows
+from siloflow.analysis.studies.validation.rows import Criteria
+from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
+from siloflow.analysis.studies.silo_recirculation.tracks_io import load_tracks
+from siloflow.model.cases.silo_recirculation import recirculation_cases
+from siloflow.model.record import read_run_record
+from siloflow.engines.config import validate_config
+from siloflow.engines.layout import case_root, run_dir, run_path
 from tests.conftest import NO_BLENDER, TINY_BLENDING, TINY_SILO, liggghts, require_liggghts, run_snakemake
 from tests.paraview_checks import check_paraview_folder
 from tests.notebooks import execute_notebook, figures

@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.frames import clumps_from_frame
-from analysis.numerics.force_balance import settled_fill_balance
-from model.cases.silo_flat import build_silo_case
-from engines.config import load_config_file, validate_config
-from engines.interface import EngineOptions, EngineRunError, engine_for
-from engines.yade.run import restart_files
+from siloflow.model.frames import clumps_from_frame
+from siloflow.analysis.numerics.force_balance import settled_fill_balance
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from siloflow.engines.interface import EngineOptions, EngineRunError, engine_for
+from siloflow.engines.yade.run import restart_files
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
 from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 from tests.conftest import run_snakemake
 
 pytestmark = pytest.mark.core_seconds(20)

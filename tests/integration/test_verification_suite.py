@@ -7,10 +7,10 @@ from __future__ import annotations
 import pytest
 import yaml
 
-from analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table
-from model.cases.verification import verification_cases
-from engines.interface import EngineOptions, engine_named
-from engines.config import REPO_ROOT
+from siloflow.analysis.studies.verification import measure_problem, trajectories_from_frames, verification_table
+from siloflow.model.cases.verification import verification_cases
+from siloflow.engines.interface import EngineOptions, engine_named
+from tests.repo import REPO_ROOT
 from tests.conftest import DEFAULT_CONFIG, NO_BLENDER, NO_BLENDING, require_liggghts, require_yade, run_snakemake
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(40)]

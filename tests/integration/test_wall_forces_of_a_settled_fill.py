@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.frames import clumps_from_frame
-from model.constants import GRAVITY
-from model.cases.silo_flat import build_silo_case
-from engines.config import load_config_file, validate_config
-from engines.interface import EngineOptions, engine_for
+from siloflow.model.frames import clumps_from_frame
+from siloflow.model.constants import GRAVITY
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import load_config_file, validate_config
+from siloflow.engines.interface import EngineOptions, engine_for
 from tests.conftest import DEFAULT_CONFIG, FAST_POUR, TINY_SETTLE, require_liggghts
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(10)]

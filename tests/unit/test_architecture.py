@@ -1,10 +1,10 @@
 """The layout holds: layers point one way, no import circles, no function-local imports, and only the LIGGGHTS
 package and templates know LIGGGHTS (its code, file names and formats).
 
-Layers (../shared/design/ARCHITECTURE.md): workflow -> engines, analysis, calibration; calibration -> analysis;
+Layers, as subpackages of ``siloflow``: workflow -> engines, analysis, calibration; calibration -> analysis;
 engines and analysis -> the neutral model (``model``), which imports nothing else of siloflow; engines import nothing
-of analysis, analysis nothing of engines. The notebook API (the package ``siloflow``) is the top layer: it may import
-every other package, and none imports it.
+of analysis, analysis nothing of engines. The notebook API (``siloflow.api``) and the command line
+(``siloflow.cli``) are the top layer: nothing imports them, and neither imports the other.
 """
 
 from __future__ import annotations
@@ -15,10 +15,14 @@ from pathlib import Path
 
 import pytest
 
-from engines.config import REPO_ROOT
-from engines.interface import ENGINE_KINDS, engine_named
+from tests.repo import REPO_ROOT
+from siloflow.engines.interface import ENGINE_KINDS, engine_named
 
-PACKAGES = ("model", "engines", "analysis", "calibration", "siloflow")
+#: The package's Python modules, the workflow's scripts apart (they run inside Snakemake).
+PACKAGES = ("siloflow/model", "siloflow/engines", "siloflow/analysis", "siloflow/calibration", "siloflow/api",
+            "siloflow/cli", "siloflow/__init__.py")
+#: The top layer: user-facing entry points that nothing else of siloflow imports.
+TOP_LAYERS = ("api", "cli")
 
 
 def _module_name(path: Path) -> str:
@@ -29,7 +33,19 @@ def _module_name(path: Path) -> str:
 
 
 def _python_files(*folders: str) -> list[Path]:
-    return sorted(p for folder in folders for p in (REPO_ROOT / folder).rglob("*.py") if "__pycache__" not in p.parts)
+    found = []
+    for folder in folders:
+        root = REPO_ROOT / folder
+        found += [root] if root.is_file() else [p for p in root.rglob("*.py") if "__pycache__" not in p.parts]
+        if not root.exists() and (single := root.with_suffix(".py")).is_file():
+            found.append(single)
+    return sorted(found)
+
+
+def _layer(module: str) -> str:
+    """The subpackage of ``siloflow`` a module belongs to (``siloflow.engines.config`` -> ``engines``)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
 
 
 def _is_type_checking(node: ast.If) -> bool:
@@ -93,7 +109,7 @@ def _graph() -> dict[str, set[str]]:
 
 def test_no_function_local_imports():
     found = [f"{path.relative_to(REPO_ROOT)}:{line} imports {module}"
-             for path in _python_files(*PACKAGES, "workflow/scripts", "tests")
+             for path in _python_files(*PACKAGES, "siloflow/workflow/scripts", "tests")
              for line, module in _imports(path)[1]]
     assert not found, "imports belong at the top of a module:\n" + "\n".join(found)
 
@@ -101,9 +117,9 @@ def test_no_function_local_imports():
 def test_layers_point_one_way():
     wrong = []
     for module, targets in _graph().items():
-        top = module.split(".")[0]
+        top = _layer(module)
         for target in targets:
-            other = target.split(".")[0]
+            other = _layer(target)
             if top == "model" and other != "model":
                 wrong.append(f"{module} -> {target} (the neutral model depends on nothing above it)")
             if top == "analysis" and other not in ("analysis", "model"):
@@ -112,14 +128,15 @@ def test_layers_point_one_way():
                 wrong.append(f"{module} -> {target} (calibration may use analysis and the model only)")
             if top == "engines" and other not in ("engines", "model"):
                 wrong.append(f"{module} -> {target} (engines take only the neutral model)")
-            if other == "siloflow" and top != "siloflow":
-                wrong.append(f"{module} -> {target} (the notebook API is the top layer: nothing imports it)")
+            if other in TOP_LAYERS and top != other:
+                wrong.append(f"{module} -> {target} (the notebook API and the command line are the top layer: "
+                             "nothing imports them)")
     assert not wrong, "\n".join(sorted(wrong))
 
 
 def test_the_workflow_does_not_go_through_the_notebook_api():
-    found = [f"{path.relative_to(REPO_ROOT)}:{line} imports {module}" for path in _python_files("workflow/scripts")
-             for line, module in _imports(path)[0] if module.split(".")[0] == "siloflow"]
+    found = [f"{path.relative_to(REPO_ROOT)}:{line} imports {module}" for path in _python_files("siloflow/workflow/scripts")
+             for line, module in _imports(path)[0] if module.split(".")[:2] in (["siloflow", "api"], ["siloflow"])]
     assert not found, "the workflow calls the library, not the notebook API built on it:\n" + "\n".join(found)
 
 
@@ -156,25 +173,27 @@ def test_no_import_circles():
     assert not cycles, f"import circles: {cycles}"
 
 
-#: What names LIGGGHTS' code, file names or formats; only engines/liggghts/ and templates/liggghts/ may say these.
+#: What names LIGGGHTS' code, file names or formats; only siloflow/engines/liggghts/ and siloflow/templates/liggghts/ may say these.
 LIGGGHTS_NAMES = re.compile(
-    r"engines\.liggghts|engines/liggghts|liggghts/\w+\.(?:lmp\.)?j2|in\.liggghts|log\.liggghts|\.lmp\b|custom/vtk|"
+    r"engines\.liggghts|siloflow/engines/liggghts|liggghts/\w+\.(?:lmp\.)?j2|in\.liggghts|log\.liggghts|\.lmp\b|custom/vtk|"
     r"wall/gran|pair/gran|mesh/surface|dump_prefix|CONTACT_PREFIX|read_force_history|forces\.txt|wall_forces\.txt|"
     r"id_multisphere|particles_\*|boundingBox"
 )
 
 
-#: What names YADE's code, file names or formats; only engines/yade/ and templates/yade/ may say these.
+#: What names YADE's code, file names or formats; only siloflow/engines/yade/ and siloflow/templates/yade/ may say these.
 YADE_NAMES = re.compile(
-    r"engines\.yade|engines/yade|yade/\w+\.py\.j2|log\.yade|yade-double|wall_force_history|\bO\.(?:bodies|engines|save|load)\b|"
+    r"engines\.yade|siloflow/engines/yade|yade/\w+\.py\.j2|log\.yade|yade-double|wall_force_history|\bO\.(?:bodies|engines|save|load)\b|"
     r"appendClumped|MindlinPhys|settled_fill_\w*\.npz|particles_\w*\.npz"
 )
 #: Per engine: the pattern of its names and the package that alone may say them.
-ENGINE_NAMES = {"liggghts": (LIGGGHTS_NAMES, ("engines", "liggghts")), "yade": (YADE_NAMES, ("engines", "yade"))}
+ENGINE_NAMES = {"liggghts": (LIGGGHTS_NAMES, ("siloflow", "engines", "liggghts")),
+                "yade": (YADE_NAMES, ("siloflow", "engines", "yade"))}
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_NAMES))
-@pytest.mark.parametrize("folder", ["engines", "analysis", "calibration", "siloflow", "workflow", "Snakefile"])
+@pytest.mark.parametrize("folder", ["siloflow/engines", "siloflow/analysis", "siloflow/calibration", "siloflow/api",
+                                    "siloflow/cli", "siloflow/workflow", "Snakefile"])
 def test_only_an_engines_package_names_its_files_and_formats(folder, engine):
     pattern, package = ENGINE_NAMES[engine]
     root = REPO_ROOT / folder
@@ -182,7 +201,7 @@ def test_only_an_engines_package_names_its_files_and_formats(folder, engine):
     found = []
     for path in paths:
         relative = path.relative_to(REPO_ROOT)
-        if relative.parts[:2] == package or "__pycache__" in relative.parts:
+        if relative.parts[:3] == package or "__pycache__" in relative.parts:
             continue
         for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
             match = pattern.search(line)
@@ -196,6 +215,6 @@ def test_every_engine_kind_is_registered_and_names_its_base_template():
     for name in ENGINE_KINDS:
         engine = engine_named(name)
         assert engine.name == name
-        assert (REPO_ROOT / "templates" / engine.base_template).is_file()
+        assert (REPO_ROOT / "siloflow" / "templates" / engine.base_template).is_file()
         from_registry.append(name)
     assert from_registry == ["liggghts", "yade"]

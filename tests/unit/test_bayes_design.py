@@ -1,4 +1,4 @@
-"""Unit tests for calibration.bayes.design: the first design fills the prior box, later designs sit where a known
+"""Unit tests for siloflow.calibration.bayes.design: the first design fills the prior box, later designs sit where a known
 posterior has mass, spread out and away from the runs already made."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from scipy.spatial.distance import cdist, pdist
 from scipy.stats import qmc
 from threadpoolctl import threadpool_limits
 
-from calibration.bayes.design import fit_mixture, greedy_maximin, posterior_design, space_filling_design
+from siloflow.calibration.bayes.design import fit_mixture, greedy_maximin, posterior_design, space_filling_design
 
 LOWER = np.array([0.0, 0.0, 0.0])
 UPPER = np.array([1.0, 0.2, 0.8])  # sliding, rolling, wall friction [-]

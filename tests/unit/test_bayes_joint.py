@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from calibration.bayes.joint import (calibration_of, draw_estimates, first_design, iterate, next_sets, points_of_set,
+from siloflow.calibration.bayes.joint import (calibration_of, draw_estimates, first_design, iterate, next_sets, points_of_set,
                                      point_estimate, predictive_sets, ridge_sets, twin_sets, twin_targets, twin_truth,
                                      with_targets)
-from calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
-from calibration.parameters import apply_calibrated_parameters, posterior_draw_configs
-from calibration.bayes.posterior import in_credible_region
-from engines.config import ConfigError, validate_config
-from model.cases.jenike import build_jenike_case
+from siloflow.calibration.bayes.runs import completed_sets, failed_runs, observations, with_runs
+from siloflow.calibration.parameters import apply_calibrated_parameters, posterior_draw_configs
+from siloflow.calibration.bayes.posterior import in_credible_region
+from siloflow.engines.config import ConfigError, validate_config
+from siloflow.model.cases.jenike import build_jenike_case
 
 
 @pytest.fixture(autouse=True)

@@ -1,4 +1,4 @@
-"""Unit tests for calibration.bayes.noise: the pooled seed-noise variance of replicate runs, by hand."""
+"""Unit tests for siloflow.calibration.bayes.noise: the pooled seed-noise variance of replicate runs, by hand."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from calibration.bayes.noise import seed_noise
+from siloflow.calibration.bayes.noise import seed_noise
 
 
 def test_the_pooled_variance_of_hand_computable_groups():

@@ -1,4 +1,4 @@
-"""Unit tests for calibration.bayes.posterior: the prior and likelihood by hand, the sampler against the analytic
+"""Unit tests for siloflow.calibration.bayes.posterior: the prior and likelihood by hand, the sampler against the analytic
 posterior of a linear Gaussian model, and the summaries on known Gaussian samples."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import pytest
 from scipy import stats
 from threadpoolctl import threadpool_limits
 
-from calibration.bayes.posterior import (
+from siloflow.calibration.bayes.posterior import (
     Prior,
     credible_interval,
     in_credible_region,

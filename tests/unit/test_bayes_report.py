@@ -11,11 +11,11 @@ import pytest
 from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
 
-from calibration.bayes.joint import Calibration, calibration_of
-from engines.config import validate_config
-from calibration.bayes.plots import CHART_COLOR, plot_corner, plot_predictive
-from calibration.bayes.posterior import Prior
-from calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
+from siloflow.calibration.bayes.joint import Calibration, calibration_of
+from siloflow.engines.config import validate_config
+from siloflow.calibration.bayes.plots import CHART_COLOR, plot_corner, plot_predictive
+from siloflow.calibration.bayes.posterior import Prior
+from siloflow.calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
                                       predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -1,4 +1,4 @@
-"""Unit tests for calibration.bayes.stopping on sample sets that did and did not move."""
+"""Unit tests for siloflow.calibration.bayes.stopping on sample sets that did and did not move."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from calibration.bayes.stopping import posterior_moved, posterior_shift
+from siloflow.calibration.bayes.stopping import posterior_moved, posterior_shift
 
 
 def _standardised(n, d, seed):

@@ -1,4 +1,4 @@
-"""Unit tests for calibration.bayes.surrogate on a synthetic calibration chart: bulk friction angle [deg] saturating
+"""Unit tests for siloflow.calibration.bayes.surrogate on a synthetic calibration chart: bulk friction angle [deg] saturating
 with particle sliding friction (an arctan) and rising linearly with rolling friction."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from calibration.bayes.design import space_filling_design
-from calibration.bayes.surrogate import Surrogate
+from siloflow.calibration.bayes.design import space_filling_design
+from siloflow.calibration.bayes.surrogate import Surrogate
 
 LOWER = np.array([0.1, 0.0])  # particle sliding friction, rolling friction [-]
 UPPER = np.array([1.0, 0.2])

@@ -8,19 +8,19 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.grid import Fields, Grid
-from analysis.numerics.replicates import combine_replicates
-from analysis.studies.blender.comparison import BlenderMetrics, best_blender, comparison_table
-from analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity, gravity_scaling
-from analysis.studies.blender.modes import continuous_mode, discontinuous_mode
-from analysis.studies.blender.profiles import (
+from siloflow.analysis.numerics.grid import Fields, Grid
+from siloflow.analysis.numerics.replicates import combine_replicates
+from siloflow.analysis.studies.blender.comparison import BlenderMetrics, best_blender, comparison_table
+from siloflow.analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity, gravity_scaling
+from siloflow.analysis.studies.blender.modes import continuous_mode, discontinuous_mode
+from siloflow.analysis.studies.blender.profiles import (
     flow_channel_boundary_over_height,
     height_profile,
     passage_velocities,
     profiles_over_time,
 )
-from analysis.studies.blender.steady_field import BlenderField
-from analysis.studies.blender.tracers import layer_rtd, tabulated_rtd, tracer_layer, tracer_pathlines, virtual_tracer_rtd
+from siloflow.analysis.studies.blender.steady_field import BlenderField
+from siloflow.analysis.studies.blender.tracers import layer_rtd, tabulated_rtd, tracer_layer, tracer_pathlines, virtual_tracer_rtd
 
 SPEED = 0.5  # m/s, downward
 DX = 0.01

@@ -11,14 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.cases import case_for_run
-from model.cases.blender import (
+from siloflow.model.cases import case_for_run
+from siloflow.model.cases.blender import (
     blender_cases, blender_mesh_set, build_blender_case, fill_cross_section_area,
 )
-from model.cases.blender_geometry import blender_geometry
-from model.cases.blender_meshes import is_watertight
-from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts.blender import render_blender_deck, write_blender_inputs
+from siloflow.model.cases.blender_geometry import blender_geometry
+from siloflow.model.cases.blender_meshes import is_watertight
+from siloflow.engines.config import ConfigError, load_config, validate_config
+from siloflow.engines.liggghts.blender import render_blender_deck, write_blender_inputs
 from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"

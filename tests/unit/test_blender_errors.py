@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.uncertainty import Significance
-from analysis.studies.blender.comparison import BlenderMetrics, comparison_table, figure_columns, significance_rows
-from analysis.studies.blender.errors import (
+from siloflow.analysis.numerics.uncertainty import Significance
+from siloflow.analysis.studies.blender.comparison import BlenderMetrics, comparison_table, figure_columns, significance_rows
+from siloflow.analysis.studies.blender.errors import (
     effective_count,
     homogenisation_error,
     passage_velocity_estimates,
@@ -19,8 +19,8 @@ from analysis.studies.blender.errors import (
     steady_flow_rate_estimate,
     tracer_errors,
 )
-from analysis.numerics.lti import recirculations_to_homogenise
-from analysis.studies.blender.steady_field import BlenderField
+from siloflow.analysis.numerics.lti import recirculations_to_homogenise
+from siloflow.analysis.studies.blender.steady_field import BlenderField
 
 NAN = math.nan
 SE_1234 = math.sqrt(5.0 / 3.0) / 2.0  # std([1, 2, 3, 4], ddof=1) / sqrt(4)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from analysis.numerics.grid import Grid
-from analysis.studies.blender.window_fields import (
+from siloflow.analysis.numerics.grid import Grid
+from siloflow.analysis.studies.blender.window_fields import (
     PlanarField,
     discharged_mass_history,
     frame_fields,
@@ -12,14 +12,14 @@ from analysis.studies.blender.window_fields import (
     mean_velocity_history,
     window_average_field,
 )
-from analysis.studies.blender.window_fields_io import (
+from siloflow.analysis.studies.blender.window_fields_io import (
     read_frame_fields,
     read_planar_fields,
     write_frame_fields,
     write_planar_fields,
 )
-from analysis.numerics.clump_tracks import ClumpTracks
-from analysis.numerics.eulerian_rtd import silo_bins
+from siloflow.analysis.numerics.clump_tracks import ClumpTracks
+from siloflow.analysis.numerics.eulerian_rtd import silo_bins
 
 
 def test_frames_in_window_selects_inclusive_bounds_and_names_an_empty_window():

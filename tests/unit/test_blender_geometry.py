@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from model.cases.blender_geometry import INSERT_PRESETS, blender_geometry
-from model.cases.blender_passages import annulus_bounds, clear_widths, geometry_summary
-from model.cases.blender_meshes import blender_meshes
+from siloflow.model.cases.blender_geometry import INSERT_PRESETS, blender_geometry
+from siloflow.model.cases.blender_passages import annulus_bounds, clear_widths, geometry_summary
+from siloflow.model.cases.blender_meshes import blender_meshes
 
 # The study's full scale (SEED_DIGEST section 5).
 FULL = dict(width=0.45, depth=0.04, vertical_height=1.5, hopper_half_angle=30.0, outlet_width=0.04,

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from model.cases.blender_geometry import blender_geometry
-from model.cases.blender_meshes import blender_meshes, is_watertight, mirror_x, signed_volume
-from model.cases.geometry import horizontal_rectangle, read_stl, write_stl
+from siloflow.model.cases.blender_geometry import blender_geometry
+from siloflow.model.cases.blender_meshes import blender_meshes, is_watertight, mirror_x, signed_volume
+from siloflow.model.cases.geometry import horizontal_rectangle, read_stl, write_stl
 
 # The study's full scale (SEED_DIGEST section 5) and a half scale with thinner walls.
 FULL = dict(width=0.45, depth=0.04, vertical_height=1.5, hopper_half_angle=30.0, outlet_width=0.04,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.blender.plots: PNGs are written and the plotted data are the input (files under
+"""Unit tests for siloflow.analysis.studies.blender.plots: PNGs are written and the plotted data are the input (files under
 tmp_path)."""
 
 from __future__ import annotations
@@ -8,14 +8,14 @@ import math
 import numpy as np
 import pytest
 
-import analysis.studies.blender.plots as blender_plots
-import analysis.studies.silo_recirculation.rtd_plots as rtd_plots
-from analysis.studies.blender.comparison import comparison_table
-from analysis.studies.blender.modes import continuous_mode, discontinuous_mode
-from analysis.studies.blender.profiles import flow_channel_boundary_over_height, passage_velocities, profiles_over_time
-from analysis.studies.blender.steady_field import BlenderField
-from analysis.studies.blender.tracers import layer_rtd, tracer_pathlines
-from analysis.studies.blender.plots import (
+import siloflow.analysis.studies.blender.plots as blender_plots
+import siloflow.analysis.studies.silo_recirculation.rtd_plots as rtd_plots
+from siloflow.analysis.studies.blender.comparison import comparison_table
+from siloflow.analysis.studies.blender.modes import continuous_mode, discontinuous_mode
+from siloflow.analysis.studies.blender.profiles import flow_channel_boundary_over_height, passage_velocities, profiles_over_time
+from siloflow.analysis.studies.blender.steady_field import BlenderField
+from siloflow.analysis.studies.blender.tracers import layer_rtd, tracer_pathlines
+from siloflow.analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_configuration_comparison,
     plot_continuous_mode,

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.blender.steady_field import BlenderField
-from analysis.studies.blender.study import (
+from siloflow.analysis.studies.blender.steady_field import BlenderField
+from siloflow.analysis.studies.blender.study import (
     BlenderSettings,
     analyse_blender,
     key_heights,
@@ -17,8 +17,8 @@ from analysis.studies.blender.study import (
     study_metrics,
     study_summary,
 )
-from analysis.io.tables import write_json
-from analysis.studies.blender.errors import sine_vrr_error
+from siloflow.analysis.io.tables import write_json
+from siloflow.analysis.studies.blender.errors import sine_vrr_error
 
 V = 0.05          # downward speed [m/s]
 FILL = 0.2        # fill height [m]

@@ -1,8 +1,8 @@
-"""Unit tests for analysis.studies.blender.tables: rows and summaries of a hand-built blender study, the
+"""Unit tests for siloflow.analysis.studies.blender.tables: rows and summaries of a hand-built blender study, the
 comparison page, and gravity scaling of hand-written run summaries.
 
 The study is built by hand from its dataclasses with round numbers; only the parts the tables and
-:func:`analysis.studies.blender.study.study_summary` read are filled (the profile behind the passage means, the
+:func:`siloflow.analysis.studies.blender.study.study_summary` read are filled (the profile behind the passage means, the
 flow channel boundary and the pathline integration result are None).
 """
 
@@ -14,14 +14,14 @@ import math
 import numpy as np
 import pytest
 
-from analysis.io.tables import write_json
-from analysis.numerics.lti import VRRTable
-from analysis.numerics.rtd import RTD
-from analysis.studies.blender.comparison import BlenderMetrics
-from analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode
-from analysis.studies.blender.profiles import PassageVelocities, ProfilesOverTime
-from analysis.studies.blender.study import BlenderStudy, metrics_from_summary, rtd_from_summary
-from analysis.studies.blender.tables import (
+from siloflow.analysis.io.tables import write_json
+from siloflow.analysis.numerics.lti import VRRTable
+from siloflow.analysis.numerics.rtd import RTD
+from siloflow.analysis.studies.blender.comparison import BlenderMetrics
+from siloflow.analysis.studies.blender.modes import ContinuousMode, DiscontinuousMode
+from siloflow.analysis.studies.blender.profiles import PassageVelocities, ProfilesOverTime
+from siloflow.analysis.studies.blender.study import BlenderStudy, metrics_from_summary, rtd_from_summary
+from siloflow.analysis.studies.blender.tables import (
     blender_summary,
     comparison_markdown,
     gravity_rows,
@@ -32,7 +32,7 @@ from analysis.studies.blender.tables import (
     rtd_rows,
     vrr_period_rows,
 )
-from analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD
+from siloflow.analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD
 
 NAN = math.nan
 # RTD of 4 virtual tracers out at 0.5, 1.5, 2.5 and 3.5 s, t_m = 2 s.

@@ -1,4 +1,4 @@
-"""Unit tests for calibration.charts: the PNG is written and the plotted data are the input (files under tmp_path
+"""Unit tests for siloflow.calibration.charts: the PNG is written and the plotted data are the input (files under tmp_path
 only)."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from calibration.charts import plot_calibration_chart, plot_force_history, plot_lid_comparison, plot_polar_histogram
-from calibration.contact_diagnostics import angular_histogram
-from calibration.friction import BulkFriction, SteadyWindow
-from calibration.inversion import CalibrationCurve, curves_from_table
-from calibration.shear import ShearSignals
+from siloflow.calibration.charts import plot_calibration_chart, plot_force_history, plot_lid_comparison, plot_polar_histogram
+from siloflow.calibration.contact_diagnostics import angular_histogram
+from siloflow.calibration.friction import BulkFriction, SteadyWindow
+from siloflow.calibration.inversion import CalibrationCurve, curves_from_table
+from siloflow.calibration.shear import ShearSignals
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

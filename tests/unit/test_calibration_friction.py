@@ -1,4 +1,4 @@
-"""Unit tests for calibration.friction and calibration.contact_diagnostics on synthetic input with exact answers."""
+"""Unit tests for siloflow.calibration.friction and siloflow.calibration.contact_diagnostics on synthetic input with exact answers."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from calibration.contact_diagnostics import angular_histogram, mobilised_friction_by_azimuth, mobilised_friction_histogram
-from calibration.friction import (
+from siloflow.calibration.contact_diagnostics import angular_histogram, mobilised_friction_by_azimuth, mobilised_friction_histogram
+from siloflow.calibration.friction import (
     BulkFriction,
     SteadyWindow,
     bulk_friction,

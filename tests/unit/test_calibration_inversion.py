@@ -1,4 +1,4 @@
-"""Unit tests for calibration.inversion on synthetic charts with exact answers."""
+"""Unit tests for siloflow.calibration.inversion on synthetic charts with exact answers."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import yaml
 
-from calibration.inversion_errors import interpolation_error, inversion_error
-from calibration.inversion import (
+from siloflow.calibration.inversion_errors import interpolation_error, inversion_error
+from siloflow.calibration.inversion import (
     CalibrationCurve,
     Inversion,
     UnreachableTarget,

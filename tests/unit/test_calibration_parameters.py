@@ -2,9 +2,9 @@
 
 import pytest
 
-from calibration.parameters import apply_calibrated_parameters
-from engines.config import validate_config
-from model.cases.silo_flat import build_silo_case
+from siloflow.calibration.parameters import apply_calibrated_parameters
+from siloflow.engines.config import validate_config
+from siloflow.model.cases.silo_flat import build_silo_case
 
 PARAMETERS = {
     "shape": "sphere4",

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.forces import WallForceHistory
-from calibration.shear import shear_signals
+from siloflow.model.forces import WallForceHistory
+from siloflow.calibration.shear import shear_signals
 
 
 def _history(walls=("lid", "shear_ring", "base"), signals=True) -> WallForceHistory:

@@ -2,10 +2,10 @@
 
 import pytest
 
-from calibration.sweep import chart_rows, lid_comparison
-from model.cases.jenike_sweep import (CALIBRATION_CHART, CHECK, SHAPE_CHART, diagnostic_points, is_chart_point,
+from siloflow.calibration.sweep import chart_rows, lid_comparison
+from siloflow.model.cases.jenike_sweep import (CALIBRATION_CHART, CHECK, SHAPE_CHART, diagnostic_points, is_chart_point,
                                         point_role, sweep_points)
-from engines.config import ConfigError, validate_config
+from siloflow.engines.config import ConfigError, validate_config
 
 
 def test_default_sweep_is_shape_x_test_x_sliding_x_rolling():

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from calibration.table import POINT_COLUMNS, point_table
+from siloflow.calibration.table import POINT_COLUMNS, point_table
 
 
 def _summary(mu, bulk, error, window="steady", lid="rigid", speed=0.03, run="r"):

@@ -10,19 +10,19 @@ from pathlib import Path
 
 import pytest
 
-from engines.config import ConfigError, load_schema, validate_config
-from engines.estimates import estimate_case
-from engines.interface import CaseNotSupported, engine_for
-from engines.layout import case_root, run_path
-from engines.liggghts.engine import ADAPTERS, Adapter, LiggghtsEngine
-from engines.planning import config_estimates
-from model.cases import cases_of, reference_runs, run_roles
-from model.cases.common import run_id
-from model.cases.config_checks import ConfigError as ModelConfigError
-from model.cases.kinds import CASE_KINDS, CaseKind, case_kind, configured_kinds, kind_of_case, register_case_kind
-from model.cases.stages import Stage
-from model.cost import CostModel, estimate_run
-from model.record import RunRecord, RunRecordError
+from siloflow.engines.config import ConfigError, load_schema, validate_config
+from siloflow.engines.estimates import estimate_case
+from siloflow.engines.interface import CaseNotSupported, engine_for
+from siloflow.engines.layout import case_root, run_path
+from siloflow.engines.liggghts.engine import ADAPTERS, Adapter, LiggghtsEngine
+from siloflow.engines.planning import config_estimates
+from siloflow.model.cases import cases_of, reference_runs, run_roles
+from siloflow.model.cases.common import run_id
+from siloflow.model.cases.config_checks import ConfigError as ModelConfigError
+from siloflow.model.cases.kinds import CASE_KINDS, CaseKind, case_kind, configured_kinds, kind_of_case, register_case_kind
+from siloflow.model.cases.stages import Stage
+from siloflow.model.cost import CostModel, estimate_run
+from siloflow.model.record import RunRecord, RunRecordError
 
 FRAGMENT = """\
 description: A box of clumps poured and left to settle (a test's case kind).

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.coarse_graining on synthetic particles with exact answers."""
+"""Unit tests for siloflow.analysis.numerics.coarse_graining on synthetic particles with exact answers."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.coarse_graining import (
+from siloflow.analysis.numerics.coarse_graining import (
     HAVE_NUMBA,
     KERNELS,
     coarse_grain,
@@ -16,9 +16,9 @@ from analysis.numerics.coarse_graining import (
     kernel_shift,
     kernel_support_radius,
 )
-from analysis.numerics.grid import Fields, Grid
-from analysis.numerics.field_ops import average_fields, depth_average, front_wall_slice
-from analysis.numerics.contact_stress import contact_stress
+from siloflow.analysis.numerics.grid import Fields, Grid
+from siloflow.analysis.numerics.field_ops import average_fields, depth_average, front_wall_slice
+from siloflow.analysis.numerics.contact_stress import contact_stress
 
 BACKENDS = ["numpy"] + (["numba"] if HAVE_NUMBA else [])
 WIDTH = 0.0045  # 3 radii of a 3 mm sphere, the study's kernel width [m]

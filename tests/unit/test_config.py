@@ -7,12 +7,13 @@ import copy
 import pytest
 import yaml
 
-from model.cases import cases_of
-from model.cases.silo_flat import build_silo_case
+from siloflow.model.cases import cases_of
+from siloflow.model.cases.silo_flat import build_silo_case
 from snakemake.utils import update_config
 
-from engines.config import SCHEMA_PATH, ConfigError, load_config, load_config_file, load_schema, validate_config
-from engines.interface import CaseNotSupported, engine_for
+from siloflow.engines.config import SCHEMA_PATH, ConfigError, load_config, load_config_file, load_schema, validate_config
+from siloflow.engines.interface import CaseNotSupported, engine_for
+from tests.repo import REPO_ROOT
 
 
 def _schema_properties(node, path="", definitions=None):
@@ -58,7 +59,7 @@ def test_validation_does_not_modify_its_input(raw_default_config):
 
 def test_default_and_thesis_configs_are_valid():
     for name in ("config/config.yaml", "config/thesis.yaml"):
-        config = load_config(SCHEMA_PATH.parents[2] / name)
+        config = load_config(REPO_ROOT / name)
         assert config["silo_flat"]["particle_model"] == "sphere2"
 
 
@@ -219,8 +220,8 @@ def update_config_copy(base: dict, layer: dict) -> dict:
 
 
 def test_the_bayesian_twin_configuration_layers_over_the_default_one():
-    raw = load_config_file(SCHEMA_PATH.parents[2] / "config" / "config.yaml")
-    twin = load_config_file(SCHEMA_PATH.parents[2] / "config" / "bayesian_twin.yaml")
+    raw = load_config_file(REPO_ROOT / "config" / "config.yaml")
+    twin = load_config_file(REPO_ROOT / "config" / "bayesian_twin.yaml")
     config = validate_config(update_config_copy(raw, twin))
     bayesian = config["calibration"]["bayesian"]
     assert bayesian["twin"]["enabled"] and bayesian["engines"] == ["liggghts"]

@@ -12,14 +12,15 @@ import time
 
 import pytest
 
-from model.cases import cases_of
-from model.cases.kinds import configured_kinds
-from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
-from model.cases.jenike_cell import segments_for_chord
-from model.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
-from model.cases.silo_flat import build_silo_case
-from engines.config import REPO_ROOT, ConfigError, load_config_file, load_schema, validate_config
-from engines.planning import config_estimates
+from siloflow.model.cases import cases_of
+from siloflow.model.cases.kinds import configured_kinds
+from siloflow.model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases
+from siloflow.model.cases.jenike_cell import segments_for_chord
+from siloflow.model.cases.physics import MAX_STEPS, engine_seeds, free_fall_time, steps_for
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import ConfigError, load_config_file, load_schema, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.engines.planning import config_estimates
 
 #: The bounds (schema maxima and minima): the largest seed, replicate count, MPI ranks, name length, and the
 #: smallest time step fraction and particle model scale.
@@ -279,7 +280,7 @@ def _hang(signum, frame):
 def test_no_number_of_the_default_config_at_an_extreme_overflows_the_planner(default_config):
     """Every number of the validated default config, set in turn to each of :data:`EXTREMES`, is accepted or refused
     with a ConfigError or a ValueError within a second: never an OverflowError, ZeroDivisionError or other
-    ArithmeticError, nor a hang. Each configuration is validated, planned (:func:`engines.planning.config_estimates`,
+    ArithmeticError, nor a hang. Each configuration is validated, planned (:func:`siloflow.engines.planning.config_estimates`,
     which builds every case kind's runs with ``cases_of``) and its cross-engine check's runs are built. The sweep is
     the full one, all of the config's some 350 numbers (about 1050 configurations, 15 to 20 s on the busy 2-core
     development machine)."""

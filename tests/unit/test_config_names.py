@@ -13,8 +13,9 @@ from typing import NamedTuple
 
 import pytest
 
-from engines.config import REPO_ROOT, ConfigError, load_config_file, load_schema, validate_config
-from engines.templating import UnsafeDeckValue, check_context, deck_environment
+from siloflow.engines.config import ConfigError, load_config_file, load_schema, validate_config
+from tests.repo import REPO_ROOT
+from siloflow.engines.templating import UnsafeDeckValue, check_context, deck_environment
 
 #: A name every pattern of the schema and of the decks accepts, and the same with a trailing newline.
 NAME = "twin"
@@ -175,7 +176,7 @@ def test_a_name_with_a_trailing_newline_is_refused_naming_the_key(position, fill
 
 def test_every_deck_filter_and_the_context_check_refuse_a_name_with_a_trailing_newline():
     ours = {name: function for name, function in deck_environment().filters.items()
-            if getattr(function, "__module__", "") == "engines.templating"}
+            if getattr(function, "__module__", "") == "siloflow.engines.templating"}
     # names, paths and YADE's string literals take strings; numbers and integers refuse them anyway
     assert {"name", "path", "pystr", "num", "int"} <= set(ours)
     for function in ours.values():

@@ -7,7 +7,7 @@ import time
 import pytest
 import yaml
 
-from engines.config_yaml import (
+from siloflow.engines.config_yaml import (
     MAX_ALIASES, MAX_BYTES, MAX_DEPTH, MAX_NODES, ConfigFileError, load_config_text, main, read_config_file,
 )
 

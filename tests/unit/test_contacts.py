@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from engines.liggghts.contacts import ContactDumpError, parse_local_dump, read_contacts
-from analysis.numerics.force_chains import all_force_chains, force_chain_segments
+from siloflow.engines.liggghts.contacts import ContactDumpError, parse_local_dump, read_contacts
+from siloflow.analysis.numerics.force_chains import all_force_chains, force_chain_segments
 
 DUMP = """ITEM: TIMESTEP
 22000

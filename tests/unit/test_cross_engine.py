@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from model.frames import ClumpFrame
-from analysis.studies.cross_engine import centreline_vertical_velocity, compare_engines
-from model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases, jenike_point_label
-from engines.config import ConfigError, validate_config
+from siloflow.model.frames import ClumpFrame
+from siloflow.analysis.studies.cross_engine import centreline_vertical_velocity, compare_engines
+from siloflow.model.cases.cross_engine import cross_engine_cases, cross_engine_jenike_cases, jenike_point_label
+from siloflow.engines.config import ConfigError, validate_config
 
 
 def _frame(time, x, z, vz):

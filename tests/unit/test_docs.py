@@ -18,8 +18,9 @@ from pathlib import Path, PurePosixPath
 import pytest
 import yaml
 
-from engines.config import RENAMED_KEYS, REPLACED_KEYS, REPO_ROOT, load_schema
-from engines.validation_groups import group_of_part
+from siloflow.engines.config import RENAMED_KEYS, REPLACED_KEYS, load_schema
+from tests.repo import REPO_ROOT
+from siloflow.engines.validation_groups import group_of_part
 
 README_MAX_LINES = 220
 
@@ -67,7 +68,7 @@ def test_the_site_builds_strictly_with_every_page_of_its_navigation(tmp_path):
     assert (site / "validation" / "silo" / "runs.csv").is_file()
     # the API reference is rendered from the docstrings, not left as its ::: directives
     api = (site / "api" / "engines.html").read_text(encoding="utf-8")
-    assert "engines.interface" in api and ":::" not in api
+    assert "siloflow.engines.interface" in api and ":::" not in api
 
 
 def test_the_readme_is_a_short_entry_point_with_the_two_commands():
@@ -80,11 +81,11 @@ def test_the_readme_is_a_short_entry_point_with_the_two_commands():
 # --- Every name the manual gives exists ------------------------------------------------------------------------------
 # The pages are read as text: their inline code spans (`...`), their fenced code blocks and the API pages' `::: module`
 # lines. What a span names is told by its form, and only those forms are checked:
-#   path        a path into the repository (`engines/preflight.py`, `templates/liggghts/`; in a fenced folder listing
+#   path        a path into the repository (`siloflow/engines/preflight.py`, `siloflow/templates/liggghts/`; in a fenced folder listing
 #               also relative to the folder its line describes); <placeholders>, * globs and ... are left alone
 #   source      a bare source file name (`case_deck.py`, `macros.j2`): a file of that name in the repository, in the
-#               folder when the prose lists it after one ("`analysis/studies/blender/`: `modes.py`, `study.py`")
-#   python      a dotted name in the project's packages (`engines.preflight.preflight`), `python -m <module>`,
+#               folder when the prose lists it after one ("`siloflow/analysis/studies/blender/`: `modes.py`, `study.py`")
+#   python      a dotted name in the project's packages (`siloflow.engines.preflight.preflight`), `python -m <module>`,
 #               `::: <module>`, or a name given from a module's last part (`physics.free_fall_time`)
 #   key         a config key: a dotted name whose first part is a top-level section of the schema, one given relative
 #               to its section (`fill.balance_planes`), a setting (`davis.out_of_plane: keep`), a key in a formula
@@ -96,7 +97,7 @@ def test_the_readme_is_a_short_entry_point_with_the_two_commands():
 #   group       a validation group or part (`make validate GROUP=silo_2`)
 #   identifier  a class of the project (`PlanarField.kind`, `RunRecord`) or a module-level constant (`CASE_KINDS`)
 #   function    a called name (`engine_named(record.engine)`, `stages()`): a function or method of the project
-#   defined     a name the prose places in a file ("`stable_timestep` in `model/cases/physics.py`")
+#   defined     a name the prose places in a file ("`stable_timestep` in `siloflow/model/cases/physics.py`")
 # Anything else (engine commands, math, output columns and files, values, results/ paths) is prose and is not
 # checked. A dotted name that may be either a module or a config key (`calibration.shape`, `shear.velocity`) passes
 # as either.
@@ -118,7 +119,7 @@ FILE_SUFFIXES = frozenset("json csv png py npz vti vtk pvd yaml yml md html txt 
 
 #: Names the manual gives on purpose although nothing defines them, each with why. The test checks that each is still
 #: in the manual and still undefined, so that this list cannot go stale either. (Keys of earlier versions that the
-#: manual names as such need no entry: engines.config's RENAMED_KEYS and REPLACED_KEYS list them.)
+#: manual names as such need no entry: siloflow.engines.config's RENAMED_KEYS and REPLACED_KEYS list them.)
 DELIBERATELY_UNDEFINED = {
     "silo_flat.widht": "configuration.md's example of a misspelt key, which the preflight refuses with 'did you mean'",
 }
@@ -500,7 +501,7 @@ def _rule_patterns() -> tuple[re.Pattern, ...]:
     """The workflow's rules: `rule <name>:`, and the rules a loop names (`name: f"validate_{_group}"`, which any
     name in place of each {...} matches)."""
     texts = [path.read_text(encoding="utf-8")
-             for path in [REPO_ROOT / "Snakefile", *sorted((REPO_ROOT / "workflow" / "rules").glob("*.smk"))]]
+             for path in [REPO_ROOT / "Snakefile", *sorted((REPO_ROOT / "siloflow" / "workflow" / "rules").glob("*.smk"))]]
     static = {name for text in texts for name in re.findall(r"^\s*rule\s+(\w+)\s*:", text, re.M)}
     built = {name for text in texts
              for name in re.findall(r"^\s*rule\s*:\s*\n\s*name\s*:\s*f?[\"']([^\"']+)[\"']", text, re.M)}
@@ -566,10 +567,10 @@ def test_the_deliberately_undefined_names_are_still_in_the_docs_and_still_undefi
 
 
 @pytest.mark.parametrize("markdown, exists", [
-    ("`engines/preflight.py` and `templates/liggghts/`", True),
+    ("`siloflow/engines/preflight.py` and `siloflow/templates/liggghts/`", True),
     ("`engines/preflght.py`", False),
-    ("`analysis.numerics.force_balance.settled_fill_balance`", True),
-    ("`analysis.numerics.force_balance.settled_balance`", False),
+    ("`siloflow.analysis.numerics.force_balance.settled_fill_balance`", True),
+    ("`siloflow.analysis.numerics.force_balance.settled_balance`", False),
     ("`python -m engines.planing config/config.yaml`", False),
     ("rule `silo_run`, the `silo_metrics` rule, `rule validate_silo_series`", True),
     ("rules `silo_run` and `silo_runs`", False),
@@ -581,8 +582,8 @@ def test_the_deliberately_undefined_names_are_still_in_the_docs_and_still_undefi
     ("`estimates.seconds_per_sphere_step_by_case.hopper`", False),  # not one of its propertyNames
     ("`PlanarField.kind` and `CASE_KINDS`", True),
     ("`PlanarField.knd`", False),
-    ("`stable_timestep` in `model/cases/particles.py`", False),
-    ("`analysis/studies/blender/`: `modes.py`, `mode.py`", False),
+    ("`stable_timestep` in `siloflow/model/cases/particles.py`", False),
+    ("`siloflow/analysis/studies/blender/`: `modes.py`, `mode.py`", False),
     ("`make validate GROUP=silo_2`", True),
     ("`make validate GROUP=hopper_1`", False),
 ])

@@ -1,5 +1,5 @@
-"""Reading a user's own LIGGGHTS dumps (engines.liggghts.dump_files.read_dump_files) through
-engines.liggghts.dumps.readable_frames: the step of a VTK file from its name, a text file's own steps, and the
+"""Reading a user's own LIGGGHTS dumps (siloflow.engines.liggghts.dump_files.read_dump_files) through
+siloflow.engines.liggghts.dumps.readable_frames: the step of a VTK file from its name, a text file's own steps, and the
 damaged-dump policy, on copies of dumps LIGGGHTS wrote (tests/fixtures/liggghts/)."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from engines.interface import DumpFile
-from engines.liggghts.dump_files import read_dump_files
-from engines.liggghts.dumps import readable_frames
-from engines.liggghts.vtk_legacy import DumpFormatError
+from siloflow.engines.interface import DumpFile
+from siloflow.engines.liggghts.dump_files import read_dump_files
+from siloflow.engines.liggghts.dumps import readable_frames
+from siloflow.engines.liggghts.vtk_legacy import DumpFormatError
 
 FIXTURES = Path(__file__).resolve().parent.parent / "fixtures" / "liggghts"
 TIMESTEP = 2e-5  # s

@@ -21,17 +21,17 @@ from pathlib import Path
 
 import pytest
 
-from model.existing_run import ExistingSiloRun
-from engines.config import ConfigError
-from engines.existing_runs import check_existing_run
-from model.file_messages import first_not_read, not_regular, unreadable
-from engines.jenike_checks import FORCE_COLUMNS, read_jenike_force_history
-from engines.liggghts.contacts import ContactDumpError, read_contacts
-from engines.liggghts.dump_text import read_custom_dump
-from engines.liggghts.dumps import DumpFormatError, dump_format, read_file_frames
-from engines.liggghts.forces import QUANTITIES, read_wall_force_file
-from engines.liggghts.settled import read_settled_spheres
-from engines.yade.outputs import DamagedOutput, read_frame as read_yade_frame, read_wall_forces as read_yade_forces
+from siloflow.model.existing_run import ExistingSiloRun
+from siloflow.engines.config import ConfigError
+from siloflow.engines.existing_runs import check_existing_run
+from siloflow.model.file_messages import first_not_read, not_regular, unreadable
+from siloflow.engines.jenike_checks import FORCE_COLUMNS, read_jenike_force_history
+from siloflow.engines.liggghts.contacts import ContactDumpError, read_contacts
+from siloflow.engines.liggghts.dump_text import read_custom_dump
+from siloflow.engines.liggghts.dumps import DumpFormatError, dump_format, read_file_frames
+from siloflow.engines.liggghts.forces import QUANTITIES, read_wall_force_file
+from siloflow.engines.liggghts.settled import read_settled_spheres
+from siloflow.engines.yade.outputs import DamagedOutput, read_frame as read_yade_frame, read_wall_forces as read_yade_forces
 
 FIXTURES = Path(__file__).resolve().parent.parent / "fixtures" / "liggghts"
 SECRET = "SECRET_TOKEN=abc"

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 import pyvista
 
-from model.frames import ParticleFrame, clumps_from_frame
-from engines.liggghts.dumps import (
+from siloflow.model.frames import ParticleFrame, clumps_from_frame
+from siloflow.engines.liggghts.dumps import (
     DumpFormatError,
     parse_legacy_vtk_polydata,
     read_custom_dump,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from vtkmodules.vtkIOLegacy import vtkPolyDataWriter
 
-from engines.liggghts.dumps import (
+from siloflow.engines.liggghts.dumps import (
     DumpFormatError,
     frame_from_arrays,
     parse_custom_dump,

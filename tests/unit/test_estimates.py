@@ -9,11 +9,12 @@ from types import SimpleNamespace
 
 import pytest
 
-from model.cases.blender import blender_cases, build_blender_case
-from model.cases.silo_recirculation import recirculation_cases
-from engines.config import REPO_ROOT, load_config
-from analysis.numerics.flow import beverloo_mass_flow_rate
-from model.cost import (
+from siloflow.model.cases.blender import blender_cases, build_blender_case
+from siloflow.model.cases.silo_recirculation import recirculation_cases
+from siloflow.engines.config import load_config
+from tests.repo import REPO_ROOT
+from siloflow.analysis.numerics.flow import beverloo_mass_flow_rate
+from siloflow.model.cost import (
     CostModel,
     MeasuredWork,
     RunEstimate,
@@ -26,15 +27,15 @@ from model.cost import (
     pour_sphere_steps,
     wall_time,
 )
-from model.cases.silo_cost import (
+from siloflow.model.cases.silo_cost import (
     estimate_blender_case,
     estimate_recirculation_case,
     estimate_silo_case,
     silo_run_steps,
     sink_fall_time,
 )
-from model.cases.jenike_cost import estimate_jenike_case, jenike_levelled_clumps, jenike_run_steps
-from engines.estimates import (
+from siloflow.model.cases.jenike_cost import estimate_jenike_case, jenike_levelled_clumps, jenike_run_steps
+from siloflow.engines.estimates import (
     ESTIMATE_COLUMNS,
     InsufficientDiskSpace,
     check_disk_space,
@@ -43,14 +44,14 @@ from engines.estimates import (
     format_duration,
     total_dump_bytes,
 )
-from model.cases.kinds import CASE_KINDS, configured_kinds
-from model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
-from engines.liggghts.cost import (StageCost, TimedRun, calibrate_cost_model, elapsed_seconds, measured_work, stage_costs,
+from siloflow.model.cases.kinds import CASE_KINDS, configured_kinds
+from siloflow.model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case
+from siloflow.engines.liggghts.cost import (StageCost, TimedRun, calibrate_cost_model, elapsed_seconds, measured_work, stage_costs,
                                    timed_runs)
-from engines.interface import engine_named
-from engines.liggghts.run import LOG_NAME, RESUME_STEM
-from engines.run_files import FAILED_ATTEMPTS
-from model.cases.silo_flat import build_silo_case
+from siloflow.engines.interface import engine_named
+from siloflow.engines.liggghts.run import LOG_NAME, RESUME_STEM
+from siloflow.engines.run_files import FAILED_ATTEMPTS
+from siloflow.model.cases.silo_flat import build_silo_case
 
 JENIKE_POINT = {
     "shape": "sphere2",

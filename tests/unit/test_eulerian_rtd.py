@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from analysis.numerics.eulerian_rtd import bin_velocity_series, eulerian_residence_times, inlet_bins, silo_bins
+from siloflow.analysis.numerics.eulerian_rtd import bin_velocity_series, eulerian_residence_times, inlet_bins, silo_bins
 
 
 def test_silo_bins_tile_the_silo_exactly():

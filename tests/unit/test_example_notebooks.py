@@ -10,7 +10,7 @@ import nbformat
 import pytest
 
 import siloflow
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 
 NOTEBOOKS = sorted((REPO_ROOT / "examples").glob("*.ipynb"))
 #: What a notebook may import: the public API, and what it plots and computes with.

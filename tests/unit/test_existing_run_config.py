@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from model.existing_run import ExistingRunError, ExistingSiloRun
-from model.cases.silo_flat import build_silo_case
-from engines.config import ConfigError, existing_silo_runs, validate_config
-from engines.existing_runs import check_existing_run, check_existing_runs, opening_files, read_existing_frames
-from engines.interface import DumpFile, engine_named
-from engines.liggghts.dump_files import check_dump_pattern, match_dump_files
+from siloflow.model.existing_run import ExistingRunError, ExistingSiloRun
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import ConfigError, existing_silo_runs, validate_config
+from siloflow.engines.existing_runs import check_existing_run, check_existing_runs, opening_files, read_existing_frames
+from siloflow.engines.interface import DumpFile, engine_named
+from siloflow.engines.liggghts.dump_files import check_dump_pattern, match_dump_files
 
 FIXTURES = Path(__file__).resolve().parent.parent / "fixtures" / "liggghts"
 DESCRIPTION = {"folder": "runs/mine", "dumps": "post/silo*.vtk", "width": 0.02, "depth": 0.02, "outlet_width": 0.006,

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from model.existing_run import ExistingSiloRun
-from model.frames import ClumpFrame, ParticleFrame
-from model.constants import GRAVITY
-from analysis.studies.silo_flat.existing_run import (
+from siloflow.model.existing_run import ExistingSiloRun
+from siloflow.model.frames import ClumpFrame, ParticleFrame
+from siloflow.model.constants import GRAVITY
+from siloflow.analysis.studies.silo_flat.existing_run import (
     SKIPPED_ANALYSES,
     analyses_summary,
     existing_field_study,
@@ -26,8 +26,8 @@ from analysis.studies.silo_flat.existing_run import (
     silo_dimensions,
     to_silo_coordinates,
 )
-from analysis.studies.silo_flat.field_study import SiloFieldOptions, field_summary
-from analysis.studies.silo_flat.metrics import EscapedParticles, could_reach_outlet, escaped_clumps
+from siloflow.analysis.studies.silo_flat.field_study import SiloFieldOptions, field_summary
+from siloflow.analysis.studies.silo_flat.metrics import EscapedParticles, could_reach_outlet, escaped_clumps
 
 ORIGIN = (0.1, 0.2, 0.3)  # the dumps' coordinates of the silo axis (x), front wall (y) and outlet plane (z) (m)
 TIMESTEP = 1e-4  # s

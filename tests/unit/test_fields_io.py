@@ -1,4 +1,4 @@
-"""Unit tests for analysis.io.fields: .vti/.pvd open in pyvista with the arrays; .npz round trip is exact."""
+"""Unit tests for siloflow.analysis.io.fields: .vti/.pvd open in pyvista with the arrays; .npz round trip is exact."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.numerics.grid import Grid
-from analysis.numerics.coarse_graining import coarse_grain
-from analysis.numerics.contact_stress import contact_stress
-from analysis.numerics.field_ops import depth_average
-from analysis.io.fields import (
+from siloflow.analysis.numerics.grid import Grid
+from siloflow.analysis.numerics.coarse_graining import coarse_grain
+from siloflow.analysis.numerics.contact_stress import contact_stress
+from siloflow.analysis.numerics.field_ops import depth_average
+from siloflow.analysis.io.fields import (
     fields_image,
     load_fields_npz,
     read_fields_vti,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.flow on synthetic input with exact answers (no engine)."""
+"""Unit tests for siloflow.analysis.numerics.flow on synthetic input with exact answers (no engine)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.flow import (
+from siloflow.analysis.numerics.flow import (
     BulkDensity,
     DischargeHistory,
     FlowRateFit,
@@ -20,7 +20,7 @@ from analysis.numerics.flow import (
     steady_flow_rate,
     volumetric_flow_rate,
 )
-from model.cases.particles import clump_volume, equivalent_diameter
+from siloflow.model.cases.particles import clump_volume, equivalent_diameter
 
 # --------------------------------------------------------------------------- Beverloo
 

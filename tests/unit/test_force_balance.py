@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.contacts import ContactFrame
-from model.frames import ParticleFrame
-from model.settled import SettledFill
-from analysis.numerics.force_balance import (
+from siloflow.model.contacts import ContactFrame
+from siloflow.model.frames import ParticleFrame
+from siloflow.model.settled import SettledFill
+from siloflow.analysis.numerics.force_balance import (
     BalanceTolerances,
     balance_problems,
     fill_balance,

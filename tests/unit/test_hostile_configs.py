@@ -1,6 +1,6 @@
 """Hostile and malformed configurations, each fed through the path `snakemake -n` takes when it parses the workflow
-(``workflow/rules/common.smk`` calls :func:`engines.preflight.preflight`, then
-:func:`analysis.io.measured_inputs.check_measured_inputs`): every one is refused within a second, before any run
+(``siloflow/workflow/rules/common.smk`` calls :func:`siloflow.engines.preflight.preflight`, then
+:func:`siloflow.analysis.io.measured_inputs.check_measured_inputs`): every one is refused within a second, before any run
 directory exists, with the offending key (or file line) named and no file's contents echoed.
 
 Each configuration is a file laid over the default one, as ``snakemake --configfile config/config.yaml --configfile
@@ -16,9 +16,10 @@ import pytest
 import yaml
 from snakemake.utils import update_config
 
-from engines.config import REPO_ROOT, load_config_file
-from analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
-from engines.preflight import PreflightError, preflight
+from siloflow.engines.config import load_config_file
+from tests.repo import REPO_ROOT
+from siloflow.analysis.io.measured_inputs import MeasuredInputError, check_measured_inputs
+from siloflow.engines.preflight import PreflightError, preflight
 
 DEFAULT_CONFIG = REPO_ROOT / "config" / "config.yaml"
 
@@ -111,7 +112,7 @@ HOSTILE = [
 
 
 def _workflow_checks(config: dict, config_files: list) -> list:
-    """What ``workflow/rules/common.smk`` runs when the workflow is parsed, in its order; the measured PIV files."""
+    """What ``siloflow/workflow/rules/common.smk`` runs when the workflow is parsed, in its order; the measured PIV files."""
     return check_measured_inputs(preflight(config, config_files).config["silo_flat"])
 
 

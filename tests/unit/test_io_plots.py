@@ -1,4 +1,4 @@
-"""Unit tests for analysis.io.plots, what every plot writer shares: the silo outline it draws, the atomic figure
+"""Unit tests for siloflow.analysis.io.plots, what every plot writer shares: the silo outline it draws, the atomic figure
 writer (PNG, PDF, SVG, the formats of plots.format) and the argument checks (files under tmp_path only); and that the
 workflow names its plots in the configured format."""
 
@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from analysis.io.plots import (
+from siloflow.analysis.io.plots import (
     PLOT_FORMATS,
     finite_abscissa,
     matching_ordinate,
@@ -21,7 +21,8 @@ from analysis.io.plots import (
     silo_outline,
     tuple_entry,
 )
-from engines.config import REPO_ROOT, load_schema
+from siloflow.engines.config import load_schema
+from tests.repo import REPO_ROOT
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -92,8 +93,8 @@ def test_the_writer_takes_every_format_the_configuration_offers():
 def test_the_workflow_names_every_plot_in_the_configured_format():
     """The rules and their scripts give a plot's suffix as plots.format says (plot_file in common.smk, the rule's
     plot_format parameter), never as a literal."""
-    files = [REPO_ROOT / "Snakefile", *sorted((REPO_ROOT / "workflow" / "rules").glob("*.smk")),
-             *sorted((REPO_ROOT / "workflow" / "scripts").glob("*.py"))]
+    files = [REPO_ROOT / "Snakefile", *sorted((REPO_ROOT / "siloflow" / "workflow" / "rules").glob("*.smk")),
+             *sorted((REPO_ROOT / "siloflow" / "workflow" / "scripts").glob("*.py"))]
     literal = re.compile(r"\.(?:%s)[\"']" % "|".join(PLOT_FORMATS))
     found = [f"{path.relative_to(REPO_ROOT)}:{number}" for path in files
              for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if literal.search(line)]

@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engines.interface import CaseNotSupported, engine_named
+from siloflow.engines.interface import CaseNotSupported, engine_named
 
-from engines.config import ConfigError, load_config, validate_config
-from model.cases.geometry import read_stl
-from model.cases.jenike import (
+from siloflow.engines.config import ConfigError, load_config, validate_config
+from siloflow.model.cases.geometry import read_stl
+from siloflow.model.cases.jenike import (
     FILL_SOLID_FRACTION,
     LID_TYPE,
     PARTICLE_TYPE,
@@ -24,11 +24,11 @@ from model.cases.jenike import (
     build_jenike_case,
     force_sample_every,
 )
-from model.cases.jenike_cell import circle_intersection_area
-from engines.interface import EngineRunError
-from engines.markers import Marker
-from engines.jenike_checks import FORCE_COLUMNS, check_jenike_run, read_jenike_force_history
-from engines.liggghts.jenike import (
+from siloflow.model.cases.jenike_cell import circle_intersection_area
+from siloflow.engines.interface import EngineRunError
+from siloflow.engines.markers import Marker
+from siloflow.engines.jenike_checks import FORCE_COLUMNS, check_jenike_run, read_jenike_force_history
+from siloflow.engines.liggghts.jenike import (
     CONTACT_COLUMNS,
     read_contact_dump,
     jenike_deck_context,
@@ -36,8 +36,8 @@ from engines.liggghts.jenike import (
     set_aside_previous_jenike_attempt,
     write_jenike_inputs,
 )
-from model.cases.physics import hertz_contact_time, rayleigh_time
-from engines.templating import UnsafeDeckValue, render_deck
+from siloflow.model.cases.physics import hertz_contact_time, rayleigh_time
+from siloflow.engines.templating import UnsafeDeckValue, render_deck
 from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from model.cases.jenike import CHORD_TOLERANCE
-from model.cases.jenike_cell import annulus, circle_intersection_area, cylinder_wall, disk, segments_for_chord
+from siloflow.model.cases.jenike import CHORD_TOLERANCE
+from siloflow.model.cases.jenike_cell import annulus, circle_intersection_area, cylinder_wall, disk, segments_for_chord
 
 
 def _sagitta(radius: float, n: int) -> float:

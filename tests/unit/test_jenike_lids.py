@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from model.cases.jenike_lids import lid_sphere_layout
+from siloflow.model.cases.jenike_lids import lid_sphere_layout
 
 
 @pytest.mark.parametrize("outer", [0.0182, 0.0457])

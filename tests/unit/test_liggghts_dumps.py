@@ -1,4 +1,4 @@
-"""Unit tests for engines.liggghts.dumps: exact round trips, the strict layout, damaged files, clumps, file lists.
+"""Unit tests for siloflow.engines.liggghts.dumps: exact round trips, the strict layout, damaged files, clumps, file lists.
 
 Every dump here is written with pyvista (tests/dump_fixtures.py), in the layout LIGGGHTS writes.
 """
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import pyvista
 
-from model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
-from engines.liggghts.dumps import (
+from siloflow.model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
+from siloflow.engines.liggghts.dumps import (
     DumpFormatError,
     dump_step,
     frame_from_arrays,
@@ -53,7 +53,7 @@ def test_round_trip_is_exact(tmp_path):
 
 def test_fixture_layout_matches_liggghts(tmp_path):
     # The layout of tests/dump_fixtures.py, line by line, as LIGGGHTS writes it (module docstring of
-    # engines.liggghts.dumps); tests/integration/test_dumps_liggghts.py compares it with the real engine.
+    # siloflow.engines.liggghts.dumps); tests/integration/test_dumps_liggghts.py compares it with the real engine.
     points, fields = liggghts_like_fields(2)
     content = liggghts_dump_bytes(points, fields, tmp_path)
     lines = [line for line in content.split(b"\n") if line[:1].isalpha() or line.startswith(b"#")]

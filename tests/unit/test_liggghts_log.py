@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from engines.interface import EngineNotFound, EngineRunError
-from engines.liggghts.run import engine_command, set_aside_previous_attempt
-from engines.liggghts.markers import error_lines
-from engines.markers import parse_markers
-from engines.silo_checks import check_silo_run
-from model.cases.silo_flat import build_silo_case
+from siloflow.engines.interface import EngineNotFound, EngineRunError
+from siloflow.engines.liggghts.run import engine_command, set_aside_previous_attempt
+from siloflow.engines.liggghts.markers import error_lines
+from siloflow.engines.markers import parse_markers
+from siloflow.engines.silo_checks import check_silo_run
+from siloflow.model.cases.silo_flat import build_silo_case
 
 LOG = """\
 print "SILOFLOW filled step=$(step) time=$(time) clumps=${n_clumps} ke_per_clump=${ke_per_clump}"

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from engines.liggghts.thermo import ThermoProgress, ThermoRow, column_name
-from engines.progress import progress_report
+from siloflow.engines.liggghts.thermo import ThermoProgress, ThermoRow, column_name
+from siloflow.engines.progress import progress_report
 
 # Screen output as LIGGGHTS 3.8 writes it (header names cut to 8 characters, no v_ prefix), with the noise
 # between thermo rows: INFO and WARNING lines, insertion progress, run statistics, blank lines.

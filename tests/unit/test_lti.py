@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.lti (convolution with the RTD, VRR, recirculation) on exact cases."""
+"""Unit tests for siloflow.analysis.numerics.lti (convolution with the RTD, VRR, recirculation) on exact cases."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.lti import (
+from siloflow.analysis.numerics.lti import (
     Recirculation,
     VRRTable,
     carson_royal_recycle,
@@ -20,7 +20,7 @@ from analysis.numerics.lti import (
     variance_reduction_ratio,
     vrr_versus_period,
 )
-from analysis.numerics.rtd import johanson_rtd, perfect_mixer_rtd, plug_flow_rtd
+from siloflow.analysis.numerics.rtd import johanson_rtd, perfect_mixer_rtd, plug_flow_rtd
 
 TAU = 1.0
 DT = 2.0e-3

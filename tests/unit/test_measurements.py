@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from analysis.studies.silo_flat.measured import (
+from siloflow.analysis.studies.silo_flat.measured import (
     MeasurementFormatError,
     compare_with_measurement,
     parse_measured_profiles,

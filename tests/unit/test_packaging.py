@@ -13,7 +13,7 @@ import tomllib
 
 import yaml
 
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 
 PYPROJECT = tomllib.loads((REPO_ROOT / "pyproject.toml").read_text())
 #: The project's own top-level packages.
@@ -37,7 +37,7 @@ def _pipeline_imports() -> dict[str, set[str]]:
     """``{top-level module: {file, ...}}`` of every import in the pipeline's modules, function bodies included (an
     import there runs when the function does)."""
     found: dict[str, set[str]] = {}
-    files = [path for folder in ("model", "engines", "analysis", "calibration", "siloflow", "workflow/scripts")
+    files = [path for folder in ("model", "engines", "analysis", "calibration", "siloflow", "siloflow/workflow/scripts")
              for path in (REPO_ROOT / folder).rglob("*.py") if "__pycache__" not in path.parts]
     for path in files:
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
@@ -87,7 +87,7 @@ def test_the_declared_licence_is_the_one_shipped():
 def test_the_workflow_profile_carries_the_rerun_policy_for_every_snakemake_call():
     """Snakemake reads profiles/default/ beside the Snakefile on every call (plain `snakemake`, the Makefile's, the
     SLURM profile's): a code change reruns no finished simulation; the Makefile does not repeat the policy."""
-    profile = yaml.safe_load((REPO_ROOT / "profiles" / "default" / "config.yaml").read_text())
+    profile = yaml.safe_load((REPO_ROOT / "siloflow" / "workflow" / "profiles" / "default" / "config.yaml").read_text())
     assert profile == {"rerun-triggers": ["mtime", "params", "input"], "rerun-incomplete": True}
     makefile = (REPO_ROOT / "Makefile").read_text()
     assert "--rerun-triggers" not in makefile and "--rerun-incomplete" not in makefile

@@ -1,18 +1,18 @@
 """The fields of a run for ParaView: depth-averaged planar fields (blender, recirculating silo) as .vti with a .pvd
-(analysis.io.planar_fields_vtk), and the flat-bottom silo's field series put on its particles' clock
-(analysis.studies.silo_flat.field_clock with analysis.io.fields.read_pvd / write_pvd). Read back with pyvista."""
+(siloflow.analysis.io.planar_fields_vtk), and the flat-bottom silo's field series put on its particles' clock
+(siloflow.analysis.studies.silo_flat.field_clock with siloflow.analysis.io.fields.read_pvd / write_pvd). Read back with pyvista."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from analysis.io.fields import read_pvd, write_fields_vti, write_pvd
-from analysis.io.planar_fields_vtk import write_planar_field_series, write_planar_field_vti
-from analysis.io.vtk_xml import write_vtk_xml
-from analysis.numerics.grid import Fields, Grid
-from analysis.studies.blender.window_fields import PlanarField
-from analysis.studies.silo_flat.field_clock import field_clock_origin
+from siloflow.analysis.io.fields import read_pvd, write_fields_vti, write_pvd
+from siloflow.analysis.io.planar_fields_vtk import write_planar_field_series, write_planar_field_vti
+from siloflow.analysis.io.vtk_xml import write_vtk_xml
+from siloflow.analysis.numerics.grid import Fields, Grid
+from siloflow.analysis.studies.blender.window_fields import PlanarField
+from siloflow.analysis.studies.silo_flat.field_clock import field_clock_origin
 
 pyvista = pytest.importorskip("pyvista")
 

@@ -1,5 +1,5 @@
 """Lines and walls of a run for ParaView, read back with pyvista: pathlines (one polyline per tracer, with its
-residence time), the recirculating silo's tracks cut into passes (analysis.studies.silo_recirculation.pass_paths),
+residence time), the recirculating silo's tracks cut into passes (siloflow.analysis.studies.silo_recirculation.pass_paths),
 force chains (one two-point line per contact, with its normal force) and the wall meshes of a case."""
 
 from __future__ import annotations
@@ -9,22 +9,22 @@ import math
 import numpy as np
 import pytest
 
-from analysis.io.vtk_lines import (
+from siloflow.analysis.io.vtk_lines import (
     write_force_chains_vtp,
     write_pass_paths_vtp,
     write_pathlines_vtp,
     write_polylines_vtp,
 )
-from analysis.io.vtk_walls import write_walls_vtp
-from analysis.numerics.clump_tracks import ClumpTracks, TrackedClumps
-from analysis.numerics.exit_times import outlet_exits
-from analysis.numerics.force_chains import force_chain_segments
-from analysis.numerics.pathlines import EXITED, NOT_EXITED, OUTSIDE, PathlineResult, integrate_pathlines
-from analysis.studies.silo_recirculation.pass_paths import pass_paths
-from model.cases.geometry import horizontal_rectangle, vertical_rectangle_x
-from model.cases.kinds import CASE_KINDS
-from model.cases.silo_flat import silo_meshes
-from model.contacts import ContactFrame
+from siloflow.analysis.io.vtk_walls import write_walls_vtp
+from siloflow.analysis.numerics.clump_tracks import ClumpTracks, TrackedClumps
+from siloflow.analysis.numerics.exit_times import outlet_exits
+from siloflow.analysis.numerics.force_chains import force_chain_segments
+from siloflow.analysis.numerics.pathlines import EXITED, NOT_EXITED, OUTSIDE, PathlineResult, integrate_pathlines
+from siloflow.analysis.studies.silo_recirculation.pass_paths import pass_paths
+from siloflow.model.cases.geometry import horizontal_rectangle, vertical_rectangle_x
+from siloflow.model.cases.kinds import CASE_KINDS
+from siloflow.model.cases.silo_flat import silo_meshes
+from siloflow.model.contacts import ContactFrame
 
 pyvista = pytest.importorskip("pyvista")
 

@@ -1,4 +1,4 @@
-"""analysis.io.particle_series: a run's particle frames as .vtp files with a .pvd on the simulated clock, read back
+"""siloflow.analysis.io.particle_series: a run's particle frames as .vtp files with a .pvd on the simulated clock, read back
 with pyvista exactly (points, vertex cells, every array the frame carries, times)."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.io.particle_series import particle_file_name, write_particle_frame_vtp, write_particle_series
-from model.frames import ParticleFrame
+from siloflow.analysis.io.particle_series import particle_file_name, write_particle_frame_vtp, write_particle_series
+from siloflow.model.frames import ParticleFrame
 
 pyvista = pytest.importorskip("pyvista")
 

@@ -1,4 +1,4 @@
-"""analysis.io.paraview_state: the ParaView state of a run names exactly the files of its folder, relative to itself,
+"""siloflow.analysis.io.paraview_state: the ParaView state of a run names exactly the files of its folder, relative to itself,
 so a copied run folder opens; with ParaView installed, pvpython runs it and finds every file, time and array."""
 
 from __future__ import annotations
@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.io.paraview_state import StateLines, paraview_state_script, write_paraview_state
-from analysis.io.particle_series import write_particle_series
-from analysis.io.planar_fields_vtk import write_planar_field_series
-from analysis.io.vtk_lines import write_force_chains_vtp, write_polylines_vtp
-from analysis.io.vtk_walls import write_walls_vtp
-from analysis.numerics.force_chains import ForceChainSegments
-from analysis.studies.blender.window_fields import PlanarField
-from model.cases.geometry import horizontal_rectangle
-from model.frames import ParticleFrame
+from siloflow.analysis.io.paraview_state import StateLines, paraview_state_script, write_paraview_state
+from siloflow.analysis.io.particle_series import write_particle_series
+from siloflow.analysis.io.planar_fields_vtk import write_planar_field_series
+from siloflow.analysis.io.vtk_lines import write_force_chains_vtp, write_polylines_vtp
+from siloflow.analysis.io.vtk_walls import write_walls_vtp
+from siloflow.analysis.numerics.force_chains import ForceChainSegments
+from siloflow.analysis.studies.blender.window_fields import PlanarField
+from siloflow.model.cases.geometry import horizontal_rectangle
+from siloflow.model.frames import ParticleFrame
 from tests.paraview_checks import named_files, open_state_in_pvpython
 
 pytest.importorskip("pyvista")

@@ -1,11 +1,11 @@
-"""Unit tests for analysis.numerics.pathlines: virtual tracers through velocity fields with exact residence times."""
+"""Unit tests for siloflow.analysis.numerics.pathlines: virtual tracers through velocity fields with exact residence times."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from analysis.numerics.pathlines import (
+from siloflow.analysis.numerics.pathlines import (
     EXITED,
     HAVE_NUMBA,
     NOT_EXITED,
@@ -15,8 +15,8 @@ from analysis.numerics.pathlines import (
     interpolate_velocity,
     time_levels,
 )
-from analysis.numerics.rtd import rtd_from_exit_times
-from analysis.numerics.tracer_seeds import lattice_seeds
+from siloflow.analysis.numerics.rtd import rtd_from_exit_times
+from siloflow.analysis.numerics.tracer_seeds import lattice_seeds
 from tests.bench.bench_pathlines import integrate_with_scipy, max_relative_difference
 
 BACKENDS = ["numba", "numpy"] if HAVE_NUMBA else ["numpy"]

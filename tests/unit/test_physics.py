@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from model.cases.particles import model_parameters, particle_template
-from model.cases.physics import (
+from siloflow.model.cases.particles import model_parameters, particle_template
+from siloflow.model.cases.physics import (
     engine_seeds, free_fall_time, free_fall_velocity, hertz_contact_time, is_prime, rayleigh_time, stable_timestep, steps_for,
 )
 

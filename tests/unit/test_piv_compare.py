@@ -8,14 +8,14 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from analysis.io.measured_piv import load_measured_piv, measured_piv_paths
-from analysis.piv.accuracy import derived_errors, profile_error_rows
-from analysis.piv.calibration import ImageScale
-from analysis.piv.compare import comparison_rows, dem_front_wall, error_band, profile_pairs
-from analysis.piv.derived import field_quantities, planar_profile
-from analysis.piv.field import PivRows, PlanarField
-from analysis.piv.measured import MeasuredPiv, check_windows, measured_fields, measured_piv_settings
-from analysis.studies.silo_flat.piv_plots import plot_piv_comparison
+from siloflow.analysis.io.measured_piv import load_measured_piv, measured_piv_paths
+from siloflow.analysis.piv.accuracy import derived_errors, profile_error_rows
+from siloflow.analysis.piv.calibration import ImageScale
+from siloflow.analysis.piv.compare import comparison_rows, dem_front_wall, error_band, profile_pairs
+from siloflow.analysis.piv.derived import field_quantities, planar_profile
+from siloflow.analysis.piv.field import PivRows, PlanarField
+from siloflow.analysis.piv.measured import MeasuredPiv, check_windows, measured_fields, measured_piv_settings
+from siloflow.analysis.studies.silo_flat.piv_plots import plot_piv_comparison
 
 X = np.round(np.arange(-0.05, 0.0501, 0.005), 6)  # 21 nodes, one at x = 0
 Z = np.array([0.02, 0.04])

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 import scipy.io
 
-from analysis.io.piv import PivFormatError, read_davis, read_openpiv, read_pivlab_mat, read_pivlab_txt
-from analysis.piv.field import NODE_KINDS
+from siloflow.analysis.io.piv import PivFormatError, read_davis, read_openpiv, read_pivlab_mat, read_pivlab_txt
+from siloflow.analysis.piv.field import NODE_KINDS
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures" / "piv"
 

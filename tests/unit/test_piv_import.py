@@ -10,7 +10,7 @@ import openpiv.tools
 import pytest
 import scipy.io
 
-from analysis.io.piv import (
+from siloflow.analysis.io.piv import (
     PivFormatError,
     PivReadOptions,
     read_openpiv,
@@ -20,11 +20,11 @@ from analysis.io.piv import (
     read_pivlab_txt,
     write_piv_csv,
 )
-from analysis.io.piv_base import axis_steps
-from analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
-from analysis.piv.field import NODE_KINDS, PivRows, PlanarField, field_from_rows, time_average
-from analysis.piv.hampel import hampel_filter, hampel_outliers
-from analysis.piv.measured import MeasuredPiv
+from siloflow.analysis.io.piv_base import axis_steps
+from siloflow.analysis.piv.calibration import ImageScale, piv_field, scale_from_markers
+from siloflow.analysis.piv.field import NODE_KINDS, PivRows, PlanarField, field_from_rows, time_average
+from siloflow.analysis.piv.hampel import hampel_filter, hampel_outliers
+from siloflow.analysis.piv.measured import MeasuredPiv
 
 # ---------------------------------------------------------------------------------------------- the scale
 

@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.io.measured_piv import load_measured_piv
-from analysis.io.piv import PivReadOptions, read_options, read_pivlab_txt
-from analysis.piv.calibration import ImageScale
-from analysis.piv.field import (
+from siloflow.analysis.io.measured_piv import load_measured_piv
+from siloflow.analysis.io.piv import PivReadOptions, read_options, read_pivlab_txt
+from siloflow.analysis.piv.calibration import ImageScale
+from siloflow.analysis.piv.field import (
     DEFAULT_VALID_KINDS,
     INTERPOLATED,
     MEASURED,
@@ -24,8 +24,8 @@ from analysis.piv.field import (
     field_from_rows,
     kind_codes,
 )
-from analysis.piv.measured import MeasuredPiv, measured_fields, measured_piv_settings
-from engines.config import ConfigError, validate_config
+from siloflow.analysis.piv.measured import MeasuredPiv, measured_fields, measured_piv_settings
+from siloflow.engines.config import ConfigError, validate_config
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures" / "piv"
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.piv.accuracy import (
+from siloflow.analysis.piv.accuracy import (
     PivSettings,
     accuracy_row,
     accuracy_table,
@@ -14,11 +14,11 @@ from analysis.piv.accuracy import (
     synthetic_piv,
     visible_top,
 )
-from analysis.piv.calibration import ImageScale
-from analysis.piv.field import PlanarField
-from analysis.piv.front_wall import field_errors, front_wall_image, front_wall_spheres, window_mean_velocity
-from analysis.piv.synthetic import piv_displacements, render_particle_image
-from analysis.studies.silo_flat.piv_plots import plot_piv_accuracy
+from siloflow.analysis.piv.calibration import ImageScale
+from siloflow.analysis.piv.field import PlanarField
+from siloflow.analysis.piv.front_wall import field_errors, front_wall_image, front_wall_spheres, window_mean_velocity
+from siloflow.analysis.piv.synthetic import piv_displacements, render_particle_image
+from siloflow.analysis.studies.silo_flat.piv_plots import plot_piv_accuracy
 
 HEIGHT, WIDTH = 400, 320
 

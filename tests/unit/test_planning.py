@@ -6,12 +6,12 @@ import math
 
 import pytest
 
-import engines.planning as planning
-from model.record import RunRecord
-from engines.config import load_config
-from model.cost import CostModel, MeasuredWork, RunEstimate
-from engines.estimates import InsufficientDiskSpace
-from engines.planning import (
+import siloflow.engines.planning as planning
+from siloflow.model.record import RunRecord
+from siloflow.engines.config import load_config
+from siloflow.model.cost import CostModel, MeasuredWork, RunEstimate
+from siloflow.engines.estimates import InsufficientDiskSpace
+from siloflow.engines.planning import (
     COMPARISON_COLUMNS,
     calibrated_model,
     check_run_disk_space,

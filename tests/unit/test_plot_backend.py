@@ -8,11 +8,11 @@ import os
 import subprocess
 import sys
 
-from engines.config import REPO_ROOT
+from tests.repo import REPO_ROOT
 
-#: The packages whose every module is imported; ``siloflow`` (the user-facing API) only where it exists.
-PACKAGES = ("analysis", "calibration", "engines", "model")
-OPTIONAL_PACKAGES = ("siloflow",)
+#: The packages whose every module is imported; the notebook API (``siloflow.api``) only where it exists.
+PACKAGES = ("siloflow.analysis", "siloflow.calibration", "siloflow.engines", "siloflow.model")
+OPTIONAL_PACKAGES = ("siloflow.api",)
 #: A backend other than the default that works without a display, as a notebook's own choice stands for.
 OWN_BACKEND = "svg"
 
@@ -52,7 +52,7 @@ def test_importing_every_module_keeps_the_backend_the_user_chose():
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout.splitlines()[-1])
     assert not found["failed"], f"modules that did not import: {found['failed']}"
-    assert {"analysis.io.plots", "calibration.charts", "analysis.studies.silo_flat.plots"} <= set(found["modules"])
+    assert {"siloflow.analysis.io.plots", "siloflow.calibration.charts", "siloflow.analysis.studies.silo_flat.plots"} <= set(found["modules"])
     assert found["pyplot"], "no module imported pyplot: the test would not see a backend switched on its import"
     assert found["before"] == OWN_BACKEND
     assert found["after"] == OWN_BACKEND, f"importing siloflow switched matplotlib's backend to {found['after']!r}"

@@ -1,5 +1,5 @@
-"""Unit tests for the discharge plot (analysis.studies.silo_flat.plots: the PNG and the plotted data) and
-analysis.io.tables (files under tmp_path only)."""
+"""Unit tests for the discharge plot (siloflow.analysis.studies.silo_flat.plots: the PNG and the plotted data) and
+siloflow.analysis.io.tables (files under tmp_path only)."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from analysis.numerics.flow import DischargeHistory, discharged_mass_history, steady_flow_rate
-from analysis.studies.silo_flat.plots import plot_discharge
-from analysis.io.tables import markdown_table, write_discharge_history_csv, write_flow_table, write_json, write_text
+from siloflow.analysis.numerics.flow import DischargeHistory, discharged_mass_history, steady_flow_rate
+from siloflow.analysis.studies.silo_flat.plots import plot_discharge
+from siloflow.analysis.io.tables import markdown_table, write_discharge_history_csv, write_flow_table, write_json, write_text
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

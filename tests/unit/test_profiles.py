@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.profiles, .kinematic and .janssen on synthetic profiles with exact answers."""
+"""Unit tests for siloflow.analysis.numerics.profiles, .kinematic and .janssen on synthetic profiles with exact answers."""
 
 from __future__ import annotations
 
@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.grid import Fields, Grid
-from analysis.numerics.coarse_graining import coarse_grain
-from analysis.numerics.field_ops import depth_average
-from analysis.numerics.janssen import janssen_characteristic_depth, janssen_coefficient, janssen_vertical_stress
-from analysis.numerics.kinematic import (
+from siloflow.analysis.numerics.grid import Fields, Grid
+from siloflow.analysis.numerics.coarse_graining import coarse_grain
+from siloflow.analysis.numerics.field_ops import depth_average
+from siloflow.analysis.numerics.janssen import janssen_characteristic_depth, janssen_coefficient, janssen_vertical_stress
+from siloflow.analysis.numerics.kinematic import (
     KinematicFit,
     fit_kinematic_constant,
     kinematic_horizontal_velocity,
     kinematic_velocity,
 )
-from analysis.numerics.profiles import (
+from siloflow.analysis.numerics.profiles import (
     FlowChannelBoundary,
     ProfileErrors,
     flow_channel_boundary,

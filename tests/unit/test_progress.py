@@ -14,8 +14,8 @@ import threading
 
 import pytest
 
-from engines.liggghts.thermo import ThermoProgress, ThermoRow
-from engines.progress import Progress, ProgressMonitor, progress_report
+from siloflow.engines.liggghts.thermo import ThermoProgress, ThermoRow
+from siloflow.engines.progress import Progress, ProgressMonitor, progress_report
 
 HEADER = "Step Atoms Time n_clumps ke_per_c CPU\n"
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 import scipy.io
 
-from analysis.io import piv_base
-from analysis.io.measured_piv import measured_piv_paths
-from analysis.io.piv import PivFormatError, read_piv_file
-from analysis.io.piv_base import not_a_number
-from analysis.studies.silo_flat.measured import MeasurementFormatError, read_measured_profiles
+from siloflow.analysis.io import piv_base
+from siloflow.analysis.io.measured_piv import measured_piv_paths
+from siloflow.analysis.io.piv import PivFormatError, read_piv_file
+from siloflow.analysis.io.piv_base import not_a_number
+from siloflow.analysis.studies.silo_flat.measured import MeasurementFormatError, read_measured_profiles
 
 SECRET = "SECRET_TOKEN=abc"
 #: /proc/self/environ's layout: NAME=value entries separated by NUL bytes, no line end.

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.silo_recirculation.bulk_density import flowing_bulk_density, slab_bulk_density
-from engines.config import ConfigError, validate_config
+from siloflow.analysis.studies.silo_recirculation.bulk_density import flowing_bulk_density, slab_bulk_density
+from siloflow.engines.config import ConfigError, validate_config
 
 
 def test_slab_density_is_the_mass_of_the_centres_inside_over_the_slab_volume():

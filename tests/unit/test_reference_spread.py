@@ -6,13 +6,13 @@ import math
 
 import pytest
 
-from analysis.numerics.reference_spread import (combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
+from siloflow.analysis.numerics.reference_spread import (combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
                                                with_reference_spread)
-from calibration.friction import SECOND_HALF, STEADY, combined_window_method
-from model.cases import cases_of, reference_runs
-from model.cases.jenike import jenike_cases
-from model.cases.jenike_sweep import reference_point, sweep_points
-from engines.config import validate_config
+from siloflow.calibration.friction import SECOND_HALF, STEADY, combined_window_method
+from siloflow.model.cases import cases_of, reference_runs
+from siloflow.model.cases.jenike import jenike_cases
+from siloflow.model.cases.jenike_sweep import reference_point, sweep_points
+from siloflow.engines.config import validate_config
 
 
 def _run(flow, index, vrr, problems=()):

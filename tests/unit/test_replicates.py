@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from analysis.numerics.replicates import combine_replicates, replicate_error
+from siloflow.analysis.numerics.replicates import combine_replicates, replicate_error
 
 
 def test_one_seed_keeps_its_within_run_error():

@@ -1,18 +1,18 @@
-"""The results layout is defined once (engines/layout.py): the rule files build every path from its names, and never
+"""The results layout is defined once (siloflow/engines/layout.py): the rule files build every path from its names, and never
 write a folder of results/ themselves."""
 
 from __future__ import annotations
 
 import re
 
-from engines.config import REPO_ROOT
-from engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CROSS_ENGINE_DIR, RESULTS, SUMMARY_DIR, VALIDATION_RECORD,
+from tests.repo import REPO_ROOT
+from siloflow.engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CROSS_ENGINE_DIR, RESULTS, SUMMARY_DIR, VALIDATION_RECORD,
                             VERIFICATION_DIR, case_root)
-from model.cases.kinds import configured_kinds
+from siloflow.model.cases.kinds import configured_kinds
 
 
 def test_the_rule_files_write_no_results_folder_of_their_own():
-    for path in sorted((REPO_ROOT / "workflow" / "rules").glob("*.smk")):
+    for path in sorted((REPO_ROOT / "siloflow" / "workflow" / "rules").glob("*.smk")):
         text = path.read_text()
         assert not re.search(r"\{RESULTS\}/", text.replace('{RESULTS}/ (', "")), f"{path.name} builds a results path"
         assert '"results/' not in text, f"{path.name} names a results folder"

@@ -6,14 +6,14 @@ from pathlib import Path
 
 import pytest
 
-from model.cases.blender import build_blender_case
-from model.cases.silo_recirculation import build_recirculation_case
-from engines.config import load_config
-from engines.liggghts.run import Resume, attempt_logs, restart_every, restart_files
-from engines.liggghts.silo_flat import silo_deck_context
-from engines.liggghts.blender import blender_deck_context
-from engines.liggghts.silo_recirculation import recirculation_deck_context
-from model.cases.silo_flat import build_silo_case
+from siloflow.model.cases.blender import build_blender_case
+from siloflow.model.cases.silo_recirculation import build_recirculation_case
+from siloflow.engines.config import load_config
+from siloflow.engines.liggghts.run import Resume, attempt_logs, restart_every, restart_files
+from siloflow.engines.liggghts.silo_flat import silo_deck_context
+from siloflow.engines.liggghts.blender import blender_deck_context
+from siloflow.engines.liggghts.silo_recirculation import recirculation_deck_context
+from siloflow.model.cases.silo_flat import build_silo_case
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.rtd on samples and curves with exact answers."""
+"""Unit tests for siloflow.analysis.numerics.rtd on samples and curves with exact answers."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.rtd import (
+from siloflow.analysis.numerics.rtd import (
     RTD,
     RTDMoments,
     johanson_rtd,
@@ -16,7 +16,7 @@ from analysis.numerics.rtd import (
     rtd_from_exit_times,
     rtd_moments,
 )
-from analysis.numerics.residence_statistics import (
+from siloflow.analysis.numerics.residence_statistics import (
     appearance_times,
     cohort_means_within,
     mean_residence_time,

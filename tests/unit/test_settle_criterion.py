@@ -8,11 +8,11 @@ import math
 
 import pytest
 
-from model.constants import GRAVITY
-from model.cases.blender import build_blender_case
-from model.cases.silo_flat import build_silo_case
-from model.cases.silo_recirculation import build_recirculation_case
-from engines.config import ConfigError, validate_config
+from siloflow.model.constants import GRAVITY
+from siloflow.model.cases.blender import build_blender_case
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.model.cases.silo_recirculation import build_recirculation_case
+from siloflow.engines.config import ConfigError, validate_config
 
 #: The single-sphere clump of the default particle models: radius 1.9 mm, hdpe of 950 kg/m^3.
 SPHERE_DIAMETER = 0.0038

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engines.liggghts.contacts import ContactDumpError
-from engines.liggghts.jenike import SETTLED_CONTACT_PREFIX, read_jenike_pair_contacts
-from engines.liggghts.settled import SETTLED_COLUMNS, read_settled_fill
+from siloflow.engines.liggghts.contacts import ContactDumpError
+from siloflow.engines.liggghts.jenike import SETTLED_CONTACT_PREFIX, read_jenike_pair_contacts
+from siloflow.engines.liggghts.settled import SETTLED_COLUMNS, read_settled_fill
 
 STEP = 200
 TIMESTEP = 1e-5

@@ -7,10 +7,10 @@ import math
 
 import pytest
 
-from engines.config import validate_config
-from model.cases.common import material_table, run_id
-from model.cases import case_for_run
-from model.cases.silo_flat import build_silo_case
+from siloflow.engines.config import validate_config
+from siloflow.model.cases.common import material_table, run_id
+from siloflow.model.cases import case_for_run
+from siloflow.model.cases.silo_flat import build_silo_case
 
 
 def test_clump_count_follows_the_fill_height(tiny_config):

@@ -1,4 +1,4 @@
-"""The writer of a silo field study's files (analysis.io.silo_field_study): every file it names, with what the study
+"""The writer of a silo field study's files (siloflow.analysis.io.silo_field_study): every file it names, with what the study
 holds, and nothing written when a destination is missing."""
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from model.frames import ClumpFrame
-from analysis.io.fields import load_fields_npz, read_fields_vti
-from analysis.io.silo_field_study import SILO_FIELD_STUDY_FILES, write_silo_field_study
-from analysis.io.tables import read_table
-from analysis.studies.silo_flat.field_study import (
+from siloflow.model.frames import ClumpFrame
+from siloflow.analysis.io.fields import load_fields_npz, read_fields_vti
+from siloflow.analysis.io.silo_field_study import SILO_FIELD_STUDY_FILES, write_silo_field_study
+from siloflow.analysis.io.tables import read_table
+from siloflow.analysis.studies.silo_flat.field_study import (
     SiloDimensions,
     SiloFieldOptions,
     analyse_silo_fields,

@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 from scipy.optimize import OptimizeWarning
 
-from model.cases.silo_flat import build_silo_case
-from model.contacts import ContactFrame
-from model.frames import ClumpFrame
-from model.constants import GRAVITY
-from analysis.numerics.field_ops import depth_average
-from analysis.numerics.grid import Fields, Grid
-from analysis.numerics.profiles import flow_channel_boundary, velocity_profile
-from analysis.numerics.janssen import janssen_vertical_stress
-from analysis.studies.silo_flat.field_comparisons import (
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.model.contacts import ContactFrame
+from siloflow.model.frames import ClumpFrame
+from siloflow.model.constants import GRAVITY
+from siloflow.analysis.numerics.field_ops import depth_average
+from siloflow.analysis.numerics.grid import Fields, Grid
+from siloflow.analysis.numerics.profiles import flow_channel_boundary, velocity_profile
+from siloflow.analysis.numerics.janssen import janssen_vertical_stress
+from siloflow.analysis.studies.silo_flat.field_comparisons import (
     MEASURED_PLANES,
     compare_with_measurements,
     comparison_plane,
@@ -27,7 +27,7 @@ from analysis.studies.silo_flat.field_comparisons import (
     parametric_profiles,
     parametric_rows,
 )
-from analysis.studies.silo_flat.field_study import (
+from siloflow.analysis.studies.silo_flat.field_study import (
     COVERED_DENSITY_FRACTION,
     FIELD_BATCHES,
     SURFACE_COLUMN_DIAMETERS,
@@ -46,7 +46,7 @@ from analysis.studies.silo_flat.field_study import (
     profile_rows,
     vtk_series,
 )
-from analysis.studies.silo_flat.fields import (
+from siloflow.analysis.studies.silo_flat.fields import (
     FieldSettings,
     JanssenComparison,
     ProfileAnalysis,
@@ -60,7 +60,7 @@ from analysis.studies.silo_flat.fields import (
     profile_uncertainty,
     silo_grid,
 )
-from analysis.studies.silo_flat.measured import MeasuredProfile
+from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile
 
 
 def test_grid_tiles_the_silo_and_rounds_the_top_up_to_whole_cells():

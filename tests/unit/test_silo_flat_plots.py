@@ -1,4 +1,4 @@
-"""Unit tests for the flat-bottom silo plots (analysis.studies.silo_flat.plots): each writes its PNG and the figure
+"""Unit tests for the flat-bottom silo plots (siloflow.analysis.studies.silo_flat.plots): each writes its PNG and the figure
 it returns shows the synthetic input, scaled to the axes' units (files under tmp_path only).
 
 The discharge plot is tested in test_plots_tables.py.
@@ -10,11 +10,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from analysis.numerics.force_chains import ForceChainSegments
-from analysis.numerics.flow import DischargeHistory, FlowRateFit
-from analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis, ProfileUncertainty
-from analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
-from analysis.studies.silo_flat.plots import (
+from siloflow.analysis.numerics.force_chains import ForceChainSegments
+from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
+from siloflow.analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis, ProfileUncertainty
+from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
+from siloflow.analysis.studies.silo_flat.plots import (
     plot_centreline_velocity,
     plot_discharge,
     plot_force_chains,

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from model.frames import ClumpFrame
-from analysis.numerics.flow import DischargeHistory, steady_flow_rate
-from analysis.studies.silo_flat.metrics import (
+from siloflow.model.frames import ClumpFrame
+from siloflow.analysis.numerics.flow import DischargeHistory, steady_flow_rate
+from siloflow.analysis.studies.silo_flat.metrics import (
     FLOW_RATE_BATCHES,
     SLAB_DIAMETERS,
     EscapedParticles,

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import copy
 
-from engines.liggghts.silo_flat import render_silo_deck
-from model.cases.silo_flat import build_silo_case, parametric_variants, silo_cases
+from siloflow.engines.liggghts.silo_flat import render_silo_deck
+from siloflow.model.cases.silo_flat import build_silo_case, parametric_variants, silo_cases
 
 
 def _contact(config, a, b):

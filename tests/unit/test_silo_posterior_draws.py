@@ -5,7 +5,7 @@ import math
 import pytest
 from scipy import stats
 
-from analysis.studies.silo_flat.posterior_draws import (
+from siloflow.analysis.studies.silo_flat.posterior_draws import (
     POSTERIOR_MEAN, base_vertical_stress, calibration_spread, posterior_draw_rows,
 )
 

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation (tracks, concentration, vrr, tracers) on exact cases.
+"""Unit tests for siloflow.analysis.studies.silo_recirculation (tracks, concentration, vrr, tracers) on exact cases.
 
 Most tests use a "conveyor": N clumps evenly spaced along z, all moving down at a constant speed
 through the periodic domain, so every crossing, re-entry and pass is known in closed form.
@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from model.frames import ClumpFrame, ParticleFrame
-from analysis.numerics.rtd import rtd_from_exit_times
-from analysis.studies.silo_recirculation.concentration import (
+from siloflow.model.frames import ClumpFrame, ParticleFrame
+from siloflow.analysis.numerics.rtd import rtd_from_exit_times
+from siloflow.analysis.studies.silo_recirculation.concentration import (
     OutletConcentration,
     batch_inlet_signal,
     first_pass_concentration,
@@ -21,10 +21,10 @@ from analysis.studies.silo_recirculation.concentration import (
     outlet_concentration,
     predicted_concentration_from_first_pass,
 )
-from analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_count, tracer_passes
-from analysis.numerics.clump_tracks import ClumpTracks, clump_tracks, tracks_from_frames
-from analysis.studies.silo_recirculation.tracks import RecirculationEvents, clumps_above_outlet, recirculation_events
-from analysis.studies.silo_recirculation.vrr import (
+from siloflow.analysis.studies.silo_recirculation.tracers import TracerPasses, tracer_count, tracer_passes
+from siloflow.analysis.numerics.clump_tracks import ClumpTracks, clump_tracks, tracks_from_frames
+from siloflow.analysis.studies.silo_recirculation.tracks import RecirculationEvents, clumps_above_outlet, recirculation_events
+from siloflow.analysis.studies.silo_recirculation.vrr import (
     RecirculationVRR,
     holdup_residence_time,
     recirculation_number,

@@ -10,17 +10,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.cases import case_for_run
-from model.cases.silo_recirculation import (
+from siloflow.model.cases import case_for_run
+from siloflow.model.cases.silo_recirculation import (
     apply_flow_pattern,
     build_recirculation_case,
     estimated_residence_time,
     recirculation_cases,
 )
-from model.cases.physics import steps_for
-from engines.config import ConfigError, load_config, validate_config
-from model.cases.silo_recirculation import recirculation_meshes
-from engines.liggghts.silo_recirculation import render_recirculation_deck, write_recirculation_inputs
+from siloflow.model.cases.physics import steps_for
+from siloflow.engines.config import ConfigError, load_config, validate_config
+from siloflow.model.cases.silo_recirculation import recirculation_meshes
+from siloflow.engines.liggghts.silo_recirculation import render_recirculation_deck, write_recirculation_inputs
 from tests.golden_files import assert_matches_golden
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"

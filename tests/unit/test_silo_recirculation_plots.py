@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.plots and .rtd_plots: PNGs are written (under tmp_path only)
+"""Unit tests for siloflow.analysis.studies.silo_recirculation.plots and .rtd_plots: PNGs are written (under tmp_path only)
 and the plotted data are the input, as each writer's docstring promises."""
 
 from __future__ import annotations
@@ -10,16 +10,16 @@ from matplotlib.collections import PathCollection
 from matplotlib.colors import to_hex
 from matplotlib.path import Path as MplPath
 
-import analysis.studies.silo_recirculation.plots as plots
-import analysis.studies.silo_recirculation.rtd_plots as rtd_plots
+import siloflow.analysis.studies.silo_recirculation.plots as plots
+import siloflow.analysis.studies.silo_recirculation.rtd_plots as rtd_plots
 from tests.plot_data import saved_figures
-from analysis.studies.silo_recirculation.plots import (
+from siloflow.analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
     plot_outlet_concentration,
     plot_paths_comparison,
     plot_vrr_versus_recirculations,
 )
-from analysis.studies.silo_recirculation.rtd_plots import (
+from siloflow.analysis.studies.silo_recirculation.rtd_plots import (
     plot_lti_comparison,
     plot_recirculation_model,
     plot_residence_time_comparison,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.shortcut on the plug-flow conveyor of
+"""Unit tests for siloflow.analysis.studies.silo_recirculation.shortcut on the plug-flow conveyor of
 ``test_silo_recirculation_study.py`` (100 clumps moving down at 0.1 m/s through a periodic domain; t_res = 7.5 s,
 every pass exactly 7.5 s, 30 s of frames = 4 recirculations).
 
@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.studies.silo_recirculation.configured import analyse_configured, configured_layouts
-from analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
-from analysis.studies.silo_recirculation.study import Layout, analyse_blending
+from siloflow.analysis.studies.silo_recirculation.configured import analyse_configured, configured_layouts
+from siloflow.analysis.studies.silo_recirculation.shortcut import shortcut_rows, tracks_until
+from siloflow.analysis.studies.silo_recirculation.study import Layout, analyse_blending
 from tests.unit.test_silo_recirculation_study import (
     BOTTOM, LAYOUTS, OUTLET, PASS_TIME, PASSES, PERIOD_FRACTIONS, RTD_BINS, TIMES, TOLERANCE, TOP, TRACER_FRACTION,
     TRACER_START, WINDOW_FRACTION, conveyor_tracks,

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.study (the composed blending analysis) on exact cases.
+"""Unit tests for siloflow.analysis.studies.silo_recirculation.study (the composed blending analysis) on exact cases.
 
 Most tests use the "conveyor" of ``test_silo_recirculation_blending.py`` (helpers copied here): 100 clumps evenly spaced
 along z, all moving down at 0.1 m/s through a domain periodic in z, so every crossing, re-entry, pass,
@@ -21,9 +21,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.clump_tracks import ClumpTracks
-from analysis.studies.silo_recirculation.tracks import RecirculationEvents, recirculation_events
-from analysis.studies.silo_recirculation.study import (
+from siloflow.analysis.numerics.clump_tracks import ClumpTracks
+from siloflow.analysis.studies.silo_recirculation.tracks import RecirculationEvents, recirculation_events
+from siloflow.analysis.studies.silo_recirculation.study import (
     residence_summary,
     BlendingResult,
     Layout,
@@ -37,7 +37,7 @@ from analysis.studies.silo_recirculation.study import (
     snapshot_frames,
     verify_eulerian_rtd,
 )
-from analysis.numerics.rtd import johanson_rtd
+from siloflow.analysis.numerics.rtd import johanson_rtd
 
 # --------------------------------------------------------------------------- the conveyor
 

@@ -1,4 +1,4 @@
-"""Unit tests for analysis.studies.silo_recirculation.tables: the rows and summaries of a hand-built result.
+"""Unit tests for siloflow.analysis.studies.silo_recirculation.tables: the rows and summaries of a hand-built result.
 
 The result is built by hand from its dataclasses, with numbers chosen so every row follows in closed form:
 ``t_open = 0``, ``t_res = 2 s``, windows of 1 s (centres 0.5, 1.5, 2.5 s, so Nr = 0.25, 0.75, 1.25), 4, 4 and
@@ -15,11 +15,11 @@ import math
 import numpy as np
 import pytest
 
-from analysis.io.tables import write_flow_table, write_json
-from analysis.numerics.lti import VRRTable
-from analysis.numerics.rtd import RTD
-from analysis.studies.silo_recirculation.concentration import OutletConcentration
-from analysis.studies.silo_recirculation.study import (
+from siloflow.analysis.io.tables import write_flow_table, write_json
+from siloflow.analysis.numerics.lti import VRRTable
+from siloflow.analysis.numerics.rtd import RTD
+from siloflow.analysis.studies.silo_recirculation.concentration import OutletConcentration
+from siloflow.analysis.studies.silo_recirculation.study import (
     BlendingResult,
     Layout,
     LayoutResult,
@@ -27,7 +27,7 @@ from analysis.studies.silo_recirculation.study import (
     ParticleRTD,
     VerificationResult,
 )
-from analysis.studies.silo_recirculation.tables import (
+from siloflow.analysis.studies.silo_recirculation.tables import (
     blending_summary,
     clumps_per_window,
     concentration_rows,
@@ -40,10 +40,10 @@ from analysis.studies.silo_recirculation.tables import (
     vrr_period_rows,
     vrr_rows,
 )
-from analysis.numerics.uncertainty import Estimate
-from analysis.studies.silo_recirculation.tracers import TracerPasses
-from analysis.studies.silo_recirculation.transit import TransitLittlesLaw
-from analysis.studies.silo_recirculation.vrr import LittlesLaw, RecirculationVRR
+from siloflow.analysis.numerics.uncertainty import Estimate
+from siloflow.analysis.studies.silo_recirculation.tracers import TracerPasses
+from siloflow.analysis.studies.silo_recirculation.transit import TransitLittlesLaw
+from siloflow.analysis.studies.silo_recirculation.vrr import LittlesLaw, RecirculationVRR
 
 NAN = math.nan
 EDGES = np.array([0.0, 1.0, 2.0, 3.0])

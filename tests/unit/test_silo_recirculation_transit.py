@@ -23,12 +23,12 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.residence_statistics import mean_residence_time
-from analysis.studies.silo_recirculation.study import loop_timing, transit_timing
-from analysis.studies.silo_recirculation.tracers import tracer_passes
-from analysis.numerics.clump_tracks import ClumpTracks
-from analysis.studies.silo_recirculation.tracks import recirculation_events
-from analysis.studies.silo_recirculation.transit import (
+from siloflow.analysis.numerics.residence_statistics import mean_residence_time
+from siloflow.analysis.studies.silo_recirculation.study import loop_timing, transit_timing
+from siloflow.analysis.studies.silo_recirculation.tracers import tracer_passes
+from siloflow.analysis.numerics.clump_tracks import ClumpTracks
+from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
+from siloflow.analysis.studies.silo_recirculation.transit import (
     passes_in_progress,
     stagnant_clumps,
     transit_horizon,

@@ -1,4 +1,4 @@
-"""Unit tests for the standard errors of the recirculation study's figures (analysis.studies.silo_recirculation.vrr):
+"""Unit tests for the standard errors of the recirculation study's figures (siloflow.analysis.studies.silo_recirculation.vrr):
 the mean residence time from Little's law and the VRR per recirculation, on hand-built series with exact answers."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from analysis.studies.silo_recirculation.vrr import (
+from siloflow.analysis.studies.silo_recirculation.vrr import (
     RecirculationVRR,
     littles_law,
     vrr_by_recirculation,

@@ -18,17 +18,17 @@ import numpy as np
 import pytest
 
 import siloflow
-from analysis.numerics.clump_tracks import clump_tracks, tracks_from_frames
-from analysis.numerics.exit_times import outlet_exits
-from analysis.numerics.lti import vrr_versus_period
-from analysis.numerics.rtd import rtd_from_exit_times
-from analysis.studies.silo_flat.field_study import SiloDimensions, SiloFieldOptions, analyse_silo_fields
-from analysis.studies.silo_recirculation.tracks import recirculation_events
-from engines.config import REPO_ROOT
-from engines.jenike_checks import FORCE_COLUMNS
-from model.constants import GRAVITY
-from model.frames import ParticleFrame
-from model.record import RunRecord
+from siloflow.analysis.numerics.clump_tracks import clump_tracks, tracks_from_frames
+from siloflow.analysis.numerics.exit_times import outlet_exits
+from siloflow.analysis.numerics.lti import vrr_versus_period
+from siloflow.analysis.numerics.rtd import rtd_from_exit_times
+from siloflow.analysis.studies.silo_flat.field_study import SiloDimensions, SiloFieldOptions, analyse_silo_fields
+from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
+from tests.repo import REPO_ROOT
+from siloflow.engines.jenike_checks import FORCE_COLUMNS
+from siloflow.model.constants import GRAVITY
+from siloflow.model.frames import ParticleFrame
+from siloflow.model.record import RunRecord
 from tests.dump_fixtures import write_liggghts_dump
 
 DT = 1e-5  # time step of every synthetic run [s]

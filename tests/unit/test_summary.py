@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.io.tables import read_table, write_flow_table
-from analysis.report.cells import format_cell, format_number, format_value_with_error
-from analysis.report.summary import (
+from siloflow.analysis.io.tables import read_table, write_flow_table
+from siloflow.analysis.report.cells import format_cell, format_number, format_value_with_error
+from siloflow.analysis.report.summary import (
     BLENDER_COLUMNS,
     COLUMNS,
     MEASURED_COLUMNS,
@@ -25,9 +25,9 @@ from analysis.report.summary import (
     summary_html,
     summary_sections,
 )
-from analysis.studies.blender.comparison import comparison_table
-from analysis.studies.silo_flat.field_comparisons import measured_comparison_rows
-from analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
+from siloflow.analysis.studies.blender.comparison import comparison_table
+from siloflow.analysis.studies.silo_flat.field_comparisons import measured_comparison_rows
+from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
 from test_blender_analysis import metrics
 
 PARAMETERS = {

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from engines.config import ConfigError, load_config, validate_config
-from engines.liggghts.inputs import INNER_SPHERE_FRACTION, processor_grid, template_spheres
-from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
-from model.cases.silo_flat import build_silo_case
-from engines.templating import (
+from siloflow.engines.config import ConfigError, load_config, validate_config
+from siloflow.engines.liggghts.inputs import INNER_SPHERE_FRACTION, processor_grid, template_spheres
+from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.templating import (
     UnsafeDeckValue,
     check_context,
     deck_environment,

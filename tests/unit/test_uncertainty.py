@@ -1,4 +1,4 @@
-"""Unit tests for analysis.numerics.uncertainty on synthetic input with exact answers."""
+"""Unit tests for siloflow.analysis.numerics.uncertainty on synthetic input with exact answers."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis.numerics.uncertainty import (
+from siloflow.analysis.numerics.uncertainty import (
     Estimate,
     SeedSpread,
     Significance,
@@ -21,7 +21,7 @@ from analysis.numerics.uncertainty import (
     proportion_interval,
     seed_spread,
 )
-from analysis.numerics.vrr_noise import (
+from siloflow.analysis.numerics.vrr_noise import (
     CEILING_FACTOR,
     vrr_ceiling,
     vrr_near_ceiling,

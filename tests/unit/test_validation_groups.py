@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from engines.config import REPO_ROOT, load_config
-from model.cost import RunEstimate
-from model.cases import REFERENCE, VARIANT
-from model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
-from engines.planning import config_estimates, group_runs
-from engines.validation_groups import (
+from siloflow.engines.config import load_config
+from tests.repo import REPO_ROOT
+from siloflow.model.cost import RunEstimate
+from siloflow.model.cases import REFERENCE, VARIANT
+from siloflow.model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
+from siloflow.engines.planning import config_estimates, group_runs
+from siloflow.engines.validation_groups import (
     COMPLETE,
     GROUP_BUDGET_S,
     GROUPS,
@@ -36,7 +37,7 @@ from engines.validation_groups import (
     split_groups,
     status_lines,
 )
-from analysis.io.validation_record import RUNS as RECORD_RUNS
+from siloflow.analysis.io.validation_record import RUNS as RECORD_RUNS
 from tests.conftest import validation_record_cli
 
 CLI = validation_record_cli()

@@ -12,15 +12,16 @@ import pytest
 import yaml
 from PIL import Image
 
-from model.record import RunRecord, RunRecordError
-from analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
+from siloflow.model.record import RunRecord, RunRecordError
+from siloflow.analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            RECORD_PLOT_COLOURS, read_validation_rows, restore_products,
                                            write_group_record, write_record_plot)
-from analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, provenance_row, record_page, run_wall_time,
+from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, provenance_row, record_page, run_wall_time,
                                               simulated_time)
-from analysis.studies.validation.rows import COLUMNS, row
-from engines.config import REPO_ROOT, load_config_file
-from engines.layout import REPOSITORY_RECORD
+from siloflow.analysis.studies.validation.rows import COLUMNS, row
+from siloflow.engines.config import load_config_file
+from tests.repo import REPO_ROOT
+from siloflow.engines.layout import REPOSITORY_RECORD
 from tests.conftest import validation_record_cli
 
 CLI = validation_record_cli()

@@ -4,13 +4,13 @@ import math
 
 import pytest
 
-from analysis.report.summary import summary_html
-from analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows, rtd_peak
-from analysis.studies.validation.calibration import calibration_rows
-from analysis.studies.validation.rows import NO, UNKNOWN, YES, Criteria, precise, ratio, resolved, row, verdict
-from analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
-from analysis.studies.validation.table import page_sections, scale_limits
-from engines.config import validate_config
+from siloflow.analysis.report.summary import summary_html
+from siloflow.analysis.studies.validation.blending import blender_rows, gravity_rows, recirculation_rows, rtd_peak
+from siloflow.analysis.studies.validation.calibration import calibration_rows
+from siloflow.analysis.studies.validation.rows import NO, UNKNOWN, YES, Criteria, precise, ratio, resolved, row, verdict
+from siloflow.analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows
+from siloflow.analysis.studies.validation.table import page_sections, scale_limits
+from siloflow.engines.config import validate_config
 
 CRITERIA = Criteria()
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from model.frames import ParticleFrame
-from analysis.numerics.verification import (
+from siloflow.model.frames import ParticleFrame
+from siloflow.analysis.numerics.verification import (
     HERTZ_TIME_CONSTANT,
     axis_precession_angle,
     incline_acceleration,
@@ -21,8 +21,8 @@ from analysis.numerics.verification import (
     sliding_to_rolling,
     zero_crossings,
 )
-from analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
-from model.cases.verification import PROBLEMS, verification_cases
+from siloflow.analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
+from siloflow.model.cases.verification import PROBLEMS, verification_cases
 
 
 def test_hertz_time_constant_is_the_integral_it_names():

@@ -9,21 +9,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.forces import WallForceHistory
-from engines.config import load_config
-from model.cases.silo_flat import build_silo_case
-from engines.liggghts.forces import (
+from siloflow.model.forces import WallForceHistory
+from siloflow.engines.config import load_config
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.engines.liggghts.forces import (
     RESUMED_WALL_FORCES_PREFIX,
     read_jenike_forces,
     read_silo_wall_forces,
     read_wall_force_file,
     read_wall_forces,
 )
-from engines.liggghts.run import WALL_FORCES_NAME
-from engines.liggghts.jenike import FORCES_NAME
-from engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS
-from engines.liggghts.run import RESUME_STEM, Resume
-from engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
+from siloflow.engines.liggghts.run import WALL_FORCES_NAME
+from siloflow.engines.liggghts.jenike import FORCES_NAME
+from siloflow.engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS
+from siloflow.engines.liggghts.run import RESUME_STEM, Resume
+from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 DT = 1e-5

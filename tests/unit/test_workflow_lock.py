@@ -1,4 +1,4 @@
-"""The Snakemake launcher (engines.workflow_lock): it holds an flock for the whole run, refuses while another run is
+"""The Snakemake launcher (siloflow.engines.workflow_lock): it holds an flock for the whole run, refuses while another run is
 live, removes a killed run's stale locks with the run's own workflow arguments, and passes on Snakemake's exit code.
 
 Snakemake is replaced by a small script that records its arguments; no engine and no Snakemake run.
@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from engines.config import REPO_ROOT
-from engines.workflow_lock import (
+from tests.repo import REPO_ROOT
+from siloflow.engines.workflow_lock import (
     LAUNCHER_LOCK,
     LiveRunError,
     acquire_launcher_lock,
@@ -126,7 +126,7 @@ def test_the_launcher_lock_is_refused_while_held_and_names_the_directory_and_hol
 
 def test_the_launcher_lock_is_free_once_its_holder_is_killed_with_sigkill(tmp_path):
     holder = subprocess.Popen(
-        [sys.executable, "-c", "import sys, time; from engines.workflow_lock import acquire_launcher_lock; "
+        [sys.executable, "-c", "import sys, time; from siloflow.engines.workflow_lock import acquire_launcher_lock; "
                                "lock = acquire_launcher_lock(sys.argv[1]); print('held', flush=True); time.sleep(60)",
          str(tmp_path)],
         cwd=REPO_ROOT, stdout=subprocess.PIPE, text=True)
@@ -155,7 +155,7 @@ def test_stale_lock_files_are_the_files_in_snakemakes_lock_folder(tmp_path):
     (["snakemake", "-n"], True),
     (["nice", "-n", "19", "python", "-m", "snakemake"], True),
     (["python", "-m", "snakemake.cli"], True),
-    (["python", "-m", "engines.workflow_lock", "--snakefile", "/repo/Snakefile", "--directory", "/run"], False),
+    (["python", "-m", "siloflow.engines.workflow_lock", "--snakefile", "/repo/Snakefile", "--directory", "/run"], False),
     (["python", "-m", "snakemake_executor_plugin_slurm"], False),
     (["liggghts", "-in", "in.case"], False),
     ([], False),
@@ -277,7 +277,7 @@ def test_snakemake_keeps_the_directory_locked_when_the_launcher_alone_is_killed(
     monkeypatch.setenv("FAKE_PID_FILE", str(pid_file))
     monkeypatch.setenv("FAKE_SLEEP", "60")
     launcher = subprocess.Popen(
-        [sys.executable, "-c", "import json, sys; from engines.workflow_lock import launch; "
+        [sys.executable, "-c", "import json, sys; from siloflow.engines.workflow_lock import launch; "
                                "launch(json.loads(sys.argv[1]), snakemake=json.loads(sys.argv[2]), proc=sys.argv[3])",
          json.dumps(_run_arguments(tmp_path)), json.dumps(command), str(tmp_path)],
         cwd=REPO_ROOT)

@@ -12,25 +12,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.cases import cases_of
-from model.cases.common import material_table
-from model.cases.particles import clump_inertia, clump_volume
-from model.cases.blender import build_blender_case
-from model.cases.silo_flat import build_silo_case
-from model.cases.silo_recirculation import build_recirculation_case
-from engines.config import ConfigError, load_config, validate_config
-from engines.interface import CaseNotSupported, engine_named
-from engines.templating import UnsafeDeckValue, deck_string, render_deck
-from model.cost import MeasuredWork
-from engines.yade.cost import elapsed_cpu_seconds, measured_seconds_per_sphere_step, measured_work
-from engines.yade.run import LOG_NAME, RESUME_STEM
-from engines.run_files import FAILED_ATTEMPTS
-from engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
-from engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
-from engines.yade.progress import ScriptProgress
-from engines.yade.blender import blender_script_context, render_blender_script
-from engines.yade.silo_flat import render_silo_script, silo_script_context
-from engines.yade.silo_recirculation import render_recirculation_script
+from siloflow.model.cases import cases_of
+from siloflow.model.cases.common import material_table
+from siloflow.model.cases.particles import clump_inertia, clump_volume
+from siloflow.model.cases.blender import build_blender_case
+from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.model.cases.silo_recirculation import build_recirculation_case
+from siloflow.engines.config import ConfigError, load_config, validate_config
+from siloflow.engines.interface import CaseNotSupported, engine_named
+from siloflow.engines.templating import UnsafeDeckValue, deck_string, render_deck
+from siloflow.model.cost import MeasuredWork
+from siloflow.engines.yade.cost import elapsed_cpu_seconds, measured_seconds_per_sphere_step, measured_work
+from siloflow.engines.yade.run import LOG_NAME, RESUME_STEM
+from siloflow.engines.run_files import FAILED_ATTEMPTS
+from siloflow.engines.yade.inputs import hertz_stiffness_at_load, principal_clump, rolling_friction
+from siloflow.engines.yade.outputs import DamagedOutput, read_frame, read_frames, read_settled_fill, read_wall_forces
+from siloflow.engines.yade.progress import ScriptProgress
+from siloflow.engines.yade.blender import blender_script_context, render_blender_script
+from siloflow.engines.yade.silo_flat import render_silo_script, silo_script_context
+from siloflow.engines.yade.silo_recirculation import render_recirculation_script
 from tests.golden_files import assert_matches_golden
 from tests.unit.test_templating import INJECTIONS
 

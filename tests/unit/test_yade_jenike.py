@@ -8,14 +8,14 @@ import ast
 import numpy as np
 import pytest
 
-from model.cases.jenike import build_jenike_case, jenike_cases
-from engines.config import validate_config
-from engines.interface import engine_named
-from engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS, jenike_wall_forces, read_jenike_force_history
-from engines.yade.jenike import (
+from siloflow.model.cases.jenike import build_jenike_case, jenike_cases
+from siloflow.engines.config import validate_config
+from siloflow.engines.interface import engine_named
+from siloflow.engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS, jenike_wall_forces, read_jenike_force_history
+from siloflow.engines.yade.jenike import (
     jenike_script_context, read_pair_contacts, read_wall_contacts, render_jenike_script,
 )
-from engines.yade.outputs import DamagedOutput
+from siloflow.engines.yade.outputs import DamagedOutput
 from tests.golden_files import assert_matches_golden
 
 POINT = {"shape": "sphere2", "test": "internal", "sliding_friction": 0.3, "rolling_friction": 0.1,

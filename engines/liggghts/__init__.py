@@ -1,9 +1,0 @@
-"""LIGGGHTS (LIGGGHTS-PUBLIC 3.8): everything siloflow knows about this engine, its decks, runs and file formats.
-
-Importing the package registers :class:`~engines.liggghts.engine.LiggghtsEngine` under the name ``liggghts``
-(:func:`engines.interface.engine_named`).
-"""
-
-from engines.liggghts.engine import LiggghtsEngine
-
-__all__ = ["LiggghtsEngine"]

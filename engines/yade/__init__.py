@@ -1,9 +1,0 @@
-"""YADE (Debian ``yade`` 2023.02): everything siloflow knows about this engine, its scripts, runs and file formats.
-
-Importing the package registers :class:`~engines.yade.engine.YadeEngine` under the name ``yade``
-(:func:`engines.interface.engine_named`).
-"""
-
-from engines.yade.engine import YadeEngine
-
-__all__ = ["YadeEngine"]

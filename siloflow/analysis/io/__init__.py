@@ -1,0 +1,1 @@
+"""siloflow.analysis.io."""

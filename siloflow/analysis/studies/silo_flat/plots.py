@@ -1,0 +1,334 @@
+"""Plots of the flat-bottom silo flow in the study's style: discharge, velocity profiles and fields, stresses.
+
+Each writer takes arrays or dataclasses and a path, draws one figure and saves it atomically in the format of the
+path's suffix, PNG, PDF or SVG (:func:`siloflow.analysis.io.plots.save_figure`). It returns that figure, already closed (let go
+by pyplot, so a caller that ignores it leaks nothing): its artists still hold the plotted data, which is what the
+tests check."""
+
+from __future__ import annotations
+
+import os
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+
+from siloflow.analysis.io.plots import save_figure, silo_outline
+from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
+
+
+def plot_discharge(
+    history: DischargeHistory,
+    fit: FlowRateFit,
+    beverloo_rate: float | None,
+    path: str | os.PathLike,
+    title: str,
+    rate_error: float | None = None,
+) -> Figure:
+    """Plot discharged mass against time with the fitted and Beverloo flow rates.
+
+    Draws the discharged mass, the least-squares line over the steady window
+    (shaded), and, for comparison, a line of the Beverloo slope through the
+    fitted line at the window midpoint (so only the slopes are compared).
+
+    Parameters
+    ----------
+    history : siloflow.analysis.numerics.flow.DischargeHistory
+        Time since opening [s] and discharged mass [kg].
+    fit : siloflow.analysis.numerics.flow.FlowRateFit
+        Steady flow rate fit [kg/s] and its window [s].
+    beverloo_rate : float or None
+        Beverloo mass flow rate [kg/s]; None to omit the line.
+    path : str or os.PathLike
+        Destination plot file, written atomically in the format of its suffix (:func:`siloflow.analysis.io.plots.save_figure`).
+    title : str
+        Figure title.
+    rate_error : float, optional
+        Standard error of the flow rate [kg/s] for the legend (batch means of the rate); None: the
+        least-squares error of the fit, ``fit.standard_error``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
+    """
+    time = np.asarray(history.time, dtype=float)
+    error = fit.standard_error if rate_error is None else rate_error
+    mass = np.asarray(history.discharged_mass, dtype=float)
+
+    figure, axes = plt.subplots(figsize=(6.4, 4.4))
+    try:
+        axes.plot(time, mass, ".", markersize=3, color="0.35", label="DEM discharged mass")
+        axes.axvspan(fit.t_start, fit.t_end, color="tab:blue", alpha=0.08, label="steady window")
+
+        window_time = np.array([fit.t_start, fit.t_end])
+        axes.plot(
+            window_time,
+            fit.intercept + fit.mass_flow_rate * window_time,
+            "-",
+            color="tab:blue",
+            linewidth=2,
+            label=f"fit: {fit.mass_flow_rate:.4g} ± {error:.2g} kg/s",
+        )
+        if beverloo_rate is not None:
+            midpoint_time = 0.5 * (fit.t_start + fit.t_end)
+            midpoint_mass = fit.intercept + fit.mass_flow_rate * midpoint_time
+            axes.plot(
+                window_time,
+                midpoint_mass + beverloo_rate * (window_time - midpoint_time),
+                "--",
+                color="tab:red",
+                linewidth=1.5,
+                label=f"Beverloo: {beverloo_rate:.4g} kg/s",
+            )
+
+        axes.set_xlabel("time since opening [s]")
+        axes.set_ylabel("discharged mass [kg]")
+        axes.set_title(title)
+        axes.grid(True, alpha=0.3)
+        axes.legend(loc="upper left", fontsize="small")
+        figure.tight_layout()
+        save_figure(figure, path)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
+                            fcb_fraction_index: int = -1, uncertainty=None) -> Figure:
+    """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary in red.
+
+    Each profile is drawn at its height z as z + s v_z(x), with the scale s chosen so that the fastest
+    profile spans 80 % of the spacing between heights; the red dots mark the flow channel boundary at the
+    chosen fraction of the centreline velocity. With ``uncertainty`` (a
+    :class:`~siloflow.analysis.studies.silo_flat.fields.ProfileUncertainty`) each dot gets a horizontal error bar of one
+    standard error (mm), one errorbar container per height (NaN errors draw nothing).
+    """
+    heights = profiles.heights
+    spacing = np.min(np.diff(heights)) if heights.size > 1 else 0.02
+    peak = np.nanmax(np.abs(profiles.v_z)) or 1.0
+    scale = 0.8 * spacing / peak
+    x_mm = 1e3 * profiles.x
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        for i, z in enumerate(heights):
+            axes.axhline(1e3 * z, color="0.8", linewidth=0.6)
+            axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
+            boundary_mm = 1e3 * np.array([profiles.fcb_left[i, fcb_fraction_index],
+                                          profiles.fcb_right[i, fcb_fraction_index]])
+            axes.plot(boundary_mm, [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
+            if uncertainty is not None:
+                errors = [uncertainty.fcb_left_error[i, fcb_fraction_index],
+                          uncertainty.fcb_right_error[i, fcb_fraction_index]]
+                axes.errorbar(boundary_mm, [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
+                              fmt="none", ecolor="red", elinewidth=1.0, capsize=3)
+        fraction = profiles.fcb_fractions[fcb_fraction_index]
+        axes.plot([], [], "o", color="red", label=f"FCB at {100 * fraction:g} % of centreline v_z")
+        axes.plot([], [], color="tab:blue", label=f"v_z (1 mm = {1e-3 / scale:.3g} m/s)")
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        axes.legend(loc="upper center", fontsize=8)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, title: str) -> Figure:
+    """Contours of the depth-averaged vertical velocity v_z(x, z) (m/s); ``v_z`` has shape (nx, nz)."""
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        levels = np.linspace(np.min(v_z), 0.0, 21) if np.min(v_z) < 0 else 21
+        filled = axes.contourf(1e3 * np.asarray(x), 1e3 * np.asarray(z), np.asarray(v_z).T, levels=levels,
+                               cmap="viridis")
+        figure.colorbar(filled, ax=axes, label="v_z [m/s]")
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * np.max(z))
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_kinematic_constant(heights, B, path, title: str, B_error=None) -> Figure:
+    """Kinematic constant B (mm) against height above the outlet (mm), with horizontal error bars of one
+    standard error ``B_error`` (m, NaN draws none) when given."""
+    figure, axes = plt.subplots(figsize=(5.0, 4.0))
+    try:
+        axes.plot(1e3 * np.asarray(B), 1e3 * np.asarray(heights), "o-")
+        if B_error is not None:
+            axes.errorbar(1e3 * np.asarray(B), 1e3 * np.asarray(heights), xerr=1e3 * np.asarray(B_error),
+                          fmt="none", ecolor="tab:blue", capsize=3, label="± standard error")
+        axes.set_xlabel("B [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        axes.grid(alpha=0.3)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_janssen(comparison, path, title: str) -> Figure:
+    """Mean vertical stress against depth below the surface: DEM contacts with horizontal error bars of one
+    standard error, Janssen's formula and the hydrostatic ``rho_b g h``."""
+    figure, axes = plt.subplots(figsize=(5.0, 4.0))
+    try:
+        depth_mm = 1e3 * comparison.depth_below_surface
+        axes.plot(comparison.simulated, depth_mm, "o", label="DEM (contact stress)")
+        axes.errorbar(comparison.simulated, depth_mm, xerr=comparison.simulated_error, fmt="none",
+                      ecolor="tab:blue", capsize=2, label="DEM ± standard error")
+        axes.plot(comparison.janssen, depth_mm, "-", label="Janssen")
+        axes.plot(comparison.hydrostatic, depth_mm, ":", color="0.3", label="hydrostatic rho_b g h")
+        axes.invert_yaxis()
+        axes.set_xlabel("vertical stress [Pa]")
+        axes.set_ylabel("depth below surface [mm]")
+        axes.set_title(title)
+        axes.legend(fontsize=8)
+        axes.grid(alpha=0.3)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_centreline_velocity(times, heights, velocities, path, title: str) -> Figure:
+    """Centreline vertical velocity against time since opening, one line per height."""
+    figure, axes = plt.subplots(figsize=(6.0, 4.0))
+    try:
+        for j, z in enumerate(heights):
+            axes.plot(times, velocities[:, j], label=f"z = {1e3 * z:g} mm")
+        axes.set_xlabel("time since opening [s]")
+        axes.set_ylabel("v_z on the axis [m/s]")
+        axes.set_title(title)
+        axes.legend(fontsize=8)
+        axes.grid(alpha=0.3)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_force_chains(segments, width: float, outlet_width: float, top: float, path, title: str) -> Figure:
+    """Branch vectors of contacts in a slice, coloured by normal force (capped)."""
+    figure, axes = plt.subplots(figsize=(5.0, 6.0))
+    try:
+        lines = np.stack([1e3 * segments.start[:, [0, 2]], 1e3 * segments.end[:, [0, 2]]], axis=1)
+        collection = LineCollection(lines, array=segments.normal_force, cmap="inferno_r", linewidths=1.2)
+        collection.set_clim(0.0, segments.cap)
+        axes.add_collection(collection)
+        figure.colorbar(collection, ax=axes, shrink=0.6, label=f"normal force [N] (capped at {segments.cap:.3g} N)")
+        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+        axes.set_xlim(-0.55e3 * width, 0.55e3 * width)
+        axes.set_ylim(-2.0, 1e3 * top)
+        axes.set_aspect("equal")
+        axes.set_xlabel("x [mm]")
+        axes.set_ylabel("z [mm]")
+        axes.set_title(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_measured_comparison(comparisons, path, title: str) -> Figure:
+    """Simulated against measured v_z(x), one panel row per measured profile, with the error metrics."""
+    rows = max(1, len(comparisons))
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.6 * rows), squeeze=False)
+    try:
+        for axes, comparison in zip(axes_list[:, 0], comparisons):
+            measured = comparison.measured
+            x_mm = 1e3 * measured.x
+            if measured.uncertainty is not None:
+                axes.errorbar(x_mm, measured.v_z, yerr=measured.uncertainty, fmt="o", markersize=3, label="measured")
+            else:
+                axes.plot(x_mm, measured.v_z, "o", markersize=3, label="measured")
+            axes.plot(x_mm, comparison.simulated_v_z, "-", label="DEM")
+            errors = comparison.errors
+            axes.set_title(f"z = {1e3 * measured.z:g} mm, {measured.window}: mean error {errors.mean_error_percent:.1f} %, "
+                           f"RMS {errors.rms_error:.3g} m/s", fontsize=9)
+            axes.set_ylabel("v_z [m/s]")
+            axes.grid(alpha=0.3)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        axes_list[0, 0].legend(fontsize=8)
+        figure.suptitle(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_parametric_study(x, profiles, labels, flow_rates, height: float, path, title: str) -> Figure:
+    """v_z profiles at one height (left) and the steady mass flow rate (right) for each run of a study."""
+    figure, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.0), gridspec_kw={"width_ratios": [3, 2]})
+    try:
+        for profile, label in zip(profiles, labels):
+            left.plot(1e3 * np.asarray(x), profile, label=label)
+        left.set_xlabel("x [mm]")
+        left.set_ylabel(f"v_z at z = {1e3 * height:g} mm [m/s]")
+        left.grid(alpha=0.3)
+        left.legend(fontsize=7)
+        positions = np.arange(len(labels))
+        right.bar(positions, flow_rates, color="tab:blue")
+        right.set_xticks(positions, labels, rotation=45, ha="right", fontsize=7)
+        right.set_ylabel("steady mass flow rate [kg/s]")
+        right.grid(alpha=0.3, axis="y")
+        figure.suptitle(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_kinematic_horizontal_velocity(profiles, path, title: str) -> Figure:
+    """Horizontal velocity from the DEM (v_x) against the kinematic model's u = -B dv_z/dx at each height."""
+    rows = len(profiles.heights)
+    figure, axes_list = plt.subplots(rows, 1, figsize=(6.0, 2.2 * rows), squeeze=False, sharex=True)
+    try:
+        x_mm = 1e3 * profiles.x
+        for i, axes in enumerate(axes_list[:, 0]):
+            axes.plot(x_mm, profiles.v_x[i], "o", markersize=3, label="DEM v_x")
+            axes.plot(x_mm, profiles.kinematic_u[i], "-", label="kinematic u = -B dv_z/dx")
+            axes.set_ylabel(f"z = {1e3 * profiles.heights[i]:g} mm\n[m/s]", fontsize=8)
+            axes.grid(alpha=0.3)
+        axes_list[0, 0].legend(fontsize=8)
+        axes_list[-1, 0].set_xlabel("x [mm]")
+        figure.suptitle(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure
+
+
+def plot_posterior_draws(rows, spread, path, title: str) -> Figure:
+    """Each figure of the silo at the posterior mean and at each posterior draw, with each run's standard error and
+    the calibration's error bar (``spread``: :func:`siloflow.analysis.studies.silo_flat.posterior_draws.calibration_spread`) as
+    a band about the posterior mean's value."""
+    figure, axes = plt.subplots(1, len(spread), figsize=(4.5 * len(spread), 3.8), squeeze=False)
+    try:
+        positions = np.arange(len(rows))
+        labels = [row["label"] for row in rows]
+        for axis, summary in zip(axes[0], spread):
+            name = summary["figure"]
+            axis.errorbar(positions, [row[name] for row in rows], yerr=[row[f"{name}_error"] for row in rows],
+                          fmt="o", capsize=3, color="tab:blue", label="run ± its standard error")
+            centre, band = summary["posterior_mean"], summary["calibration_sd"]
+            if np.isfinite(centre) and np.isfinite(band):
+                axis.axhspan(centre - band, centre + band, color="tab:orange", alpha=0.25,
+                             label="posterior mean ± calibration sd")
+            axis.set_xticks(positions, labels, rotation=30, ha="right", fontsize=8)
+            axis.set_ylabel(f"{name.replace('_', ' ')} [{summary['unit']}]")
+            axis.grid(alpha=0.3, axis="y")
+            axis.legend(fontsize=7)
+        figure.suptitle(title)
+        save_figure(figure, path, tight=True)
+    finally:
+        plt.close(figure)
+    return figure

@@ -1,0 +1,81 @@
+"""LIGGGHTS decks and runs of the recirculating silo (blending study).
+
+The run directory has the layout of :mod:`siloflow.engines.liggghts.run` (``deck/``, ``dumps/``, ``log.liggghts``,
+``engine.out``, ``run.json`` written last). Periodic boundaries and multisphere clumps work together in
+LIGGGHTS 3.8, serially and under MPI with the domain split along the periodic direction: clumps cross the
+bottom boundary whole and re-enter at the top with their ids. The recirculation stage therefore runs with
+``thermo_modify lost error``, and the run is checked for an unchanged clump count.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from siloflow.model.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
+from siloflow.engines.liggghts.run import Resume, run_checked
+from siloflow.model.record import RunRecord
+from siloflow.engines.liggghts.silo_flat import silo_deck_context
+from siloflow.engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
+from siloflow.engines.liggghts.inputs import ENGINE_NAME, write_case_inputs
+from siloflow.engines.templating import render_deck
+
+def recirculation_deck_context(case: RecirculationCase) -> dict:
+    """The rendering context of ``siloflow/templates/liggghts/silo_recirculation.lmp.j2``."""
+    context = silo_deck_context(case.silo)
+    bottom = case.silo.materials.type_of(case.silo.wall_materials["bottom"])
+    context["title"] = f"siloflow-silo_recirculation-{case.run_id}"
+    # The vertical boundary is periodic: what leaves the channel bottom re-enters at the top.
+    context["boundary"] = [context["boundary"][0], context["boundary"][1], "p"]
+    context["meshes"] = context["meshes"] + [
+        {"id": name, "file": f"deck/meshes/{name}.stl", "type": bottom} for name in CHANNEL_MESHES
+    ]
+    context["closed_floor"] = context["closed_floor"] + list(CHANNEL_MESHES)
+    context["open_floor"] = context["open_floor"] + list(CHANNEL_MESHES)
+    context["feeder"] = {
+        "zone": list(case.feeder_zone),
+        "velocity": case.feeder_velocity,
+        # the atoms of one clump as the deck inserts them (a one-sphere model's has an inner sphere)
+        "spheres_per_clump": len(context["particle"]["spheres"]),
+    }
+    return context
+
+
+def render_recirculation_deck(case: RecirculationCase) -> str:
+    """The LIGGGHTS deck of a recirculation run."""
+    return render_deck("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case))
+
+
+def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) -> Path:
+    """Write deck, meshes and ``case.json`` into ``deck_dir``; returns the deck path."""
+    return write_case_inputs(recirculation_meshes(case), case.summary(), render_recirculation_deck(case), deck_dir)
+
+
+def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_dir: Path) -> dict:
+    """Check a finished recirculation run: the batch silo's checks, then no clump lost while recirculating.
+
+    Raises
+    ------
+    EngineRunError
+        As :func:`siloflow.engines.liggghts.run.check_silo_run`, or when the clump count changed during recirculation.
+    """
+    return check_silo_run(case.silo, markers, dump_files, run_dir, last_stage="recirculated", clumps_conserved=True)
+
+
+def run_recirculation(
+    case: RecirculationCase, run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int = 1,
+    mpirun: str = "mpirun",
+) -> RunRecord:
+    """Run a rendered recirculation deck, check it and write ``run.json``; returns the record."""
+    return run_checked(
+        run_dir,
+        lambda markers, dumps: check_recirculation_run(case, markers, dumps, Path(run_dir)),
+        {"executable": executable, "mpi_ranks": mpi_ranks, "mpirun": mpirun,
+         "target_time": expected_simulated_time(case.silo)},
+        lambda checked: silo_run_record(
+            ENGINE_NAME,
+            "silo_recirculation", case.run_id, checked,
+            {"flow_pattern": case.pattern, "role": case.role,
+             "estimated_residence_time_s": case.estimated_residence_time},
+            [-case.channel_length, case.silo.domain_top]),
+        Resume("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps),
+    )

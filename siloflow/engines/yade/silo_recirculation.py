@@ -1,0 +1,61 @@
+"""YADE scripts of the recirculating silo (blending study): the batch silo's script (:mod:`siloflow.engines.yade.silo_flat`)
+with the channel below the outlet, the feeder in its lower half and a vertical boundary through which clumps leave at
+the channel bottom and re-enter at the top of the domain, as the LIGGGHTS deck's periodic z.
+
+YADE's periodic cell would also wrap x and y, so the script moves a clump that fell below the channel bottom to the
+top of the domain itself (whole, with its x, y and velocity) at every feeder check. The feeder blocks the z velocity of
+the clumps in its zone at the feeder velocity (x and y stay free), as the LIGGGHTS deck's ``setforce`` in z; it is
+checked every :data:`FEEDER_EVERY` steps, so a clump may enter the zone up to that many steps before it is held.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from siloflow.model.record import RunRecord
+from siloflow.model.cases.silo_recirculation import RecirculationCase, recirculation_meshes
+from siloflow.engines.templating import render_deck
+from siloflow.engines.yade.inputs import write_script_inputs
+from siloflow.engines.yade.run import YadeOptions
+from siloflow.engines.yade.silo_flat import check_silo_case, run_silo_type, silo_script_context
+
+__all__ = ["FEEDER_EVERY", "recirculation_script_context", "render_recirculation_script", "run_recirculation",
+           "write_recirculation_inputs"]
+
+#: Steps between the feeder's checks (and the re-entry of the clumps below the channel).
+FEEDER_EVERY = 10
+
+
+def recirculation_script_context(case: RecirculationCase) -> dict:
+    """The rendering context of ``siloflow/templates/yade/silo_recirculation.py.j2``."""
+    context = silo_script_context(case.silo)
+    bottom = context["meshes"][0]["material"]
+    context.update({
+        "title": f"siloflow-silo_recirculation-{case.run_id}",
+        "meshes": [{"id": name, "material": bottom} for name in recirculation_meshes(case)],
+        "channel_bottom": -case.channel_length,
+        "feeder": {"zone": list(case.feeder_zone), "velocity": case.feeder_velocity, "every": FEEDER_EVERY},
+        "discharge": {**context["discharge"], "stage": "recirculate", "marker": "recirculated"},
+    })
+    return context
+
+
+def render_recirculation_script(case: RecirculationCase) -> str:
+    """The YADE script of a recirculation run."""
+    check_silo_case(case.silo)
+    return render_deck("yade/silo_recirculation.py.j2", recirculation_script_context(case))
+
+
+def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) -> Path:
+    """Write the script, the meshes and ``case.json`` into ``deck_dir``; returns the script path."""
+    return write_script_inputs(case.summary(), render_recirculation_script(case), deck_dir, recirculation_meshes(case))
+
+
+def run_recirculation(case: RecirculationCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
+    """Run a rendered recirculation script, check it (the batch silo's checks, and no clump lost while
+    recirculating) and write ``run.json``; returns the record."""
+    return run_silo_type(case.silo, "silo_recirculation", case.run_id, run_dir, options, last_stage="recirculated",
+                         clumps_conserved=True,
+                         labels={"flow_pattern": case.pattern, "role": case.role,
+                                 "estimated_residence_time_s": case.estimated_residence_time},
+                         domain_z=[-case.channel_length, case.silo.domain_top])

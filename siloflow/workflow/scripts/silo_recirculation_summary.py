@@ -1,0 +1,21 @@
+"""Snakemake adapter: VRR per recirculation of every flow pattern and batch layout, in one table and one plot."""
+
+import json
+from pathlib import Path
+
+from siloflow.analysis.io.tables import write_flow_table
+from siloflow.analysis.numerics.reference_spread import floor_table
+from siloflow.analysis.numerics.replicates import combine_replicates
+from siloflow.analysis.studies.silo_recirculation.plots import plot_vrr_versus_recirculations
+from siloflow.analysis.studies.silo_recirculation.tables import summary_rows
+from siloflow.engines.logs import logged_to
+
+with logged_to(snakemake.log[0]) as log:
+    rows, curves = summary_rows([json.loads(Path(path).read_text()) for path in snakemake.input.summaries])
+    # replicates (the same flow pattern with other seeds) become one row per layout: their mean and its error
+    rows = combine_replicates(rows, ["flow_pattern", "layout"])
+    # a flow pattern run once takes the relative spread of the one run with several seeds (reference_replicates)
+    rows = floor_table(rows)[0]
+    write_flow_table(snakemake.output.table, rows)
+    plot_vrr_versus_recirculations(curves, snakemake.output.vrr_plot, "VRR per recirculation: flow patterns and layouts")
+    log.info("%d flow pattern x layout rows", len(rows))
