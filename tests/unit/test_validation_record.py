@@ -169,6 +169,20 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
                        "config/validation.yaml", "config/thesis.yaml", {"silo": ["silo_1", "silo_2"]})
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
+    # the page opens with the study it compares with, by the thesis's chapters, and what its study column quotes
+    assert lines[1:4] == [
+        "",
+        "The record compares siloflow with a published study: a PhD thesis on DEM and PIV of HDPE pellet flow and "
+        "blending in planar silos and a multi-flow blender, done with EDEM 2.7; siloflow runs the study's method on "
+        "LIGGGHTS and YADE instead ([What siloflow reproduces](../index.md#what-siloflow-reproduces)). The pellets are "
+        "multisphere clumps with rolling friction (§4.2), calibrated by Jenike direct shear tests (ch. 4: the "
+        "calibration groups); the flat-bottom silo is validated against PIV (ch. 3 and 5: the silo groups); blending "
+        "in the recirculating silo is measured by residence time distributions and variance reduction ratios (ch. 6: "
+        "the blending group); the multi-flow blender has a cone-in-cone insert and a blending tube (ch. 7 and App. A: "
+        "the blender group). Section numbers are the thesis's. The \"study\" column quotes the study's figure or "
+        "finding that a row is judged against, \"-\" where the study gives none.",
+        ""]
+    assert lines[4].startswith("The study's comparisons at the validation scale (`config/validation.yaml`)")
     assert "| calibration | missing | 0 | - | - | 0 | 0 |" in lines
     assert "| silo | stale | 3 | 2.50 h | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 |" in lines
     assert "| silo_series | complete | 1 | 1.00 h | 1.00 h | 1 | 1 |" in lines

@@ -3,9 +3,10 @@ them, and the page that renders them.
 
 A group's record is three things the pipeline writes (``make validate GROUP=<name>``): ``table.csv`` (its rows of
 the validation table, :data:`siloflow.analysis.studies.validation.rows.COLUMNS`), ``runs.csv`` (one provenance row per run,
-:data:`RUN_COLUMNS`) and a few plots. :func:`record_page` renders every group's record as one Markdown page, with
-each group's freshness against the configuration and, for the rows the scale does not show, what would show them
-and at what cost. Pure: the readers and writers are :mod:`siloflow.analysis.io.validation_record`.
+:data:`RUN_COLUMNS`) and a few plots. :func:`record_page` renders every group's record as one Markdown page, which
+opens with the study it compares with (:data:`STUDY_PARAGRAPH`), with each group's freshness against the
+configuration and, for the rows the scale does not show, what would show them and at what cost. Pure: the readers
+and writers are :mod:`siloflow.analysis.io.validation_record`.
 """
 
 from __future__ import annotations
@@ -18,7 +19,20 @@ from siloflow.model.checks import number_or_nan
 from siloflow.model.record import RunRecord
 from siloflow.analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
 
-__all__ = ["RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time", "record_page"]
+__all__ = ["STUDY_PARAGRAPH", "RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time",
+           "record_page"]
+
+#: The page's opening paragraph: the study the record compares with, by the thesis's own chapters and sections.
+STUDY_PARAGRAPH = (
+    "The record compares siloflow with a published study: a PhD thesis on DEM and PIV of HDPE pellet flow and "
+    "blending in planar silos and a multi-flow blender, done with EDEM 2.7; siloflow runs the study's method on "
+    "LIGGGHTS and YADE instead ([What siloflow reproduces](../index.md#what-siloflow-reproduces)). The pellets are "
+    "multisphere clumps with rolling friction (§4.2), calibrated by Jenike direct shear tests (ch. 4: the calibration "
+    "groups); the flat-bottom silo is validated against PIV (ch. 3 and 5: the silo groups); blending in the "
+    "recirculating silo is measured by residence time distributions and variance reduction ratios (ch. 6: the "
+    "blending group); the multi-flow blender has a cone-in-cone insert and a blending tube (ch. 7 and App. A: the "
+    "blender group). Section numbers are the thesis's. The \"study\" column quotes the study's figure or finding "
+    "that a row is judged against, \"-\" where the study gives none.")
 
 #: The columns of a group's ``runs.csv``, in order.
 RUN_COLUMNS = ("run_id", "group", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
@@ -133,8 +147,9 @@ def _hours(seconds: float) -> str:
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None) -> str:
-    """The record's page (Markdown): per group its freshness, runs and rows, and for each row the scale does not
-    show, what scale would show it and what that scale costs.
+    """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
+    freshness, runs and rows, and for each row the scale does not show, what scale would show it and what that scale
+    costs.
 
     Parameters
     ----------
@@ -163,6 +178,8 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     """
     lines = [
         "# The validation record",
+        "",
+        STUDY_PARAGRAPH,
         "",
         f"The study's comparisons at the validation scale (`{config_name}`), each as value ± standard error, written "
         "by `make validate GROUP=<name>` from the runs' own files: nothing here is typed in. \"Scale shows\" is judged "
