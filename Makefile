@@ -1,15 +1,22 @@
 # siloflow: the two commands a newcomer needs are `make run` and `make test`.
-# Both install what is missing first (Debian packages, then the Python package) and are idempotent.
+# Both install what is missing first (Debian packages, then siloflow into a virtual environment of its own) and are
+# idempotent. Every target runs siloflow's own command (`siloflow`, here `$(SILOFLOW)`) from that environment.
 
-PYTHON   ?= python3
-CONFIG   ?= config/config.yaml
-CORES    ?= 2
-SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
-APT_PACKAGES := liggghts openmpi-bin
-YADE_MODULES := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
+SYSTEM_PYTHON ?= python3
+VENV          ?= .venv
+PYTHON        ?= $(VENV)/bin/python
+SILOFLOW       = $(PYTHON) -m siloflow
+CONFIG        ?= config/config.yaml
+CORES         ?= 2
+SUDO          := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
+APT_PACKAGES  := liggghts openmpi-bin
+YADE_MODULES  := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
+PIP            = $(PYTHON) -m pip install --quiet --disable-pip-version-check
 
-.PHONY: install install-system install-python run verify bayesian validate validate-status test test-physics test-unit test-integration dry-run bench estimate docs
+.PHONY: install install-system install-python install-test install-docs run run-tiny check verify bayesian validate \
+	validate-status test test-physics test-unit test-integration dry-run bench estimate docs
 
+# What running needs; the test and documentation extras come with `make test` and `make docs` only.
 install: install-system install-python
 
 # Debian packages: only when an engine or the MPI launcher is missing.
@@ -21,8 +28,9 @@ install-system:
 	else \
 		echo "LIGGGHTS: $$(command -v liggghts), MPI: $$(command -v mpirun)"; \
 	fi
-	@# YADE without its recommends (62 packages instead of a desktop); siloflow imports its Python modules from
-	@# /usr/bin/python3 and never starts its launcher, which opens ports.
+	@# YADE without its recommends (62 packages instead of a desktop). Its scripts run under Debian's /usr/bin/python3,
+	@# which imports YADE's modules; siloflow's environment never imports them and never starts YADE's launcher,
+	@# which opens ports.
 	@if [ ! -d $(YADE_MODULES) ]; then \
 		echo "Installing yade (no recommends) with apt-get"; \
 		$(SUDO) apt-get update -qq && \
@@ -31,85 +39,105 @@ install-system:
 		echo "YADE: $(YADE_MODULES)"; \
 	fi
 
-# pip is a no-op when everything is already satisfied. The docs extra builds the documentation site (`make docs`,
-# which `make test` checks).
-install-python:
-	@$(PYTHON) -m pip install --quiet --disable-pip-version-check -e ".[test,docs]"
+# The virtual environment. Debian's python3 refuses pip installs into itself (PEP 668, "externally-managed-
+# environment"), and a machine's own interpreter may not be Debian's: a venv of whichever python3 comes first on PATH
+# behaves the same on both. Debian ships the venv module apart (python3-venv).
+$(VENV)/bin/python:
+	@if ! $(SYSTEM_PYTHON) -c "import ensurepip, venv" >/dev/null 2>&1; then \
+		echo "Installing python3-venv with apt-get"; \
+		$(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq python3-venv; \
+	fi
+	$(SYSTEM_PYTHON) -m venv $(VENV)
 
-# Snakemake goes through siloflow.engines.workflow_lock: after a killed run it removes the stale Snakemake lock first, and it
-# refuses to start (unlocking nothing) while another run is live in the same directory.
-RUN_SNAKEMAKE = $(PYTHON) -m siloflow.engines.workflow_lock --snakefile $(CURDIR)/Snakefile
+# pip runs again only when pyproject.toml changed since (a stamp per set of extras, kept in the environment).
+$(VENV)/.installed-run: pyproject.toml | $(PYTHON)
+	@mkdir -p $(VENV)
+	$(PIP) -e .
+	@touch $@
+$(VENV)/.installed-test: pyproject.toml | $(PYTHON)
+	@mkdir -p $(VENV)
+	$(PIP) -e ".[test]"
+	@touch $@
+$(VENV)/.installed-docs: pyproject.toml | $(PYTHON)
+	@mkdir -p $(VENV)
+	$(PIP) -e ".[docs]"
+	@touch $@
 
-# The report collects every plot with its caption and the summary page (RUN_DIR/results/report.html).
-# Reruns follow changed inputs and parameters, not changed siloflow code: an upgrade must not repeat hours of
-# finished simulations (run ids already change with every parameter that defines a run), and the outputs a killed run
-# left unfinished are redone. The workflow's own profile (profiles/default/) sets that policy for every Snakemake
-# call, these and a plain `snakemake` alike. RUN_DIR is where results/ and .snakemake/ go.
+install-python: $(VENV)/.installed-run
+install-test: install-system $(VENV)/.installed-test
+install-docs: $(VENV)/.installed-docs
+
+# `siloflow run`: checks the configuration before anything runs, runs the workflow under a launcher that removes the
+# stale Snakemake lock a killed run left (and refuses while another run is live in the same folder), then writes the
+# report (RUN_DIR/results/report.html, every plot with its caption and a summary page). Reruns follow changed inputs
+# and parameters, not changed siloflow code: an upgrade must not repeat hours of finished simulations (run ids
+# change with every parameter that defines a run), and the outputs a killed run left unfinished are redone (the
+# workflow's own profile, siloflow/workflow/profiles/default/). RUN_DIR is where results/ and .snakemake/ go.
 RUN_DIR ?= .
 
 run: install
-	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG))
-	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) --cores $(CORES)
-	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
-		--report $(abspath $(RUN_DIR))/results/report.html
+	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES)
+
+# A first result in minutes: the tiny configuration (numbers without physical meaning), into results/tiny/; the
+# example notebooks open its runs by default.
+TINY_DIR ?= results/tiny
+
+run-tiny: install
+	$(SILOFLOW) run --config config/tiny.yaml --directory $(TINY_DIR) --cores $(CORES)
+
+# Validate CONFIG and plan it; nothing runs.
+check: install-python
+	$(SILOFLOW) check --config $(CONFIG) --cores $(CORES)
 
 # The checks the demo tier leaves out of `make run` (config/checks.yaml over CONFIG): the DEM verification suite,
 # the one-particle-thick recirculating silo and the lid comparison, then the report with their pages.
-CHECKS_CONFIG := $(CURDIR)/config/checks.yaml
+CHECKS_CONFIG := config/checks.yaml
 
 verify: install
-	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG)) $(CHECKS_CONFIG)
-	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
-		--cores $(CORES)
-	$(RUN_SNAKEMAKE) --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) $(CHECKS_CONFIG) \
-		--report $(abspath $(RUN_DIR))/results/report.html
+	$(SILOFLOW) run --config $(CONFIG) --config $(CHECKS_CONFIG) --directory $(RUN_DIR) --cores $(CORES)
 
 # The joint Bayesian calibration (calibration.bayesian, its own target): per engine, Jenike runs placed by the
 # posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it;
 # its report is RUN_DIR/results/report-bayesian.html.
 bayesian: install
-	$(PYTHON) -m siloflow.engines.config_yaml $(abspath $(CONFIG))
-	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
-		--cores $(CORES)
-	$(RUN_SNAKEMAKE) bayesian_calibration --directory $(abspath $(RUN_DIR)) --configfile $(abspath $(CONFIG)) \
-		--report $(abspath $(RUN_DIR))/results/report-bayesian.html
+	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES) --target bayesian_calibration \
+		--report $(RUN_DIR)/results/report-bayesian.html
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
 # (make estimate CONFIG=config/validation.yaml prints its cost, per group and part). It works in results/validation/
 # (its own results/ and reports there, so that it never overwrites the default run's), prints the estimate of every run
 # first and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group
-# (siloflow.engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series, blending,
-# blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record is written
-# and copied into docs/validation/ once all its runs have finished, whichever part finished them. A group that compares
-# against another group's runs (calibration_checks, silo_series) starts from the products of those runs that the
-# other group's record keeps (docs/validation/<group>/products/), restored into results/validation/ where missing,
-# so that it runs on a machine other than the one that made them.
+# (siloflow.engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series,
+# blending, blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record
+# is written and copied into docs/validation/ once all its runs have finished, whichever part finished them. A group
+# that compares against another group's runs (calibration_checks, silo_series) starts from the products of those runs
+# that the other group's record keeps (docs/validation/<group>/products/), restored into results/validation/ where
+# missing, so that it runs on a machine other than the one that made them.
 # `make validate-status` says which groups of the record in docs/validation/ are complete, stale or missing.
 VALIDATION_CONFIG ?= config/validation.yaml
 VALIDATION_DIR    ?= results/validation
 VALIDATION_RECORD ?= docs/validation
 FULL_SCALE_CONFIG ?= config/thesis.yaml
-VALIDATION_RECORD_CLI = $(PYTHON) $(CURDIR)/workflow/scripts/validation_record_cli.py
-# the target goes before these options: --configfile takes every word after it
-VALIDATION_OPTIONS = --directory $(abspath $(VALIDATION_DIR)) --configfile $(abspath $(VALIDATION_CONFIG))
+VALIDATION_RUN     = $(SILOFLOW) run --config $(VALIDATION_CONFIG) --directory $(VALIDATION_DIR) --cores $(CORES)
 GROUP             ?=
 
 validate: install
 	@mkdir -p $(VALIDATION_DIR)/results
-	$(if $(GROUP),$(VALIDATION_RECORD_CLI) restore '$(GROUP)' $(VALIDATION_CONFIG) $(VALIDATION_RECORD) $(VALIDATION_DIR))
-	$(PYTHON) -m siloflow.engines.planning $(VALIDATION_CONFIG) $(VALIDATION_DIR)/results --cores $(CORES)
-	$(RUN_SNAKEMAKE) $(if $(GROUP),validate_$(GROUP)) $(VALIDATION_OPTIONS) --cores $(CORES) \
-		--keep-going
-	@groups="$$($(VALIDATION_RECORD_CLI) finished $(VALIDATION_CONFIG) $(VALIDATION_DIR) $(if $(GROUP),'$(GROUP)'))" || exit 1; \
+	$(if $(GROUP),$(SILOFLOW) record restore --group '$(GROUP)' --config $(VALIDATION_CONFIG) \
+		--record $(VALIDATION_RECORD) --directory $(VALIDATION_DIR))
+	$(SILOFLOW) estimate --config $(VALIDATION_CONFIG) --directory $(VALIDATION_DIR) --cores $(CORES)
+	$(VALIDATION_RUN) $(if $(GROUP),--target 'validate_$(GROUP)') --keep-going --no-report
+	@groups="$$($(SILOFLOW) record finished --config $(VALIDATION_CONFIG) --directory $(VALIDATION_DIR) \
+		$(if $(GROUP),--group '$(GROUP)'))" || exit 1; \
 	for group in $$groups; do \
-		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --cores $(CORES) && \
-		$(RUN_SNAKEMAKE) validate_$$group $(VALIDATION_OPTIONS) --report $(abspath $(VALIDATION_DIR))/report-$$group.html && \
-		$(VALIDATION_RECORD_CLI) publish $(VALIDATION_DIR) $(VALIDATION_RECORD) $$group || exit 1; \
+		$(VALIDATION_RUN) --target validate_$$group --report $(VALIDATION_DIR)/report-$$group.html && \
+		$(SILOFLOW) record publish --directory $(VALIDATION_DIR) --record $(VALIDATION_RECORD) --group $$group \
+		|| exit 1; \
 	done
-	$(VALIDATION_RECORD_CLI) page $(VALIDATION_CONFIG) $(FULL_SCALE_CONFIG) $(VALIDATION_RECORD)
+	$(SILOFLOW) record page --config $(VALIDATION_CONFIG) --full-scale $(FULL_SCALE_CONFIG) --record $(VALIDATION_RECORD)
 
 validate-status: install-python
-	$(VALIDATION_RECORD_CLI) status $(VALIDATION_CONFIG) $(VALIDATION_RECORD)
+	$(SILOFLOW) record status --config $(VALIDATION_CONFIG) --record $(VALIDATION_RECORD)
 
 # One pytest worker per core (pytest-xdist). A test file runs whole on one worker (--dist loadfile), so each
 # module's fixture, and so its engine runs, happens once. Files go out in the order tests/conftest.py sorts them,
@@ -117,30 +145,31 @@ validate-status: install-python
 # Two tiers. `make test`: the unit tests and the integration tests that run every engine on every case and stage at
 # the smallest size that exercises them. `make test-physics`: the tests marked `physics` (pyproject.toml), physics
 # checks that need larger or extra runs. .ci/run runs both; test-unit and test-integration run their folder's tests
-# of both tiers.
+# of both tiers. The unit tests build the documentation site, so the docs extra comes too.
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile --no-loadscope-reorder
 
-test: install
+test: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests siloflow/api siloflow/analysis/numerics
 
-test-physics: install
+test-physics: install-test
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m physics tests
 
-test-unit: install
+test-unit: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/unit
 
-test-integration: install
+test-integration: install-test
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/integration
 
-# Particle counts, steps, wall time and disk of every run of a config, before running it: make estimate CONFIG=config/thesis.yaml
+# Particle counts, steps, wall time and disk of every run of a config, before running it:
+# make estimate CONFIG=config/thesis.yaml
 estimate: install-python
-	$(PYTHON) -m siloflow.engines.planning $(CONFIG) --cores $(CORES)
+	$(SILOFLOW) estimate --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES)
 
 dry-run: install
-	$(PYTHON) -m snakemake -n --cores $(CORES) --configfile $(CONFIG)
+	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES) --dry-run
 
 # Speed figures are ratios against a baseline measured in the same run (results/bench/).
-bench: install
+bench: install-test
 	$(PYTHON) -m tests.bench.bench_dumps results/bench/dumps.csv
 	$(PYTHON) -m tests.bench.bench_coarse_graining results/bench/coarse_graining.csv
 	$(PYTHON) -m tests.bench.bench_pathlines results/bench/pathlines.csv
@@ -153,5 +182,5 @@ bench: install
 # reference cannot render. Open $(DOCS_SITE)/index.html.
 DOCS_SITE ?= build/site
 
-docs: install-python
+docs: install-docs
 	NO_MKDOCS_2_WARNING=1 $(PYTHON) -m mkdocs build --strict --site-dir $(DOCS_SITE)

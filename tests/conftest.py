@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import importlib.util
 import os
 import shutil
 import subprocess
@@ -17,6 +16,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 import pytest
 
+from siloflow.cli.main import main
 from siloflow.engines.config import load_config_file, validate_config
 from tests.repo import REPO_ROOT
 from siloflow.model.cases import cases_of
@@ -201,14 +201,9 @@ def run_snakemake(workdir, *arguments: str, targets=()) -> subprocess.CompletedP
     )
 
 
-def validation_record_cli():
-    """The validation record's command line (siloflow/workflow/scripts/validation_record_cli.py, a script of the workflow
-    layer, not a package module), loaded as a module."""
-    spec = importlib.util.spec_from_file_location("validation_record_cli",
-                                                  REPO_ROOT / "siloflow" / "workflow" / "scripts" / "validation_record_cli.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+def record_main(words: list[str]) -> int:
+    """``siloflow record WORDS...`` run in this process; returns its exit code."""
+    return main(["record", *words])
 
 
 def liggghts():

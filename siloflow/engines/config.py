@@ -183,6 +183,22 @@ def load_config_file(path: str | Path) -> dict:
         raise ConfigError(str(error)) from None
 
 
+def layered_config(paths: Iterable[str | Path]) -> dict:
+    """Configuration files read as plain data (:func:`load_config_file`) and layered in order, as Snakemake layers
+    ``--configfile A B``: a later file's mappings merge key by key into the earlier ones', its other values replace
+    theirs. Not validated.
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the key or line a file is refused for.
+    """
+    layered: dict = {}
+    for path in paths:
+        layered = _deep_merge(layered, load_config_file(path))
+    return layered
+
+
 def _with_defaults(validator_class, definitions: Mapping):
     """Extend a jsonschema validator so that ``properties`` fills in declared defaults (also those of a
     ``#/definitions/...`` reference, which the shared case keys use)."""

@@ -22,10 +22,9 @@ reads in milliseconds (the C loader, used for the schema, cannot be extended thi
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import yaml
 
@@ -224,19 +223,3 @@ def read_config_file(path: str | Path) -> dict:
     except UnicodeDecodeError:
         raise ConfigFileError(f"{path}: not UTF-8 text") from None
     return load_config_text(text, str(path))
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Command line: ``python -m siloflow.engines.config_yaml FILE...`` reads each configuration file as plain data before
-    Snakemake does (``make run`` calls it); prints the first refusal and returns 2, else 0."""
-    for path in list(sys.argv[1:] if argv is None else argv):
-        try:
-            read_config_file(path)
-        except (ConfigFileError, OSError) as error:
-            print(f"siloflow: invalid configuration: {error}", file=sys.stderr)
-            return 2
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

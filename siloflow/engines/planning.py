@@ -1,8 +1,8 @@
 """What a configuration will cost before it runs, and what its finished runs then took.
 
-``python -m siloflow.engines.planning CONFIG [RESULTS_DIR]`` (``make estimate CONFIG=...``) prints the estimate of every run
-the configuration defines and, once some of them have finished under ``RESULTS_DIR``, each one's estimated CPU time
-against what its engine measured (:func:`comparison_rows`). The workflow refuses to start runs whose estimated output
+``siloflow estimate --config CONFIG`` (``make estimate CONFIG=...``) prints the estimate of every run the
+configuration defines and, once some of them have finished in its results folder, each one's estimated CPU time
+against what its engine measured (:func:`comparison_rows`, :func:`estimate_report`). The workflow refuses to start runs whose estimated output
 does not fit on the disk of ``results/`` (:func:`ensure_disk_space`), unless ``estimates.disk_check`` is false.
 """
 
@@ -12,13 +12,11 @@ import dataclasses
 import math
 import shutil
 import statistics
-import sys
 from pathlib import Path
 
 from siloflow.model.record import RunRecordError, read_run_record
 from siloflow.model.cases import cases_of, run_roles
 from siloflow.model.cases.kinds import configured_kinds
-from siloflow.engines.config import ConfigError, load_config
 from siloflow.engines.interface import engine_for
 from siloflow.model.cost import CostModel, MeasuredWork, RunEstimate
 from siloflow.engines.estimates import (
@@ -281,29 +279,12 @@ def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[Run
     return assign(estimates, {run: role for kind in configured_kinds() for run, role in run_roles(config, kind).items()})
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Print the estimate table of a configuration file, the cost of each validation group on ``--cores`` cores
-    (default 2), the free space of the results folder and, for the runs that have finished there, estimated against
-    measured CPU time."""
-    argv = sys.argv[1:] if argv is None else argv
-    cores = 2
-    if len(argv) >= 2 and argv[-2] == "--cores":
-        if not argv[-1].isdigit() or int(argv[-1]) < 1:
-            print(f"--cores takes a whole number of cores >= 1, got {argv[-1]!r}", file=sys.stderr)
-            return 2
-        cores, argv = int(argv[-1]), argv[:-2]
-    if len(argv) not in (1, 2):
-        print("usage: python -m siloflow.engines.planning CONFIG [RESULTS_DIR] [--cores N]", file=sys.stderr)
-        return 2
-    try:
-        config = load_config(argv[0])
-        apriori = cost_model(config)
-        estimates = config_estimates(config, apriori)
-    except (ConfigError, ValueError) as error:
-        # a configuration that cannot be read or planned: the message names the file and the key, no traceback
-        print(f"siloflow: invalid configuration: {error}", file=sys.stderr)
-        return 2
-    results = argv[1] if len(argv) == 2 else "results"
+def estimate_report(config: dict, label: str, results: str | Path, cores: int) -> str:
+    """The estimate the command line prints for a validated configuration (``label`` names it): the estimate table,
+    the cost of each validation group on ``cores`` cores, the free space of ``results`` and, for the runs that have
+    finished there, estimated against measured CPU time."""
+    apriori = cost_model(config)
+    estimates = config_estimates(config, apriori)
     measured = measured_runs(config, estimates, results)
     model = apriori
     if not measured:
@@ -312,24 +293,18 @@ def main(argv: list[str] | None = None) -> int:
         model = calibrated_model(apriori, measured)
         source = (f"measured on this machine, the median of {len(measured)} finished run(s) under {results}/; the "
                   f"config says {apriori.seconds_per_sphere_step:.3g}")
-    print(f"Estimates for {argv[0]} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere-step on one "
-          f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
-          f"{model.settle_fraction:.0%} of its longest time)")
-    print(estimate_table(config_estimates(config, model) if measured else estimates))
-    print()
+    lines = [f"Estimates for {label} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere-step on one "
+             f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
+             f"{model.settle_fraction:.0%} of its longest time)",
+             estimate_table(config_estimates(config, model) if measured else estimates), ""]
     made = group_runs(config, config_estimates(config, model) if measured else estimates)
     # the parts come from the config's own cost model, so that measuring a run never moves a run to another part
     parts = split_groups(group_runs(config, estimates))
-    print("\n".join(cost_lines(group_costs(made, cores), cores, part_costs(parts, made, cores))))
+    lines += cost_lines(group_costs(made, cores), cores, part_costs(parts, made, cores))
     waiting = pending(estimates, results)
-    print(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
-          f"{format_bytes(total_dump_bytes(waiting))}; {format_bytes(free_bytes(results))} free for {results}/")
+    lines.append(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
+                 f"{format_bytes(total_dump_bytes(waiting))}; {format_bytes(free_bytes(results))} free for {results}/")
     if measured:
         steps = [run_steps(results, estimate) for estimate, _ in measured]
-        print()
-        print(comparison_report(measured, steps, apriori, model))
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+        lines += ["", comparison_report(measured, steps, apriori, model)]
+    return "\n".join(lines)

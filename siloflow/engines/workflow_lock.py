@@ -1,7 +1,7 @@
 """Start Snakemake in a working directory that a killed run may have left locked, and never unlock a live run.
 
-``python -m siloflow.engines.workflow_lock <snakemake arguments...>`` runs ``python -m snakemake <snakemake arguments...>``
-(``make run`` and ``make validate`` call it). Snakemake marks the files a run works on in ``.snakemake/locks/``
+:func:`launch` runs ``python -m snakemake <snakemake arguments...>`` (``siloflow run`` calls it, and so ``make run``
+and ``make validate``). Snakemake marks the files a run works on in ``.snakemake/locks/``
 and removes the marks when it ends; a Snakemake killed with SIGKILL cannot, and every later call in that directory
 fails with "Directory cannot be locked" until ``snakemake --unlock``. Unlocking by hand is only safe when no
 Snakemake is still running there, which the user has to know. The launcher decides it instead:
@@ -334,17 +334,3 @@ def _run_child(command: list[str], lock_fd: int) -> int:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     return 128 - returncode if returncode < 0 else returncode
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Command line: ``python -m siloflow.engines.workflow_lock <snakemake arguments...>``; returns the exit code."""
-    arguments = list(sys.argv[1:] if argv is None else argv)
-    try:
-        return launch(arguments)
-    except LiveRunError as error:
-        print(f"siloflow: {error}", file=sys.stderr, flush=True)
-        return 75  # EX_TEMPFAIL: the same call succeeds once the live run has ended
-
-
-if __name__ == "__main__":
-    sys.exit(main())

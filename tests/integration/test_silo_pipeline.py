@@ -34,8 +34,9 @@ from siloflow.engines.layout import run_dir as layout_run_dir
 from siloflow.engines.liggghts.cost import calibrate_cost_model
 from siloflow.engines.planning import config_estimates, measured_cost_model, run_directory
 from tests.paraview_checks import check_paraview_folder
+from siloflow.cli.record import publish
 from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
-                            liggghts, require_liggghts, run_snakemake, validation_record_cli)
+                            liggghts, require_liggghts, run_snakemake)
 from tests.notebooks import execute_notebook, figures
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(250)]
@@ -130,8 +131,8 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
                            targets=["validate_silo", "validate_silo_series"])
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "silo_run" not in result.stdout + result.stderr
-    record_dir, cli = tmp_path / "docs", validation_record_cli()
-    assert cli.publish(workdir, record_dir, ["calibration", "silo", "silo_series"]) == ["silo", "silo_series"]
+    record_dir = tmp_path / "docs"
+    assert publish(workdir, record_dir, ["calibration", "silo", "silo_series"]) == ["silo", "silo_series"]
     record, series = read_group_record(record_dir / "silo"), read_group_record(record_dir / "silo_series")
     planned = {case.run_id for case in cases_of(_validated({**TINY_SILO, **SILO_PARAMETRIC}), "silo_flat").values()}
     assert len(planned) == 2 and [run["run_id"] for run in record.runs] == [run_dir.name]

@@ -7,6 +7,7 @@ import math
 import pytest
 
 import siloflow.engines.planning as planning
+from siloflow.cli.main import main
 from siloflow.model.record import RunRecord
 from siloflow.engines.config import load_config
 from siloflow.model.cost import CostModel, MeasuredWork, RunEstimate
@@ -21,7 +22,7 @@ from siloflow.engines.planning import (
     cost_model,
     ensure_disk_space,
     estimate_table,
-    main,
+    estimate_report,
     measured_cost_model,
     measured_runs,
     pending,
@@ -71,17 +72,19 @@ def test_one_run_is_checked_where_it_writes_unless_disabled(estimates, tmp_path)
     assert estimates[0].run_id in preflight(config, estimates[0], tmp_path)
 
 
-def test_the_estimate_table_and_command(estimates, capsys):
+def test_the_estimate_table_and_command(estimates, tmp_path, capsys):
     table = estimate_table(estimates).splitlines()
     assert table[0].split()[:3] == ["run", "kind", "mpi_ranks"]
     assert len(table) == len(estimates) + 2 and table[-1].startswith(f"total ({len(estimates)} runs)")
-    assert main([str(DEFAULT_CONFIG)]) == 0
+    command = ["estimate", "--config", str(DEFAULT_CONFIG), "--directory", str(tmp_path)]
+    assert main(command) == 0
     out = capsys.readouterr().out
     assert "runs still to do" in out and "Validation groups (make validate GROUP=<name>) on 2 core(s)" in out
-    assert main([str(DEFAULT_CONFIG), "--cores", "8"]) == 0
+    assert f"free for {tmp_path / 'results'}/" in out
+    assert main([*command, "--cores", "8"]) == 0
     assert "on 8 core(s)" in capsys.readouterr().out
-    assert main([str(DEFAULT_CONFIG), "--cores", "0"]) == 2
-    assert "--cores takes a whole number of cores >= 1, got '0'" in capsys.readouterr().err
+    assert main([*command, "--cores", "0"]) == 2
+    assert "argument --cores: takes a whole number of cores >= 1, got '0'" in capsys.readouterr().err
     assert main([]) == 2
 
 
@@ -90,9 +93,10 @@ def test_the_estimate_command_refuses_a_config_it_cannot_read_without_a_tracebac
     config = tmp_path / "yte.yaml"
     marker = tmp_path / "evaluated"
     config.write_text(f"__use_yte__: true\ndefaults:\n  seed: ?__import__('pathlib').Path('{marker}').touch() or 1\n")
-    assert main([str(config)]) == 2
+    assert main(["estimate", "--config", str(config)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"siloflow: invalid configuration: {config}: sets __use_yte__") and "Traceback" not in err
+    assert err.startswith(f"siloflow estimate: invalid configuration: {config.resolve()}: sets __use_yte__")
+    assert "Traceback" not in err and len(err.splitlines()) == 1
     assert not marker.exists()
 
 
@@ -156,8 +160,7 @@ def test_finished_runs_are_compared_with_their_estimates(estimates, tmp_path, mo
     assert measured_runs(config, estimates, tmp_path) == [(e, MeasuredWork(90.0, 3.0e8)) for e in done]
     model, count = measured_cost_model(config, estimates, tmp_path)
     assert (model.seconds_per_sphere_step, count) == (3.0e-7, 2)
-    assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
-    out = capsys.readouterr().out
+    out = estimate_report(config, str(DEFAULT_CONFIG), tmp_path, cores=2)
     assert "3e-07 s per sphere-step on one core, measured on this machine, the median of 2 finished run(s)" in out
     lines = out.splitlines()
     header = next(i for i, line in enumerate(lines) if line.startswith("run ") and "measured_cpu" in line)
@@ -173,9 +176,8 @@ def test_finished_runs_are_compared_with_their_estimates(estimates, tmp_path, mo
                                  f"{estimated * 3e-7 / apriori:.3g} core-h, ratio {estimated * 3600 / 180 * 3e-7 / apriori:.3g}")
 
 
-def test_without_finished_runs_only_the_estimates_are_printed(tmp_path, capsys):
-    assert main([str(DEFAULT_CONFIG), str(tmp_path)]) == 0
-    out = capsys.readouterr().out
+def test_without_finished_runs_only_the_estimates_are_printed(tmp_path):
+    out = estimate_report(load_config(DEFAULT_CONFIG), str(DEFAULT_CONFIG), tmp_path, cores=2)
     assert "no run of it has finished here yet" in out and "measured_cpu" not in out and "total: estimated" not in out
 
 

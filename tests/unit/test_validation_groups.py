@@ -38,10 +38,10 @@ from siloflow.engines.validation_groups import (
     status_lines,
 )
 from siloflow.analysis.io.validation_record import RUNS as RECORD_RUNS
-from tests.conftest import validation_record_cli
+from siloflow.cli import record as CLI
+from tests.conftest import record_main
 
-CLI = validation_record_cli()
-status_main, recorded_runs = CLI.main, CLI.recorded_runs
+recorded_runs = CLI.recorded_runs
 
 
 def _estimate(run_id: str, kind: str, wall_time_s: float, mpi_ranks: int = 1) -> RunEstimate:
@@ -167,7 +167,7 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
     _write_runs(tmp_path / "calibration", sorted(planned["calibration"]))
     _write_runs(tmp_path / "silo", ["sphere2-0000000000"])
     assert recorded_runs(tmp_path) == {"calibration": planned["calibration"], "silo": {"sphere2-0000000000"}}
-    assert status_main(["status", str(config), str(tmp_path)]) == 1
+    assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 1
     lines = capsys.readouterr().out.splitlines()
     assert lines[1].split()[:2] == ["calibration", "complete"]
     assert lines[2].split()[:2] == ["silo", "stale"] and "no longer planned: sphere2-0000000000" in lines[2]
@@ -175,7 +175,7 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
     for name in ("silo", "blending", "blender"):
         (tmp_path / name).mkdir(exist_ok=True)
         (tmp_path / name / RECORD_RUNS).write_text("run_id\n" + "".join(f"{run}\n" for run in sorted(planned[name])))
-    assert status_main(["status", str(config), str(tmp_path)]) == 0
+    assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 0
     (tmp_path / "blender" / RECORD_RUNS).write_text("run,case\na,b\n")
     with pytest.raises(ValueError, match="blender/runs.csv: the provenance has no run_id column"):
         recorded_runs(tmp_path)
@@ -183,15 +183,15 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
 
 def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert status_main(["check", "blending_1", config, str(tmp_path)]) == 0
-    assert status_main(["check", "silos", config, str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "silos", "--config", config, "--record", str(tmp_path)]) == 2
     assert "unknown validation group 'silos'; this configuration's groups and parts are calibration_1," in (
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
-    assert status_main(["check", "blending", config, str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("runs in 2 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2" in
             capsys.readouterr().err)
-    assert status_main(["status"]) == 2
+    assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
 
 def test_a_group_longer_than_a_session_is_split_first_fit_decreasing():
@@ -268,12 +268,12 @@ def test_a_group_s_record_waits_for_every_run_behind_its_rows():
 
 def test_validate_writes_a_record_only_once_the_group_s_runs_have_finished(tmp_path, capsys):
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert status_main(["finished", config, str(tmp_path), "silo_2"]) == 0
+    assert record_main(["finished", "--config", config, "--directory", str(tmp_path), "--group", "silo_2"]) == 0
     captured = capsys.readouterr()
     assert captured.out.strip() == ""
     assert captured.err.strip() == ("siloflow: silo: 3 of 3 runs behind its rows still to make; its record is written "
                                     "by the `make validate GROUP=` that makes the last")
-    assert status_main(["finished", config, str(tmp_path), "silos"]) == 2
+    assert record_main(["finished", "--config", config, "--directory", str(tmp_path), "--group", "silos"]) == 2
 
 
 def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, capsys):
@@ -287,16 +287,16 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
         check_reads("calibration_checks", {"calibration": MISSING, "calibration_shapes": MISSING})
     # through the command line, before anything runs: the validation config plans the checks, the empty record has none
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert status_main(["check", "calibration_1", config, str(tmp_path)]) == 0
-    assert status_main(["check", "calibration_checks_1", config, str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "calibration_1", "--config", config, "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "calibration_checks_1", "--config", config, "--record", str(tmp_path)]) == 2
     assert "run make validate GROUP=calibration_1 then make validate GROUP=calibration_2 then" in capsys.readouterr().err
     # restoring the runs a group reads checks first: nothing is copied for a group that cannot run yet
     workdir = tmp_path / "work"
-    assert status_main(["restore", "calibration_checks_1", config, str(tmp_path), str(workdir)]) == 2
+    assert record_main(["restore", "--group", "calibration_checks_1", "--config", config, "--record", str(tmp_path), "--directory", str(workdir)]) == 2
     assert "run make validate GROUP=calibration_1 then make validate GROUP=calibration_2 then" in capsys.readouterr().err and not workdir.exists()
-    assert status_main(["restore", "calibration_1", config, str(tmp_path), str(workdir)]) == 0
+    assert record_main(["restore", "--group", "calibration_1", "--config", config, "--record", str(tmp_path), "--directory", str(workdir)]) == 0
     assert capsys.readouterr().out == "" and not workdir.exists()
     # a group read in parts is named part by part
-    assert status_main(["check", "silo_series_1", config, str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "silo_series_1", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
             "validate GROUP=silo_2 first") in capsys.readouterr().err

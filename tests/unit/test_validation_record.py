@@ -22,9 +22,9 @@ from siloflow.analysis.studies.validation.rows import COLUMNS, row
 from siloflow.engines.config import load_config_file
 from tests.repo import REPO_ROOT
 from siloflow.engines.layout import REPOSITORY_RECORD
-from tests.conftest import validation_record_cli
+from siloflow.cli import record as CLI
+from tests.conftest import record_main
 
-CLI = validation_record_cli()
 RECORD_PAGE, page, publish = CLI.RECORD_PAGE, CLI.page, CLI.publish
 
 #: The pixels of a small plot: white, a red line and a blue one (row by row, RGB).
@@ -137,9 +137,9 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
     raw = load_config_file(REPO_ROOT / "config" / "validation.yaml")
     config = tmp_path / "validation_pdf.yaml"
     config.write_text(yaml.safe_dump({**raw, "plots": {"format": "pdf"}}, sort_keys=False))
-    assert CLI.main(["check", "blending_1", str(config), str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "blending_1", "--config", str(config), "--record", str(tmp_path)]) == 2
     assert re.search(message, capsys.readouterr().err)
-    assert CLI.main(["check", "blending_1", str(REPO_ROOT / "config" / "validation.yaml"), str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "blending_1", "--config", str(REPO_ROOT / "config" / "validation.yaml"), "--record", str(tmp_path)]) == 0
 
 
 def test_a_table_without_the_validation_columns_is_refused(tmp_path):

@@ -1,22 +1,20 @@
-"""Command line of the validation record: `make validate-status`, the record's copy into the repository and its page,
-and `make validate GROUP=<name>`'s check. An adapter of the workflow layer (it joins the planner and the record's
-analysis): ``python siloflow/workflow/scripts/validation_record_cli.py <command> ...``.
+"""``siloflow record``: the validation record in ``docs/validation/``, against the runs a configuration plans.
 
-``status CONFIG RECORD_DIR`` prints, per group, whether the record in ``RECORD_DIR`` (``docs/validation``) is
-complete, stale or missing against the runs ``CONFIG`` plans (:func:`siloflow.engines.validation_groups.group_status`);
-``publish WORKDIR RECORD_DIR [GROUP]`` copies the records a `make validate` wrote in ``WORKDIR`` into ``RECORD_DIR``;
-``page CONFIG FULL_SCALE_CONFIG RECORD_DIR`` writes ``RECORD_DIR/README.md`` from the record
-(:func:`siloflow.analysis.studies.validation.record.record_page`); ``check GROUP CONFIG RECORD_DIR`` refuses, before anything
-runs, an unknown group or part, a group that runs in parts (naming them), one whose rows compare against a group
-not yet complete in the record, or a configuration whose plots are not PNG, which the record keeps
-(``plots.format``); ``restore GROUP CONFIG RECORD_DIR WORKDIR`` checks as ``check`` does, then copies into WORKDIR
-the products of the runs of the groups GROUP reads that their records keep and WORKDIR lacks (so that a group reads
-the runs another session made instead of making them again); ``finished CONFIG WORKDIR [GROUP]`` prints the groups
-(of GROUP's only) whose every run has finished in WORKDIR, whose record `make validate` then writes.
+``status`` prints, per group, whether the record is complete, stale or missing against the runs ``--config``
+(default ``config/validation.yaml``) plans (:func:`siloflow.engines.validation_groups.group_status`); ``publish``
+copies the records a validation run wrote in ``--directory`` into the record; ``page`` writes the record's page
+(``README.md``) from the record (:func:`siloflow.analysis.studies.validation.record.record_page`); ``check --group``
+refuses, before anything runs, an unknown group or part, a group that runs in parts (naming them), one whose rows
+compare against a group not yet complete in the record, or a configuration whose plots are not PNG, which the record
+keeps (``plots.format``); ``restore --group`` checks as ``check`` does, then copies into ``--directory`` the products
+of the runs of the groups it reads that their records keep and the folder lacks (so that a group reads the runs
+another session made instead of making them again); ``finished`` prints the groups (of ``--group``'s only) whose
+every run has finished in ``--directory``, whose record ``make validate`` then writes.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -169,61 +167,106 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Command line; returns 0 when every group is complete (status) or the group exists (check), 1 when a group is
-    stale or missing, 2 on a usage error."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if len(argv) == 4 and argv[0] == "check":
-        try:
-            check(argv[1], argv[2], argv[3])
-        except ValueError as error:
-            print(f"siloflow: {error}", file=sys.stderr)
-            return 2
-        return 0
-    if len(argv) == 5 and argv[0] == "restore":
-        try:
-            restored = restore(*argv[1:])
-        except ValueError as error:
-            print(f"siloflow: {error}", file=sys.stderr)
-            return 2
-        for other, count in restored.items():
-            print(f"siloflow: {count} products of the runs of {other} restored from {argv[3]}/{other} into {argv[4]}")
-        return 0
-    if len(argv) in (3, 4) and argv[0] == "finished":
-        try:
-            ready, waiting = finished(argv[1], argv[2], argv[3] if len(argv) == 4 else None)
-        except ValueError as error:
-            print(f"siloflow: {error}", file=sys.stderr)
-            return 2
-        for line in waiting:
-            print(f"siloflow: {line}", file=sys.stderr)
-        print(" ".join(ready))
-        return 0
-    if len(argv) == 3 and argv[0] == "status":
-        planned = _planned(argv[1])
-        recorded = recorded_runs(argv[2])
-        print(f"The validation record in {argv[2]} against the runs {argv[1]} plans:")
-        print("\n".join(status_lines(planned, recorded)))
-        return 1 if {STALE, MISSING} & set(group_status(planned, recorded).values()) else 0
-    if len(argv) in (3, 4) and argv[0] == "publish":
-        try:
-            groups = [check_group(argv[3])] if len(argv) == 4 else list(GROUPS)
-        except ValueError as error:
-            print(f"siloflow: {error}", file=sys.stderr)
-            return 2
-        copied = publish(argv[1], argv[2], groups)
-        print(f"validation record of {', '.join(copied) or 'no group'} copied into {argv[2]}")
-        return 0
-    if len(argv) == 4 and argv[0] == "page":
-        path = write_text(Path(argv[3]) / RECORD_PAGE, page(argv[1], argv[2], argv[3]))
-        print(f"siloflow result: {path.resolve()}")
-        return 0
-    print("usage: validation_record_cli.py status CONFIG RECORD_DIR | publish WORKDIR RECORD_DIR [GROUP] | "
-          "page CONFIG FULL_SCALE_CONFIG RECORD_DIR | check GROUP CONFIG RECORD_DIR | "
-          "restore GROUP CONFIG RECORD_DIR WORKDIR | finished CONFIG WORKDIR [GROUP]",
-          file=sys.stderr)
-    return 2
+#: The configurations and the record the commands take by default, relative to the working directory.
+VALIDATION_CONFIG, FULL_SCALE_CONFIG, RECORD_DIR = "config/validation.yaml", "config/thesis.yaml", "docs/validation"
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+class RecordError(ValueError):
+    """A record command's refusal; its message is the one line the user reads."""
+
+
+def _config(args: argparse.Namespace) -> str:
+    files = args.config or [VALIDATION_CONFIG]
+    if len(files) != 1:
+        raise RecordError("the record is judged against one configuration: give --config once")
+    if not Path(files[0]).is_file():
+        raise RecordError(f"config file {files[0]!r}: no such file")
+    return files[0]
+
+
+def _status(args: argparse.Namespace) -> int:
+    config = _config(args)
+    try:
+        planned, recorded = _planned(config), recorded_runs(args.record)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    print(f"The validation record in {args.record} against the runs {config} plans:")
+    print("\n".join(status_lines(planned, recorded)))
+    return 1 if {STALE, MISSING} & set(group_status(planned, recorded).values()) else 0
+
+
+def _publish(args: argparse.Namespace) -> int:
+    try:
+        groups = [check_group(args.group)] if args.group else list(GROUPS)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    copied = publish(args.directory, args.record, groups)
+    print(f"validation record of {', '.join(copied) or 'no group'} copied into {args.record}")
+    return 0
+
+
+def _page(args: argparse.Namespace) -> int:
+    config = _config(args)
+    if not Path(args.full_scale).is_file():
+        raise RecordError(f"config file {args.full_scale!r}: no such file")
+    path = write_text(Path(args.record) / RECORD_PAGE, page(config, args.full_scale, args.record, args.cores))
+    print(f"siloflow result: {path.resolve()}")
+    return 0
+
+
+def _check_command(args: argparse.Namespace) -> int:
+    try:
+        check(args.group, _config(args), args.record)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    return 0
+
+
+def _restore(args: argparse.Namespace) -> int:
+    try:
+        restored = restore(args.group, _config(args), args.record, args.directory)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    for other, count in restored.items():
+        print(f"siloflow: {count} products of the runs of {other} restored from {args.record}/{other} into "
+              f"{args.directory}")
+    return 0
+
+
+def _finished(args: argparse.Namespace) -> int:
+    try:
+        ready, waiting = finished(_config(args), args.directory, args.group)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    for line in waiting:
+        print(f"siloflow: {line}", file=sys.stderr)
+    print(" ".join(ready))
+    return 0
+
+
+def add_parser(commands, common) -> None:
+    """Add ``record`` and its commands to the command line's subcommands; ``common`` adds --config, --cores and
+    --directory to a parser."""
+    parser = commands.add_parser("record", help="the validation record: status, publish, page, check, restore, "
+                                 "finished", description=__doc__.split("\n\n")[0].strip('"'))
+    verbs = parser.add_subparsers(dest="verb", metavar="VERB", required=True, parser_class=type(parser))
+    working = "the validation run's working folder (its results/ holds the runs; default: the current folder)"
+    for name, handler, help_text, group in (
+            ("status", _status, "whether each group's record is complete, stale or missing (exit 1 if any is not "
+                                "complete)", None),
+            ("publish", _publish, "copy the records a validation run wrote into the record", "optional"),
+            ("page", _page, "write the record's page (README.md) from the record", None),
+            ("check", _check_command, "refuse a group that cannot run now, before anything runs", "required"),
+            ("restore", _restore, "check a group, then restore the runs it reads from the record", "required"),
+            ("finished", _finished, "print the groups whose every run has finished", "optional")):
+        sub = verbs.add_parser(name, help=help_text, description=help_text[0].upper() + help_text[1:] + ".")
+        common(sub, working)
+        sub.add_argument("--record", default=RECORD_DIR, metavar="DIR",
+                         help=f"the record's folder (default: {RECORD_DIR})")
+        if name == "page":
+            sub.add_argument("--full-scale", default=FULL_SCALE_CONFIG, metavar="FILE",
+                             help=f"the full-scale configuration the page quotes costs of (default: {FULL_SCALE_CONFIG})")
+        if group:
+            sub.add_argument("--group", required=group == "required", metavar="NAME",
+                             help="a group of the record or a part of one (silo_1, ...)")
+        sub.set_defaults(handler=handler)
