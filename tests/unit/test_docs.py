@@ -89,7 +89,8 @@ def test_the_readme_is_a_short_entry_point_with_the_two_commands():
 #               `::: <module>`, or a name given from a module's last part (`physics.free_fall_time`)
 #   key         a config key: a dotted name whose first part is a top-level section of the schema, one given relative
 #               to its section (`fill.balance_planes`), a setting (`davis.out_of_plane: keep`), a key in a formula
-#               (`Nr = tracer.start_recirculations`), and the keys of a fenced YAML example
+#               (`Nr = tracer.start_recirculations`), and the keys of a fenced YAML example; `[]` stands for a
+#               list's items (`contacts[].restitution`, as docs/configuration-reference.md writes them)
 #   rule        a Snakemake rule: a span the prose calls a rule ("rule `silo_piv_compare`") or `snakemake <target>`
 #   make        `make <target>`
 #   variable    a variable a command sets (`make estimate CONFIG=...`, `SILOFLOW_UPDATE_GOLDEN=1 python ...`): the
@@ -287,7 +288,8 @@ def _span_names(code: str, before: str, after: str, where: str) -> list[DocName]
         names += [DocName("key", key, where) for key in keys if "key" in (_dotted_kind(key) or "")]
     elif _CAMEL.fullmatch(code) or _CONSTANT.fullmatch(code):
         names.append(DocName("identifier", code, where))
-    elif (match := re.fullmatch(r"(%s)(?:\(.*\))?" % _DOTTED.pattern, code)):  # perhaps called: `engine_for(...)`
+    # perhaps called: `engine_for(...)`; a list item's key (`contacts[].restitution`) is looked up in the items
+    elif (match := re.fullmatch(r"(%s)(?:\(.*\))?" % _DOTTED.pattern, code.replace("[]", ""))):
         dotted = match.group(1)
         if dotted.rsplit(".", 1)[1].lower() not in FILE_SUFFIXES and (kind := _dotted_kind(dotted)):
             names.append(DocName(kind, dotted, where))
@@ -577,6 +579,8 @@ def test_the_deliberately_undefined_names_are_still_in_the_docs_and_still_undefi
     ("`silo_flat.fill.zone_height`, `materials.hdpe.density`, `particle_models.<name>.spheres`", True),
     ("`jenike.sweep.*`, `<case>.engine`, `tracer.start_recirculations + shortcut.residence_times`", True),
     ("`silo_flat.fill.zone_heigth`", False),
+    ("`contacts[].restitution`, `particle_models.<name>.spheres[].radius`", True),
+    ("`contacts[].restitutoin`", False),
     ("`fill.zone_heigth: 0.02`", False),
     ("`estimates.seconds_per_sphere_step_by_case.blender`", True),
     ("`estimates.seconds_per_sphere_step_by_case.hopper`", False),  # not one of its propertyNames
