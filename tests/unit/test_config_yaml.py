@@ -7,8 +7,9 @@ import time
 import pytest
 import yaml
 
+from siloflow.cli.main import main
 from siloflow.engines.config_yaml import (
-    MAX_ALIASES, MAX_BYTES, MAX_DEPTH, MAX_NODES, ConfigFileError, load_config_text, main, read_config_file,
+    MAX_ALIASES, MAX_BYTES, MAX_DEPTH, MAX_NODES, ConfigFileError, load_config_text, read_config_file,
 )
 
 
@@ -106,9 +107,8 @@ def test_the_command_line_refuses_the_first_file_it_cannot_read_as_data(tmp_path
     good.write_text("seed: 1\n")
     asks = tmp_path / "asks.yaml"
     asks.write_text("__use_yte__: true\nseed: ?1 + 1\n")
-    assert main([str(good)]) == 0
-    assert main([str(good), str(asks)]) == 2
-    assert capsys.readouterr().err == (f"siloflow: invalid configuration: {asks}: sets __use_yte__: Snakemake would "
-                                       "evaluate the file's ?-expressions as Python when it loads it. A siloflow "
-                                       "configuration is plain data: remove the key and write the values out\n")
-    assert main([str(tmp_path / "missing.yaml")]) == 2
+    assert main(["check", "--config", str(good), "--config", str(asks)]) == 2
+    assert capsys.readouterr().err == (f"siloflow check: invalid configuration: {asks}: sets __use_yte__: Snakemake "
+                                       "would evaluate the file's ?-expressions as Python when it loads it. A "
+                                       "siloflow configuration is plain data: remove the key and write the values "
+                                       "out\n")
