@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from tests.repo import REPO_ROOT
+from siloflow.cli.main import main
 from siloflow.engines.workflow_lock import (
     LAUNCHER_LOCK,
     LiveRunError,
@@ -26,7 +27,6 @@ from siloflow.engines.workflow_lock import (
     is_snakemake_command,
     launch,
     live_snakemake_processes,
-    main,
     stale_lock_files,
     unlock_command,
     working_directory,
@@ -306,7 +306,10 @@ def test_snakemake_keeps_the_directory_locked_when_the_launcher_alone_is_killed(
 def test_the_command_line_refuses_a_live_run_with_a_message_and_a_retry_exit_code(tmp_path, capsys):
     held = acquire_launcher_lock(tmp_path)
     try:
-        assert main(["--directory", str(tmp_path), "--cores", "1"]) == 75
+        assert main(["run", "--config", str(REPO_ROOT / "config" / "config.yaml"), "--directory", str(tmp_path),
+                     "--cores", "1"]) == 75
     finally:
         held.close()
-    assert capsys.readouterr().err.startswith(f"siloflow: another siloflow run is live in {tmp_path.resolve()} ")
+    err = capsys.readouterr().err
+    assert err.startswith(f"siloflow run: another siloflow run is live in {tmp_path.resolve()} ")
+    assert len(err.splitlines()) == 1
