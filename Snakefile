@@ -6,3 +6,11 @@ configfile: "config/config.yaml"
 
 
 include: "siloflow/workflow/Snakefile"
+
+
+# The included workflow's `all`, made this file's default target (a rule of the including file is the default).
+rule default:
+    input:
+        rules.all.input,
+    default_target: True
+    localrule: True
