@@ -50,7 +50,6 @@ __all__ = [
     "is_snakemake_command",
     "launch",
     "live_snakemake_processes",
-    "main",
     "stale_lock_files",
     "unlock_command",
     "working_directory",

@@ -34,7 +34,7 @@ from siloflow.engines.layout import run_dir as layout_run_dir
 from siloflow.engines.liggghts.cost import calibrate_cost_model
 from siloflow.engines.planning import config_estimates, measured_cost_model, run_directory
 from tests.paraview_checks import check_paraview_folder
-from siloflow.cli.record import publish
+from siloflow.cli import record as validation_record
 from tests.conftest import (MICRO_SILO, NO_BLENDER, NO_BLENDING, NO_VERIFICATION, TINY_JENIKE_SWEEP, TINY_SILO,
                             liggghts, require_liggghts, run_snakemake)
 from tests.notebooks import execute_notebook, figures
@@ -132,7 +132,7 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "silo_run" not in result.stdout + result.stderr
     record_dir = tmp_path / "docs"
-    assert publish(workdir, record_dir, ["calibration", "silo", "silo_series"]) == ["silo", "silo_series"]
+    assert validation_record.publish(workdir, record_dir, ["calibration", "silo", "silo_series"]) == ["silo", "silo_series"]
     record, series = read_group_record(record_dir / "silo"), read_group_record(record_dir / "silo_series")
     planned = {case.run_id for case in cases_of(_validated({**TINY_SILO, **SILO_PARAMETRIC}), "silo_flat").values()}
     assert len(planned) == 2 and [run["run_id"] for run in record.runs] == [run_dir.name]
@@ -153,12 +153,12 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
     assert record.plots == ["janssen.png", "profiles.png"] and series.plots == ["restitution.png"]
     # the page judges the record against the configuration that made it: both silo groups complete, each with the
     # one run it makes
-    text = cli.page(str(config_path), str(config_path), record_dir)
+    text = validation_record.page(str(config_path), str(config_path), record_dir)
     assert "| silo | complete | 1 |" in text and "| silo_series | complete | 1 |" in text
     assert "| calibration | missing | 0 |" in text
     # another machine: the series starts from the base run's products the silo record keeps, and makes only its own
     fresh = tmp_path / "fresh"
-    assert cli.restore("silo_series", str(config_path), record_dir, fresh) == {"silo": len(READ_PRODUCTS["silo_flat"])}
+    assert validation_record.restore("silo_series", str(config_path), record_dir, fresh) == {"silo": len(READ_PRODUCTS["silo_flat"])}
     assert (fresh / "results" / "silo_flat" / run_dir.name / "run.json").read_bytes() == (run_dir / "run.json").read_bytes()
     planned_jobs = run_snakemake(fresh, "-n", "--cores", "1", "--configfile", str(config_path),
                                  targets=["validate_silo_series"])

@@ -11,7 +11,7 @@ from siloflow.model.cases import cases_of
 from siloflow.model.cases.silo_flat import build_silo_case
 from snakemake.utils import update_config
 
-from siloflow.engines.config import SCHEMA_PATH, ConfigError, load_config, load_config_file, load_schema, validate_config
+from siloflow.engines.config import ConfigError, load_config, load_config_file, load_schema, validate_config
 from siloflow.engines.interface import CaseNotSupported, engine_for
 from tests.repo import REPO_ROOT
 
