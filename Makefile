@@ -179,8 +179,10 @@ bench: install-test
 	$(PYTHON) -m tests.bench.bench_piv results/bench/piv.csv
 
 # The documentation site (mkdocs.yml, docs/): --strict fails on a broken link, a missing page or a docstring the API
-# reference cannot render. Open $(DOCS_SITE)/index.html.
+# reference cannot render. The example notebooks are shown executed on the tiny run (made first where missing;
+# executed into build/notebooks/, which the hook docs/hooks/notebooks.py renders). Open $(DOCS_SITE)/index.html.
 DOCS_SITE ?= build/site
 
-docs: install-docs
+docs: install-docs run-tiny
+	$(PYTHON) -m tests.notebooks --tiny $(TINY_DIR)
 	NO_MKDOCS_2_WARNING=1 $(PYTHON) -m mkdocs build --strict --site-dir $(DOCS_SITE)
