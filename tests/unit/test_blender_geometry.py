@@ -12,7 +12,7 @@ from siloflow.model.cases.blender_geometry import INSERT_PRESETS, blender_geomet
 from siloflow.model.cases.blender_passages import annulus_bounds, clear_widths, geometry_summary
 from siloflow.model.cases.blender_meshes import blender_meshes
 
-# The study's full scale (SEED_DIGEST section 5).
+# The study's full scale (thesis ch. 7).
 FULL = dict(width=0.45, depth=0.04, vertical_height=1.5, hopper_half_angle=30.0, outlet_width=0.04,
             wall_thickness=0.005, tube_width=0.04, tube_inlet_above_transition=0.15 * 0.45)
 TAN30 = math.tan(math.radians(30.0))

@@ -11,7 +11,7 @@ from siloflow.model.cases.blender_geometry import blender_geometry
 from siloflow.model.cases.blender_meshes import blender_meshes, is_watertight, mirror_x, signed_volume
 from siloflow.model.cases.geometry import horizontal_rectangle, read_stl, write_stl
 
-# The study's full scale (SEED_DIGEST section 5) and a half scale with thinner walls.
+# The study's full scale (thesis ch. 7) and a half scale with thinner walls.
 FULL = dict(width=0.45, depth=0.04, vertical_height=1.5, hopper_half_angle=30.0, outlet_width=0.04,
             wall_thickness=0.005, tube_width=0.04, tube_inlet_above_transition=0.15 * 0.45)
 HALF = dict(width=0.225, depth=0.02, vertical_height=0.75, hopper_half_angle=30.0, outlet_width=0.02,

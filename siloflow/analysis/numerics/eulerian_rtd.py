@@ -2,7 +2,7 @@
 
 Pure computation on numpy arrays; no file I/O. SI units: m, m/s, s, kg.
 
-The method of SEED_DIGEST section 4 ("RTD from Eulerian fields"):
+The method of thesis ch. 6 ("RTD from Eulerian fields"):
 
 1. Split the silo into bins (a regular grid, :class:`siloflow.analysis.numerics.grid.Grid`) and take, at every
    saved instant, the mass-weighted mean velocity of the clumps whose centres lie in each bin

@@ -3,7 +3,7 @@
 Pure functions on numpy arrays; no file I/O. SI units: times in s, E in 1/s; concentrations in
 any unit (e.g. a mass fraction of blue pellets), outputs in the unit of the input.
 
-Model (SEED_DIGEST section 4)
+Model (thesis ch. 6)
 -----------------------------
 The silo is a linear, time-invariant system whose impulse response is its RTD ``E``:
 

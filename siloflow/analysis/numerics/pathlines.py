@@ -3,7 +3,7 @@
 Pure computation on numpy arrays; no file I/O. SI units: positions in m, velocities in m/s,
 times in s.
 
-The method of SEED_DIGEST section 4 ("RTD from Eulerian fields"): bin-averaged (coarse-grained)
+The method of thesis ch. 6 ("RTD from Eulerian fields"): bin-averaged (coarse-grained)
 velocities are saved at instants ``t_k``; virtual tracers seeded on a lattice
 (:func:`siloflow.analysis.numerics.tracer_seeds.lattice_seeds`) are integrated through the interpolated field,
 and the residence time of a tracer is the time it takes to cross the outlet plane ``z = outlet_z``.

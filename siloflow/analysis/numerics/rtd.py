@@ -2,7 +2,7 @@
 
 Pure functions on numpy arrays; no file I/O. SI units: times in s, E in 1/s.
 
-Definitions (Danckwerts; the blending study of SEED_DIGEST section 4)
+Definitions (Danckwerts; the blending study of thesis ch. 6)
 ---------------------------------------------------------------------
 A tracer of ``N0`` particles (or virtual tracers) enters at ``t_entry``; particle ``i`` leaves at
 ``t_exit_i`` and its residence time is ``tau_i = t_exit_i - t_entry_i``. Then

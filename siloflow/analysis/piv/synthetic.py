@@ -1,6 +1,6 @@
 """Synthetic PIV: images of the particles at the front wall rendered from DEM, and PIV run on them with OpenPIV.
 
-Rendering follows the study (SEED_DIGEST section 6): the particles seen through the front wall in one colour on grey
+Rendering follows the study (thesis ch. 3): the particles seen through the front wall in one colour on grey
 voids. Each particle is a disc, its edge anti-aliased by the fraction of a pixel it covers (``radius + 0.5 - d``,
 clipped to [0, 1], with d the pixel centre's distance from the disc centre), then optionally blurred (Gaussian,
 ``scipy.ndimage``) and given Gaussian noise. Image axes: column c to the right, row r down, pixel (c, r) covers

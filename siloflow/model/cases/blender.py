@@ -8,8 +8,8 @@ Stages: pour clumps centrally from a zone above the pile, settle (to ``blender.s
 clump's m g d, looser than the flat silo's: the heap over the internals creeps for long), remove the gate,
 discharge. In ``batch`` mode the silo empties and clumps leave the domain below the outlet; in ``continuous`` mode
 the vertical boundary is periodic, so a clump that leaves the outlet falls ``sink_depth`` and re-enters at the top
-of the silo with its id: the head stays constant and the silo is fed centrally with its own outflow (SEED_DIGEST
-section 5).
+of the silo with its id: the head stays constant and the silo is fed centrally with its own outflow (thesis
+ch. 7).
 
 Gravity scaling: at gravity factor f, gravity is f g and every time of the flow (discharge time, steady window,
 dump interval, settling checks) is divided by sqrt(f). Every Young's modulus is multiplied by f, so that the

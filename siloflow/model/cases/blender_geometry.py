@@ -1,4 +1,4 @@
-"""Planar multi-flow blender geometry: silo, hopper, cone-in-cone insert and blending tube (SEED_DIGEST section 5).
+"""Planar multi-flow blender geometry: silo, hopper, cone-in-cone insert and blending tube (thesis ch. 7).
 
 Coordinates (SI units, m): x across the width with the silo centred on x = 0, y through the depth (front wall
 y = 0, back wall y = T), z up with the outlet plane at z = 0. Every wall is a 2-D shape in the x-z plane

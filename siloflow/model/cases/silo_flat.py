@@ -224,7 +224,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
 def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
     """The configurations of the parametric studies: ``{study: [(label, config), ...]}``.
 
-    Studies (digest section 3): ``front_back_friction`` (particle-wall friction of the front and back walls,
+    Studies (thesis ch. 5): ``front_back_friction`` (particle-wall friction of the front and back walls,
     plus a run without them when ``periodic_front_back``), ``restitution`` (of all particle contacts) and
     ``friction`` (particle-particle sliding x rolling friction of all particle contacts). A front/back wall
     friction value gets its own material (a copy of the front/back wall material), so the side walls keep

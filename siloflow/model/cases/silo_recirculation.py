@@ -4,7 +4,7 @@ Geometry (SI units, as :mod:`siloflow.model.cases.silo_flat`): the planar silo o
 plane at z = 0, plus a vertical channel of the outlet width B0 from z = 0 down to z = -L (``channel_length``).
 In the lower half of the channel a feeder holds the clumps at the downward velocity ``V_out``. The domain is
 periodic in z: a clump leaving the bottom z = -L re-enters at the top of the domain (above the pile) and falls
-back onto it, so the silo is fed with its own outflow (SEED_DIGEST section 4).
+back onto it, so the silo is fed with its own outflow (thesis ch. 6).
 
 Stages: pour and settle exactly as the batch silo (the gate closes the outlet, the channel is empty), open the
 outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times

@@ -1,4 +1,4 @@
-"""The steady field of the multi-flow blender (SEED_DIGEST section 5): velocities and solid fraction on (x, z) bins.
+"""The steady field of the multi-flow blender (thesis ch. 7): velocities and solid fraction on (x, z) bins.
 
 Pure computation on numpy arrays; no file I/O. SI units: lengths in m, velocities in m/s.
 

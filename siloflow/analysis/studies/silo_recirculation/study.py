@@ -4,7 +4,7 @@
 
 Pure computation on arrays; the workflow scripts read the tracks and write tables and plots. SI units.
 
-Steps (SEED_DIGEST section 4):
+Steps (thesis ch. 6):
 
 1. Events: re-entries at the top and outlet crossings of every clump
    (:func:`siloflow.analysis.studies.silo_recirculation.tracks.recirculation_events`);

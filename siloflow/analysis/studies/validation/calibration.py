@@ -30,7 +30,7 @@ from siloflow.analysis.studies.validation.rows import NO, Criteria, plus_minus, 
 __all__ = ["SECTIONS", "calibration_rows"]
 
 GROUP = "Calibration (Jenike cell)"
-#: The study's chosen particle-scale friction of the two-sphere clump (SEED_DIGEST section 1).
+#: The study's chosen particle-scale friction of the two-sphere clump (thesis ch. 4).
 STUDY_FRICTION = {"internal": "0.35", "aluminium": "0.17", "perspex": "0.2"}
 
 
