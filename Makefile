@@ -108,7 +108,7 @@ bayesian: install
 # (its own results/ and reports there, so that it never overwrites the default run's), prints the estimate of every run
 # first and resumes where an interrupted run stopped. `make validate GROUP=<name>` runs one group
 # (siloflow.engines.validation_groups: calibration, calibration_shapes, calibration_checks, silo, silo_series,
-# blending, blender), or one part of a group longer than a working session (silo_1, silo_2, ...); each group's record
+# blending, blender), or one part of a group longer than a working session (blending_1, blending_2); each group's record
 # is written and copied into docs/validation/ once all its runs have finished, whichever part finished them. A group
 # that compares against another group's runs (calibration_checks, silo_series) starts from the products of those runs
 # that the other group's record keeps (docs/validation/<group>/products/), restored into results/validation/ where

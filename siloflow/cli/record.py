@@ -157,14 +157,16 @@ def finished(config_path: str, workdir: str | Path, name: str | None = None) -> 
 
 def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: int = 2) -> str:
     """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
-    group's measured wall time on ``cores`` cores, its parts and its cost at the scale of ``full_scale_path``."""
+    group's measured wall time on ``cores`` cores beside its estimate, its parts and its cost at the scale of
+    ``full_scale_path``."""
     made = _plan(config_path)[1]
+    estimated = {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)}
     record = read_record(record_dir, GROUPS)
     status = group_status(planned_runs(made), _run_ids(record))
     parts = {name: [part.name for part in group_parts] for name, group_parts in split_groups(made).items()}
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
-                       measured_wall_times(record, cores), cores, config_path, full_scale_path, parts)
+                       measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated)
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.

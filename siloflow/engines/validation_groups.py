@@ -61,8 +61,9 @@ GROUPS: dict[str, Group] = {
 #: The longest a group (or a part of one) may take on :data:`PART_CORES` cores (s): a working session.
 GROUP_BUDGET_S = 2.5 * 3600.0
 
-#: The share of the budget a part is filled to by its estimated wall time: a run's estimate is within about a tenth of
-#: its measured time (`make estimate`'s comparison), and the budget holds for the measured times.
+#: The share of the budget a part is filled to by its estimated wall time: with the validation configuration's rates per
+#: case kind, a group's estimate is within about a tenth of its recorded time (the record's page sets them side by
+#: side), and the budget holds for the measured times.
 PART_FILL = 0.9
 
 #: The cores the budget is for, a laptop's: the parts of a group are the same whatever the cores of the machine at

@@ -166,7 +166,8 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
     wall = CLI.measured_wall_times(groups, cores=2)
     assert wall == {"silo": {"silo_1": 5400.0, "silo_2": 1800.0}, "silo_series": {"silo_series": 3600.0}}
     text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, wall, 2,
-                       "config/validation.yaml", "config/thesis.yaml", {"silo": ["silo_1", "silo_2"]})
+                       "config/validation.yaml", "config/thesis.yaml", {"silo": ["silo_1", "silo_2"]},
+                       {"calibration": 1800.0, "silo": 9900.0})
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
     # the page opens with the study it compares with, by the thesis's chapters, and what its study column quotes
@@ -183,9 +184,10 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
         "finding that a row is judged against, \"-\" where the study gives none.",
         ""]
     assert lines[4].startswith("The study's comparisons at the validation scale (`config/validation.yaml`)")
-    assert "| calibration | missing | 0 | - | - | 0 | 0 |" in lines
-    assert "| silo | stale | 3 | 2.50 h | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 |" in lines
-    assert "| silo_series | complete | 1 | 1.00 h | 1.00 h | 1 | 1 |" in lines
+    # the estimate beside the recorded core time: 9900 s over 9000 s is 1.10; no estimate given for silo_series
+    assert "| calibration | missing | 0 | - | 0.50 h | - | 0 | 0 |" in lines
+    assert "| silo | stale | 3 | 2.50 h | 2.75 h (1.10) | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 |" in lines
+    assert "| silo_series | complete | 1 | 1.00 h | - | 1.00 h | 1 | 1 |" in lines
     assert "Not recorded yet: `make validate GROUP=calibration`." in lines
     # the stale group runs in parts: the page names them
     assert ("**Stale**: the runs below are not those `config/validation.yaml` now plans; `make validate GROUP=silo_1`, "

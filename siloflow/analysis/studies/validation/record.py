@@ -146,7 +146,8 @@ def _hours(seconds: float) -> str:
 
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
-                parts: Mapping[str, Sequence[str]] | None = None) -> str:
+                parts: Mapping[str, Sequence[str]] | None = None,
+                estimated_core_s: Mapping[str, float] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows, and for each row the scale does not show, what scale would show it and what that scale
     costs.
@@ -171,6 +172,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     parts : mapping, optional
         ``{group: [part]}``: what `make validate GROUP=` takes for each group the configuration runs in parts (a
         group absent runs whole).
+    estimated_core_s : mapping, optional
+        ``{group: CPU s}``: each group's runs as ``config_name``'s cost model estimates them, shown beside the
+        recorded core time with their ratio (a group absent: "-").
 
     Returns
     -------
@@ -186,8 +190,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
         "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
         "",
-        f"| group | status | runs it makes | core time | wall time on {cores} cores (per part) | rows | shown at this scale |",
-        "|---|---|---|---|---|---|---|",
+        f"| group | status | runs it makes | core time | estimated (estimate / recorded) | wall time on {cores} cores "
+        "(per part) | rows | shown at this scale |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for name, state in status.items():
         record, part_walls = groups.get(name, GroupRecord()), wall_s.get(name, {})
@@ -195,7 +200,10 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         core = math.fsum(run_wall_time(run) * int(run["cores"]) for run in made)
         shown = sum(row["scale_shows"] == YES for row in record.rows)
         wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
-        lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | "
+        estimate = (estimated_core_s or {}).get(name, math.nan)
+        estimated = "-" if not math.isfinite(estimate) else (
+            f"{_hours(estimate)} ({estimate / core:.2f})" if made and core > 0 else _hours(estimate))
+        lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | {estimated} | "
                      f"{wall if made else '-'} | {len(record.rows)} | {shown} |")
     for name, state in status.items():
         record = groups.get(name)
