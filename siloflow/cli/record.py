@@ -23,7 +23,9 @@ from typing import Sequence
 from siloflow.analysis.io.tables import write_text
 from siloflow.analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_record, restore_products,
                                            write_group_record)
+from siloflow.analysis.studies.validation.findings import FINDINGS
 from siloflow.analysis.studies.validation.record import record_page, run_wall_time
+from siloflow.analysis.studies.validation.scale import FINDING_SCALES, scale_verdict
 from siloflow.engines.config import load_config
 from siloflow.engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
 from siloflow.engines.planning import config_estimates, group_runs, run_directory
@@ -161,12 +163,17 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     ``full_scale_path``."""
     made = _plan(config_path)[1]
     estimated = {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)}
+    config = load_config(config_path)
+    # the dimensions alone: whether each row computes its quantity as the study defines it is the row's to say
+    scales = [(finding, scale_verdict(finding.id, FINDING_SCALES[finding.id].kind, config, True))
+              for finding in FINDINGS]
     record = read_record(record_dir, GROUPS)
     status = group_status(planned_runs(made), _run_ids(record))
     parts = {name: [part.name for part in group_parts] for name, group_parts in split_groups(made).items()}
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
-                       measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated)
+                       measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
+                       scales)
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from siloflow.analysis.studies.validation.rows import NO, YES, row
-from siloflow.analysis.studies.validation.scale import (FINDINGS, STUDY, STUDY_PARTICLE_DIAMETER, Thresholds,
+from siloflow.analysis.studies.validation.scale import (FINDING_SCALES, STUDY, STUDY_PARTICLE_DIAMETER, Thresholds,
                                                         scale_verdict)
 from siloflow.engines.config import load_config, validate_config
 from siloflow.model.cases.blender import build_blender_case
@@ -66,7 +66,7 @@ def _looser_fill(raw):
 
 def test_at_the_study_s_dimensions_every_finding_is_at_scale():
     config = _config()
-    for finding, entry in FINDINGS.items():
+    for finding, entry in FINDING_SCALES.items():
         verdict = scale_verdict(finding, entry.kind, config, True)
         assert verdict.at_study_scale and verdict.differences == (), (finding, verdict.text)
         assert verdict.text.startswith(f"at the study's scale for {finding} (")
@@ -151,10 +151,10 @@ def test_a_larger_silo_than_the_study_s_is_not_at_its_scale_but_more_particles_a
 def test_a_quantity_not_defined_as_the_study_s_is_not_at_scale_and_says_so():
     verdict = scale_verdict("B4", "silo_recirculation", _config(), False)
     assert not verdict.at_study_scale and verdict.differences == () and not verdict.definition_as_study
-    assert verdict.text == f"the quantity is not defined or sampled as the study's: {FINDINGS['B4'].definition}"
+    assert verdict.text == f"the quantity is not defined or sampled as the study's: {FINDING_SCALES['B4'].definition}"
     assert "Nr = 4" in verdict.text and "§6.4.2" in verdict.text
-    assert "t_rm = hold-up volume / volumetric flow rate" in FINDINGS["B7"].definition
-    assert "20, 40, 80 and 120 mm" in FINDINGS["S5"].definition
+    assert "t_rm = hold-up volume / volumetric flow rate" in FINDING_SCALES["B7"].definition
+    assert "20, 40, 80 and 120 mm" in FINDING_SCALES["S5"].definition
 
 
 def test_the_verdict_takes_no_value_and_is_the_same_whatever_value_a_row_carries():
@@ -163,10 +163,10 @@ def test_the_verdict_takes_no_value_and_is_the_same_whatever_value_a_row_carries
     assert not any(word in name for name in parameters for word in ("value", "result", "row", "error"))
     config = load_config(REPO_ROOT / "config" / "validation.yaml")
     before = copy.deepcopy(config)
-    expected = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDINGS.items()}
+    expected = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDING_SCALES.items()}
     values = [*np.random.default_rng(7).normal(0.0, 1e3, 40), 0.0, -1.0, math.inf, -math.inf, math.nan, 1e300]
     for value in values:
-        for finding, entry in FINDINGS.items():
+        for finding, entry in FINDING_SCALES.items():
             verdict = scale_verdict(finding, entry.kind, config, True)
             judged = row("group", finding, "case", value, abs(value) / 10, "-", "",
                          YES if verdict.at_study_scale else NO, verdict.text)
@@ -204,7 +204,7 @@ def test_the_thresholds_default_to_the_schema_s():
 
 
 def test_every_finding_names_dimensions_the_study_gives_and_cites_a_section():
-    for finding, entry in FINDINGS.items():
+    for finding, entry in FINDING_SCALES.items():
         assert set(entry.dimensions) <= set(STUDY[entry.kind]), finding
         assert "§" in entry.definition, finding
     assert STUDY_PARTICLE_DIAMETER == pytest.approx(3.33e-3, abs=5e-6)
@@ -213,7 +213,7 @@ def test_every_finding_names_dimensions_the_study_gives_and_cites_a_section():
 
 def test_the_validation_config_is_judged_finding_by_finding():
     config = load_config(REPO_ROOT / "config" / "validation.yaml")
-    verdicts = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDINGS.items()}
+    verdicts = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDING_SCALES.items()}
     summary = "\n".join(f"{finding}: {'at scale' if v.at_study_scale else 'not at scale'}: {v.text}"
                         for finding, v in verdicts.items())
     depth = {d.name: d for d in verdicts["M1"].differences}.get("depth")

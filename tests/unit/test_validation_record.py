@@ -16,12 +16,14 @@ from siloflow.model.record import RunRecord, RunRecordError
 from siloflow.analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            RECORD_PLOT_COLOURS, read_validation_rows, restore_products,
                                            write_group_record, write_record_plot)
-from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, provenance_row, record_page, run_wall_time,
-                                              simulated_time)
+from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, findings_scale_section, provenance_row,
+                                                         record_page, run_wall_time, simulated_time)
 from siloflow.analysis.studies.validation.rows import COLUMNS, row
 from siloflow.engines.config import load_config_file
 from tests.repo import REPO_ROOT
 from siloflow.engines.layout import REPOSITORY_RECORD
+from siloflow.analysis.studies.validation.findings import FINDINGS, finding
+from siloflow.analysis.studies.validation.scale import DimensionDifference, ScaleVerdict
 from siloflow.cli import record as CLI
 from tests.conftest import record_main
 
@@ -286,3 +288,27 @@ def test_the_wall_time_is_read_from_snakemake_s_benchmark(tmp_path):
     path.write_text("time,rss\n1,2\n")
     with pytest.raises(ValueError, match="not a Snakemake benchmark"):
         benchmark_wall_time(path)
+
+
+def test_the_findings_section_counts_per_chapter_and_names_what_differs():
+    at_scale = ScaleVerdict("C1", "jenike", True, (), True, "bulk friction", "at the study's scale")
+    depth = DimensionDifference("depth", 0.0125, 0.04, 0.3125, 3.75, "at least 0.9 of the study's and at least 10 "
+                                "particle diameters", "the walls")
+    fill = DimensionDifference("fill_height", 0.1, 0.27, 0.37, 30.0, "at least 0.9 of the study's", "the head")
+    shallow = ScaleVerdict("S1", "silo_flat", False, (depth, fill), True, "stress", "")
+    undefined = ScaleVerdict("B4", "silo_recirculation", False, (), False, "VRR at Nr = 4", "")
+    lines = findings_scale_section([(finding("C1"), at_scale), (finding("S1"), shallow), (finding("B4"), undefined)],
+                                   "config/validation.yaml")
+    assert lines[0] == "## The study's findings at this scale"
+    assert lines[4:9] == ["| chapter | at the study's scale | not at the study's scale |", "|---|---|---|",
+                          "| 4 | 1 | 0 |", "| 5 | 0 | 1 |", "| 6 | 0 | 1 |"]
+    assert lines[-3:] == [
+        "| C1 | §4.4.3.1 | yes | - |",
+        "| S1 | §5.4.1 | no | depth 0.31, 3.8 particle diameters; fill height 0.37 |",
+        "| B4 | §6.4.2 | no | -; the quantity is not defined as the study's |"]
+
+
+def test_every_finding_of_the_study_is_on_the_record_page():
+    text = (REPO_ROOT / "docs" / "validation" / "README.md").read_text(encoding="utf-8")
+    missing = [item.id for item in FINDINGS if f"\n| {item.id} | " not in text]
+    assert not missing, f"findings without a line on the record's page: {missing}"

@@ -17,7 +17,9 @@ from dataclasses import dataclass, field
 
 from siloflow.model.checks import number_or_nan
 from siloflow.model.record import RunRecord
+from siloflow.analysis.studies.validation.findings import Finding
 from siloflow.analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
+from siloflow.analysis.studies.validation.scale import ScaleVerdict
 
 __all__ = ["STUDY_PARAGRAPH", "RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time",
            "record_page"]
@@ -144,10 +146,64 @@ def _hours(seconds: float) -> str:
     return f"{seconds / 3600.0:.2f} h"
 
 
+def _difference_brief(difference) -> str:
+    """A dimension that differs, in a table cell: its ratio to the study's, and its particle diameters where a floor in
+    particle diameters bears on it (``fill height 0.37``, ``depth 0.31, 3.8 particle diameters``)."""
+    brief = f"{difference.name.replace('_', ' ')} {difference.ratio:.2g}"
+    if difference.run_diameters is not None and "particle diameters" in difference.threshold:
+        brief += f", {difference.run_diameters:.1f} particle diameters"
+    return brief
+
+
+def findings_scale_section(verdicts: Sequence[tuple[Finding, ScaleVerdict]], config_name: str) -> list[str]:
+    """The page's section on the study's findings: for each, whether ``config_name``'s runs are at the study's scale
+    for it, judged from the configuration alone (:func:`siloflow.analysis.studies.validation.scale.scale_verdict`),
+    with each dimension that differs as a ratio to the study's; then a count per chapter.
+
+    Parameters
+    ----------
+    verdicts : sequence of (Finding, ScaleVerdict)
+        Every finding of the study, in its order, with its verdict on the configuration's dimensions.
+    config_name : str
+        The configuration, as the page names it.
+
+    Returns
+    -------
+    list of str
+        Markdown lines.
+    """
+    chapters: dict[int, list[int]] = {}
+    for finding, verdict in verdicts:
+        counts = chapters.setdefault(finding.chapter, [0, 0])
+        counts[0 if verdict.at_study_scale else 1] += 1
+    lines = [
+        "## The study's findings at this scale",
+        "",
+        f"Whether the runs of `{config_name}` are at the study's scale for each of its findings, judged from the "
+        "configuration alone, never from a result: every dimension the finding depends on as a ratio to the study's "
+        "(`validation.scale` of the configuration reference gives the bounds and their reasons), and in particle "
+        "diameters. A finding the tier is not at the scale of can still be measured; its rows are results at another scale. The groups' rows below still carry one "
+        "verdict each, \"scale shows\", judged from the runs themselves.",
+        "",
+        "| chapter | at the study's scale | not at the study's scale |",
+        "|---|---|---|",
+    ]
+    lines += [f"| {chapter} | {counts[0]} | {counts[1]} |" for chapter, counts in sorted(chapters.items())]
+    lines += ["", "| finding | thesis | at the study's scale | what differs (ratio to the study's) |", "|---|---|---|---|"]
+    for finding, verdict in verdicts:
+        differs = "; ".join(_difference_brief(difference) for difference in verdict.differences) or "-"
+        if not verdict.definition_as_study:
+            differs = f"{differs}; the quantity is not defined as the study's"
+        lines.append(f"| {finding.id} | {finding.section} | {YES if verdict.at_study_scale else NO} | "
+                     f"{_cell(differs)} |")
+    return lines
+
+
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None,
-                estimated_core_s: Mapping[str, float] | None = None) -> str:
+                estimated_core_s: Mapping[str, float] | None = None,
+                findings_scale: Sequence[tuple[Finding, ScaleVerdict]] = ()) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows, and for each row the scale does not show, what scale would show it and what that scale
     costs.
@@ -175,6 +231,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     estimated_core_s : mapping, optional
         ``{group: CPU s}``: each group's runs as ``config_name``'s cost model estimates them, shown beside the
         recorded core time with their ratio (a group absent: "-").
+    findings_scale : sequence of (Finding, ScaleVerdict), optional
+        The study's findings with whether ``config_name`` is at their scale (:func:`findings_scale_section`), shown
+        before the groups; none: no such section.
 
     Returns
     -------
@@ -190,6 +249,10 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
         "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
         "",
+    ]
+    if findings_scale:
+        lines += [*findings_scale_section(findings_scale, config_name), "", "## The groups", ""]
+    lines += [
         f"| group | status | runs it makes | core time | estimated (estimate / recorded) | wall time on {cores} cores "
         "(per part) | rows | shown at this scale |",
         "|---|---|---|---|---|---|---|---|",

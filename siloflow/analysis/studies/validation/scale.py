@@ -28,7 +28,7 @@ from siloflow.model.cases.blender_geometry import BlenderGeometry, blender_geome
 from siloflow.model.cases.kinds import kind_of_case
 from siloflow.model.cases.particles import clump_volume, equivalent_diameter, particle_template
 
-__all__ = ["STUDY", "STUDY_PARTICLE_DIAMETER", "FINDINGS", "REASONS", "FLOORS", "Thresholds", "StudyDimension",
+__all__ = ["STUDY", "STUDY_PARTICLE_DIAMETER", "FINDING_SCALES", "REASONS", "FLOORS", "Thresholds", "StudyDimension",
            "FindingScale", "DimensionDifference", "ScaleVerdict", "scale_verdict"]
 
 
@@ -141,7 +141,7 @@ _VRR_TEXT = "VRR, the input over the output variance of the blue concentration, 
 _RTD_TEXT = ("a tracer of 10 % of the silo volume injected at the inlet of the steady flow, theta = t / t_rm with "
              "t_rm = hold-up volume / volumetric flow rate (§6.2.3.3, §6.5.1)")
 #: Per finding id: its kind, the dimensions that bear on it and the study's definition of its quantity.
-FINDINGS: Mapping[str, FindingScale] = MappingProxyType({
+FINDING_SCALES: Mapping[str, FindingScale] = MappingProxyType({
     "C1": FindingScale("jenike", _CELL, "bulk internal friction F_t,avg / (F_N + W_solids) over the steady shear at "
                        "rolling friction 0, particle friction down to 0 (§4.3.3, §4.4.3.1)", _ALL_SHAPES),
     "C2": FindingScale("jenike", _CELL, "bulk internal friction at rolling friction 0 over particle friction 0-1, "
@@ -358,21 +358,21 @@ def scale_verdict(finding_id: str, kind: str, config_or_case, definition_as_stud
     Parameters
     ----------
     finding_id : str
-        A key of :data:`FINDINGS` (C1-C7, S1-S6, B1-B8, M1-M4).
+        A key of :data:`FINDING_SCALES` (C1-C7, S1-S6, B1-B8, M1-M4).
     kind : str
         The case kind of the run: the finding's (``jenike``, ``silo_flat``, ``silo_recirculation``, ``blender``).
     config_or_case : Mapping or case object
         The validated configuration (:func:`siloflow.engines.config.load_config`), or the built case of the run
         (``SiloCase``, ``RecirculationCase``, ``BlenderCase``, ``JenikeCase``). Never a result.
     definition_as_study : bool
-        Whether the row computed its quantity as the study defines and samples it (``FINDINGS[id].definition``).
+        Whether the row computed its quantity as the study defines and samples it (``FINDING_SCALES[id].definition``).
     thresholds : Thresholds, optional
         The bounds; by default the configuration's (``validation``), or the schema's defaults for a case.
 
     Returns
     -------
     ScaleVerdict
-        At scale when every dimension in ``FINDINGS[finding_id].dimensions`` is and the definition is the study's.
+        At scale when every dimension in ``FINDING_SCALES[finding_id].dimensions`` is and the definition is the study's.
 
     Raises
     ------
@@ -381,9 +381,9 @@ def scale_verdict(finding_id: str, kind: str, config_or_case, definition_as_stud
     ValueError
         When ``kind`` is not the finding's, or a case is not of ``kind``.
     """
-    if finding_id not in FINDINGS:
-        raise KeyError(f"unknown finding {finding_id!r}; the findings are {', '.join(FINDINGS)}")
-    finding = FINDINGS[finding_id]
+    if finding_id not in FINDING_SCALES:
+        raise KeyError(f"unknown finding {finding_id!r}; the findings are {', '.join(FINDING_SCALES)}")
+    finding = FINDING_SCALES[finding_id]
     if kind != finding.kind:
         raise ValueError(f"finding {finding_id} is about the {finding.kind} case, not {kind}")
     if isinstance(config_or_case, Mapping):
