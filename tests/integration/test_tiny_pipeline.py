@@ -4,7 +4,9 @@ them (`siloflow run --config config/tiny.yaml --directory results/tiny`) in a fo
 example notebooks open its runs by default (no SILOFLOW_RUN), and the documentation site's build step executes them
 on it (tests/notebooks.py, rendered by docs/hooks/notebooks.py).
 
-Seven engine runs, about two minutes on two cores with the report.
+Seven engine runs, about two minutes on two cores with the report: a whole extra pipeline beside the integration
+tests that exercise each stage, so it runs in the physics tier (`make test-physics`), which keeps `make test` within
+its budget.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from tests.conftest import require_liggghts
 from tests.notebooks import execute_examples, execute_notebook, figures
 from tests.repo import REPO_ROOT
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(260)]
+pytestmark = [pytest.mark.integration, pytest.mark.physics, pytest.mark.core_seconds(260)]
 
 TINY = REPO_ROOT / "config" / "tiny.yaml"
 #: The case kind each notebook reads.
