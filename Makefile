@@ -145,19 +145,20 @@ validate-status: install-python
 # Two tiers. `make test`: the unit tests and the integration tests that run every engine on every case and stage at
 # the smallest size that exercises them. `make test-physics`: the tests marked `physics` (pyproject.toml), physics
 # checks that need larger or extra runs. .ci/run runs both; test-unit and test-integration run their folder's tests
-# of both tiers. The unit tests build the documentation site, so the docs extra comes too.
+# of both tiers. The unit tests build the documentation site and the tiny pipeline's test its notebooks' pages, so
+# the docs extra comes too.
 PYTEST_PARALLEL := -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 test: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m "not physics" tests siloflow/api siloflow/analysis/numerics
 
-test-physics: install-test
+test-physics: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) -m physics tests
 
 test-unit: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/unit
 
-test-integration: install-test
+test-integration: install-test install-docs
 	$(PYTHON) -m pytest $(PYTEST_PARALLEL) tests/integration
 
 # Particle counts, steps, wall time and disk of every run of a config, before running it:
