@@ -12,22 +12,22 @@ analysis stack (numba, pyvista) the notebook API pulls in.
 
 import importlib
 
-#: The notebook API's public names (:mod:`siloflow.api`), resolved on first access.
-_API_NAMES = frozenset({
+#: The notebook API's public names (:mod:`siloflow.api` exports these), resolved on first access.
+API_NAMES = frozenset({
     "ExitTimes", "Run", "bulk_friction", "coarse_grain", "default_width", "discharge", "exit_times", "fill_surface",
     "janssen_comparison", "open_run", "residence_time_distribution", "silo_dimensions", "silo_grid", "time_average",
     "velocity_profiles", "vrr",
 })
 
-__all__ = sorted(_API_NAMES)
+__all__ = sorted(API_NAMES)
 
 
 def __getattr__(name: str):
     # PEP 562: `from siloflow import open_run` finds the name here the first time it is asked for.
-    if name in _API_NAMES:
+    if name in API_NAMES:
         return getattr(importlib.import_module("siloflow.api"), name)
     raise AttributeError(f"module 'siloflow' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | _API_NAMES)
+    return sorted(set(globals()) | API_NAMES)

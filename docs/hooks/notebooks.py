@@ -7,18 +7,18 @@ stored, without outputs, under a note that says how to build it. An executed cop
 notebook's (the notebook was edited since) counts as none. The figures become PNG files of the site beside the page.
 Nothing executed is committed: examples/ holds the notebooks without outputs, build/ is not in git.
 
-Only the standard library and MkDocs: the notebook is JSON (nbformat 4), its cells become Markdown, code blocks and
-output blocks.
+The notebook is read with nbformat (the docs extra has it); its cells become Markdown, code blocks and output
+blocks.
 """
 
 from __future__ import annotations
 
 import base64
-import json
 import posixpath
 import re
 from pathlib import Path
 
+import nbformat
 from mkdocs.structure.files import File
 
 #: The line that puts a notebook in a page, its path relative to the repository root (mkdocs.yml's folder).
@@ -100,7 +100,7 @@ def render(root: Path, notebook_path: str, page_uri: str) -> tuple[str, list[tup
 
 
 def _read(path: Path) -> dict:
-    return json.loads(path.read_text(encoding="utf-8"))
+    return nbformat.read(path, as_version=4)
 
 
 def _text(value) -> str:

@@ -15,6 +15,7 @@ Nothing here draws: the notebooks in ``examples/`` plot with matplotlib, and imp
 backend alone.
 """
 
+from siloflow import API_NAMES
 from siloflow.analysis.numerics.coarse_graining import default_width
 from siloflow.analysis.numerics.exit_times import ExitTimes, exit_times
 from siloflow.api.fields import coarse_grain, silo_grid, time_average, velocity_profiles
@@ -24,21 +25,4 @@ from siloflow.api.residence import residence_time_distribution, vrr
 from siloflow.api.runs import Run, open_run
 from siloflow.api.silo import discharge, fill_surface, silo_dimensions
 
-__all__ = [
-    "ExitTimes",
-    "Run",
-    "bulk_friction",
-    "coarse_grain",
-    "default_width",
-    "discharge",
-    "exit_times",
-    "fill_surface",
-    "janssen_comparison",
-    "open_run",
-    "residence_time_distribution",
-    "silo_dimensions",
-    "silo_grid",
-    "time_average",
-    "velocity_profiles",
-    "vrr",
-]
+__all__ = sorted(API_NAMES)

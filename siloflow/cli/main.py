@@ -17,8 +17,9 @@ from pathlib import Path
 from typing import Sequence
 
 from siloflow.cli import record
-from siloflow.engines.config import ConfigError, layered_config, validate_config
+from siloflow.engines.config import PACKAGE_ROOT, ConfigError, layered_config, validate_config
 from siloflow.engines.config_yaml import ConfigFileError
+from siloflow.engines.estimates import format_bytes, total_dump_bytes
 from siloflow.engines.layout import RESULTS
 from siloflow.engines.planning import estimate_report
 from siloflow.engines.preflight import Preflight, PreflightError, preflight
@@ -32,7 +33,6 @@ DEFAULT_CONFIG = "config/config.yaml"
 #: The report ``siloflow run`` writes, relative to the working directory (``--directory``).
 DEFAULT_REPORT = f"{RESULTS}/report.html"
 #: The package's workflow and its own profile (the rerun policy: package data, so that an installed siloflow runs).
-PACKAGE_ROOT = Path(__file__).resolve().parent.parent
 SNAKEFILE = PACKAGE_ROOT / "workflow" / "Snakefile"
 WORKFLOW_PROFILE = PACKAGE_ROOT / "workflow" / "profiles" / "default"
 #: Exit codes: a usage error or refused input, and a run that is live in the same folder (EX_TEMPFAIL).
@@ -128,11 +128,10 @@ def check(args: argparse.Namespace) -> int:
     for estimate in checked.estimates:
         by_kind[estimate.kind] = by_kind.get(estimate.kind, 0) + 1
     core_hours = sum(estimate.core_seconds for estimate in checked.estimates) / 3600.0
-    dumps_gb = sum(estimate.dump_bytes for estimate in checked.estimates) / 1e9
     runs = ", ".join(f"{kind} {count}" for kind, count in by_kind.items())
     print(f"{_label(files)}: valid. {len(checked.estimates)} engine runs ({runs}); about {core_hours:.3g} core-hours "
-          f"({core_hours / args.cores:.3g} h on {args.cores} cores if every core is busy) and {dumps_gb:.3g} GB of "
-          f"dumps. Nothing was run; `siloflow estimate` gives each run's cost.")
+          f"({core_hours / args.cores:.3g} h on {args.cores} cores if every core is busy) and "
+          f"{format_bytes(total_dump_bytes(checked.estimates))} of dumps. Nothing was run; `siloflow estimate` gives each run's cost.")
     return 0
 
 
