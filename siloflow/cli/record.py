@@ -161,9 +161,9 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     """The record's page for the record under ``record_dir``, judged against ``config_path``'s plan, with each
     group's measured wall time on ``cores`` cores beside its estimate, its parts and its cost at the scale of
     ``full_scale_path``."""
-    made = _plan(config_path)[1]
-    estimated = {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)}
     config = load_config(config_path)
+    made = group_runs(config, config_estimates(config))
+    estimated = {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)}
     # the dimensions alone: whether each row computes its quantity as the study defines it is the row's to say
     scales = [(finding, scale_verdict(finding.id, FINDING_SCALES[finding.id].kind, config, True))
               for finding in FINDINGS]
