@@ -9,7 +9,8 @@ compare against a group not yet complete in the record, or a configuration whose
 keeps (``plots.format``); ``restore --group`` checks as ``check`` does, then copies into ``--directory`` the products
 of the runs of the groups it reads that their records keep and the folder lacks (so that a group reads the runs
 another session made instead of making them again); ``finished`` prints the groups (of ``--group``'s only) whose
-every run has finished in ``--directory``, whose record ``make validate`` then writes.
+every run has finished in ``--directory``, whose record ``make validate`` then writes; ``rederive`` derives a group's
+rows again from the products its record keeps, with today's row code (no run).
 """
 
 from __future__ import annotations
@@ -21,11 +22,14 @@ from pathlib import Path
 from typing import Sequence
 
 from siloflow.analysis.io.tables import write_text
+from siloflow.analysis.io.validation_products import read_group_products, row_code_digest
 from siloflow.analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_record, restore_products,
                                            write_group_record)
+from siloflow.analysis.studies.validation.group_rows import UNMADE, judged_rows
 from siloflow.analysis.studies.validation.findings import FINDINGS
 from siloflow.analysis.studies.validation.record import record_page, run_wall_time
 from siloflow.analysis.studies.validation.scale import FINDING_SCALES, scale_verdict
+from siloflow.calibration.table import point_table
 from siloflow.engines.config import load_config
 from siloflow.engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
 from siloflow.engines.planning import config_estimates, group_runs, run_directory
@@ -40,6 +44,50 @@ RECORD_PAGE = "README.md"
 def _run_ids(record: dict) -> dict[str, set[str]]:
     """``{group: {run id}}`` of a record read with :func:`siloflow.analysis.io.validation_record.read_record`."""
     return {name: {run["run_id"] for run in group.runs} for name, group in record.items()}
+
+
+def other_row_code(record: dict) -> dict[str, bool]:
+    """``{group: whether its record keeps what re-derives its rows}`` of the recorded groups whose rows were written by
+    other row code than today's (:func:`siloflow.analysis.io.validation_products.row_code_digest`)."""
+    today = row_code_digest()
+    return {name: group.derivation is not None for name, group in record.items()
+            if (group.derivation or {}).get("row_code") != today}
+
+
+def rederive(config_path: str, record_dir: str | Path, groups: Sequence[str]) -> dict[str, int]:
+    """Derive again the rows of each of ``groups`` from the products its record keeps, with today's row code and
+    ``config_path``'s ``validation`` section and dimensions, and write them into its record (its runs, plots and
+    products unchanged). A product is looked for in the group's own record, then in those of the groups it reads.
+    Returns ``{group: rows}``; refuses (ValueError) a group whose record keeps no derivation or lacks a product."""
+    config = load_config(config_path)
+    record_dir = Path(record_dir)
+    written = {}
+    for name in groups:
+        group = read_group_record(record_dir / name) if (record_dir / name / "runs.csv").is_file() else None
+        if group is None or group.derivation is None:
+            raise ValueError(f"{name}: its record keeps no derivation (written before records kept one): "
+                             f"`make validate GROUP={name}` records it again")
+        derivation = group.derivation
+        places = [record_dir / other / PRODUCTS for other in (name, *GROUPS[name].reads)]
+
+        def found(path: str) -> Path:
+            for place in places:
+                if (place / path).is_file():
+                    return place / path
+            raise ValueError(f"{name}: product {path} is in none of the records of {', '.join((name, *GROUPS[name].reads))}")
+
+        kind = derivation["kind"]
+        inputs = {key: [found(path) for path in paths] for key, paths in derivation["inputs"].items()}
+        data = read_group_products(kind, inputs)
+        if kind == "jenike":
+            data["points"] = point_table(data["summaries"])
+        rows = judged_rows(kind, data, derivation["params"], config["validation"],
+                           lambda finding, as_study: scale_verdict(finding, kind, config, as_study))
+        write_group_record(record_dir / name, rows, group.runs, {plot: record_dir / name / plot for plot in group.plots},
+                           {product: record_dir / name / PRODUCTS / product for product in group.products},
+                           {**derivation, "row_code": row_code_digest()})
+        written[name] = len(rows)
+    return written
 
 
 def recorded_runs(record_dir: str | Path) -> dict[str, set[str]]:
@@ -59,7 +107,8 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
             record = read_group_record(source)
             write_group_record(Path(record_dir) / name, record.rows, record.runs,
                                {plot: source / plot for plot in record.plots},
-                               {product: source / PRODUCTS / product for product in record.products})
+                               {product: source / PRODUCTS / product for product in record.products},
+                               record.derivation)
             copied.append(name)
     return copied
 
@@ -163,17 +212,17 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     ``full_scale_path``."""
     config = load_config(config_path)
     made = group_runs(config, config_estimates(config))
-    estimated = {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)}
+    estimated = {estimate.run_id: estimate.core_seconds for runs in made.values() for estimate in runs}
     # the dimensions alone: whether each row computes its quantity as the study defines it is the row's to say
-    scales = [(finding, scale_verdict(finding.id, FINDING_SCALES[finding.id].kind, config, True))
-              for finding in FINDINGS]
+    verdicts = {finding.id: scale_verdict(finding.id, FINDING_SCALES[finding.id].kind, config, True)
+                for finding in FINDINGS}
     record = read_record(record_dir, GROUPS)
-    status = group_status(planned_runs(made), _run_ids(record))
+    status = group_status(planned_runs(made), _run_ids(record), other_row_code(record))
     parts = {name: [part.name for part in group_parts] for name, group_parts in split_groups(made).items()}
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
-                       scales)
+                       verdicts, UNMADE)
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.
@@ -199,9 +248,24 @@ def _status(args: argparse.Namespace) -> int:
         planned, recorded = _planned(config), recorded_runs(args.record)
     except ValueError as error:
         raise RecordError(str(error)) from None
-    print(f"The validation record in {args.record} against the runs {config} plans:")
-    print("\n".join(status_lines(planned, recorded)))
-    return 1 if {STALE, MISSING} & set(group_status(planned, recorded).values()) else 0
+    other = other_row_code(read_record(args.record, GROUPS))
+    print(f"The validation record in {args.record} against the runs {config} plans and today's row code:")
+    print("\n".join(status_lines(planned, recorded, other)))
+    return 1 if {STALE, MISSING} & set(group_status(planned, recorded, other).values()) else 0
+
+
+def _rederive(args: argparse.Namespace) -> int:
+    try:
+        groups = [check_group(args.group)] if args.group else [
+            name for name, derivable in other_row_code(read_record(args.record, GROUPS)).items() if derivable]
+        written = rederive(_config(args), args.record, groups)
+    except ValueError as error:
+        raise RecordError(str(error)) from None
+    for name, count in written.items():
+        print(f"siloflow: {count} rows of {name} derived again from the products its record keeps")
+    if not written:
+        print("siloflow: no group's rows to derive again")
+    return 0
 
 
 def _publish(args: argparse.Namespace) -> int:
@@ -257,7 +321,7 @@ def add_parser(commands, common) -> None:
     """Add ``record`` and its commands to the command line's subcommands; ``common`` adds --config, --cores and
     --directory to a parser."""
     parser = commands.add_parser("record", help="the validation record: status, publish, page, check, restore, "
-                                 "finished", description=__doc__.split("\n\n")[0].strip('"'))
+                                 "finished, rederive", description=__doc__.split("\n\n")[0].strip('"'))
     verbs = parser.add_subparsers(dest="verb", metavar="VERB", required=True, parser_class=type(parser))
     working = "the validation run's working folder (its results/ holds the runs; default: the current folder)"
     for name, handler, help_text, group in (
@@ -267,7 +331,9 @@ def add_parser(commands, common) -> None:
             ("page", _page, "write the record's page (README.md) from the record", None),
             ("check", _check_command, "refuse a group that cannot run now, before anything runs", "required"),
             ("restore", _restore, "check a group, then restore the runs it reads from the record", "required"),
-            ("finished", _finished, "print the groups whose every run has finished", "optional")):
+            ("finished", _finished, "print the groups whose every run has finished", "optional"),
+            ("rederive", _rederive, "derive a group's rows again from the products its record keeps (default: "
+                                    "every group whose rows other row code wrote and whose record can)", "optional")):
         sub = verbs.add_parser(name, help=help_text, description=help_text[0].upper() + help_text[1:] + ".")
         common(sub, working)
         sub.add_argument("--record", default=RECORD_DIR, metavar="DIR",

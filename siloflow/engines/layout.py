@@ -23,7 +23,7 @@ from pathlib import Path, PurePosixPath
 
 from siloflow.model.cases.kinds import case_kind
 
-__all__ = ["RESULTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK",
+__all__ = ["RESULTS", "CASE_SUMMARY", "EXISTING_RUNS", "EXISTING_RUN_WILDCARD", "RUN_BENCHMARK", "RUN_PROVENANCE",
            "RUN_RECORD", "READ_PRODUCTS", "SILO_ROW_PRODUCTS", "CALIBRATION_DIR", "CALIBRATED_PARAMETERS",
            "BAYESIAN_DIR", "CROSS_ENGINE_DIR", "SUMMARY_DIR", "VALIDATION_RECORD", "REPOSITORY_RECORD", "VERIFICATION_DIR", "case_root", "existing_run_dir", "existing_run_path", "run_dir",
            "run_path", "write_text_atomic"]
@@ -37,6 +37,8 @@ CASE_SUMMARY = "deck/case.json"
 RUN_RECORD = "run.json"
 #: Snakemake's benchmark of a run step: its wall time (column ``s``) and memory.
 RUN_BENCHMARK = "logs/run_benchmark.tsv"
+#: Each attempt of a run step: its start, the commit of the code and the engine's version (siloflow.engines.provenance).
+RUN_PROVENANCE = "logs/run_provenance.json"
 
 #: The products across runs, each in its folder under :data:`RESULTS`: the calibration (tables, charts, the chosen
 #: parameters), the summary (the validation table, the report's summary page, the validation record), the DEM

@@ -315,8 +315,9 @@ def planned_runs(made: Mapping[str, Sequence[RunEstimate]]) -> dict[str, set[str
             for name in own if own[name]}
 
 
-def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]]) -> dict[str, str]:
-    """Each group's status in the record against the plan.
+def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]],
+                 other_code: Iterable[str] = ()) -> dict[str, str]:
+    """Each group's status in the record against the plan and the row code.
 
     Parameters
     ----------
@@ -325,30 +326,41 @@ def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
     recorded : mapping
         ``{group: {run id}}`` of the runs behind the record's rows (its provenance); a group absent or empty has no
         record.
+    other_code : iterable of str
+        The recorded groups whose rows were written by other row code than today's.
 
     Returns
     -------
     dict
         ``{group: status}`` for every group of ``planned``: :data:`MISSING` without a record, :data:`COMPLETE` when
-        the record's runs are exactly those planned, else :data:`STALE` (a run changed, was added or left out).
+        the record's runs are exactly those planned and its rows were written by today's row code, else
+        :data:`STALE` (a run changed, was added or left out, or the row code changed).
     """
-    status = {}
+    status, changed = {}, set(other_code)
     for name, runs in planned.items():
         held = set(recorded.get(name, ()))
-        status[name] = MISSING if not held else COMPLETE if held == set(runs) else STALE
+        status[name] = MISSING if not held else COMPLETE if held == set(runs) and name not in changed else STALE
     return status
 
 
-def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]]) -> list[str]:
-    """`make validate-status`'s lines: per group, its status and the runs that differ from the plan."""
+def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]],
+                 other_code: Mapping[str, bool] | None = None) -> list[str]:
+    """`make validate-status`'s lines: per group, its status, the runs that differ from the plan and whether its rows
+    were written by other row code (``other_code``: ``{group: whether its record keeps what re-derives its rows}``)."""
     lines = []
-    for name, status in group_status(planned, recorded).items():
+    other_code = dict(other_code or {})
+    for name, status in group_status(planned, recorded, other_code).items():
         held, runs = set(recorded.get(name, ())), set(planned[name])
         line = f"{name:18s} {status:9s} {len(held & runs)} of {len(runs)} planned runs recorded"
-        if status == STALE:
+        if status == STALE and held != runs:
             gone, new = sorted(held - runs), sorted(runs - held)
             line += (f"; recorded but no longer planned: {', '.join(gone) or 'none'}; planned but not recorded: "
                      f"{', '.join(new) or 'none'}")
+        if name in other_code and held:
+            line += ("; its rows were written by other row code: `siloflow record rederive --group "
+                     f"{name}` derives them again from the products its record keeps" if other_code[name] else
+                     "; its rows were written by other row code and its record keeps no products to derive them "
+                     f"from: `make validate GROUP={name}` records it again")
         lines.append(line)
     return lines
 

@@ -21,8 +21,8 @@ import yaml
 from siloflow.model.record import read_run_record
 from siloflow.analysis.numerics.clump_tracks import tracks_from_frames
 from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
-from siloflow.analysis.studies.validation.blending import blender_rows, gravity_rows
-from siloflow.analysis.studies.validation.rows import Criteria
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances
+from siloflow.analysis.studies.validation.blender import GRAVITY_GROUP, blender_rows, gravity_rows
 from siloflow.model.cases.blender import blender_cases
 from siloflow.engines.config import validate_config
 from siloflow.engines.layout import case_root, run_dir
@@ -145,20 +145,22 @@ def test_steady_flow_rate_scales_with_the_square_root_of_gravity(blender_pipelin
 
 @pytest.mark.physics  # the gravity rows need the run at gravity factor 4
 def test_validation_rows_of_the_real_runs_normalise_passages_and_scale_with_gravity(blender_pipeline):
-    """The validation table's blender rows from the runs' own files (the tiny insert is the mass-flow one here)."""
+    """The validation table's blender rows from the runs' own files: the tiny insert is none of the study's, so its
+    rows state no finding; the gravity series is a similarity check of the code."""
     _, runs = blender_pipeline
-    summaries = [json.loads((runs[g] / "metrics" / "blender.json").read_text()) for g in (1.0, 4.0)]
-    cases = [json.loads((runs[g] / "deck" / "case.json").read_text()) for g in (1.0, 4.0)]
-    criteria = Criteria(mass_flow_configuration="tiny")
-    rows = blender_rows(summaries, cases, criteria)
-    # no tube: the interior annulus spans both plates and is the innermost passage
-    assert [row["figure"] for row in rows][:3] == [
-        "Exterior annulus v_z / cross-section mean", "Interior annulus v_z / cross-section mean",
-        "Exterior annulus / interior annulus v_z (mass flow of the insert)"]
-    assert all(np.isfinite(row["value"]) for row in rows)
-    scaled = gravity_rows(summaries, criteria)
-    scaled = [row for row in scaled if np.isfinite(row["value"])]  # no tube velocity without a tube
-    assert len(scaled) == 2 and all(row["value_error"] > 0.0 for row in scaled)
+    taken = [{"case": json.loads((runs[g] / "deck" / "case.json").read_text()),
+              "summary": json.loads((runs[g] / "metrics" / "blender.json").read_text()),
+              "note": f"one seed at {g:g} g", "dof": None} for g in (1.0, 4.0)]
+    rows = blender_rows(taken, AgreementTolerances())
+    # no tube: the interior and the exterior annulus at the insert outlet
+    assert [row["figure"] for row in rows][:2] == [
+        "Interior annulus v_z / cross-section mean at the insert outlet",
+        "Exterior annulus v_z / cross-section mean at the insert outlet"]
+    assert all(np.isfinite(row["value"]) and row["finding"] == "-" for row in rows)
+    scaled = [row for row in gravity_rows(taken, AgreementTolerances()) if np.isfinite(row["value"])]
+    assert len(scaled) == 2 and all(row["value_error"] > 0.0 for row in scaled)  # no tube velocity without a tube
+    assert all(row["group"] == GRAVITY_GROUP and row["finding"] == "-" for row in scaled)
+    assert all("one seed at 1 g" in row["evidence"] and "one seed at 4 g" in row["evidence"] for row in scaled)
     (flow,) = [row for row in scaled if row["figure"].startswith("Mass flow rate")]
     assert flow["value"] == pytest.approx(1.0, abs=0.1)  # the 4 g flow rate is 2x the 1 g one, as asserted above
 

@@ -19,7 +19,9 @@ import pyvista
 from siloflow.model.frames import clumps_from_frame
 from siloflow.model.record import read_run_record
 from siloflow.analysis.io.tables import read_table
+from siloflow.analysis.io.validation_products import row_code_digest
 from siloflow.analysis.io.validation_record import read_group_record
+from siloflow.engines.provenance import read_attempts
 from siloflow.analysis.piv.accuracy import PivSettings, silo_image_scale, synthetic_piv
 from siloflow.analysis.piv.front_wall import front_wall_image, front_wall_spheres
 from siloflow.analysis.piv.synthetic import piv_displacements
@@ -83,12 +85,16 @@ def test_the_validation_table_judges_the_tiny_silo_and_the_summary_points_to_mak
     rows = read_table(workdir / "results" / "summary" / "validation.csv")
     density = next(row for row in rows if row["figure"] == "Filling bulk density")
     assert density["case"] == run_dir.name and density["value"] > 0.0 and density["value_error"] > 0.0
-    assert density["scale_shows"] == "no" and "3.6 particle diameters (>= 10)" in density["evidence"]
+    # the tiny silo is 12 mm deep: not at the study's scale, whatever its density
+    assert density["finding"] == "S2" and density["scale"] == "not at scale"
+    assert "3.6 particle diameters" in density["scale_reason"]
+    assert density["agreement"] in ("reproduced", "not reproduced", "not resolved")
     groups = {row["group"] for row in rows}
     assert groups == {"Calibration (Jenike cell)", "Flat-bottom silo", "Front-wall friction series"}
-    assert all(row["scale_shows"] in ("yes", "no", "unknown") for row in rows)
+    assert all(row["scale"] in ("at scale", "not at scale", "-") for row in rows)
     page = (workdir / "results" / "summary" / "summary.html").read_text()
-    assert "What this scale cannot show" in page and "make validate" in page
+    assert "Against the study&#x27;s findings" in page or "Against the study's findings" in page
+    assert "make validate" in page
     assert "validation table" in (workdir / "results" / "summary" / "validation.html").read_text()
 
 
@@ -145,12 +151,19 @@ def test_the_silo_groups_are_recorded_with_the_provenance_of_their_runs_and_thei
     assert base["engine"] == "liggghts" and base["engine_version"] == liggghts().installed_version() != "unknown"
     assert float(base["wall_time_s"]) > 0.0 and base["cores"] == "1" and len(base["commit"]) >= 40
     assert float(base["earlier_attempts_s"]) == 0.0  # started once: no earlier attempt set aside
+    # the code that ran the run, noted by its one attempt, not the code that wrote the record
+    assert base["attempts"] == "1" and read_attempts(run_dir)[-1]["commit"] == base["commit"]
     assert float(base["simulated_time_s"]) == pytest.approx(max(
         stage["time"] for stage in read_run_record(run_dir / "run.json").stages.values() if "time" in stage))
     assert {row["group"] for row in record.rows} == {"Flat-bottom silo"}
     assert {row["group"] for row in series.rows} == {"Front-wall friction series"}
     assert all("one seed: within-run error only" in row["evidence"] for row in record.rows + series.rows)
     assert record.plots == ["janssen.png", "profiles.png"] and series.plots == ["restitution.png"]
+    # the record keeps what its rows are computed from: they derive again with no run
+    assert record.derivation["kind"] == "silo_flat" and record.derivation["row_code"] == row_code_digest()
+    assert validation_record.rederive(str(config_path), record_dir, ["silo", "silo_series"]) == {
+        "silo": len(record.rows), "silo_series": len(series.rows)}
+    assert read_group_record(record_dir / "silo").rows == record.rows
     # the page judges the record against the configuration that made it: both silo groups complete, each with the
     # one run it makes
     text = validation_record.page(str(config_path), str(config_path), record_dir)

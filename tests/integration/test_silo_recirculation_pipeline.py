@@ -19,8 +19,10 @@ import yaml
 
 from siloflow.analysis.io.tables import read_table
 from siloflow.analysis.numerics.uncertainty import Significance, difference_significant
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances
 from siloflow.analysis.studies.validation.blending import recirculation_rows
-from siloflow.analysis.studies.validation.rows import Criteria
+from siloflow.analysis.studies.validation.rows import NOT_AT_SCALE, with_scale
+from siloflow.analysis.studies.validation.scale import scale_verdict
 from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
 from siloflow.analysis.studies.silo_recirculation.tracks_io import load_tracks
 from siloflow.model.cases.silo_recirculation import recirculation_cases
@@ -229,19 +231,27 @@ def test_the_recirculation_notebook_runs_on_the_tiny_run_and_its_checks_hold(ble
     assert len(shown) == 3 and all(png.startswith(b"\x89PNG") for png in shown)
 
 
-def test_validation_rows_of_the_real_run_carry_errors_and_a_verdict(blending_pipeline):
-    """The validation table's recirculation rows from the run's own files: a 12 mm deep silo (3.6 particle
-    diameters) does not show the study's physics; the fill dilates while it flows, and the drop has an error."""
+def test_validation_rows_of_the_real_run_carry_errors_and_both_verdicts(blending_pipeline):
+    """The validation table's recirculation rows from the run's own files: each judged against a finding of ch. 6;
+    a 12 mm deep silo (3.6 particle diameters) is not at the study's scale, whatever its figures; the fill dilates
+    while it flows, and the drop has an error."""
     _, runs, _ = blending_pipeline
     run = runs["blending"]
     summary = json.loads((run / "metrics" / "blending.json").read_text())
     assert summary["settled_bulk_density_kg_m3"] > summary["flowing_bulk_density_kg_m3"] > 0.0
     assert summary["bulk_density_drop_error"] > 0.0
-    rows = recirculation_rows(json.loads((run / "deck" / "case.json").read_text()), summary,
-                              read_table(run / "metrics" / "rtd.csv"), Criteria())
-    assert len(rows) == 5 + 3  # one VRR row per layout, RTD peak, t_s/t_d, bulk density drop
-    assert all(math.isfinite(row["value"]) and row["value_error"] > 0.0 for row in rows)
-    assert {row["scale_shows"] for row in rows} == {"no"} and "particle diameters (>= 10)" in rows[0]["evidence"]
+    case = json.loads((run / "deck" / "case.json").read_text())
+    rows = recirculation_rows([{"case": case, "summary": summary, "rtd": read_table(run / "metrics" / "rtd.csv"),
+                                "note": "one seed", "dof": None}], AgreementTolerances())
+    assert rows and all(row["finding"][0] == "B" for row in rows)
+    assert all(row["agreement"] in ("reproduced", "not reproduced", "not resolved") for row in rows)
+    assert all(row["evidence"].endswith("one seed") for row in rows)
+    measured = [row for row in rows if math.isfinite(row["value"])]
+    assert measured and all(row["value_error"] > 0.0 for row in measured)
+    config = validate_config(copy.deepcopy(CONFIG))
+    judged = with_scale(rows, lambda finding, as_study: scale_verdict(finding, "silo_recirculation", config, as_study))
+    assert {row["scale"] for row in judged} == {NOT_AT_SCALE}
+    assert all("particle diameters" in row["scale_reason"] for row in judged)
 
 
 @pytest.mark.physics

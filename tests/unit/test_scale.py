@@ -9,7 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from siloflow.analysis.studies.validation.rows import NO, YES, row
+from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, Agreement
+from siloflow.analysis.studies.validation.findings import FINDINGS
+from siloflow.analysis.studies.validation.rows import AT_SCALE, NOT_AT_SCALE, row, with_scale
 from siloflow.analysis.studies.validation.scale import (FINDING_SCALES, STUDY, STUDY_PARTICLE_DIAMETER, Thresholds,
                                                         scale_verdict)
 from siloflow.engines.config import load_config, validate_config
@@ -165,13 +167,16 @@ def test_the_verdict_takes_no_value_and_is_the_same_whatever_value_a_row_carries
     before = copy.deepcopy(config)
     expected = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDING_SCALES.items()}
     values = [*np.random.default_rng(7).normal(0.0, 1e3, 40), 0.0, -1.0, math.inf, -math.inf, math.nan, 1e300]
+    first_part = {item.id: item.parts[0].id for item in FINDINGS}
     for value in values:
         for finding, entry in FINDING_SCALES.items():
             verdict = scale_verdict(finding, entry.kind, config, True)
-            judged = row("group", finding, "case", value, abs(value) / 10, "-", "",
-                         YES if verdict.at_study_scale else NO, verdict.text)
+            built = row("group", finding, "case", value, abs(value) / 10, "-", "", finding=first_part[finding],
+                        agreement=Agreement(NOT_REPRODUCED, "a disagreement"))
+            (judged,) = with_scale([built], lambda f, d, kind=entry.kind: scale_verdict(f, kind, config, d))
             assert verdict == expected[finding]
-            assert judged["scale_shows"] == (YES if expected[finding].at_study_scale else NO)
+            assert judged["scale"] == (AT_SCALE if expected[finding].at_study_scale else NOT_AT_SCALE)
+            assert judged["scale_reason"] == expected[finding].text and judged["agreement"] == NOT_REPRODUCED
     assert config == before
 
 

@@ -349,11 +349,12 @@ def test_recirculation_rows_add_the_transit_times_and_seed_count_when_the_table_
     assert "0.436 ± 0.012" in page and "0.416 ± 0.011" in page
 
 
-def test_summary_lists_the_validation_rows_this_scale_cannot_show():
-    limits = [{"figure": "Filling bulk density", "case": "r", "note": "depth 12.0 mm = 3.6 particle diameters (>= 10)"}]
-    sections = summary_sections({"shape": "sphere2"}, [], [], [], [], scale_limits=limits)
-    assert sections[-1].title == "What this scale cannot show" and sections[-1].rows == limits
+def test_summary_lists_the_validation_rows_judged_against_the_study():
+    findings = [{"finding": "S2", "figure": "Filling bulk density", "case": "r", "agreement": "not reproduced",
+                 "scale": "at scale", "note": "S2: 564 ± 1 lies outside 618 to 627.4"}]
+    sections = summary_sections({"shape": "sphere2"}, [], [], [], [], findings=findings)
+    assert sections[-1].title == "Against the study's findings" and sections[-1].rows == findings
     assert "make validate" in sections[-1].explanation and sections[-1].legend
-    every = summary_sections({"shape": "sphere2"}, [], [], [], [], scale_limits=[])[-1]
-    assert every.rows == [{"note": "Every row of the validation table is shown at this scale."}]
+    none = summary_sections({"shape": "sphere2"}, [], [], [], [], findings=[])[-1]
+    assert none.rows[0]["note"].startswith("No row of this configuration")
     assert summary_sections({"shape": "sphere2"}, [], [], [], [])[-1].title == "Settled fills"

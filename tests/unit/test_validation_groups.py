@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from siloflow.engines.config import load_config
@@ -37,7 +39,8 @@ from siloflow.engines.validation_groups import (
     split_groups,
     status_lines,
 )
-from siloflow.analysis.io.validation_record import RUNS as RECORD_RUNS
+from siloflow.analysis.io.validation_products import row_code_digest
+from siloflow.analysis.io.validation_record import DERIVATION, RUNS as RECORD_RUNS
 from siloflow.cli import record as CLI
 from tests.conftest import record_main
 
@@ -71,8 +74,9 @@ def test_the_validation_config_s_runs_fall_into_their_groups():
     config = load_config(REPO_ROOT / "config" / "validation.yaml")
     made = group_runs(config, config_estimates(config))
     counts = {name: len(runs) for name, runs in made.items()}
-    # 8 sphere2 internal + 8 aluminium; 8 sphere + 8 sphere4; 4 blocked + 4 servo + 1 restitution + 2 seeds + 1 slower
-    assert counts == {"calibration": 16, "calibration_shapes": 16, "calibration_checks": 12, "silo": 3,
+    # 8 sphere2 internal + 8 aluminium + 2 more seeds of its reference point; 8 sphere + 8 sphere4 + 2 more seeds of
+    # each one's; 4 blocked + 4 servo + 1 restitution + 1 slower
+    assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 10, "silo": 3,
                       "silo_series": 4, "blending": 5, "blender": 7}
 
 
@@ -167,13 +171,22 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
     _write_runs(tmp_path / "calibration", sorted(planned["calibration"]))
     _write_runs(tmp_path / "silo", ["sphere2-0000000000"])
     assert recorded_runs(tmp_path) == {"calibration": planned["calibration"], "silo": {"sphere2-0000000000"}}
+    # the calibration's rows were written by other row code, and its record keeps nothing to derive them from
+    assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 1
+    line = capsys.readouterr().out.splitlines()[1]
+    assert line.split()[:2] == ["calibration", "stale"] and "`make validate GROUP=calibration` records it again" in line
+    (tmp_path / "calibration" / DERIVATION).write_text(json.dumps({"row_code": "0" * 16}))
+    assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 1
+    assert "`siloflow record rederive --group calibration` derives them" in capsys.readouterr().out
+    for name in ("calibration", "silo", "blending", "blender"):
+        (tmp_path / name).mkdir(exist_ok=True)
+        (tmp_path / name / DERIVATION).write_text(json.dumps({"row_code": row_code_digest()}))
     assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 1
     lines = capsys.readouterr().out.splitlines()
     assert lines[1].split()[:2] == ["calibration", "complete"]
     assert lines[2].split()[:2] == ["silo", "stale"] and "no longer planned: sphere2-0000000000" in lines[2]
     assert lines[3].split()[:2] == ["blending", "missing"]
     for name in ("silo", "blending", "blender"):
-        (tmp_path / name).mkdir(exist_ok=True)
         (tmp_path / name / RECORD_RUNS).write_text("run_id\n" + "".join(f"{run}\n" for run in sorted(planned[name])))
     assert record_main(["status", "--config", str(config), "--record", str(tmp_path)]) == 0
     (tmp_path / "blender" / RECORD_RUNS).write_text("run,case\na,b\n")
@@ -189,8 +202,8 @@ def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("runs in 2 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2" in
-            capsys.readouterr().err)
+    assert ("runs in 3 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
+            "GROUP=blending_3" in capsys.readouterr().err)
     assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
 

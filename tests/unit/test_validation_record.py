@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import shutil
@@ -13,10 +14,14 @@ import yaml
 from PIL import Image
 
 from siloflow.model.record import RunRecord, RunRecordError
-from siloflow.analysis.io.validation_record import (PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
+from siloflow.analysis.io.validation_products import row_code_digest
+from siloflow.analysis.io.validation_record import (DERIVATION, LEGACY_MARK, PRODUCTS, RUNS, TABLE, benchmark_wall_time, read_group_record, read_record,
                                            RECORD_PLOT_COLOURS, read_validation_rows, restore_products,
                                            write_group_record, write_record_plot)
-from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, findings_scale_section, provenance_row,
+from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, Agreement
+from siloflow.analysis.studies.validation.findings_summary import finding_statuses
+from siloflow.analysis.studies.validation.rows import AT_SCALE
+from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, findings_section, provenance_row,
                                                          record_page, run_wall_time, simulated_time)
 from siloflow.analysis.studies.validation.rows import COLUMNS, row
 from siloflow.engines.config import load_config_file
@@ -53,18 +58,22 @@ def _record(run_id="sphere2-abc", stages=None, ranks=1) -> RunRecord:
 
 
 def _rows():
-    return [row("Flat-bottom silo", "Filling bulk density", "sphere2-abc", 547.6, 1.7, "kg/m3", "667", "yes",
-                "depth 40 mm = 12.0 particle diameters (>= 10)"),
-            row("Flat-bottom silo", "Wall share | of weight", "sphere2-abc", math.nan, math.nan, "-", "", "no",
-                "depth 12 mm = 3.6 particle diameters (>= 10)")]
+    density = row("Flat-bottom silo", "Filling bulk density", "sphere2-abc", 547.6, 1.7, "kg/m3", "settled fill",
+                  dof=2.0, finding="S2", agreement=Agreement(NOT_REPRODUCED, "S2: 547.6 lies outside 618 to 627.4"))
+    density.update(scale=AT_SCALE, scale_reason="at the study's scale for S2")
+    return [density,
+            row("Flat-bottom silo", "Wall share | of weight", "sphere2-abc", math.nan, math.nan, "-",
+                "depth 12 mm = 3.6 particle diameters", study="")]
 
 
 def test_the_provenance_row_names_the_run_its_engine_and_its_time():
-    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, 20.25, "2026-11-28")
+    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, 20.25, "2026-11-28",
+                         2)
     assert list(got) == list(RUN_COLUMNS)
     assert got == {"run_id": "sphere2-abc", "group": "silo", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
                    "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5,
-                   "earlier_attempts_s": 20.25, "cores": 2, "date": "2026-11-28"}
+                   "earlier_attempts_s": 20.25, "attempts": 2, "cores": 2, "date": "2026-11-28"}
+    assert provenance_row(_record(), "silo", "3.8", [1], "c", 1.0, 0.0, "2026-11-28")["attempts"] == ""
     # the time of all its attempts; a record written before earlier attempts were timed gives the last one's only
     assert run_wall_time(got) == 81.75
     assert run_wall_time({key: value for key, value in got.items() if key != "earlier_attempts_s"}) == 61.5
@@ -94,9 +103,9 @@ def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
     back = read_group_record(folder)
     assert back.plots == ["profiles.png"] and _pixels(folder / "profiles.png") == PIXELS
     assert back.runs == [{**{k: str(v) for k, v in runs[0].items()}}]  # text: a commit of digits stays text
-    assert back.rows[0] == _rows()[0]
-    assert math.isnan(back.rows[1]["value"]) and back.rows[1]["study_value"] == ""
-    assert read_validation_rows(folder / TABLE)[0]["study_value"] == "667"
+    assert back.rows[0] == {**_rows()[0], "dof": "2.0"}
+    assert math.isnan(back.rows[1]["value"]) and back.rows[1]["study"] == ""
+    assert read_validation_rows(folder / TABLE)[0]["study"] == _rows()[0]["study"]
     assert read_record(tmp_path, ["calibration", "silo"]) == {"silo": back}
     with pytest.raises(ValueError, match="a PNG file name without a folder"):
         write_group_record(folder, _rows(), runs, {"../x.png": plot})
@@ -147,21 +156,30 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
 def test_a_table_without_the_validation_columns_is_refused(tmp_path):
     path = tmp_path / "table.csv"
     path.write_text("figure,value\nx,1\n")
-    with pytest.raises(ValueError, match="needs the columns group, case, value_error"):
+    with pytest.raises(ValueError, match="needs the columns group, case, finding, value_error"):
         read_validation_rows(path)
 
 
-def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
+def test_a_table_written_by_older_row_code_is_read_with_no_verdict(tmp_path):
+    path = tmp_path / "table.csv"
+    path.write_text("group,figure,case,value,value_error,unit,study_value,scale_shows,evidence\n"
+                    "Silo,Density,r,564.0,1.0,kg/m3,667,yes,deep enough\n")
+    (entry,) = read_validation_rows(path)
+    assert (entry["finding"], entry["agreement"], entry["scale"], entry["study"]) == ("-", "-", "-", "667")
+    assert entry["value"] == 564.0 and entry["evidence"] == f"({LEGACY_MARK}) deep enough"
+
+
+def test_the_page_renders_status_runs_rows_and_both_verdicts():
     # the silo group ran in two parts: silo_1 made two runs side by side, silo_2 one
     # silo_2's run was interrupted once: its attempt before the last took 900 s, which counts
-    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, 0.0, "2026-11-28"),
-            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, 0.0, "2026-11-29"),
-            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, 900.0, "2026-11-29")]
+    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, 0.0, "2026-11-28", 1),
+            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, 0.0, "2026-11-29", 1),
+            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, 900.0, "2026-11-29", 2)]
     # the series' record also lists the base run it compares against, made by the silo group
     # and its record predates the time of earlier attempts
     series = [{key: value for key, value in
                provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, 0.0, "2026-11-29").items()
-               if key != "earlier_attempts_s"}, runs[0]]
+               if key not in ("earlier_attempts_s", "attempts")}, runs[0]]
     groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"]),
               "silo_series": GroupRecord(rows=_rows()[:1], runs=series)}
     status = {"calibration": "missing", "silo": "stale", "silo_series": "complete"}
@@ -169,7 +187,7 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
     assert wall == {"silo": {"silo_1": 5400.0, "silo_2": 1800.0}, "silo_series": {"silo_series": 3600.0}}
     text = record_page(groups, status, {"calibration": 86400.0, "silo": 2 * 86400.0}, wall, 2,
                        "config/validation.yaml", "config/thesis.yaml", {"silo": ["silo_1", "silo_2"]},
-                       {"calibration": 1800.0, "silo": 9900.0})
+                       {"sphere2-abc": 5000.0, "sphere2-def": 2000.0, "sphere2-jkl": 2900.0, "calibration-x": 1800.0})
     lines = text.splitlines()
     assert lines[0] == "# The validation record"
     # the page opens with the study it compares with, by the thesis's chapters, and what its study column quotes
@@ -186,26 +204,28 @@ def test_the_page_renders_status_runs_rows_and_what_the_scale_cannot_show():
         "finding that a row is judged against, \"-\" where the study gives none.",
         ""]
     assert lines[4].startswith("The study's comparisons at the validation scale (`config/validation.yaml`)")
-    # the estimate beside the recorded core time: 9900 s over 9000 s is 1.10; no estimate given for silo_series
-    assert "| calibration | missing | 0 | - | 0.50 h | - | 0 | 0 |" in lines
-    assert "| silo | stale | 3 | 2.50 h | 2.75 h (1.10) | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 |" in lines
-    assert "| silo_series | complete | 1 | 1.00 h | - | 1.00 h | 1 | 1 |" in lines
+    # the estimate of the recorded runs beside their recorded core time: 9900 s over 9000 s is 1.10; the series'
+    # own run is not planned (no estimate), its base run is not its own
+    assert "| calibration | missing | 0 | - | - | - | 0 | 0 | 0 |" in lines
+    assert "| silo | stale | 3 | 2.50 h | 2.75 h (1.10) | silo_1 1.50 h, silo_2 0.50 h | 2 | 1 | 1 |" in lines
+    assert "| silo_series | complete | 1 | 1.00 h | - | 1.00 h | 1 | 1 | 1 |" in lines
     assert "Not recorded yet: `make validate GROUP=calibration`." in lines
     # the stale group runs in parts: the page names them
-    assert ("**Stale**: the runs below are not those `config/validation.yaml` now plans; `make validate GROUP=silo_1`, "
-            "then `make validate GROUP=silo_2` brings the record up to date.") in lines
+    assert ("**Stale**: the runs below are not those `config/validation.yaml` now plans, or the code that writes the "
+            "rows changed since they were recorded; `make validate GROUP=silo_1`, then `make validate GROUP=silo_2` "
+            "brings the record up to date (`make validate-status` says which).") in lines
     assert ("3 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
             "[`silo/runs.csv`](silo/runs.csv). 1 run(s) were interrupted and run again; their attempts before the "
             "last took 0.25 h, counted in the group's times above.") in lines
     assert "For 1 run(s) the record gives the time of the last attempt only." in text
-    assert ("| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | 667 | yes | "
-            "depth 40 mm = 12.0 particle diameters (>= 10) |") in lines
-    assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | no |" in text
-    assert "runs this group in about 2 core-days (`make estimate CONFIG=config/thesis.yaml`)" in text
-    assert "- Wall share \\| of weight (sphere2-abc): depth 12 mm = 3.6 particle diameters (>= 10)" in lines
+    # a run that did not note its own commit: the page says whose commit the record holds
+    assert "2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, unknown (the record was written by c0ffee)" in text
+    study = _rows()[0]["study"]
+    assert (f"| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | S2 | {study} | not reproduced "
+            "| at scale | S2: 547.6 lies outside 618 to 627.4; at the study's scale for S2; settled fill |") in lines
+    assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | - | - | - |" in text
+    assert "runs this group in about" not in text  # no row of these groups is off the study's scale
     assert "![profiles.png](silo/profiles.png)" in lines
-    assert list(COLUMNS) == ["group", "figure", "case", "value", "value_error", "unit", "study_value", "scale_shows",
-                             "evidence"]
 
 
 def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_path):
@@ -290,25 +310,49 @@ def test_the_wall_time_is_read_from_snakemake_s_benchmark(tmp_path):
         benchmark_wall_time(path)
 
 
-def test_the_findings_section_counts_per_chapter_and_names_what_differs():
-    at_scale = ScaleVerdict("C1", "jenike", True, (), True, "bulk friction", "at the study's scale")
-    depth = DimensionDifference("depth", 0.0125, 0.04, 0.3125, 3.75, "at least 0.9 of the study's and at least 10 "
-                                "particle diameters", "the walls")
+def test_the_findings_section_counts_per_chapter_lists_what_is_not_reproduced_and_why_parts_are_unmeasured():
+    at_scale = ScaleVerdict("S2", "silo_flat", True, (), True, "density", "at the study's scale")
     fill = DimensionDifference("fill_height", 0.1, 0.27, 0.37, 30.0, "at least 0.9 of the study's", "the head")
-    shallow = ScaleVerdict("S1", "silo_flat", False, (depth, fill), True, "stress", "")
-    undefined = ScaleVerdict("B4", "silo_recirculation", False, (), False, "VRR at Nr = 4", "")
-    lines = findings_scale_section([(finding("C1"), at_scale), (finding("S1"), shallow), (finding("B4"), undefined)],
-                                   "config/validation.yaml")
-    assert lines[0] == "## The study's findings at this scale"
-    assert lines[4:9] == ["| chapter | at the study's scale | not at the study's scale |", "|---|---|---|",
-                          "| 4 | 1 | 0 |", "| 5 | 0 | 1 |", "| 6 | 0 | 1 |"]
-    assert lines[-3:] == [
-        "| C1 | §4.4.3.1 | yes | - |",
-        "| S1 | §5.4.1 | no | depth 0.31, 3.8 particle diameters; fill height 0.37 |",
-        "| B4 | §6.4.2 | no | -; the quantity is not defined as the study's |"]
+    shallow = ScaleVerdict("S1", "silo_flat", False, (fill,), True, "stress", "")
+    off = row("Silo", "Janssen", "r", 1.3, 0.01, "-", "e", finding="S1.janssen",
+              agreement=Agreement(NOT_REPRODUCED, "S1.janssen: 1.3 outside 0.9 to 1.1"))
+    off.update(scale="not at scale")
+    statuses = finding_statuses([_rows()[0], off])
+    lines = findings_section(statuses, {"S2": at_scale, "S1": shallow}, {"S3.mass_flow": "no experiment rate"},
+                             "config/validation.yaml")
+    assert lines[0] == "## Does siloflow reproduce the study?"
+    header = lines.index("| chapter | reproduced | not reproduced | not resolved | not at the study's scale | not measured |")
+    assert lines[header + 3] == "| 5 | 0 | 1 | 0 | 1 | 4 |" and lines[header + 2] == "| 4 | 0 | 0 | 0 | 0 | 7 |"
+    failed = lines.index("### Findings not reproduced")
+    assert lines[failed + 2].startswith("- **S2** (§5.4.2, §3.10): ")
+    assert lines[failed + 3].startswith("  - Filling bulk density (sphere2-abc): 548 ± 1.7 kg/m3; the study: ")
+    assert "- S1.janssen: Janssen (r): 1.3 ± 0.01; the study: ratio about 1 (about_relative); S1.janssen: 1.3 outside 0.9 to 1.1" in lines
+    assert "| S1 | §5.4.1 | not at the study's scale | 1 | no | fill height 0.37 |" in lines
+    assert "| S2 | §5.4.2, §3.10 | not reproduced | 1 | yes | - |" in lines
+    assert "- S3.mass_flow: no experiment rate" in lines
+    assert any(line.startswith("- C1.finite_at_zero: its group's rows in this record predate it") for line in lines)
 
 
 def test_every_finding_of_the_study_is_on_the_record_page():
     text = (REPO_ROOT / "docs" / "validation" / "README.md").read_text(encoding="utf-8")
     missing = [item.id for item in FINDINGS if f"\n| {item.id} | " not in text]
     assert not missing, f"findings without a line on the record's page: {missing}"
+
+
+def test_rederive_writes_a_group_s_rows_again_from_the_products_its_record_keeps(tmp_path, capsys):
+    config = str(REPO_ROOT / "config" / "validation.yaml")
+    shutil.copytree(REPO_ROOT / "docs" / "validation" / "silo", tmp_path / "silo")
+    derivation = json.loads((tmp_path / "silo" / DERIVATION).read_text())
+    (tmp_path / "silo" / DERIVATION).write_text(json.dumps({**derivation, "row_code": "older"}))
+    (tmp_path / "silo" / TABLE).write_text("group,figure,case,value,value_error,unit,study_value,scale_shows,evidence\n"
+                                           "Silo,Density,r,1.0,0.1,kg/m3,667,yes,old\n")
+    assert record_main(["rederive", "--record", str(tmp_path), "--config", config]) == 0
+    assert "rows of silo derived again from the products its record keeps" in capsys.readouterr().out
+    again = read_group_record(tmp_path / "silo")
+    assert again.rows == read_group_record(REPO_ROOT / "docs" / "validation" / "silo").rows
+    assert again.derivation["row_code"] == row_code_digest() and again.runs and again.products
+    # a record that keeps no derivation cannot be derived again: it is recorded again
+    shutil.copytree(REPO_ROOT / "docs" / "validation" / "blender", tmp_path / "blender")
+    (tmp_path / "blender" / DERIVATION).unlink(missing_ok=True)
+    assert record_main(["rederive", "--group", "blender", "--record", str(tmp_path), "--config", config]) == 2
+    assert "blender: its record keeps no derivation" in capsys.readouterr().err

@@ -13,6 +13,7 @@ which keeps the whole record, plots included, well under 2 MB.
 from __future__ import annotations
 
 import csv
+import json
 import os
 import shutil
 import time
@@ -24,13 +25,16 @@ from PIL import Image
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.io.tables import write_flow_table
 from siloflow.analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
-from siloflow.analysis.studies.validation.rows import COLUMNS
+from siloflow.analysis.studies.validation.rows import COLUMNS, NO_FINDING
 
-__all__ = ["TABLE", "RUNS", "PRODUCTS", "RECORD_PLOT_FORMAT", "RECORD_PLOT_COLOURS", "check_plot_format", "benchmark_wall_time",
+__all__ = ["TABLE", "RUNS", "DERIVATION", "PRODUCTS", "RECORD_PLOT_FORMAT", "RECORD_PLOT_COLOURS", "check_plot_format", "benchmark_wall_time",
            "read_validation_rows", "write_record_plot", "write_group_record", "read_group_record", "read_record", "restore_products"]
 
 #: A group's table rows and its runs' provenance, in its folder.
 TABLE, RUNS = "table.csv", "runs.csv"
+#: What re-derives a group's rows from the products its record keeps: the case kind, the configuration keys the rows
+#: use, the products by name and the digest of the row code that wrote the table.
+DERIVATION = "derivation.json"
 #: The folder of a group's record that keeps the products of its runs another group reads, each under its path in the
 #: workflow's working directory (``products/results/...``).
 PRODUCTS = "products"
@@ -77,11 +81,12 @@ def _product_path(name: str) -> Path:
 
 def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], runs: Sequence[Mapping],
                        plots: Mapping[str, str | os.PathLike],
-                       products: Mapping[str, str | os.PathLike] | None = None) -> Path:
-    """Write one group's record into ``directory``: its rows, its runs, its plots (``{name: source file}``) and the
-    products of its runs another group reads (``{path in the working directory: source file}``, under
-    :data:`PRODUCTS`), replacing the group's previous record there (a plot or product no longer made is removed).
-    Returns the folder."""
+                       products: Mapping[str, str | os.PathLike] | None = None,
+                       derivation: Mapping | None = None) -> Path:
+    """Write one group's record into ``directory``: its rows, its runs, its plots (``{name: source file}``), the
+    products its rows are computed from and those of its runs another group reads (``{path in the working directory:
+    source file}``, under :data:`PRODUCTS`) and what re-derives its rows (:data:`DERIVATION`, when given), replacing
+    the group's previous record there (a plot or product no longer made is removed). Returns the folder."""
     directory = Path(directory)
     if not rows or not runs:
         raise ValueError(f"a group's record needs rows and runs; got {len(rows)} rows and {len(runs)} runs")
@@ -92,7 +97,10 @@ def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], ru
         check_plot_format(Path(source).suffix.lstrip("."))
     directory.mkdir(parents=True, exist_ok=True)
     write_flow_table(directory / TABLE, [{column: row[column] for column in COLUMNS} for row in rows])
-    write_flow_table(directory / RUNS, [{column: run[column] for column in RUN_COLUMNS} for run in runs])
+    # a record written before a provenance column existed leaves it empty
+    write_flow_table(directory / RUNS, [{column: run.get(column, "") for column in RUN_COLUMNS} for run in runs])
+    if derivation is not None:
+        (directory / DERIVATION).write_text(json.dumps(derivation, indent=2, sort_keys=True) + "\n", encoding="utf-8")
     for stale in directory.glob(f"*.{RECORD_PLOT_FORMAT}"):
         if stale.name not in plots:
             stale.unlink()
@@ -121,13 +129,26 @@ def benchmark_wall_time(path: str | os.PathLike) -> float:
 
 #: The numeric columns of the validation table; the others are text (a study value such as "667" stays as written).
 NUMBERS = ("value", "value_error")
+#: What a table written by older row code (a single verdict, ``scale_shows``) lacks, as read: no finding, no verdict.
+LEGACY_MARK = "written by older row code, before the rows were judged against the study's findings"
+
+
+def _legacy(row: Mapping) -> dict:
+    """A row of a table written before the rows had findings, in today's columns, judged against nothing."""
+    return {**{column: "" for column in COLUMNS}, "group": row["group"], "figure": row["figure"], "case": row["case"],
+            "finding": NO_FINDING, "value": row["value"], "value_error": row["value_error"], "unit": row["unit"],
+            "study": row.get("study_value") or "-", "agreement": NO_FINDING, "scale": NO_FINDING,
+            "evidence": f"({LEGACY_MARK}) {row.get('evidence', '')}"}
 
 
 def read_validation_rows(path: str | os.PathLike) -> list[dict]:
     """Rows of a validation table CSV (:data:`siloflow.analysis.studies.validation.rows.COLUMNS`): value and error as float
-    (NaN where empty), every other column as text."""
+    (NaN where empty), every other column as text. A table written by older row code (with ``scale_shows``) is read
+    with no finding and no verdict, its evidence marked (:data:`LEGACY_MARK`)."""
     with open(path, newline="", encoding="utf-8") as handle:
         rows = list(csv.DictReader(handle))
+    if rows and "scale_shows" in rows[0] and "agreement" not in rows[0]:
+        rows = [_legacy(row) for row in rows]
     missing = [column for column in COLUMNS if rows and column not in rows[0]]
     if missing:
         raise ValueError(f"{path}: a validation table needs the columns {', '.join(missing)}")
@@ -151,7 +172,9 @@ def read_group_record(directory: str | os.PathLike) -> GroupRecord:
     kept = directory / PRODUCTS
     products = sorted(path.relative_to(kept).as_posix() for path in kept.rglob("*") if path.is_file())
     plots = sorted(p.name for p in directory.glob(f"*.{RECORD_PLOT_FORMAT}"))
-    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=plots, products=products)
+    derivation = (json.loads((directory / DERIVATION).read_text(encoding="utf-8"))
+                  if (directory / DERIVATION).is_file() else None)
+    return GroupRecord(rows=rows, runs=_runs(directory / RUNS), plots=plots, products=products, derivation=derivation)
 
 
 def read_record(record_dir: str | os.PathLike, groups: Iterable[str]) -> dict[str, GroupRecord]:

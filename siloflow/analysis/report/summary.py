@@ -126,8 +126,14 @@ COLUMNS: dict[str, Column] = {
     # the validation table (summary/validation.csv)
     "value": Column("Value", kind=ESTIMATE),
     "unit": Column("Unit", kind=TEXT),
-    "study_value": Column("The study", kind=TEXT),
-    "scale_shows": Column("The scale shows it", kind=TEXT),
+    "finding": Column("Finding of the study", kind=TEXT),
+    "dof": Column("Degrees of freedom of the error", kind=TEXT),
+    "study": Column("The study", kind=TEXT),
+    "agreement": Column("Agreement", kind=TEXT),
+    "agreement_reason": Column("Why", kind=TEXT),
+    "differs": Column("Defined otherwise than the study", kind=TEXT),
+    "scale": Column("At the study's scale", kind=TEXT),
+    "scale_reason": Column("What differs from the study's scale", kind=TEXT),
     "evidence": Column("From the run", kind=TEXT),
     # the verification table (verification/verification.csv)
     "quantity": Column("Quantity", kind=TEXT),
@@ -503,23 +509,21 @@ DIFFERENCES_LEGEND = ("A − B: the difference of a figure between two configura
                       "(batch means, tracer counts); replicates: N >= 3 adds the spread over seeds.")
 
 
-SCALE_LIMITS = ("Rows of the validation table (the report's validation page) whose physics the scale of this "
-                "configuration does not show, with the run's figures that decided. The validation scale "
-                "(`make validate`, config/validation.yaml, about 15 core-hours) runs the study at the smallest "
-                "scale that shows them: the study's 40 mm deep silos, its 95 mm Jenike cell with four particle "
-                "frictions, a deeper blender and the gravity series.")
+AGAINST_THE_STUDY = ("Rows of the validation table (the report's validation page) that a finding of the study states, "
+                     "with their agreement and whether this configuration is at the study's scale for the finding. "
+                     "The validation scale (`make validate`, config/validation.yaml) runs the study nearer its own "
+                     "scale; its record is docs/validation/.")
 
 
-SCALE_LIMITS_LEGEND = ("A row is not shown when its run is too small in particle diameters (silo depth, cell, "
-                       "outlet), its settled fill fails the force balance, its VRR reaches the outlet windows' "
-                       "counting-noise ceiling, the blender's mass-flow insert is not in mass flow, or its error does "
-                       "not resolve the effect; the criteria are in the configuration's validation section.")
+AGAINST_THE_STUDY_LEGEND = ("Agreement: the row's 95 % interval against the study's band, or the sign or order of a "
+                            "trend; \"not resolved\" when its error or steadiness cannot tell. Scale: judged from the "
+                            "configuration alone, never from a result.")
 
 
 def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Sequence[Mapping],
                      recirculation: Sequence[Mapping], blender: Sequence[Mapping],
                      balances: Sequence[Mapping] = (), blender_differences: Sequence[Mapping] = (),
-                     scale_limits: Sequence[Mapping] | None = None) -> list[Section]:
+                     findings: Sequence[Mapping] | None = None) -> list[Section]:
     """The sections of the summary page (:func:`summary_html`) from the results of every stage.
 
     Parameters
@@ -534,15 +538,16 @@ def summary_sections(parameters: Mapping, flows: Sequence[Mapping], measured: Se
         The force balance of each settled fill (``metrics/fill_balance.json``).
     blender_differences : sequence of mapping
         The blender comparison's differences (``comparison/significance.csv``).
-    scale_limits : sequence of mapping, optional
-        The validation rows this scale does not show: figure, case, note
-        (:func:`siloflow.analysis.studies.validation.table.scale_limits`); None leaves the section out.
+    findings : sequence of mapping, optional
+        The validation rows judged against a finding of the study: finding, figure, case, agreement, scale, note
+        (:func:`siloflow.analysis.studies.validation.table.against_the_study`); None leaves the section out.
     """
     limits = []
-    if scale_limits is not None:
-        limits = [Section("What this scale cannot show", SCALE_LIMITS,
-                          list(scale_limits) or [{"note": "Every row of the validation table is shown at this scale."}],
-                          SCALE_LIMITS_LEGEND)]
+    if findings is not None:
+        limits = [Section("Against the study's findings", AGAINST_THE_STUDY,
+                          list(findings) or [{"note": "No row of this configuration's validation table is judged "
+                                                      "against a finding of the study."}],
+                          AGAINST_THE_STUDY_LEGEND)]
     return [
         Section("Calibration", calibration_explanation(parameters), calibration_rows(parameters),
                 CALIBRATION_LEGEND),

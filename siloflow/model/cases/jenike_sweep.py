@@ -46,9 +46,10 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
     test at every sliding friction and the first rolling friction with the other lid (key ``"lid"``).
     These three studies go to the shapes of ``sensitivity_shapes`` and (the first two) the tests of
     ``sensitivity_tests`` (null: all). Duplicates are dropped, order is
-    stable. With ``reference_replicates: M`` the reference point (:func:`reference_point`) runs M times: the
-    copies carry ``"replicate": 1 ... M - 1``, which the case adds to its seed. The shear-speed study runs the
-    reference point at each velocity of ``shear_velocity_sensitivity`` (key ``"shear_velocity"``, m/s).
+    stable. With ``reference_replicates: M`` the reference point (:func:`reference_point`) and each other shape's
+    (:func:`replicated_points`) run M times: the copies carry ``"replicate": 1 ... M - 1``, which the case adds to
+    its seed, so that every chart carries the spread between seeds of a point of its own. The shear-speed study runs
+    the reference point at each velocity of ``shear_velocity_sensitivity`` (key ``"shear_velocity"``, m/s).
 
     Parameters
     ----------
@@ -109,11 +110,32 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
                 }
                 if point not in points:
                     points.append(point)
+    for replicated in replicated_points(sweep, points):
+        points += [{**replicated, "replicate": k} for k in range(1, sweep.get("reference_replicates", 1))]
     reference = reference_point(sweep)
     if reference is not None and reference in points:
-        points += [{**reference, "replicate": k} for k in range(1, sweep.get("reference_replicates", 1))]
         points += [{**reference, "shear_velocity": float(v)} for v in sweep.get("shear_velocity_sensitivity", [])]
     return points
+
+
+def replicated_points(sweep: dict, points: list[dict]) -> list[dict]:
+    """The points of ``points`` that run ``reference_replicates`` times: the reference point (:func:`reference_point`)
+    and, for every other shape, the same point of its own (its first sensitivity test, else its first test, at the
+    middle sliding friction, the first rolling friction and the base restitution), so that each shape's charts carry
+    a spread between seeds of their own."""
+    reference = reference_point(sweep)
+    chosen = [reference] if reference is not None and reference in points else []
+    tests = sweep.get("sensitivity_tests") or sweep["tests"]
+    for shape in sweep["shapes"]:
+        if any(point["shape"] == shape for point in chosen):
+            continue
+        test = next((test for test in tests if test in sweep["tests"]), sweep["tests"][0])
+        point = {"shape": shape, "test": test, "sliding_friction": middle_sliding_friction(sweep),
+                 "rolling_friction": float(sweep["rolling_friction"][0]), "restitution": float(sweep["restitution"]),
+                 "rotation_blocked": False}
+        if point in points:
+            chosen.append(point)
+    return chosen
 
 
 def reference_point(sweep: dict) -> dict | None:
@@ -140,6 +162,9 @@ def is_chart_point(point: dict, base_restitution: float) -> bool:
 def point_role(point: dict, base_restitution: float, calibration_shape: str) -> str:
     """The role of a sweep point (:data:`ROLES`): a chart point of ``calibration_shape`` or of another shape, or a
     check."""
+    if "replicate" in point:
+        # a replicate belongs to the chart of the point it repeats: its seeds give that chart's spread
+        point = {key: value for key, value in point.items() if key != "replicate"}
     if not is_chart_point(point, base_restitution):
         return CHECK
     return CALIBRATION_CHART if point["shape"] == calibration_shape else SHAPE_CHART

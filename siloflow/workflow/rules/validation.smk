@@ -73,22 +73,24 @@ def group_rows_inputs(group):
 
 
 def group_rows_params(group):
-    """The configuration a group's rows use: the keys of its case kind only."""
+    """The configuration a group's rows use (siloflow.analysis.studies.validation.group_rows.group_rows): the keys of
+    its case kind only, with the run ids of the reference configuration's seeds and, for the front-wall series, each
+    run's label."""
     kind = GROUPS[group].kind
-    params = {"group": group, "kind": kind, "criteria": config["validation"]}
+    params = {"group": group, "reference": [] if kind == "jenike" else references(kind)}
     if kind == "jenike":
-        jenike = config["jenike"]
+        jenike, targets = config["jenike"], config["calibration"]
         # the rows each role's group judges: the curves of its charts, the coefficients read from the calibration
         # shape's, the checks against the charts
         sections = {CALIBRATION_CHART: ("curves", "calibrated"), SHAPE_CHART: ("curves",), CHECK: ("comparisons",)}
-        params.update(sections=[section for role in GROUPS[group].roles for section in sections[role]])
-        params.update(cell_diameter=jenike["cell"]["inner_diameter"],
-                      shapes={shape: config["particle_models"][shape] for shape in jenike["sweep"]["shapes"]},
-                      density=config["materials"][jenike["particle_material"]]["density"],
+        params.update(sections=[section for role in GROUPS[group].roles for section in sections[role]],
                       base_restitution=jenike["sweep"]["restitution"], lid=jenike["lid"],
-                      shear_velocity=jenike["shear"]["velocity"])
+                      shear_velocity=jenike["shear"]["velocity"],
+                      targets={test: [angle - targets["tolerance_deg"], angle + targets["tolerance_deg"]]
+                               for test, angle in targets["targets_deg"].items()})
     elif kind == "silo_flat":
-        params.update(profile_height=config["silo_flat"]["parametric"]["profile_height"])
+        params.update(profile_height=config["silo_flat"]["parametric"]["profile_height"],
+                      labels=front_wall_labels() if group == "silo_series" else {})
     return params
 
 
@@ -113,10 +115,9 @@ for _group in ROW_GROUPS:
         output:
             rows=f"{SUMMARY_DIR}/rows/{_group}.csv",
         params:
-            **group_rows_params(_group),
-            # the Jenike rows take the reference point's seeds from the calibration table
-            reference=lambda wildcards, kind=GROUPS[_group].kind: [] if kind == "jenike" else references(kind),
-            labels=lambda wildcards, group=_group: front_wall_labels() if GROUPS[group].kind == "silo_flat" else {},
+            kind=GROUPS[_group].kind,
+            # a function: the calibrated silo's run ids are known after the calibration
+            rows=lambda wildcards, group=_group: group_rows_params(group),
         log:
             f"{SUMMARY_DIR}/rows/{_group}.log",
         script:
@@ -242,6 +243,21 @@ def read_products(group):
     return [run_path(kind, name, run) for run in group_made(group) for name in READ_PRODUCTS[kind]]
 
 
+def derivation(group):
+    """What re-derives a group's rows from the products its record keeps: its case kind, the configuration keys its
+    rows use and its products by name, as paths in the working directory."""
+    inputs = group_rows_inputs(group)(None)
+    return {"kind": GROUPS[group].kind, "params": group_rows_params(group),
+            "inputs": {key: [paths] if isinstance(paths, str) else list(paths) for key, paths in inputs.items()}}
+
+
+def kept_products(group):
+    """The products a group's record keeps: those of its runs another group reads, and every product its rows are
+    computed from (siloflow.analysis.io.validation_products), so that its rows can be derived again without a run."""
+    rows = [path for paths in derivation(group)["inputs"].values() for path in paths]
+    return list(dict.fromkeys([*read_products(group), *rows]))
+
+
 for _group in ROW_GROUPS:
 
     rule:
@@ -255,7 +271,7 @@ for _group in ROW_GROUPS:
             benchmarks=lambda wildcards, group=_group: [run_path(GROUPS[group].kind, RUN_BENCHMARK, run)
                                                         for run in group_runs(group)],
             plots=lambda wildcards, group=_group: list(record_plots(group).values()),
-            products=lambda wildcards, group=_group: read_products(group),
+            products=lambda wildcards, group=_group: kept_products(group),
         output:
             runs=f"{VALIDATION_RECORD}/{_group}/runs.csv",
             table=f"{VALIDATION_RECORD}/{_group}/table.csv",
@@ -264,6 +280,7 @@ for _group in ROW_GROUPS:
             seeds=lambda wildcards, group=_group: {run: list(case.seeds) for run, case in
                                                    cases(GROUPS[group].kind).items()},
             made_by=lambda wildcards, group=_group: made_by(group),
+            derivation=lambda wildcards, group=_group: derivation(group),
         log:
             f"{VALIDATION_RECORD}/{_group}.log",
         script:

@@ -1,10 +1,16 @@
 """Snakemake adapter: run the rendered inputs of one run of any case on its engine and check it (run.json last), from
-the case the workflow built."""
+the case the workflow built; each attempt first notes the code's commit and the engine's version in the run's folder."""
 
 from pathlib import Path
 
+from siloflow.engines.interface import engine_named
 from siloflow.engines.logs import logged_to
+from siloflow.engines.provenance import code_commit, note_attempt
 from siloflow.engines.runs import run_case
+from siloflow.model.cases.common import engine_kind
 
 with logged_to(snakemake.log[0]):
-    run_case(snakemake.config, snakemake.params.kind, snakemake.params.case, Path(snakemake.output.record).parent)
+    run_dir = Path(snakemake.output.record).parent
+    engine = engine_kind(snakemake.config, snakemake.params.kind)
+    note_attempt(run_dir, engine, engine_named(engine).installed_version(), code_commit(snakemake.scriptdir))
+    run_case(snakemake.config, snakemake.params.kind, snakemake.params.case, run_dir)

@@ -7,7 +7,7 @@ import yaml
 
 from siloflow.analysis.io.tables import read_table, write_text
 from siloflow.analysis.report.summary import summary_html, summary_sections
-from siloflow.analysis.studies.validation.table import scale_limits
+from siloflow.analysis.studies.validation.table import against_the_study
 from siloflow.engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
@@ -20,7 +20,7 @@ with logged_to(snakemake.log[0]) as log:
         [row for path in inputs.blender for row in read_table(path)],
         [json.loads(Path(path).read_text()) for path in inputs.balances],
         [row for path in inputs.blender_differences for row in read_table(path)],
-        scale_limits(read_table(inputs.validation)),
+        against_the_study(read_table(inputs.validation)),
     )
     write_text(snakemake.output.page, summary_html("siloflow: figures of merit", sections))
     log.info("summary page: %s rows", ", ".join(f"{len(section.rows)} {section.title.lower()}" for section in sections))

@@ -11,4 +11,4 @@ with logged_to(snakemake.log[0]) as log:
     write_flow_table(snakemake.output.table, rows)
     write_text(snakemake.output.page, summary_html("siloflow: validation table", page_sections(rows),
                                                    intro=PAGE_EXPLANATION))
-    log.info("%d rows, %d shown at this scale", len(rows), sum(r["scale_shows"] == "yes" for r in rows))
+    log.info("%d rows, %d judged against a finding of the study", len(rows), sum(r["finding"] != "-" for r in rows))

@@ -26,11 +26,10 @@ from scipy import stats
 
 from siloflow.analysis.numerics.uncertainty import Estimate, combine_independent
 from siloflow.analysis.studies.validation.findings import NEGLIGIBLE, ORDER, POWER_LAW, RATIO, SIGN, VALUE, Part
-from siloflow.analysis.studies.validation.rows import ratio
 
 __all__ = ["REPRODUCED", "NOT_REPRODUCED", "NOT_RESOLVED", "CONFIDENCE", "Agreement", "AgreementTolerances",
            "quantile", "interval", "study_band", "value_in_band", "ratio_in_band", "sign_of_change", "in_order",
-           "negligible", "power_law_exponent", "power_law"]
+           "negligible", "power_law_exponent", "power_law", "ratio"]
 
 REPRODUCED, NOT_REPRODUCED, NOT_RESOLVED = "reproduced", "not reproduced", "not resolved"
 #: Confidence level of every interval (-).
@@ -96,6 +95,20 @@ class AgreementTolerances:
         if key not in self.__dataclass_fields__:
             raise KeyError(f"no tolerance {key!r}; the tolerances are {', '.join(self.__dataclass_fields__)}")
         return getattr(self, key)
+
+
+def ratio(a: float, ua: float, b: float, ub: float) -> tuple[float, float]:
+    """``a / b`` and its first-order standard error for independent ``a`` and ``b`` (NaN when b is 0)."""
+    if b == 0.0:
+        return math.nan, math.nan
+    value = a / b
+    return value, abs(value) * combine_independent([_relative(ua, a), _relative(ub, b)])
+
+
+def _relative(error: float, value: float) -> float:
+    if value == 0.0:
+        return math.nan if error else 0.0
+    return error / abs(value)
 
 
 def quantile(dof: float | None) -> float:
@@ -202,7 +215,7 @@ def ratio_in_band(numerator: float, numerator_error: float, denominator: float, 
     """A ratio of two measured figures against the study's band (RATIO part), as :func:`value_in_band`.
 
     The two figures are taken as independent: the ratio ``r = a / b`` has the first-order error
-    ``|r| sqrt((ua / a)^2 + (ub / b)^2)`` (:func:`~siloflow.analysis.studies.validation.rows.ratio`); ``dof`` is
+    ``|r| sqrt((ua / a)^2 + (ub / b)^2)`` (:func:`ratio`); ``dof`` is
     that of the two errors (the smaller, when they differ). A zero denominator gives an unknown ratio.
     """
     _check(part, RATIO)
@@ -210,9 +223,17 @@ def ratio_in_band(numerator: float, numerator_error: float, denominator: float, 
     return _against_band(part, value, error, dof, study_band(part, tolerances), tolerances, steady)
 
 
-def sign_of_change(change: float, error: float, dof: float | None, part: Part) -> Agreement:
-    """The sign of a change (SIGN part): resolved, ``|change| > q error``, with the study's sign: reproduced;
-    resolved with the other sign: not reproduced; else not resolved. Change and error in the part's unit."""
+def _steady_or_not_resolved(agreement: Agreement, steady: bool) -> Agreement:
+    """A "reproduced" of a figure that was not steady is "not resolved"; any other verdict stands."""
+    if steady or agreement.verdict != REPRODUCED:
+        return agreement
+    return Agreement(NOT_RESOLVED, f"{agreement.reason}; but not steady")
+
+
+def sign_of_change(change: float, error: float, dof: float | None, part: Part, *, steady: bool = True) -> Agreement:
+    """The sign of a change (SIGN part): resolved, ``|change| > q error``, with the study's sign: reproduced (not
+    resolved when the figures were not ``steady``); resolved with the other sign: not reproduced; else not resolved.
+    Change and error in the part's unit."""
     _check(part, SIGN)
     if unknown := _unknown(part, change, error):
         return unknown
@@ -220,7 +241,8 @@ def sign_of_change(change: float, error: float, dof: float | None, part: Part) -
     shown = f"{part.id}: change {_shown(change, error, dof)}; study: {part.stated()}"
     if abs(change) <= q * error:
         return Agreement(NOT_RESOLVED, f"{shown}; |change| <= {q:.4g} × error")
-    return Agreement(REPRODUCED if math.copysign(1.0, change) == part.sign else NOT_REPRODUCED, shown)
+    return _steady_or_not_resolved(
+        Agreement(REPRODUCED if math.copysign(1.0, change) == part.sign else NOT_REPRODUCED, shown), steady)
 
 
 def in_order(values: Sequence[float], errors: Sequence[float], dof: float | None, part: Part) -> Agreement:
@@ -250,13 +272,13 @@ def in_order(values: Sequence[float], errors: Sequence[float], dof: float | None
 
 
 def negligible(change: float, error: float, dof: float | None, reference: float, part: Part,
-               tolerances: AgreementTolerances) -> Agreement:
+               tolerances: AgreementTolerances, *, steady: bool = True) -> Agreement:
     """A change the study calls negligible (or a level curve, a uniform velocity; NEGLIGIBLE part).
 
     The limit is ``tolerance * |reference|`` (the part's tolerance key), ``reference`` being the value the change is
     relative to, in the unit of ``change`` (its own error is left out: it moves the limit at second order only).
     The 95 % interval of the change inside ``-+ limit``: reproduced; entirely outside it: not reproduced; else not
-    resolved.
+    resolved; a "reproduced" of figures that were not ``steady`` is "not resolved".
     """
     _check(part, NEGLIGIBLE)
     if unknown := _unknown(part, change, error, reference):
@@ -266,7 +288,7 @@ def negligible(change: float, error: float, dof: float | None, reference: float,
     shown = (f"{part.id}: change {_shown(change, error, dof)}, negligible within ± {limit:.3g} "
              f"({part.tolerance} {tolerances[part.tolerance]:g} of {reference:.4g})")
     if -limit <= low and high <= limit:
-        return Agreement(REPRODUCED, f"{shown}: inside")
+        return _steady_or_not_resolved(Agreement(REPRODUCED, f"{shown}: inside"), steady)
     if high < -limit or low > limit:
         return Agreement(NOT_REPRODUCED, f"{shown}: entirely outside")
     return Agreement(NOT_RESOLVED, f"{shown}: partly outside")

@@ -1,40 +1,63 @@
-"""Validation rows of the blending studies: the recirculating silo (VRR, RTD, flowing bulk density) and the
-multi-flow blender (passage velocities, mass flow of the insert, gravity series).
+"""Validation rows of blending: the recirculating silo (thesis ch. 6, findings B1-B8) here, the multi-flow blender
+(ch. 7, M1-M4) is :mod:`siloflow.analysis.studies.validation.blender`.
 
-Inputs are files as read: per recirculation run its ``case.json``, ``blending.json`` and the rows of its
-``rtd.csv``; per blender run its ``blender.json``. A VRR is shown when it lies below the counting-noise ceiling
-of the outlet windows (their clump count); a blender insert is in mass flow when its exterior annulus moves at
-least ``mass_flow_velocity_ratio`` of the tube's velocity.
+Each row is judged against a finding part (:mod:`siloflow.analysis.studies.validation.findings`) by the rule of its
+kind (:mod:`siloflow.analysis.studies.validation.agreement`); ``differs`` says where the row's quantity is defined or
+sampled otherwise than the study's. No row decides its scale (added later from the configuration alone).
+
+Recirculation number and VRR
+----------------------------
+The analysis (:func:`siloflow.analysis.studies.silo_recirculation.vrr.vrr_by_recirculation`) counts ``Nr = (t -
+t_open) / t_res`` in holdup residence times (the silo's contents over its throughput, the study's t_rm, §6.2.3.3)
+and writes one VRR per pass: entry ``k`` of ``vrr_by_recirculation`` is the VRR of the outlet windows with ``k <= Nr
+< k + 1``, the pass that follows ``k`` recirculations. The study's "Nr = 0" (without recirculation, B5) is entry 0 and
+its "Nr = 4" (the discharge after 4 recirculations, B2-B4, B6) is entry 4. A run that covers fewer passes gives its
+last one, and its rows say so in ``differs``. A VRR near the counting-noise ceiling of the outlet windows
+(``vrr_at_ceiling``) is a lower bound of the true VRR, not a measurement: every row it enters is at most "not
+resolved".
+
+Inputs are per-run mappings ``{"case": case.json, "summary": blending.json, "rtd": rtd.csv rows, "note": str, "dof":
+float | None}``: ``note`` is the evidence about the run's seeds (appended to every row's evidence), ``dof`` the
+degrees of freedom of the run's errors (seeds - 1; None for within-run errors).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
 import numpy as np
 
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent
-from siloflow.analysis.studies.validation.rows import Criteria, plus_minus, precise, ratio, resolved, row, verdict
+from siloflow.analysis.studies.validation import agreement as rules
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
+from siloflow.analysis.studies.validation.findings import PARTS
+from siloflow.analysis.studies.validation.rows import capped, plus_minus, row, smallest_dof
 
-__all__ = ["rtd_peak", "recirculation_rows", "blender_rows", "gravity_rows"]
+__all__ = ["RECIRCULATION_GROUP", "MADE", "UNMADE", "rtd_peak", "recirculation_rows"]
 
 RECIRCULATION_GROUP = "Recirculating silo (blending)"
-BLENDER_GROUP = "Multi-flow blender"
-GRAVITY_GROUP = "Blender gravity series"
-#: The passages of the blender (metric key: name in the geometry's clear widths), outermost first.
-PASSAGES = {"exterior": "exterior annulus", "interior": "interior annulus", "tube": "tube"}
-#: Figures whose scaling with sqrt(g) the gravity rows test.
-GRAVITY_FIGURES = {"mass_flow_rate_kg_s": "mass flow rate", "tube_v_z_m_s": "tube velocity",
-                   "exterior_v_z_m_s": "exterior annulus velocity"}
+#: The study's flow patterns (``blending.json`` ``flow_pattern``) and the suffix of their finding parts.
+PATTERNS = {"internal_flow": "internal", "semi_mass_flow": "semi_mass"}
+#: The study's batch sizes, blue volume over silo volume (§6.4) (-).
+STUDY_BATCHES = (0.13, 0.25, 0.5)
+#: The Nr at which the study reads the VRR (B2-B4, B6) and its midpoint for the "slower after" part (B2).
+NR_STUDY, NR_MIDDLE = 4, 2
+#: The finding parts of ch. 6 these rows make (each given the runs it needs): all of them.
+MADE = ("B1.semi_mass", "B1.internal", "B2.grows", "B2.slower_after_2", "B3.internal",
+        "B3.stronger_in_internal", "B4.semi_mass", "B4.internal", "B5", "B6", "B7.semi_mass",
+        "B7.internal", "B8.internal", "B8.semi_mass")
+#: Every part of ch. 6 can be made.
+UNMADE = MappingProxyType({})
 
 
 def rtd_peak(times, density, t_mean: float, t_mean_error: float) -> tuple[float, float]:
     """The RTD's peak in normalised time, theta = t_peak / t_mean, and its standard error (-).
 
     The peak is the bin of largest E(t) (the first of equal ones); its time is known to a bin, so its error is
-    the bin width over sqrt(12), combined with the relative error of the mean.
+    the bin width over sqrt(12), combined with the relative error of the time scale.
 
     Parameters
     ----------
@@ -43,7 +66,7 @@ def rtd_peak(times, density, t_mean: float, t_mean_error: float) -> tuple[float,
     density : array_like, shape (n,)
         E(t) at each bin (1/s).
     t_mean, t_mean_error : float
-        The RTD's mean residence time and its standard error (s).
+        The time scale theta is taken in (the study's t_rm) and its standard error (s).
     """
     t = np.asarray(times, dtype=float)
     e = np.asarray(density, dtype=float)
@@ -54,153 +77,264 @@ def rtd_peak(times, density, t_mean: float, t_mean_error: float) -> tuple[float,
     return ratio(peak, width / math.sqrt(12.0), t_mean, t_mean_error)
 
 
-def _depth_check(case: Mapping, criteria: Criteria) -> tuple[bool, str]:
-    depth, diameter = float(case["depth_m"]), float(case["equivalent_diameter_m"])
-    return depth / diameter >= criteria.min_depth_diameters, (
-        f"depth {depth * 1000:.1f} mm = {depth / diameter:.1f} particle diameters (>= {criteria.min_depth_diameters:g})")
+def _tail(*notes: str) -> str:
+    text = "; ".join(note for note in notes if note)
+    return f"; {text}" if text else ""
 
 
-def recirculation_rows(case: Mapping, summary: Mapping, rtd: Sequence[Mapping], criteria: Criteria) -> list[dict]:
-    """Rows of one recirculating-silo run: VRR after the second recirculation per batch layout, the RTD's peak
-    and t_s/t_d, and the drop of bulk density while it flows."""
-    depth_ok, depth_text = _depth_check(case, criteria)
-    pattern = summary["flow_pattern"]
-    window = float(summary["clumps_per_window"])
-    rows = []
-    for name, layout in summary["layouts"].items():
-        values, errors = layout["vrr_by_recirculation"], layout["vrr_by_recirculation_error"]
-        ceiling = layout["vrr_at_ceiling"]
-        nr = min(2, len(values))
-        listing = "; ".join(f"Nr {i + 1}: {plus_minus(v, number_or_nan(e))}{' (ceiling)' if c else ''}"
-                            for i, (v, e, c) in enumerate(zip(values, errors, ceiling)))
-        below = not ceiling[nr - 1]
-        rows.append(row(RECIRCULATION_GROUP, f"VRR after recirculation {nr} ({name}: blue {layout['blue_fraction']:g}, "
-                                             f"{layout['sublayers']} layer(s))", pattern, values[nr - 1],
-                        number_or_nan(errors[nr - 1]), "-", "", verdict(depth_ok, below),
-                        f"{depth_text}; outlet windows of {window:.0f} clumps resolve a VRR up to the ceiling "
-                        f"{float(summary['vrr_sampling_limit']):.0f}; {listing}"))
-    ids = summary["rtd_particle_ids"]
-    chosen = [entry for entry in rtd if entry["method"] == "particle_ids"]
-    if chosen:
-        theta, theta_error = rtd_peak([float(e["time_s"]) for e in chosen], [float(e["E_per_s"]) for e in chosen],
-                                      float(ids["t_mean_s"]), number_or_nan(ids.get("t_mean_s_error")))
-        theta_precise, theta_text = precise(theta, theta_error, criteria)
-        rows.append(row(RECIRCULATION_GROUP, "RTD peak theta = t_peak / t_mean", pattern, theta, theta_error, "-", "",
-                        verdict(depth_ok, theta_precise),
-                        f"{depth_text}; {int(ids['n_tracer'])} tracer clumps, {len(chosen)} bins; {theta_text}"))
-    first, first_error = ids["t_s_over_t_d"], number_or_nan(ids.get("t_s_over_t_d_error"))
-    first_precise, first_text = precise(first, first_error, criteria)
-    rows.append(row(RECIRCULATION_GROUP, "First appearance / discharge time t_s/t_d", pattern, first, first_error, "-",
-                    "", verdict(depth_ok, first_precise),
-                    f"{depth_text}; {int(ids['n_tracer'])} tracer clumps; {first_text}"))
-    if "bulk_density_drop" in summary:
-        drop, error = summary["bulk_density_drop"], number_or_nan(summary.get("bulk_density_drop_error"))
-        seen = resolved(drop, error, criteria.coverage_factor)
+class _Run:
+    """One recirculation run as the rows read it: its pattern, layouts, note and degrees of freedom."""
+
+    def __init__(self, run: Mapping):
+        self.summary, self.rtd = run["summary"], list(run.get("rtd") or ())
+        self.pattern = str(self.summary["flow_pattern"])
+        self.suffix = PATTERNS.get(self.pattern)
+        self.note, self.dof = str(run.get("note") or ""), run.get("dof")
+        self.layouts = self.summary["layouts"]
+        limit, factor = float(self.summary["vrr_sampling_limit"]), float(self.summary["vrr_ceiling_factor"])
+        self.windows = (f"outlet windows of {float(self.summary['clumps_per_window']):.0f} clumps: counting-noise "
+                        f"ceiling {limit:.0f}, a VRR above {limit / factor:.0f} is a lower bound")
+
+    def part(self, finding: str) -> str | None:
+        """The pattern's part of a finding (``"B4"`` -> ``"B4.internal"``), None for a pattern the study did not run."""
+        return f"{finding}.{self.suffix}" if self.suffix else None
+
+    def layout(self, fraction: float, sublayers: int) -> tuple[str, Mapping] | None:
+        """The layout of that blue fraction (-) and number of sub-layers, by name, or None."""
+        for name, layout in self.layouts.items():
+            if math.isclose(float(layout["blue_fraction"]), fraction) and int(layout["sublayers"]) == sublayers:
+                return name, layout
+        return None
+
+    def vrr(self, layout: Mapping, nr: int) -> tuple[float, float, int, str]:
+        """The VRR of the pass after ``nr`` recirculations (the last pass when the run has fewer), its error, the
+        Nr taken and why it is only a bound ("" when a measurement)."""
+        values = layout["vrr_by_recirculation"]
+        errors = layout.get("vrr_by_recirculation_error") or [None] * len(values)
+        taken = min(nr, len(values) - 1)
+        bound = (f"the VRR at Nr = {taken} is at the counting-noise ceiling ({self.windows})"
+                 if layout["vrr_at_ceiling"][taken] else "")
+        return number_or_nan(values[taken]), number_or_nan(errors[taken]), taken, bound
+
+    def short(self, nr: int, wanted: int) -> str:
+        """The ``differs`` clause of a VRR read at ``nr`` instead of ``wanted``."""
+        if nr == wanted:
+            return ""
+        return (f"VRR at Nr = {nr}, the last pass of a run covering {float(self.summary['recirculations']):.2f} "
+                f"recirculations, not at Nr = {wanted} (silo_recirculation.recirculations >= {wanted + 1} reaches "
+                "it)")
+
+    def listing(self, layout: Mapping) -> str:
+        """Every pass's VRR, for evidence."""
+        errors = layout.get("vrr_by_recirculation_error") or [None] * len(layout["vrr_by_recirculation"])
+        return "; ".join(f"Nr {k}: {plus_minus(number_or_nan(v), number_or_nan(e))}{' (ceiling)' if c else ''}"
+                         for k, (v, e, c) in enumerate(zip(layout["vrr_by_recirculation"], errors,
+                                                           layout["vrr_at_ceiling"])))
+
+
+def _label(layout: Mapping, name: str) -> str:
+    sublayers = int(layout["sublayers"])
+    return (f"{name}: blue {float(layout['blue_fraction']) * 100:g} %, "
+            f"{sublayers} {'layer' if sublayers == 1 else 'sub-layers'}")
+
+
+def _judged(figure: str, case: str, value: float, error: float, unit: str, evidence: str, dof, part: str | None,
+            judge, differs: str = "") -> dict:
+    """A row judged against ``part`` by ``judge(Part)``; a row with no finding when the run's pattern is not one of
+    the study's (``part`` None)."""
+    if part is None:
+        return row(RECIRCULATION_GROUP, figure, case, value, error, unit, evidence, dof=dof,
+                   study="- (a flow pattern the study did not run)", differs=differs)
+    return row(RECIRCULATION_GROUP, figure, case, value, error, unit, evidence, dof=dof, finding=part,
+               agreement=judge(PARTS[part]), differs=differs)
+
+
+def _run_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
+    """B4, B2 (both parts) per layout, B3.internal, B6, B7, B8 and B1 of one run."""
+    rows, tail, dof, case = [], _tail(run.note), run.dof, run.pattern
+    nr_text = ("Nr in holdup residence times (contents over throughput); Nr = k is the pass after k recirculations, "
+               "windows with k <= Nr < k + 1")
+    for name, layout in run.layouts.items():
+        label, listing = _label(layout, name), run.listing(layout)
+        last, last_error, nr, bound = run.vrr(layout, NR_STUDY)
+        first, first_error, _, first_bound = run.vrr(layout, 0)
+        evidence = f"{listing}; {nr_text}; {run.windows}{tail}"
+        if int(layout["sublayers"]) == 1:
+            batch = float(layout["blue_fraction"])
+            other = "" if any(math.isclose(batch, b) for b in STUDY_BATCHES) else (
+                f"batch {batch * 100:g} %, not one of the study's 13, 25, 50 %")
+            rows.append(_judged(
+                f"VRR at Nr = {nr} ({label})", case, last, last_error, "-", evidence, dof, run.part("B4"),
+                lambda p: capped(rules.value_in_band(last, last_error, dof, p, tolerances, steady=not bound), bound),
+                differs="; ".join(filter(None, (run.short(nr, NR_STUDY), other)))))
+        if nr >= 1:
+            change = last - first, combine_independent([last_error, first_error])
+            why = "; ".join(filter(None, (first_bound, bound)))
+            rows.append(_judged(f"Change of VRR from Nr = 0 to {nr} ({label})", case, *change, "-", evidence, dof,
+                                "B2.grows", lambda p: capped(rules.sign_of_change(*change, dof, p), why),
+                                differs=run.short(nr, NR_STUDY)))
+        if nr > NR_MIDDLE:
+            rows.append(_slower(run, layout, label, nr, evidence))
+    rows += _batch_rows(run, tolerances, nr_text)
+    rows += _rtd_rows(run, tolerances)
+    if "bulk_density_drop" in run.summary:
+        summary = run.summary
+        drop, error = float(summary["bulk_density_drop"]), number_or_nan(summary.get("bulk_density_drop_error"))
         low, high = summary["bulk_density_slab_m"]
-        rows.append(row(RECIRCULATION_GROUP, "Flowing bulk density drop, 1 - rho_flowing / rho_settled", pattern,
-                        drop, error, "-", "the fill dilates while it flows", verdict(depth_ok, seen),
-                        f"{depth_text}; slab {low * 1000:.0f}-{high * 1000:.0f} mm: settled "
-                        f"{summary['settled_bulk_density_kg_m3']:.1f}, flowing "
-                        f"{plus_minus(summary['flowing_bulk_density_kg_m3'], number_or_nan(summary.get('flowing_bulk_density_kg_m3_error')), 4)} kg/m3"))
+        flowing = plus_minus(float(summary["flowing_bulk_density_kg_m3"]),
+                             number_or_nan(summary.get("flowing_bulk_density_kg_m3_error")), 4)
+        rows.append(_judged(
+            "Drop of bulk density while recirculating, 1 - flowing / filling", case, drop, error, "-",
+            f"slab {low * 1000:.0f}-{high * 1000:.0f} mm above the outlet (the study names no region): filling "
+            f"{float(summary['settled_bulk_density_kg_m3']):.1f} kg/m3 (the fill at rest), flowing {flowing} kg/m3 "
+            f"(batch means of {int(summary.get('bulk_density_batches', 0))} batches){tail}", dof, run.part("B1"),
+            lambda p: rules.value_in_band(drop, error, dof, p, tolerances)))
     return rows
 
 
-def _metric(metrics: Mapping, key: str) -> tuple[float, float]:
-    return number_or_nan(metrics.get(key)), number_or_nan(metrics.get(f"{key}_error"))
+def _slower(run: _Run, layout: Mapping, label: str, nr: int, evidence: str) -> dict:
+    """B2.slower_after_2: the VRR gain from Nr = 2 to 4 minus that from 0 to 2; with a run of fewer passes the gain
+    from 2 to its last Nr, scaled to two recirculations (so that it is the study's figure at Nr = 4)."""
+    dof = run.dof
+    (v0, e0, _, b0), (v2, e2, _, b2), (vn, en, _, bn) = (run.vrr(layout, k) for k in (0, NR_MIDDLE, nr))
+    scale = (NR_STUDY - NR_MIDDLE) / (nr - NR_MIDDLE)
+    change = scale * (vn - v2) - (v2 - v0)
+    # v2 enters both gains: its error counts with the weight (scale + 1), the two ends' with theirs.
+    error = combine_independent([scale * en, (scale + 1.0) * e2, e0])
+    differs = "" if nr == NR_STUDY else (
+        f"gain from Nr = {NR_MIDDLE} to {nr} times {scale:g}, not from {NR_MIDDLE} to {NR_STUDY}: "
+        + run.short(nr, NR_STUDY))
+    why = "; ".join(filter(None, (b0, b2, bn)))
+    return _judged(f"VRR gain from Nr = {NR_MIDDLE} to {NR_STUDY} minus gain from 0 to {NR_MIDDLE} ({label})",
+                   run.pattern, change, error, "-", evidence, dof, "B2.slower_after_2",
+                   lambda p: capped(rules.sign_of_change(change, error, dof, p), why), differs=differs)
 
 
-def _passages(widths: Mapping) -> dict[str, tuple[str, int]]:
-    """The passages a planar cross-section crosses, ``{key: (name, count)}``: the annuli twice (left and right)
-    except the interior one of an insert without a tube, which spans both plates; the tube once."""
-    present = {key: name for key, name in PASSAGES.items() if name in widths}
-    return {key: (name, 1 if key == "tube" or (key == "interior" and "tube" not in present) else 2)
-            for key, name in present.items()}
-
-
-def _cross_section_mean(metrics: Mapping, widths: Mapping) -> tuple[float, float]:
-    """Width-weighted mean v_z over the passages a planar cross-section crosses, and its error (m/s)."""
-    total, weighted, errors = 0.0, 0.0, []
-    for key, (passage, count) in _passages(widths).items():
-        value, error = _metric(metrics, f"{key}_v_z_m_s")
-        weight = count * float(widths[passage])
-        total += weight
-        weighted += weight * value
-        errors.append(weight * error)
-    return weighted / total, combine_independent(errors) / total
-
-
-def _in_mass_flow(metrics: Mapping, widths: Mapping, criteria: Criteria) -> tuple[tuple[float, float], bool]:
-    """Exterior annulus over innermost passage velocity (the tube, else the interior annulus), and whether it
-    reaches the mass-flow ratio."""
-    inner = "tube" if "tube" in widths else "interior"
-    exterior_over_inner = ratio(*_metric(metrics, "exterior_v_z_m_s"), *_metric(metrics, f"{inner}_v_z_m_s"))
-    return exterior_over_inner, exterior_over_inner[0] >= criteria.mass_flow_velocity_ratio
-
-
-def blender_rows(summaries: Sequence[Mapping], cases: Sequence[Mapping], criteria: Criteria) -> list[dict]:
-    """Per configuration at the lowest gravity factor: each passage's velocity over the cross-section mean, whether
-    the insert is in mass flow (exterior over tube velocity), its mean residence time and recirculations to
-    homogenise. The blender's scale shows them when the configuration designed for mass flow
-    (``criteria.mass_flow_configuration``) is in mass flow; ``cases`` are the runs' ``case.json``, in order."""
-    lowest = min(float(s["gravity_factor"]) for s in summaries)
-    chosen = sorted(((s, c) for s, c in zip(summaries, cases) if float(s["gravity_factor"]) == lowest),
-                    key=lambda pair: pair[0]["configuration"])
-    reference = [s for s, _ in chosen if s["configuration"] == criteria.mass_flow_configuration]
-    scale_ok = (_in_mass_flow(reference[0]["metrics"], reference[0]["geometry"]["clear_widths"], criteria)[1]
-                if reference else None)
-    scale_text = (f"{criteria.mass_flow_configuration} insert "
-                  f"{'in mass flow' if scale_ok else 'not in mass flow' if scale_ok is False else 'not run'}")
-    rows = []
-    for summary, case in chosen:
-        metrics, name = summary["metrics"], summary["configuration"]
-        depth = (f"depth {float(case['depth_m']) * 1000:.1f} mm = "
-                 f"{float(case['depth_m']) / float(case['equivalent_diameter_m']):.1f} particle diameters")
-        widths = summary["geometry"]["clear_widths"]
-        mean, mean_error = _cross_section_mean(metrics, widths)
-        for key, (passage, _) in _passages(widths).items():
-            value = ratio(*_metric(metrics, f"{key}_v_z_m_s"), mean, mean_error)
-            value_precise, value_text = precise(*value, criteria)
-            rows.append(row(BLENDER_GROUP, f"{passage.capitalize()} v_z / cross-section mean", name, *value, "-", "",
-                            verdict(scale_ok, value_precise),
-                            f"{scale_text}; cross-section mean {plus_minus(mean, mean_error)} m/s (passages weighted by "
-                            f"their clear widths); {depth}; {value_text}"))
-        exterior_over_tube, in_mass_flow = _in_mass_flow(metrics, widths, criteria)
-        inner = "tube" if "tube" in widths else "interior annulus"
-        rows.append(row(BLENDER_GROUP, f"Exterior annulus / {inner} v_z (mass flow of the insert)", name,
-                        *exterior_over_tube, "-",
-                        "mass flow" if name == criteria.mass_flow_configuration else "",
-                        verdict(scale_ok),
-                        f"{'in' if in_mass_flow else 'not in'} mass flow: the exterior annulus moves at "
-                        f"{exterior_over_tube[0]:.2f} of the {inner}'s velocity (mass flow from "
-                        f"{criteria.mass_flow_velocity_ratio:g}); {depth}, {summary['n_clumps']} clumps"))
-        for key, label in (("rtd_mean_s", "Mean residence time"),
-                           ("recirculations_to_homogenise", "Recirculations to homogenise")):
-            value = _metric(metrics, key)
-            value_precise, value_text = precise(*value, criteria)
-            rows.append(row(BLENDER_GROUP, label, name, *value, "s" if key.endswith("_s") else "-", "",
-                            verdict(scale_ok, value_precise),
-                            f"{scale_text}; error from the run's tracer counts; {value_text}"))
+def _batch_rows(run: _Run, tolerances: AgreementTolerances, nr_text: str) -> list[dict]:
+    """B3.internal (internal flow) and B6 (either pattern) of one run."""
+    rows, dof, tail = [], run.dof, _tail(run.note)
+    small, half = run.layout(0.13, 1), run.layout(0.5, 1)
+    if run.suffix == "internal" and small and half:
+        (a, ea, na, ba), (b, eb, nb, bb) = run.vrr(small[1], NR_STUDY), run.vrr(half[1], NR_STUDY)
+        change = b - a, combine_independent([ea, eb])
+        rows.append(_judged(
+            f"Change of VRR at Nr = {min(na, nb)} from the 13 % to the 50 % batch", run.pattern, *change, "-",
+            f"13 %: {plus_minus(a, ea)}, 50 %: {plus_minus(b, eb)}; {nr_text}; {run.windows}{tail}", dof,
+            "B3.internal", lambda p: capped(rules.sign_of_change(*change, dof, p), "; ".join(filter(None, (ba, bb)))),
+            differs=run.short(min(na, nb), NR_STUDY)))
+    layers = [run.layout(0.5, n) for n in (5, 3, 1)]
+    if all(layers):
+        taken = [run.vrr(layout, NR_STUDY) for _, layout in layers]
+        values, errors = [t[0] for t in taken], [t[1] for t in taken]
+        nr, why = min(t[2] for t in taken), "; ".join(t[3] for t in taken if t[3])
+        rows.append(_judged(
+            f"VRR at Nr = {nr} of the 50 % batch in 5, 3 and 1 layers", run.pattern, values[0], errors[0], "-",
+            "; ".join(f"{n}: {plus_minus(v, e)}" for n, v, e in zip((5, 3, 1), values, errors))
+            + f" (value column: 5 sub-layers); {nr_text}; {run.windows}{tail}", dof, "B6",
+            lambda p: capped(rules.in_order(values, errors, dof, p), why), differs=run.short(nr, NR_STUDY)))
     return rows
 
 
-def gravity_rows(summaries: Sequence[Mapping], criteria: Criteria) -> list[dict]:
-    """Per configuration run at 1 g and other factors f: (q_f / q_1g) / sqrt(f) for the flow rate and passage
-    velocities; 1 where q scales with sqrt(g)."""
-    rows = []
-    k = criteria.coverage_factor
-    for name in sorted({s["configuration"] for s in summaries}):
-        runs = {float(s["gravity_factor"]): s["metrics"] for s in summaries if s["configuration"] == name}
-        if 1.0 not in runs or len(runs) < 2:
+def _rtd_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
+    """B7 (theta of the RTD's peak) and B8 (t_s / t_d) of the tracer marked by particle id."""
+    rows, summary, dof, tail = [], run.summary, run.dof, _tail(run.note)
+    ids = summary["rtd_particle_ids"]
+    exited = number_or_nan(ids.get("fraction_exited"))
+    tracer = f"{int(ids['n_tracer'])} tracer clumps" + (f", {exited:.0%} of them out" if math.isfinite(exited) else "")
+    chosen = [entry for entry in run.rtd if entry["method"] == "particle_ids"]
+    if chosen:
+        if "residence_time_s" in summary:
+            # The study's t_rm (§6.2.3.3) is the silo's contents over its flow rate: the holdup over the throughput.
+            t_rm, t_rm_error = float(summary["residence_time_s"]), number_or_nan(summary.get("residence_time_s_error"))
+            scale, differs = f"t_rm = holdup / throughput = {plus_minus(t_rm, t_rm_error)} s", ""
+        else:
+            t_rm, t_rm_error = float(ids["t_mean_s"]), number_or_nan(ids.get("t_mean_s_error"))
+            scale = f"t_mean of the tracer = {plus_minus(t_rm, t_rm_error)} s"
+            differs = ("theta = t / the RTD's mean (the tracers out by the end of the run), not t / t_rm, the silo's "
+                       "contents over its flow rate (§6.2.3.3): the summary has no residence_time_s")
+        times = [float(entry["time_s"]) for entry in chosen]
+        theta, theta_error = rtd_peak(times, [float(entry["E_per_s"]) for entry in chosen], t_rm, t_rm_error)
+        rows.append(_judged(
+            "Theta of the RTD's peak, t_peak / t_rm", run.pattern, theta, theta_error, "-",
+            f"peak at {theta * t_rm:.3g} s of {len(chosen)} bins of {times[1] - times[0]:.3g} s (error: a bin over "
+            f"sqrt(12)); {scale}; {tracer}{tail}", dof, run.part("B7"),
+            lambda p: rules.value_in_band(theta, theta_error, dof, p, tolerances), differs=differs))
+    first, first_error = float(ids["t_s_over_t_d"]), number_or_nan(ids.get("t_s_over_t_d_error"))
+    differs = "" if not exited < 1.0 else (
+        f"t_d is the last exit of the {exited:.0%} of the tracer out by the end of the run, not its complete discharge")
+    rows.append(_judged(
+        "First appearance over discharge time of the tracer, t_s / t_d", run.pattern, first, first_error, "-",
+        f"t_s {plus_minus(float(ids['t_s']), number_or_nan(ids.get('t_s_error')))} s, t_d "
+        f"{plus_minus(float(ids['t_d']), number_or_nan(ids.get('t_d_error')))} s, residence times of the tracer's "
+        f"passes from their entry at the top; {tracer}{tail}", dof, run.part("B8"),
+        lambda p: rules.value_in_band(first, first_error, dof, p, tolerances), differs=differs))
+    return rows
+
+
+def _pattern_rows(internal: _Run, semi: _Run, tolerances: AgreementTolerances) -> list[dict]:
+    """B3.stronger_in_internal and B5: the two flow patterns compared."""
+    rows, dof = [], smallest_dof(internal.dof, semi.dof)
+    case = f"{internal.pattern} vs {semi.pattern}"
+    tail = _tail(f"{internal.pattern}: {internal.note}" if internal.note else "",
+                 f"{semi.pattern}: {semi.note}" if semi.note else "")
+    effects, reads = [], []
+    for run in (internal, semi):
+        small, half = run.layout(0.13, 1), run.layout(0.5, 1)
+        if small and half:
+            (a, ea, na, ba), (b, eb, nb, bb) = run.vrr(small[1], NR_STUDY), run.vrr(half[1], NR_STUDY)
+            value, error = ratio(a, ea, b, eb)
+            effects.append((value - 1.0, error, min(na, nb), "; ".join(filter(None, (ba, bb))),
+                            run.short(min(na, nb), NR_STUDY) and f"{run.pattern}: {run.short(min(na, nb), NR_STUDY)}"))
+            reads.append(f"{run.pattern}: 13 % {plus_minus(a, ea)} / 50 % {plus_minus(b, eb)} - 1 = "
+                         f"{plus_minus(value - 1.0, error)}")
+    if len(effects) == 2:
+        values, errors = [e[0] for e in effects], [e[1] for e in effects]
+        nr, why = min(e[2] for e in effects), "; ".join(e[3] for e in effects if e[3])
+        rows.append(row(RECIRCULATION_GROUP, f"Batch effect VRR(13 %) / VRR(50 %) - 1 at Nr = {nr}, internal vs "
+                                             "semi-mass flow", case, values[0], errors[0], "-",
+                        "; ".join(reads) + f" (value column: internal flow){tail}", dof=dof,
+                        finding="B3.stronger_in_internal",
+                        agreement=capped(rules.in_order(values, errors, dof, PARTS["B3.stronger_in_internal"]), why),
+                        differs="; ".join(e[4] for e in effects if e[4])))
+    for name, layout in internal.layouts.items():
+        if int(layout["sublayers"]) != 1:
             continue
-        for factor in sorted(f for f in runs if f != 1.0):
-            for key, label in GRAVITY_FIGURES.items():
-                value, error = ratio(*_metric(runs[factor], key), *_metric(runs[1.0], key))
-                scaled, scaled_error = value / math.sqrt(factor), error / math.sqrt(factor)
-                off = resolved(scaled - 1.0, scaled_error, k)
-                scaled_precise, scaled_text = precise(scaled, scaled_error, criteria)
-                rows.append(row(GRAVITY_GROUP, f"{label.capitalize()} at {factor:g} g / (1 g value x sqrt({factor:g}))",
-                                name, scaled, scaled_error, "-", "flow rate and mean velocity scale with sqrt(g)",
-                                verdict(scaled_precise),
-                                f"{'does not scale' if off else 'scales' if off is False else 'unknown'} with sqrt(g) "
-                                f"at {k:g} standard errors; {scaled_text}"))
+        other = semi.layout(float(layout["blue_fraction"]), 1)
+        if other is None:
+            continue
+        (a, ea, _, ba), (b, eb, _, bb) = internal.vrr(layout, 0), semi.vrr(other[1], 0)
+        why = "; ".join(filter(None, (ba, bb)))
+        rows.append(row(RECIRCULATION_GROUP, f"VRR at Nr = 0, internal over semi-mass flow ({_label(layout, name)})",
+                        case, *ratio(a, ea, b, eb), "-",
+                        f"internal {plus_minus(a, ea)}, semi-mass {plus_minus(b, eb)}; Nr = 0 is the first pass, "
+                        f"0 <= Nr < 1{tail}", dof=dof, finding="B5",
+                        agreement=capped(rules.ratio_in_band(a, ea, b, eb, dof, PARTS["B5"], tolerances,
+                                                              steady=not why), why)))
+    return rows
+
+
+def recirculation_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> list[dict]:
+    """The rows of the recirculating silo: per run B4 (VRR at Nr = 4 per batch), B2 (its growth, per layout),
+    B3.internal, B6, B7 (theta of the RTD's peak), B8 (t_s / t_d) and B1 (drop of bulk density); with both flow
+    patterns, B3.stronger_in_internal and B5 (VRR at Nr = 0, internal over semi-mass flow, per batch).
+
+    Parameters
+    ----------
+    runs : sequence of mapping
+        One per flow pattern: ``{"case", "summary", "rtd", "note", "dof"}`` (see the module docstring).
+    tolerances : AgreementTolerances
+
+    Returns
+    -------
+    list of dict
+        Rows of :func:`~siloflow.analysis.studies.validation.rows.row`, run by run, then the comparisons.
+    """
+    chosen = [_Run(run) for run in runs]
+    patterns = [run.pattern for run in chosen]
+    if len(set(patterns)) != len(patterns):
+        raise ValueError(f"one run per flow pattern (its seeds combined), got {patterns}")
+    rows = [entry for run in chosen for entry in _run_rows(run, tolerances)]
+    by_pattern = {run.suffix: run for run in chosen if run.suffix}
+    if len(by_pattern) == 2:
+        rows += _pattern_rows(by_pattern["internal"], by_pattern["semi_mass"], tolerances)
     return rows

@@ -17,12 +17,15 @@ from dataclasses import dataclass, field
 
 from siloflow.model.checks import number_or_nan
 from siloflow.model.record import RunRecord
-from siloflow.analysis.studies.validation.findings import Finding
-from siloflow.analysis.studies.validation.rows import NO, UNKNOWN, YES, plus_minus
+from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED
+from siloflow.analysis.studies.validation.findings_summary import FindingStatus, chapter_counts, finding_statuses, STATUSES
+from siloflow.analysis.studies.validation.rows import AT_SCALE, NO_FINDING, plus_minus
 from siloflow.analysis.studies.validation.scale import ScaleVerdict
 
+YES, NO = "yes", "no"
+
 __all__ = ["STUDY_PARAGRAPH", "RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time",
-           "record_page"]
+           "record_page", "findings_section"]
 
 #: The page's opening paragraph: the study the record compares with, by the thesis's own chapters and sections.
 STUDY_PARAGRAPH = (
@@ -38,7 +41,7 @@ STUDY_PARAGRAPH = (
 
 #: The columns of a group's ``runs.csv``, in order.
 RUN_COLUMNS = ("run_id", "group", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
-               "earlier_attempts_s", "cores", "date")
+               "earlier_attempts_s", "attempts", "cores", "date")
 
 
 @dataclass(frozen=True)
@@ -54,14 +57,18 @@ class GroupRecord:
     plots : list of str
         Its plot file names, relative to the group's folder.
     products : list of str
-        The products of its runs that other groups read, by their paths in the workflow's working directory
-        (:data:`siloflow.engines.layout.READ_PRODUCTS`).
+        The products it keeps, by their paths in the workflow's working directory: those its rows are computed from
+        and those of its runs other groups read (:data:`siloflow.engines.layout.READ_PRODUCTS`).
+    derivation : dict or None
+        What re-derives its rows from those products (case kind, configuration keys, products by name, the digest of
+        the row code that wrote them); None for a record written before it was kept.
     """
 
     rows: list = field(default_factory=list)
     runs: list = field(default_factory=list)
     plots: list = field(default_factory=list)
     products: list = field(default_factory=list)
+    derivation: dict | None = None
 
 
 def simulated_time(record: RunRecord) -> float:
@@ -79,7 +86,7 @@ def simulated_time(record: RunRecord) -> float:
 
 
 def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
-                   earlier_attempts_s: float, date: str) -> dict:
+                   earlier_attempts_s: float, date: str, attempts: int | None = None) -> dict:
     """One row of ``runs.csv`` for a finished run.
 
     Parameters
@@ -94,7 +101,8 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
     seeds : sequence of int
         The random seeds the engine was given.
     commit : str
-        The commit of siloflow's code that wrote the record (``-dirty`` appended with uncommitted changes).
+        The commit of siloflow's code that ran the run (its last attempt's, :mod:`siloflow.engines.provenance`;
+        ``-dirty`` appended with uncommitted changes).
     wall_time_s : float
         Wall time of the run step (s), Snakemake's benchmark of it: its last attempt only.
     earlier_attempts_s : float
@@ -102,11 +110,14 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
         start afresh (:meth:`siloflow.engines.interface.Engine.earlier_attempts_seconds`); 0 when it ran in one go.
     date : str
         When the run finished (ISO 8601 date).
+    attempts : int, optional
+        How many attempts the run step made (its provenance file's); None when the run does not say.
     """
     return {"run_id": record.run_id, "group": group, "case": record.case, "engine": record.engine, "engine_version": engine_version,
             "seeds": " ".join(str(int(seed)) for seed in seeds), "commit": commit,
             "simulated_time_s": simulated_time(record), "wall_time_s": float(wall_time_s),
-            "earlier_attempts_s": float(earlier_attempts_s), "cores": int(record.mpi_ranks), "date": date}
+            "earlier_attempts_s": float(earlier_attempts_s),
+            "attempts": "" if attempts is None else int(attempts), "cores": int(record.mpi_ranks), "date": date}
 
 
 def run_wall_time(run: Mapping) -> float:
@@ -128,6 +139,27 @@ def _attempts_sentence(runs: Sequence[Mapping]) -> str:
     if unknown:
         sentences.append(f"For {unknown} run(s) the record gives the time of the last attempt only.")
     return " ".join(sentences)
+
+
+def _estimated(made: Sequence[Mapping], estimates: Mapping[str, float]) -> str:
+    """The cost model's estimate of a group's recorded runs beside their recorded core time: like with like, over the
+    recorded runs the configuration still plans (a run whose id changed is another run); "-" when it plans none."""
+    held = [run for run in made if run["run_id"] in estimates]
+    if not held:
+        return "-"
+    estimate = math.fsum(estimates[run["run_id"]] for run in held)
+    recorded = math.fsum(run_wall_time(run) * int(run["cores"]) for run in held)
+    shown = f"{_hours(estimate)} ({estimate / recorded:.2f})" if recorded > 0 else _hours(estimate)
+    return shown if len(held) == len(made) else f"{shown}, {len(held)} of {len(made)} runs"
+
+
+def _run_commit(run: Mapping) -> str:
+    """The code that ran a run, as the page gives it: a provenance row written before runs noted their own commit
+    (no ``attempts``) holds the commit that wrote the record, which the page says."""
+    commit = str(run["commit"])
+    if str(run.get("attempts") or "") == "" and not commit.startswith("unknown"):
+        return f"unknown (the record was written by {commit})"
+    return commit
 
 
 def _value(row: Mapping) -> str:
@@ -155,15 +187,28 @@ def _difference_brief(difference) -> str:
     return brief
 
 
-def findings_scale_section(verdicts: Sequence[tuple[Finding, ScaleVerdict]], config_name: str) -> list[str]:
-    """The page's section on the study's findings: for each, whether ``config_name``'s runs are at the study's scale
-    for it, judged from the configuration alone (:func:`siloflow.analysis.studies.validation.scale.scale_verdict`),
-    with each dimension that differs as a ratio to the study's; then a count per chapter.
+def _measured(row: Mapping) -> str:
+    """A row's figure beside the study's, for the summary's lists."""
+    return (f"{_cell(row['figure'])} ({_cell(row['case'])}): {_cell(_value(row))}; the study: {_cell(row['study'])}; "
+            f"{_cell(row['agreement_reason'])}")
+
+
+def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, ScaleVerdict],
+                     unmade: Mapping[str, str], config_name: str) -> list[str]:
+    """The summary that opens the page: per chapter, how many findings are reproduced, not reproduced, not resolved,
+    not at the study's scale or not measured (:mod:`siloflow.analysis.studies.validation.findings_summary`); the
+    findings not reproduced, each row's figure beside the study's; the disagreements at another scale; every finding
+    with its status and its scale; the parts no row measures, with why.
 
     Parameters
     ----------
-    verdicts : sequence of (Finding, ScaleVerdict)
-        Every finding of the study, in its order, with its verdict on the configuration's dimensions.
+    statuses : sequence of FindingStatus
+        Every finding of the study, in its order, as the record's rows judge it.
+    verdicts : mapping
+        ``{finding id: ScaleVerdict}`` of ``config_name``'s dimensions (the definition taken as the study's: whether a
+        row computes its quantity so is the row's to say).
+    unmade : mapping
+        ``{part id: why no row of this tier measures it, and what would}``.
     config_name : str
         The configuration, as the page names it.
 
@@ -172,30 +217,55 @@ def findings_scale_section(verdicts: Sequence[tuple[Finding, ScaleVerdict]], con
     list of str
         Markdown lines.
     """
-    chapters: dict[int, list[int]] = {}
-    for finding, verdict in verdicts:
-        counts = chapters.setdefault(finding.chapter, [0, 0])
-        counts[0 if verdict.at_study_scale else 1] += 1
+    counts = chapter_counts(statuses)
     lines = [
-        "## The study's findings at this scale",
+        "## Does siloflow reproduce the study?",
         "",
-        f"Whether the runs of `{config_name}` are at the study's scale for each of its findings, judged from the "
-        "configuration alone, never from a result: every dimension the finding depends on as a ratio to the study's "
-        "(`validation.scale` of the configuration reference gives the bounds and their reasons), and in particle "
-        "diameters. A finding the tier is not at the scale of can still be measured; its rows are results at another scale. The groups' rows below still carry one "
-        "verdict each, \"scale shows\", judged from the runs themselves.",
+        f"Each row below judges one part of a finding of the study, by two verdicts fixed before the runs. "
+        f"*Agreement*: whether the row's 95 % interval (Student t for a spread between few seeds) lies within the "
+        "study's band, or a trend has the study's sign or order, by the rule of the finding's kind (the band where "
+        "the study gives none: `validation.agreement` of the configuration reference); precision and steadiness only "
+        "ever make a verdict \"not resolved\". *Scale*: whether the runs of "
+        f"`{config_name}` are at the study's scale for the finding, from the configuration alone (every dimension it "
+        "depends on as a ratio to the study's and in particle diameters: `validation.scale`) and from whether the row "
+        "defines and samples its quantity as the study does; a verdict never reads a result. A finding is reproduced "
+        "when every part has a row at the study's scale and all reproduce it; not reproduced when a row at scale "
+        "disagrees; rows at another scale are results there, listed apart.",
         "",
-        "| chapter | at the study's scale | not at the study's scale |",
-        "|---|---|---|",
+        "| chapter | " + " | ".join(STATUSES) + " |",
+        "|---|" + "---|" * len(STATUSES),
     ]
-    lines += [f"| {chapter} | {counts[0]} | {counts[1]} |" for chapter, counts in sorted(chapters.items())]
-    lines += ["", "| finding | thesis | at the study's scale | what differs (ratio to the study's) |", "|---|---|---|---|"]
-    for finding, verdict in verdicts:
-        differs = "; ".join(_difference_brief(difference) for difference in verdict.differences) or "-"
-        if not verdict.definition_as_study:
-            differs = f"{differs}; the quantity is not defined as the study's"
-        lines.append(f"| {finding.id} | {finding.section} | {YES if verdict.at_study_scale else NO} | "
-                     f"{_cell(differs)} |")
+    lines += [f"| {chapter} | " + " | ".join(str(count[status]) for status in STATUSES) + " |"
+              for chapter, count in counts.items()]
+    failed = [entry for entry in statuses if entry.status == NOT_REPRODUCED]
+    lines += ["", "### Findings not reproduced", ""]
+    if not failed:
+        lines.append("None at the study's scale.")
+    for entry in failed:
+        lines.append(f"- **{entry.finding.id}** ({entry.finding.section}): {_cell(entry.finding.statement)}")
+        lines += [f"  - {_measured(row)}" for row in entry.rows
+                  if row["scale"] == AT_SCALE and row["agreement"] == NOT_REPRODUCED]
+    elsewhere = [row for entry in statuses for row in entry.rows
+                 if row["scale"] != AT_SCALE and row["agreement"] == NOT_REPRODUCED]
+    lines += ["", "### Disagreements at another scale", "",
+              "Rows not at the study's scale whose figure lies outside the study's band or has the other sign: "
+              "results at this scale, not verdicts on the study.", ""]
+    lines += [f"- {row['finding']}: {_measured(row)}" for row in elsewhere] or ["None."]
+    lines += ["", "### Every finding", "",
+              "| finding | thesis | status | rows | at the study's scale (dimensions) | what differs (ratio to the study's) |",
+              "|---|---|---|---|---|---|"]
+    for entry in statuses:
+        verdict = verdicts.get(entry.finding.id)
+        differs = "; ".join(_difference_brief(d) for d in verdict.differences) if verdict else ""
+        at_scale = "-" if verdict is None else YES if verdict.at_study_scale else NO
+        lines.append(f"| {entry.finding.id} | {entry.finding.section} | {entry.status} | {len(entry.rows)} | "
+                     f"{at_scale} | {_cell(differs or '-')} |")
+    measured = {row["finding"] for entry in statuses for row in entry.rows}
+    missing = [(part.id, unmade.get(part.id, "its group's rows in this record predate it: re-derive or record the "
+                                             "group again")) for entry in statuses for part in entry.finding.parts
+               if part.id not in measured]
+    lines += ["", "### Parts no row measures", ""]
+    lines += [f"- {part}: {_cell(reason)}" for part, reason in missing] or ["None."]
     return lines
 
 
@@ -203,7 +273,7 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None,
                 estimated_core_s: Mapping[str, float] | None = None,
-                findings_scale: Sequence[tuple[Finding, ScaleVerdict]] = ()) -> str:
+                verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows, and for each row the scale does not show, what scale would show it and what that scale
     costs.
@@ -229,11 +299,13 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         ``{group: [part]}``: what `make validate GROUP=` takes for each group the configuration runs in parts (a
         group absent runs whole).
     estimated_core_s : mapping, optional
-        ``{group: CPU s}``: each group's runs as ``config_name``'s cost model estimates them, shown beside the
-        recorded core time with their ratio (a group absent: "-").
-    findings_scale : sequence of (Finding, ScaleVerdict), optional
-        The study's findings with whether ``config_name`` is at their scale (:func:`findings_scale_section`), shown
-        before the groups; none: no such section.
+        ``{run id: CPU s}``: each run ``config_name`` plans as its cost model estimates it; a group's recorded runs
+        that it still plans are shown beside their recorded core time with the ratio (none: "-").
+    verdicts : mapping, optional
+        ``{finding id: ScaleVerdict}`` of ``config_name``'s dimensions; with it, the page opens with the summary of
+        :func:`findings_section`.
+    unmade : mapping, optional
+        ``{part id: why no row measures it}`` for that summary.
 
     Returns
     -------
@@ -245,29 +317,30 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         STUDY_PARAGRAPH,
         "",
         f"The study's comparisons at the validation scale (`{config_name}`), each as value ± standard error, written "
-        "by `make validate GROUP=<name>` from the runs' own files: nothing here is typed in. \"Scale shows\" is judged "
-        "from the run itself; the evidence column quotes the figures that decided. `make validate-status` lists the "
-        "groups that are complete, stale (a run id no longer matches what the configuration plans) or missing.",
+        "by `make validate GROUP=<name>` from the runs' own files: nothing here is typed in. `make validate-status` "
+        "lists the groups that are complete, stale (a run id no longer matches what the configuration plans, or the "
+        "code that writes the rows changed) or missing.",
         "",
     ]
-    if findings_scale:
-        lines += [*findings_scale_section(findings_scale, config_name), "", "## The groups", ""]
+    if verdicts is not None:
+        rows = [row for record in groups.values() for row in record.rows]
+        lines += [*findings_section(finding_statuses(rows), verdicts, unmade or {}, config_name), "",
+                  "## The groups", ""]
     lines += [
         f"| group | status | runs it makes | core time | estimated (estimate / recorded) | wall time on {cores} cores "
-        "(per part) | rows | shown at this scale |",
-        "|---|---|---|---|---|---|---|---|",
+        "(per part) | rows | judged against a finding | at the study's scale |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, state in status.items():
         record, part_walls = groups.get(name, GroupRecord()), wall_s.get(name, {})
         made = [run for run in record.runs if run["group"] in part_walls]
         core = math.fsum(run_wall_time(run) * int(run["cores"]) for run in made)
-        shown = sum(row["scale_shows"] == YES for row in record.rows)
+        judged = sum(row["finding"] != NO_FINDING for row in record.rows)
+        shown = sum(row["scale"] == AT_SCALE for row in record.rows)
         wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
-        estimate = (estimated_core_s or {}).get(name, math.nan)
-        estimated = "-" if not math.isfinite(estimate) else (
-            f"{_hours(estimate)} ({estimate / core:.2f})" if made and core > 0 else _hours(estimate))
+        estimated = _estimated(made, estimated_core_s or {})
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | {estimated} | "
-                     f"{wall if made else '-'} | {len(record.rows)} | {shown} |")
+                     f"{wall if made else '-'} | {len(record.rows)} | {judged} | {shown} |")
     for name, state in status.items():
         record = groups.get(name)
         command = ", then ".join(f"`make validate GROUP={part}`" for part in (parts or {}).get(name, [name]))
@@ -276,10 +349,11 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
             lines.append(f"Not recorded yet: {command}.")
             continue
         if state != "complete":
-            lines += [f"**Stale**: the runs below are not those `{config_name}` now plans; {command} brings the "
-                      "record up to date.", ""]
+            lines += [f"**Stale**: the runs below are not those `{config_name}` now plans, or the code that writes the "
+                      f"rows changed since they were recorded; {command} brings the record up to date "
+                      "(`make validate-status` says which).", ""]
         engines = sorted({f"{run['engine']} {run['engine_version']}" for run in record.runs})
-        commits = sorted({str(run["commit"]) for run in record.runs})
+        commits = sorted({_run_commit(run) for run in record.runs})
         dates = sorted(str(run["date"]) for run in record.runs)
         cores = sorted({int(run["cores"]) for run in record.runs})
         lines.append(f"{len(record.runs)} runs on {', '.join(engines)}, {'/'.join(map(str, cores))} core(s) each, "
@@ -288,19 +362,20 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         attempts = _attempts_sentence(record.runs)
         if attempts:
             lines[-1] += " " + attempts
-        lines += ["", "| table | figure | case | value | study | scale shows | evidence |",
-                  "|---|---|---|---|---|---|---|"]
+        lines += ["", "| table | figure | case | value | finding | study | agreement | scale | why, and evidence |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for row in record.rows:
+            why = "; ".join(_cell(text) for text in (row["agreement_reason"], row["scale_reason"], row["evidence"])
+                            if text)
             lines.append(f"| {_cell(row['group'])} | {_cell(row['figure'])} | {_cell(row['case'])} | "
-                         f"{_cell(_value(row))} | {_cell(row['study_value'] or '-')} | {row['scale_shows']} | "
-                         f"{_cell(row['evidence'])} |")
-        unshown = [row for row in record.rows if row["scale_shows"] in (NO, UNKNOWN)]
-        if unshown:
+                         f"{_cell(_value(row))} | {row['finding']} | {_cell(row['study'] or '-')} | "
+                         f"{row['agreement']} | {row['scale']} | {why} |")
+        elsewhere = [row for row in record.rows if row["scale"] not in (AT_SCALE, NO_FINDING)]
+        if elsewhere:
             cost = full_scale_core_s.get(name, math.nan)
-            lines += ["", f"Rows this scale does not show ({len(unshown)}): each would need the scale its evidence "
-                      f"names; the study's full scale (`{full_scale_config}`) runs this group in about "
-                      f"{cost / 86400.0:.3g} core-days (`make estimate CONFIG={full_scale_config}`).", ""]
-            lines += [f"- {_cell(row['figure'])} ({_cell(row['case'])}): {_cell(row['evidence'])}" for row in unshown]
+            lines += ["", f"Rows not at the study's scale ({len(elsewhere)}): each names what differs; the study's "
+                      f"full scale (`{full_scale_config}`) runs this group in about {cost / 86400.0:.3g} core-days "
+                      f"(`make estimate CONFIG={full_scale_config}`)."]
         if record.plots:
             lines += [""] + [f"![{plot}]({name}/{plot})" for plot in record.plots]
     return "\n".join(lines) + "\n"

@@ -1,10 +1,18 @@
-"""Validation rows of the flat-bottom silo: filling bulk density, flow rate and Beverloo, Janssen, B(z), the flow
-channel and the front-wall friction series with its flow-pattern index.
+"""Validation rows of the flat-bottom silo (thesis ch. 5): each judged against a finding part S1-S6 where the study
+states one, else a measurement with no finding (the flow rate, Beverloo's C, the flow channel).
 
-The scale shows a silo figure when the silo is deep enough in particle diameters that the front and back walls do
-not set it, its settled fill carries its weight (the force balance of the physical fill), and the figure's own
-error resolves what it is about. Inputs are the run's files as read: ``case.json``, ``flow.json``,
-``fields.json``, ``fill_balance.json`` and the rows of ``janssen.csv``, ``kinematic.csv`` and
+Rows (see :mod:`siloflow.analysis.studies.validation.rows`):
+
+- S2: the filling bulk density; S1: the stress gradient near the free surface over the unit weight, the change of
+  the gradient from the top to the bottom of the fill, the stress at the base over Janssen's; S5.dem: the change of
+  the kinematic constant B from the lowest to the highest fitted height;
+- the front-wall friction series: S6.hydrostatic (the stress at the base over the hydrostatic one with frictionless
+  front and back walls) and S6.towards_internal_flow (the change of the flow-pattern index, near-wall over
+  centreline vertical velocity, from front/back friction 0 to the highest run).
+
+A settled fill that does not carry its weight (the force balance of the physical fill) is not steady: its stress
+and density rows can then be "not resolved" at most. Inputs are the run's files as read: ``case.json``,
+``flow.json``, ``fields.json``, ``fill_balance.json`` and the rows of ``janssen.csv``, ``kinematic.csv`` and
 ``flow_channel_boundary.csv``.
 """
 
@@ -12,15 +20,39 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from types import MappingProxyType
+
+import numpy as np
 
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent
-from siloflow.analysis.studies.validation.rows import Criteria, plus_minus, precise, ratio, resolved, row, verdict
+from siloflow.analysis.studies.validation import agreement as rules
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
+from siloflow.analysis.studies.validation.findings import PARTS
+from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, row
 
-__all__ = ["SiloRun", "silo_rows", "front_wall_series_rows"]
+__all__ = ["SiloRun", "silo_rows", "front_wall_series_rows", "stress_gradient", "MADE", "UNMADE"]
 
 GROUP = "Flat-bottom silo"
 SERIES_GROUP = "Front-wall friction series"
+#: The finding parts these rows make.
+MADE = ("S1.linear_near_surface", "S1.saturates", "S1.janssen", "S2", "S5.dem", "S6.hydrostatic",
+        "S6.towards_internal_flow")
+#: The parts of ch. 5 these rows cannot make, and what would make them.
+UNMADE = MappingProxyType({
+    "S3.mass_flow": "needs the experiment's mass flow rate, which no configuration key holds (the study's table in "
+                    "§5.4.2 is not legible); the rows quote the measured rate with no finding",
+    "S3.volumetric_flow": "needs the experiment's volumetric flow rate, as S3.mass_flow",
+    "S4.faster_start": "needs the experiment's PIV profiles (silo_flat.piv.measured_profiles, null in "
+                       "config/validation.yaml) and the instantaneous profiles at t = 0.1 s",
+    "S4.steady_profiles": "needs the experiment's PIV profiles (silo_flat.piv.measured_profiles)",
+    "S5.experiment": "a finding of the experiment's PIV: needs silo_flat.piv.measured_profiles",
+    "S6.uniform_velocity": "needs the velocity across the width at Z = 120 mm of the frictionless front/back run; "
+                           "the series keeps no field of its runs and the tier's fill ends below 120 mm",
+})
+#: The share of the Janssen profile's points, from either end, over which a stress gradient is fitted: the study
+#: says "near the surface" and "saturates" with no depths, so the shallowest and deepest thirds are taken.
+GRADIENT_SHARE = 1.0 / 3.0
 
 
 class SiloRun:
@@ -34,89 +66,163 @@ class SiloRun:
 
     @property
     def diameter(self) -> float:
+        """The particle's volume-equivalent diameter (m)."""
         return float(self.case["equivalent_diameter_m"])
 
-    def depth_check(self, criteria: Criteria) -> tuple[bool, str]:
-        depth = float(self.case["depth_m"])
-        ratio_ = depth / self.diameter
-        return ratio_ >= criteria.min_depth_diameters, (
-            f"depth {depth * 1000:.1f} mm = {ratio_:.1f} particle diameters (>= {criteria.min_depth_diameters:g})")
-
-    def balance_check(self) -> tuple[bool, str]:
+    def settled(self) -> tuple[bool, str]:
+        """Whether the settled fill carries its weight (no problem in the force balance), and the evidence."""
         problems = list(self.balance.get("problems") or [])
         text = f"the settled fill's walls and floor carry {float(self.balance['support_ratio']):.4f} of its weight"
         return not problems, text + (f" ({'; '.join(problems)})" if problems else "")
 
-    def outlet_check(self, criteria: Criteria) -> tuple[bool, str]:
-        outlet = float(self.case["outlet_width_m"])
-        ratio_ = outlet / self.diameter
-        return ratio_ >= criteria.min_outlet_diameters, (
-            f"outlet {outlet * 1000:.0f} mm = {ratio_:.1f} particle diameters (>= {criteria.min_outlet_diameters:g})")
+
+def _column(entries: Sequence[Mapping], key: str) -> np.ndarray:
+    return np.array([number_or_nan(entry.get(key)) for entry in entries], dtype=float)
 
 
-def silo_rows(run: SiloRun, criteria: Criteria) -> list[dict]:
-    """The base run's rows: bulk density, flow rate, Beverloo's coefficient, Janssen, B(z) and the flow channel."""
-    k = criteria.coverage_factor
+def stress_gradient(depth, stress, error) -> tuple[float, float]:
+    """The slope of the vertical stress against the depth below the surface and its standard error (Pa/m).
+
+    A straight-line fit weighted by the stresses' standard errors (:func:`numpy.polyfit`, unscaled covariance, as
+    known sigmas); unweighted with the scatter's error when an error is unknown or zero (NaN error for two points).
+
+    Parameters
+    ----------
+    depth : array_like
+        Depths below the free surface (m), at least two distinct.
+    stress, error : array_like
+        Vertical stress and its standard error at each depth (Pa).
+    """
+    x, y, e = (np.asarray(a, dtype=float) for a in (depth, stress, error))
+    if x.ndim != 1 or x.shape != y.shape or x.shape != e.shape or np.unique(x).size < 2:
+        raise ValueError("depth, stress and error must be equal 1-D arrays with two distinct depths at least")
+    if np.all(np.isfinite(e)) and np.all(e > 0):
+        coefficients, covariance = np.polyfit(x, y, 1, w=1.0 / e, cov="unscaled")
+        return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
+    if x.size == 2:
+        return float((y[1] - y[0]) / (x[1] - x[0])), math.nan
+    coefficients, covariance = np.polyfit(x, y, 1, cov=True)
+    return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
+
+
+def _ends(entries: Sequence[Mapping]) -> tuple[list, list]:
+    """The shallowest and the deepest :data:`GRADIENT_SHARE` of a Janssen profile's points (at least two each)."""
+    ordered = sorted(entries, key=lambda entry: float(entry["depth_below_surface_m"]))
+    n = max(2, int(round(GRADIENT_SHARE * len(ordered))))
+    return ordered[:n], ordered[-n:]
+
+
+def _gradient(entries: Sequence[Mapping], key: str, error_key: str) -> tuple[float, float]:
+    return stress_gradient(_column(entries, "depth_below_surface_m"), _column(entries, key), _column(entries, error_key))
+
+
+def _span(entries: Sequence[Mapping]) -> str:
+    depths = [float(entry["depth_below_surface_m"]) * 1000 for entry in entries]
+    return f"{min(depths):.0f}-{max(depths):.0f} mm below the surface ({len(depths)} points)"
+
+
+def silo_rows(run: SiloRun, tolerances: AgreementTolerances, dof: float | None, note: str = "") -> list[dict]:
+    """The base run's rows: S2, S1 and S5.dem, with the flow rate, Beverloo's C and the flow channel as
+    measurements.
+
+    Parameters
+    ----------
+    run : SiloRun
+    tolerances : AgreementTolerances
+    dof : float or None
+        Degrees of freedom of the run's errors (seeds - 1), None for within-run errors.
+    note : str
+        Evidence about the seeds, appended to every row's.
+    """
     case_name = run.case["run_id"]
-    depth_ok, depth_text = run.depth_check(criteria)
-    balance_ok, balance_text = run.balance_check()
-    outlet_ok, outlet_text = run.outlet_check(criteria)
+    settled, settled_text = run.settled()
+    tail = f"; {note}" if note else ""
     flow = run.flow
     rows = []
     density, density_error = flow["filling_bulk_density_kg_m3"], number_or_nan(flow.get("filling_bulk_density_kg_m3_error"))
-    rows.append(row(GROUP, "Filling bulk density", case_name, density, density_error, "kg/m3", "667 (40 mm deep)",
-                    verdict(depth_ok, balance_ok), f"{depth_text}; {balance_text}"))
+    rows.append(row(GROUP, "Filling bulk density", case_name, density, density_error, "kg/m3",
+                    f"{settled_text}; total particle mass over the filled volume{tail}", dof=dof, finding="S2",
+                    agreement=rules.value_in_band(density, density_error, dof, PARTS["S2"], tolerances,
+                                                  steady=settled)))
     rate, rate_error = flow["mass_flow_rate_kg_s"], number_or_nan(flow.get("mass_flow_rate_kg_s_error"))
-    steady, steady_text = precise(rate, rate_error, criteria)
-    rows.append(row(GROUP, "Steady mass flow rate", case_name, rate, rate_error, "kg/s", "",
-                    verdict(depth_ok, outlet_ok, steady),
-                    f"{depth_text}; {outlet_text}; {steady_text}; Beverloo predicts "
-                    f"{flow['beverloo_mass_flow_rate_kg_s']:.4g} kg/s"))
+    rows.append(row(GROUP, "Steady mass flow rate", case_name, rate, rate_error, "kg/s",
+                    f"{precise(rate, rate_error, tolerances)[1]}; Beverloo predicts "
+                    f"{flow['beverloo_mass_flow_rate_kg_s']:.4g} kg/s{tail}", dof=dof,
+                    study="the experiment's rate (S3; not in the configuration)"))
     beverloo = flow["beverloo"]
     ratio_value, ratio_error = flow["beverloo_ratio"], number_or_nan(flow.get("beverloo_ratio_error"))
     coefficient = beverloo["discharge_coefficient"]
     rows.append(row(GROUP, f"Beverloo discharge coefficient C (k = {beverloo['shape_coefficient']:g})", case_name,
-                    coefficient * ratio_value, coefficient * ratio_error, "-", f"{coefficient:g}",
-                    verdict(depth_ok, outlet_ok, steady),
-                    f"C that makes Beverloo match the measured rate: flow / Beverloo {plus_minus(ratio_value, ratio_error)};"
-                    f" {outlet_text}; flow rate's {steady_text}"))
-    rows += _janssen_rows(run, case_name, depth_ok, depth_text, balance_ok, k)
-    for entry in run.kinematic:
-        b, error = number_or_nan(entry["B_m"]), number_or_nan(entry.get("B_m_error"))
-        b_precise, b_text = precise(b, error, criteria)
-        rows.append(row(GROUP, f"Kinematic constant B at z = {float(entry['z_m']) * 1000:.0f} mm", case_name,
-                        b, error, "m", "", verdict(depth_ok, math.isfinite(b) and b_precise),
-                        f"{depth_text}; B = {b / run.diameter:.2f} particle diameters, error from "
-                        f"{int(float(entry['batches']))} time batches; {b_text}"))
-    rows += _channel_rows(run, case_name, depth_ok, depth_text, k)
+                    coefficient * ratio_value, coefficient * ratio_error, "-",
+                    f"C that makes Beverloo match the measured rate: flow / Beverloo {plus_minus(ratio_value, ratio_error)}"
+                    f"{tail}", dof=dof, study=f"{coefficient:g} (the configured C, silo_flat.beverloo)"))
+    rows += _janssen_rows(run, case_name, settled, settled_text, tolerances, dof, tail)
+    rows += _b_rows(run, case_name, tolerances, dof, tail)
+    rows += _channel_rows(run, case_name, dof, tail)
     return rows
 
 
-def _janssen_rows(run: SiloRun, case_name: str, depth_ok: bool, depth_text: str, balance_ok: bool,
-                  k: float) -> list[dict]:
-    if not run.janssen:
+def _janssen_rows(run: SiloRun, case_name: str, settled: bool, settled_text: str, tolerances: AgreementTolerances,
+                  dof: float | None, tail: str) -> list[dict]:
+    if len(run.janssen) < 4:
         return []
+    top, bottom = _ends(run.janssen)
+    dem_top = _gradient(top, "sigma_v_dem_Pa", "sigma_v_dem_Pa_error")
+    # rho g h is linear in the depth: its slope is rho g, with the bulk density's relative error
+    deepest_entry = max(run.janssen, key=lambda entry: float(entry["depth_below_surface_m"]))
+    depth = float(deepest_entry["depth_below_surface_m"])
+    unit_weight = (float(deepest_entry["hydrostatic_pa"]) / depth,
+                   number_or_nan(deepest_entry.get("hydrostatic_pa_error")) / depth)
+    dem_bottom = _gradient(bottom, "sigma_v_dem_Pa", "sigma_v_dem_Pa_error")
+    change = dem_bottom[0] - dem_top[0], combine_independent([dem_bottom[1], dem_top[1]])
     deepest = max(run.janssen, key=lambda entry: float(entry["depth_below_surface_m"]))
-    depth = float(deepest["depth_below_surface_m"])
     sigma, sigma_error = float(deepest["sigma_v_dem_Pa"]), number_or_nan(deepest.get("sigma_v_dem_Pa_error"))
-    hydrostatic = float(deepest["hydrostatic_pa"])
-    hydro_ratio = ratio(sigma, sigma_error, hydrostatic, number_or_nan(deepest.get("hydrostatic_pa_error")))
-    janssen_ratio = ratio(sigma, sigma_error, float(deepest["sigma_v_janssen_Pa"]), 0.0)
-    carried = resolved(1.0 - hydro_ratio[0], hydro_ratio[1], k)
-    where = f"{depth * 1000:.0f} mm below the surface"
+    janssen = float(deepest["sigma_v_janssen_Pa"])
+    hydrostatic = float(deepest["hydrostatic_pa"]), number_or_nan(deepest.get("hydrostatic_pa_error"))
+    where = f"{float(deepest['depth_below_surface_m']) * 1000:.0f} mm below the surface"
+    gradient_note = "the shallowest and deepest thirds of the profile: the study names no depths"
     return [
-        row(GROUP, f"Vertical stress / hydrostatic, {where}", case_name, *hydro_ratio, "-", "< 1 (walls carry weight)",
-            verdict(depth_ok, balance_ok, carried),
-            f"{depth_text}; DEM {plus_minus(sigma, sigma_error)} Pa against rho g h = {hydrostatic:.4g} Pa: the walls' "
-            f"share {'resolved' if carried else 'not resolved'} at {k:g} standard errors"),
-        row(GROUP, f"Vertical stress / Janssen, {where}", case_name, *janssen_ratio, "-", "1",
-            verdict(depth_ok, balance_ok, carried),
-            f"Janssen with the configured friction angles predicts {float(deepest['sigma_v_janssen_Pa']):.4g} Pa"),
+        row(GROUP, "Stress gradient near the surface / unit weight", case_name,
+            *ratio(*dem_top, *unit_weight), "-",
+            f"{settled_text}; fitted over {_span(top)}: DEM {plus_minus(*dem_top)} Pa/m, rho g "
+            f"{plus_minus(*unit_weight)} Pa/m ({gradient_note}){tail}", dof=dof, finding="S1.linear_near_surface",
+            agreement=rules.ratio_in_band(*dem_top, *unit_weight, dof, PARTS["S1.linear_near_surface"], tolerances,
+                                          steady=settled)),
+        row(GROUP, "Change of the stress gradient, bottom - top of the fill", case_name, *change, "Pa/m",
+            f"{settled_text}; top {_span(top)}: {plus_minus(*dem_top)} Pa/m; bottom {_span(bottom)}: "
+            f"{plus_minus(*dem_bottom)} Pa/m{tail}", dof=dof, finding="S1.saturates",
+            agreement=rules.sign_of_change(*change, dof, PARTS["S1.saturates"], steady=settled)),
+        row(GROUP, f"Vertical stress / Janssen, {where}", case_name, *ratio(sigma, sigma_error, janssen, 0.0), "-",
+            f"{settled_text}; DEM {plus_minus(sigma, sigma_error)} Pa; Janssen with the configured friction angles "
+            f"predicts {janssen:.4g} Pa{tail}", dof=dof, finding="S1.janssen",
+            agreement=rules.ratio_in_band(sigma, sigma_error, janssen, 0.0, dof, PARTS["S1.janssen"], tolerances,
+                                          steady=settled)),
+        row(GROUP, f"Vertical stress / hydrostatic, {where}", case_name, *ratio(sigma, sigma_error, *hydrostatic), "-",
+            f"{settled_text}; DEM {plus_minus(sigma, sigma_error)} Pa against rho g h = {hydrostatic[0]:.4g} Pa: the "
+            f"walls' share {resolution(hydrostatic[0] - sigma, combine_independent([sigma_error, hydrostatic[1]]), dof)}"
+            f"{tail}", dof=dof, study="< 1: the walls carry part of the weight (§5.4.1)"),
     ]
 
 
-def _channel_rows(run: SiloRun, case_name: str, depth_ok: bool, depth_text: str, k: float) -> list[dict]:
-    """Half-width of the flow channel at the largest boundary fraction, per height, against the silo's."""
+def _b_rows(run: SiloRun, case_name: str, tolerances: AgreementTolerances, dof: float | None, tail: str) -> list[dict]:
+    """S5.dem: B at the highest fitted height minus B at the lowest."""
+    fitted = sorted((entry for entry in run.kinematic if math.isfinite(number_or_nan(entry["B_m"]))),
+                    key=lambda entry: float(entry["z_m"]))
+    if len(fitted) < 2:
+        return []
+    low, high = fitted[0], fitted[-1]
+    change = (float(high["B_m"]) - float(low["B_m"]),
+              combine_independent([number_or_nan(high.get("B_m_error")), number_or_nan(low.get("B_m_error"))]))
+    listing = "; ".join(f"z {float(entry['z_m']) * 1000:.0f} mm: B {plus_minus(float(entry['B_m']) * 1000, number_or_nan(entry.get('B_m_error')) * 1000)} mm "
+                        f"({int(float(entry['batches']))} time batches)" for entry in fitted)
+    return [row(GROUP, f"Change of the kinematic constant B, z = {float(high['z_m']) * 1000:.0f} - "
+                       f"{float(low['z_m']) * 1000:.0f} mm", case_name, *change, "m",
+                f"{listing}; particle diameter {run.diameter * 1000:.2f} mm{tail}", dof=dof, finding="S5.dem",
+                agreement=rules.sign_of_change(*change, dof, PARTS["S5.dem"]))]
+
+
+def _channel_rows(run: SiloRun, case_name: str, dof: float | None, tail: str) -> list[dict]:
+    """Half-width of the flow channel at the largest boundary fraction, per height: a measurement."""
     if not run.boundary:
         return []
     fraction = max(float(entry["fraction"]) for entry in run.boundary)
@@ -129,11 +235,11 @@ def _channel_rows(run: SiloRun, case_name: str, depth_ok: bool, depth_text: str,
         error = 0.5 * combine_independent([number_or_nan(entry.get("x_left_m_error")),
                                            number_or_nan(entry.get("x_right_m_error"))])
         half = 0.5 * (right - left)
-        inside = resolved(half_silo - half, error, k) if math.isfinite(half) else False
         rows.append(row(GROUP, f"Flow channel half-width ({fraction:g} of centreline v_z) at z = "
                                f"{float(entry['z_m']) * 1000:.0f} mm", case_name, half, error, "m",
-                        "narrower than the silo (funnel flow)", verdict(depth_ok, inside),
-                        f"{depth_text}; the silo's half-width is {half_silo * 1000:.0f} mm"))
+                        f"the silo's half-width is {half_silo * 1000:.0f} mm: narrower "
+                        f"{resolution(half_silo - half, error, dof)}{tail}", dof=dof,
+                        study="funnel flow: narrower than the silo (§5.4.3)"))
     return rows
 
 
@@ -147,29 +253,50 @@ def _index_at(fields: Mapping, height: float) -> tuple[float, float, float]:
             float(nearest))
 
 
-def front_wall_series_rows(series: Sequence[tuple[str, SiloRun]], height: float, criteria: Criteria) -> list[dict]:
-    """One row per run of the front-wall friction series (label, run) with its flow-pattern index (wall over
-    centreline v_z) at the profile height nearest ``height`` (m), and one row with the index's change across the
-    walled runs (highest friction minus lowest; labels ``mu_fw=<value>``)."""
+#: The height of S6's velocities (m, §5.5).
+S6_HEIGHT = 0.12
+
+
+def front_wall_series_rows(series: Sequence[tuple[str, SiloRun, str]], height: float,
+                           tolerances: AgreementTolerances, dof: float | None) -> list[dict]:
+    """The front-wall friction series: per run (label, run, seed note) its flow-pattern index (wall over centreline
+    v_z) at the profile height nearest ``height`` (m), a measurement; S6.towards_internal_flow, the index's change
+    from front/back friction 0 to the highest (labels ``mu_fw=<value>``); S6.hydrostatic of the frictionless run.
+
+    ``dof`` is that of the runs' errors (seeds - 1 of the spread they carry; None for within-run errors).
+    """
     rows, walled = [], []
-    for label, run in series:
-        depth_ok, depth_text = run.depth_check(criteria)
+    for label, run, note in series:
         index, error, at = _index_at(run.fields, height)
         rows.append(row(SERIES_GROUP, f"Flow-pattern index (wall / centreline v_z) at z = {at * 1000:.0f} mm", label,
-                        index, error, "-", "", verdict(depth_ok, math.isfinite(index) and math.isfinite(error)),
-                        f"{depth_text}; run {run.case['run_id']}, flow rate "
-                        f"{plus_minus(run.flow['mass_flow_rate_kg_s'], number_or_nan(run.flow.get('mass_flow_rate_kg_s_error')))} kg/s"))
+                        index, error, "-",
+                        f"run {run.case['run_id']}, flow rate "
+                        f"{plus_minus(run.flow['mass_flow_rate_kg_s'], number_or_nan(run.flow.get('mass_flow_rate_kg_s_error')))}"
+                        f" kg/s; {note}", dof=dof, study="-"))
         if label.startswith("mu_fw="):
-            walled.append((float(label.split("=", 1)[1]), index, error, depth_ok))
+            walled.append((float(label.split("=", 1)[1]), index, error, at, run, note))
+    walled.sort(key=lambda entry: entry[0])
     if len(walled) >= 2:
-        walled.sort()
-        (low, index_low, error_low, ok_low), (high, index_high, error_high, ok_high) = walled[0], walled[-1]
-        change = index_high - index_low
-        error = combine_independent([error_low, error_high])
-        seen = resolved(change, error, criteria.coverage_factor)
-        rows.append(row(SERIES_GROUP, f"Flow-pattern index, front-wall friction {high:g} - {low:g}", "series",
-                        change, error, "-", "lower with more front-wall friction (towards funnel flow)",
-                        verdict(ok_low and ok_high, seen),
-                        f"the change is {'resolved' if seen else 'not resolved' if seen is False else 'unknown'} at "
-                        f"{criteria.coverage_factor:g} standard errors"))
+        (low, index_low, error_low, at, _, note_low), (high, index_high, error_high, _, _, note_high) = walled[0], walled[-1]
+        change = index_high - index_low, combine_independent([error_low, error_high])
+        differs = [f"at z = {at * 1000:.0f} mm, not {S6_HEIGHT * 1000:.0f} mm"] if abs(at - S6_HEIGHT) > 1e-9 else []
+        if (low, high) != (0.0, 1.0):
+            differs.append(f"front/back friction {low:g} to {high:g}, not 0 to 1")
+        rows.append(row(SERIES_GROUP, f"Change of the flow-pattern index, front-wall friction {high:g} - {low:g}",
+                        "series", *change, "-", f"{low:g}: {note_low}; {high:g}: {note_high}", dof=dof,
+                        finding="S6.towards_internal_flow", differs="; ".join(differs),
+                        agreement=rules.sign_of_change(*change, dof, PARTS["S6.towards_internal_flow"])))
+    if walled and walled[0][0] == 0.0 and walled[0][4].janssen:
+        run, note = walled[0][4], walled[0][5]
+        settled, settled_text = run.settled()
+        deepest = max(run.janssen, key=lambda entry: float(entry["depth_below_surface_m"]))
+        sigma = float(deepest["sigma_v_dem_Pa"]), number_or_nan(deepest.get("sigma_v_dem_Pa_error"))
+        hydrostatic = float(deepest["hydrostatic_pa"]), number_or_nan(deepest.get("hydrostatic_pa_error"))
+        rows.append(row(SERIES_GROUP, f"Vertical stress / hydrostatic, "
+                                      f"{float(deepest['depth_below_surface_m']) * 1000:.0f} mm below the surface, "
+                                      "front/back friction 0", "mu_fw=0", *ratio(*sigma, *hydrostatic), "-",
+                        f"{settled_text}; DEM {plus_minus(*sigma)} Pa against rho g h {hydrostatic[0]:.4g} Pa; {note}",
+                        dof=dof, finding="S6.hydrostatic",
+                        agreement=rules.ratio_in_band(*sigma, *hydrostatic, dof, PARTS["S6.hydrostatic"], tolerances,
+                                                      steady=settled)))
     return rows

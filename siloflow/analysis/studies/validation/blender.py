@@ -1,0 +1,318 @@
+"""Validation rows of the multi-flow blender (thesis ch. 7): each judged against a finding part M1-M3 where the study
+states one, else a measurement with no finding; and the gravity series, a similarity check of the code.
+
+Rows, from the runs at 1 g (see :mod:`siloflow.analysis.studies.validation.rows`):
+
+- M1: the diverging insert's steady velocity of each passage at the insert outlet over the cross-section mean;
+- M2: the converging insert's order tube > interior > exterior annulus at the insert outlet (downward speeds), and
+  the interior minus the exterior annulus velocity at the insert inlet over the cross-section mean there;
+- M3: the VRR of the continuous mode at one input period (``metrics.vrr_by_period["1"]``, LTI of the RTD),
+  converging over straight and over diverging;
+- the other inserts' passage velocities over the cross-section mean, and every insert's mean residence time and
+  recirculations to homogenise, with no finding.
+
+The cross-section mean at a height is the mean over the bins of all its passages (each passage's mean weighted by
+its bins there: equal bins, so by its width at that height), as the study normalised its profiles by the mean
+across the section (§7.4, §7.5).
+
+Gravity series (:func:`gravity_rows`): a run at ``f g`` scales every Young's modulus by ``f`` and every time by
+``1 / sqrt(f)`` (:mod:`siloflow.model.cases.blender`), so its flow is similar to the 1 g run's and every rate scales
+with ``sqrt(g)`` by construction. Its rows check the code's similarity; they are not the study's M4, whose series
+is at fixed material (§7.9): M4 is unmade (:data:`UNMADE`).
+
+Inputs are per-run mappings ``{"case": case.json, "summary": blender.json, "note": str, "dof": float | None}``:
+``note`` is the evidence about the run's seeds, appended to the evidence of every row that draws on the run;
+``dof`` the degrees of freedom of its errors (seeds - 1; None for within-run errors).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
+
+from siloflow.model.checks import number_or_nan
+from siloflow.analysis.numerics.uncertainty import combine_independent
+from siloflow.analysis.numerics.vrr_noise import vrr_near_ceiling
+from siloflow.analysis.studies.validation import agreement as rules
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
+from siloflow.analysis.studies.validation.findings import PARTS
+from siloflow.analysis.studies.validation.rows import capped, plus_minus, precise, resolution, resolved, row, smallest_dof
+
+__all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "smallest_dof", "capped", "section_mean", "blender_rows",
+           "gravity_rows"]
+
+BLENDER_GROUP = "Multi-flow blender"
+GRAVITY_GROUP = "Blender gravity series: similarity check of the code (scaled moduli)"
+#: The passages at the insert outlet (metric key: name), innermost first, and their names in the geometry's clear
+#: widths.
+PASSAGES = {"tube": "tube", "interior": "interior annulus", "exterior": "exterior annulus"}
+#: The input period over t_m of M3's VRR (the key of ``metrics.vrr_by_period``).
+M3_PERIOD = "1"
+#: Figures whose sqrt(g) scaling the gravity rows check: metric key, name, unit.
+GRAVITY_FIGURES = (("mass_flow_rate_kg_s", "mass flow rate", "kg/s"), ("tube_v_z_m_s", "tube velocity", "m/s"),
+                   ("exterior_v_z_m_s", "exterior annulus velocity", "m/s"))
+GRAVITY_STUDY = ("identity: with every modulus scaled by g and every time by 1/sqrt(g) the flow is similar, so it "
+                 "scales with sqrt(g) by construction; a check of the code's similarity, not the study's M4 (fixed "
+                 "material, §7.9)")
+#: The finding parts of ch. 7 these rows make (given the runs each needs).
+MADE = ("M1.exterior", "M1.interior", "M1.tube", "M2.outlet_order", "M2.inlet_uniform", "M3.over_straight",
+        "M3.over_diverging")
+_M4 = ("the study's series (§7.9) is at fixed material; this tier's (blender.gravity_factors, "
+       "blender.gravity_configurations) multiplies every Young's modulus by the gravity factor "
+       "(siloflow.model.cases.blender.gravity_scaled_stiffness): a similarity check of the code whose sqrt(g) scaling "
+       "holds by construction (the gravity series group), and at fixed moduli the 50 g pour pushed clumps through "
+       "the walls (LIGGGHTS: lost atoms). It would be made by blender.gravity_factors [1, 5, 50] with "
+       "blender.gravity_configurations [diverging] at fixed moduli, which no configuration key gives yet")
+#: The parts of ch. 7 these rows cannot make, and what would make them.
+UNMADE = MappingProxyType({
+    "M2.vertical_uniform": "needs the steady velocity across the width of the vertical section with its error: "
+                           "blender.json keeps the passages' means at the insert outlet and inlet only, and "
+                           "profiles.csv the window profiles at blender.profile_heights_above, without errors",
+    **{part: _M4 for part in ("M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates", "M4.interior_deviates",
+                              "M4.inlet_differential_decreases")},
+})
+
+
+def _metric(metrics: Mapping, key: str) -> tuple[float, float]:
+    return number_or_nan(metrics.get(key)), number_or_nan(metrics.get(f"{key}_error"))
+
+
+def _continuous(summary: Mapping) -> str:
+    """The ``differs`` clause of a run not in the study's continuous (constant-head) discharge."""
+    mode = summary.get("mode", "continuous")
+    return "" if mode == "continuous" else (
+        f"{mode} discharge: the study's figure is of the continuous (constant-head) discharge (§7.5)")
+
+
+def section_mean(velocities: Mapping[str, tuple[float, float]], weights: Mapping[str, float]) -> tuple[float, float]:
+    """Weighted mean of passage velocities over a cross-section and its error (m/s), the passages independent.
+
+    Parameters
+    ----------
+    velocities : mapping name -> (float, float)
+        Each passage's mean v_z and its standard error (m/s).
+    weights : mapping name -> float
+        Each passage's weight (its bins or width at that height), > 0, for every name of ``velocities`` (-).
+    """
+    total = sum(float(weights[key]) for key in velocities)
+    if not total > 0:
+        raise ValueError("the passages' weights must add up to more than 0")
+    mean = sum(float(weights[key]) * v for key, (v, _) in velocities.items()) / total
+    return mean, combine_independent([float(weights[key]) * e for key, (_, e) in velocities.items()]) / total
+
+
+def _outlet(summary: Mapping) -> tuple[dict, tuple[float, float], str, str]:
+    """The passages' (v_z, error) at the insert outlet (m/s), their cross-section mean, the evidence of its weights
+    and the ``differs`` clause when they are not the passages' widths at the insert outlet."""
+    metrics = summary["metrics"]
+    velocities = {key: _metric(metrics, f"{key}_v_z_m_s") for key in PASSAGES}
+    velocities = {key: value for key, value in velocities.items() if math.isfinite(value[0])}
+    bins = ((summary.get("passages_at_insert_outlet") or {}).get("n_bins")) or {}
+    if all(bins.get(key) for key in velocities):
+        weights = {key: float(bins[key]) for key in velocities}
+        return velocities, section_mean(velocities, weights), (
+            "passages weighted by their bins at the insert outlet (" + ", ".join(
+                f"{key} {int(w)}" for key, w in weights.items()) + ")"), ""
+    # An older summary has no bins: the narrowest clear widths stand in, each annulus crossed twice by a planar
+    # section, the tube (and an interior passage without a tube, spanning both plates) once.
+    widths = summary["geometry"]["clear_widths"]
+    once = {"tube", "interior"} if "tube" not in velocities else {"tube"}
+    weights = {key: (1 if key in once else 2) * float(widths[PASSAGES[key]]) for key in velocities}
+    return velocities, section_mean(velocities, weights), "passages weighted by their narrowest clear widths", (
+        "cross-section mean weighted by the passages' narrowest clear widths, not their widths at the insert outlet")
+
+
+def _steady(summary: Mapping) -> str:
+    low, high = summary.get("steady_window_s") or (math.nan, math.nan)
+    return f"steady window {float(low):g}-{float(high):g} s after opening"
+
+
+def _passage_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
+    """Each passage's v_z over the cross-section mean at the insert outlet: M1 for the diverging insert."""
+    name = summary["configuration"]
+    velocities, (mean, mean_error), weighting, differs = _outlet(summary)
+    if not {"interior", "exterior"} <= velocities.keys():
+        return []
+    differs = "; ".join(filter(None, (differs, _continuous(summary))))
+    rows = []
+    for key, (value, error) in velocities.items():
+        share = ratio(value, error, mean, mean_error)
+        evidence = (f"{PASSAGES[key]} {plus_minus(value, error)} m/s, cross-section mean {plus_minus(mean, mean_error)} "
+                    f"m/s ({weighting}); {_steady(summary)}; {precise(*share, tolerances)[1]}; {note}")
+        figure = f"{PASSAGES[key].capitalize()} v_z / cross-section mean at the insert outlet"
+        if name == "diverging":
+            part = PARTS[f"M1.{key}"]
+            rows.append(row(BLENDER_GROUP, figure, name, *share, "-", evidence, dof=dof, finding=part.id,
+                            agreement=rules.value_in_band(*share, dof, part, tolerances), differs=differs))
+        else:
+            rows.append(row(BLENDER_GROUP, figure, name, *share, "-", evidence, dof=dof, study="-", differs=differs))
+    return rows
+
+
+def _converging_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
+    """M2.outlet_order (downward speeds, tube first) and M2.inlet_uniform of the converging insert."""
+    name, rows = summary["configuration"], []
+    velocities, _, _, _ = _outlet(summary)
+    differs = _continuous(summary)
+    if {"tube", "interior", "exterior"} <= velocities.keys():
+        # Downward speeds, so that "fastest" is the largest, as the study's order reads.
+        speeds = [(-velocities[key][0], velocities[key][1]) for key in ("tube", "interior", "exterior")]
+        values, errors = [s[0] for s in speeds], [s[1] for s in speeds]
+        rows.append(row(BLENDER_GROUP, "Downward speed at the insert outlet, tube > interior > exterior annulus",
+                        name, values[0], errors[0], "m/s",
+                        "; ".join(f"{PASSAGES[key]} {plus_minus(v, e)} m/s" for key, v, e in
+                                  zip(("tube", "interior", "exterior"), values, errors))
+                        + f" (value column: tube); {_steady(summary)}; {note}", dof=dof, finding="M2.outlet_order",
+                        agreement=rules.in_order(values, errors, dof, PARTS["M2.outlet_order"]), differs=differs))
+    inlet = summary.get("passages_at_insert_inlet") or {}
+    means, bins = inlet.get("mean_v_z_m_s") or {}, inlet.get("n_bins") or {}
+    if {"interior", "exterior"} <= means.keys() and all(bins.get(key) for key in means):
+        # The summary keeps the inlet's means with no batch means behind them: an error only where one is written.
+        errors = inlet.get("mean_v_z_m_s_error") or {}
+        passages = {key: (float(v), number_or_nan(errors.get(key))) for key, v in means.items()}
+        mean, mean_error = section_mean(passages, bins)
+        (interior, e_i), (exterior, e_e) = passages["interior"], passages["exterior"]
+        change, change_error = ratio(interior - exterior, combine_independent([e_i, e_e]), mean, mean_error)
+        measured = "" if errors else "; its error is not measured (blender.json has no error of the inlet's passages)"
+        rows.append(row(BLENDER_GROUP, "Interior minus exterior annulus v_z at the insert inlet / cross-section mean",
+                        name, change, change_error, "-",
+                        f"interior {plus_minus(interior, e_i)} m/s, exterior {plus_minus(exterior, e_e)} m/s, mean "
+                        f"{plus_minus(mean, mean_error)} m/s over {sum(int(b) for b in bins.values())} bins"
+                        f"{measured}; {_steady(summary)}; {note}", dof=dof, finding="M2.inlet_uniform",
+                        agreement=rules.negligible(change, change_error, dof, 1.0, PARTS["M2.inlet_uniform"],
+                                                   tolerances), differs=differs))
+    return rows
+
+
+def _vrr(summary: Mapping) -> tuple[float, float, str]:
+    """M3's VRR of a run, its error and why it is only a bound ("" when a measurement)."""
+    metrics = summary["metrics"]
+    value = number_or_nan((metrics.get("vrr_by_period") or {}).get(M3_PERIOD))
+    error = number_or_nan((metrics.get("vrr_by_period_error") or {}).get(M3_PERIOD))
+    ceiling = number_or_nan(metrics.get("vrr_ceiling"))
+    if math.isfinite(value) and math.isfinite(ceiling) and ceiling > 0 and vrr_near_ceiling(value, ceiling):
+        return value, error, (f"{summary['configuration']}'s VRR is near the counting-noise ceiling {ceiling:.0f} of "
+                              "its tracers (a lower bound)")
+    return value, error, ""
+
+
+def _m3_rows(at_1g: Mapping[str, Mapping]) -> list[dict]:
+    """M3: the converging insert's VRR of the continuous mode against the straight's and the diverging's."""
+    rows = []
+    if "converging" not in at_1g:
+        return rows
+    best = at_1g["converging"]
+    for other in ("straight", "diverging"):
+        if other not in at_1g:
+            continue
+        runs = (best, at_1g[other])
+        taken = [_vrr(run["summary"]) for run in runs]
+        values, errors = [t[0] for t in taken], [t[1] for t in taken]
+        why, dof = "; ".join(t[2] for t in taken if t[2]), smallest_dof(*(run.get("dof") for run in runs))
+        verdict = capped(rules.in_order(values, errors, dof, PARTS[f"M3.over_{other}"]), why)
+        rows.append(row(BLENDER_GROUP, f"VRR of the continuous mode at period t_m, converging > {other}",
+                        f"converging vs {other}", values[0], errors[0], "-",
+                        "; ".join(f"{run['summary']['configuration']} {plus_minus(v, e)} ({run.get('note') or 'no note'})"
+                                  for run, v, e in zip(runs, values, errors))
+                        + " (value column: converging); sine input, LTI of the RTD of the steady field", dof=dof,
+                        finding=f"M3.over_{other}", agreement=verdict,
+                        differs="; ".join(filter(None, (_continuous(run["summary"]) for run in runs)))))
+    return rows
+
+
+def blender_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> list[dict]:
+    """The rows of the blender's runs at 1 g: per insert its passage velocities over the cross-section mean (M1 for
+    the diverging insert), M2 for the converging one, its mean residence time and recirculations to homogenise
+    (no finding); then M3 across inserts.
+
+    Parameters
+    ----------
+    runs : sequence of mapping
+        ``{"case", "summary", "note", "dof"}`` per run (see the module docstring); those at other gravity factors
+        are left to :func:`gravity_rows`.
+    tolerances : AgreementTolerances
+
+    Returns
+    -------
+    list of dict
+        Rows of :func:`~siloflow.analysis.studies.validation.rows.row`, insert by insert (alphabetical), then M3.
+    """
+    at_1g = {}
+    for run in runs:
+        if float(run["summary"]["gravity_factor"]) == 1.0:
+            name = run["summary"]["configuration"]
+            if name in at_1g:
+                raise ValueError(f"two runs of {name} at 1 g: pass one run per configuration (its seeds combined)")
+            at_1g[name] = run
+    rows = []
+    for name in sorted(at_1g):
+        run = at_1g[name]
+        summary, note, dof = run["summary"], run.get("note") or "", run.get("dof")
+        rows += _passage_rows(summary, note, dof, tolerances)
+        if name == "converging":
+            rows += _converging_rows(summary, note, dof, tolerances)
+        metrics = summary["metrics"]
+        for key, figure, unit, study in (
+                ("rtd_mean_s", "Mean residence time of the RTD", "s", "-"),
+                ("recirculations_to_homogenise", "Recirculations to homogenise (discontinuous mode)", "-",
+                 "- (M3 is judged on the VRR of the continuous mode)")):
+            value, error = _metric(metrics, key)
+            if math.isfinite(value):
+                rows.append(row(BLENDER_GROUP, figure, name, value, error, unit,
+                                f"{precise(value, error, tolerances)[1]}; {note}", dof=dof, study=study,
+                                differs=_continuous(summary)))
+    return rows + _m3_rows(at_1g)
+
+
+def gravity_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> list[dict]:
+    """The gravity series as a similarity check of the code: per configuration run at 1 g and at other factors f,
+    ``(q_f / q_1g) / sqrt(f)`` of the mass flow rate and the tube's and exterior annulus's velocities (1 where q
+    scales with sqrt(g)); no finding (see the module docstring).
+
+    Parameters
+    ----------
+    runs : sequence of mapping
+        ``{"case", "summary", "note", "dof"}`` per run; each row's evidence quotes the notes of its two runs.
+    tolerances : AgreementTolerances
+
+    Returns
+    -------
+    list of dict
+        One row per configuration, factor and figure known at both factors, in the group :data:`GRAVITY_GROUP`.
+    """
+    series: dict[str, dict[float, Mapping]] = {}
+    for run in runs:
+        summary = run["summary"]
+        factors = series.setdefault(summary["configuration"], {})
+        if float(summary["gravity_factor"]) in factors:
+            raise ValueError(f"two runs of {summary['configuration']} at {float(summary['gravity_factor']):g} g: pass "
+                             "one run per configuration and factor (its seeds combined)")
+        factors[float(summary["gravity_factor"])] = run
+    rows = []
+    for name in sorted(series):
+        by_factor = series[name]
+        if 1.0 not in by_factor:
+            continue
+        base = by_factor[1.0]
+        for factor in sorted(f for f in by_factor if f != 1.0):
+            run = by_factor[factor]
+            dof = smallest_dof(base.get("dof"), run.get("dof"))
+            for key, label, unit in GRAVITY_FIGURES:
+                q1, qf = _metric(base["summary"]["metrics"], key), _metric(run["summary"]["metrics"], key)
+                if not (math.isfinite(q1[0]) and math.isfinite(qf[0])):
+                    continue
+                value, error = ratio(*qf, *q1)
+                root = math.sqrt(factor)
+                scaled, scaled_error = value / root, error / root
+                off = resolved(scaled - 1.0, scaled_error, dof)
+                verdict = "unknown whether it scales" if off is None else "does not scale" if off else "scales"
+                rows.append(row(
+                    GRAVITY_GROUP, f"{label.capitalize()} at {factor:g} g / (1 g value × sqrt({factor:g}))", name,
+                    scaled, scaled_error, "-",
+                    f"{verdict} with sqrt(g): its departure from 1 is {resolution(scaled - 1.0, scaled_error, dof)}; "
+                    f"1 g: {plus_minus(*q1)} {unit} ({base.get('note') or 'no note'}); {factor:g} g: "
+                    f"{plus_minus(*qf)} {unit} ({run.get('note') or 'no note'}); "
+                    f"{precise(scaled, scaled_error, tolerances)[1]}",
+                    dof=dof, study=GRAVITY_STUDY))
+    return rows
