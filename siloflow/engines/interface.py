@@ -21,6 +21,7 @@ Adding an engine: create ``engines/<name>/`` with an :class:`Engine` subclass, i
 from __future__ import annotations
 
 import importlib
+import math
 import subprocess
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -177,11 +178,15 @@ class Engine(ABC):
         stopped before its first stage ended)."""
 
     @abstractmethod
+    def earlier_attempt_seconds(self, run_dir: str | Path) -> list[float]:
+        """Time each of a run's attempts before its last took (s), oldest first, from the engine's own timing in its
+        log, up to the last time it logged: those moved aside into ``failed_attempts/`` to start afresh
+        (:func:`siloflow.engines.run_files.set_aside_attempts`), then those resumed in place from the run's restart
+        files; none for a run made in one go. Snakemake's benchmark of the run step times its last attempt only."""
+
     def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
-        """Time a run's attempts before its last took (s), from the engine's own timing in their logs, up to the last
-        time each logged: those resumed in place from the run's restart files and those moved aside into
-        ``failed_attempts/`` to start afresh (:func:`siloflow.engines.run_files.set_aside_attempts`); 0 for a run made in one
-        go. Snakemake's benchmark of the run step times its last attempt only."""
+        """Time a run's attempts before its last took together (s): :meth:`earlier_attempt_seconds` summed."""
+        return math.fsum(self.earlier_attempt_seconds(run_dir))
 
     def measured_cost(self, run_dir: str | Path) -> float | None:
         """CPU seconds per sphere-step that a run took on this machine (s), from :meth:`measured_work`, or None when

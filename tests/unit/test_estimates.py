@@ -242,6 +242,7 @@ def test_a_run_s_attempts_before_its_last_add_up(tmp_path):
     (tmp_path / LOG_NAME).write_text(_timed_thermo([0.0, 99.0]))
     (tmp_path / f"{RESUME_STEM}1.{LOG_NAME}").write_text(_timed_thermo([0.0, 7.0]))
     assert engine.earlier_attempts_seconds(tmp_path) == 10.0 + 3.5 + 1.25 + 99.0
+    assert engine.earlier_attempt_seconds(tmp_path) == [10.0, 3.5, 1.25, 99.0]  # each, oldest first
 
 
 def test_measured_work_refuses_impossible_values():

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from siloflow.analysis.numerics.reference_spread import (combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
+from siloflow.analysis.numerics.reference_spread import (SeedSpread, combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
                                                with_reference_spread)
 from siloflow.calibration.friction import SECOND_HALF, STEADY, combined_window_method
 from siloflow.model.cases import cases_of, reference_runs
@@ -138,3 +138,13 @@ def test_a_table_s_rows_run_once_are_floored_by_the_replicated_rows():
     floored, spread, replicated = floor_table(rows)
     assert replicated == [rows[1]] and spread.seeds == 3
     assert floored == [{"flow": 2.0, "flow_error": pytest.approx(0.2), "replicates": 1}, rows[1]]
+
+
+def test_the_seed_note_says_how_the_spread_enters_the_error():
+    from_three = SeedSpread({("flow",): 0.02}, 3)
+    assert seed_note("base", SeedSpread({}, 1), True) == "one seed: within-run error only"
+    assert seed_note("base", from_three, True) == ("mean of 3 seeds; its error is the larger of the standard error of "
+                                                    "their mean and the within-run errors; 2 degrees of freedom")
+    assert seed_note("base", from_three, False) == (
+        "one seed; its error is the larger of its within-run error and its value times the standard deviation between "
+        "the 3 seeds of base relative to their mean; 2 degrees of freedom")

@@ -67,13 +67,14 @@ def _rows():
 
 
 def test_the_provenance_row_names_the_run_its_engine_and_its_time():
-    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, 20.25, "2026-11-28",
+    got = provenance_row(_record(ranks=2), "silo", "3.8.0+repack1", [11, 12, 13], "abc123", 61.5, [12.0, 8.25], "2026-11-28",
                          2)
     assert list(got) == list(RUN_COLUMNS)
     assert got == {"run_id": "sphere2-abc", "group": "silo", "case": "silo_flat", "engine": "liggghts", "engine_version": "3.8.0+repack1",
                    "seeds": "11 12 13", "commit": "abc123", "simulated_time_s": 1.75, "wall_time_s": 61.5,
-                   "earlier_attempts_s": 20.25, "attempts": 2, "cores": 2, "date": "2026-11-28"}
-    assert provenance_row(_record(), "silo", "3.8", [1], "c", 1.0, 0.0, "2026-11-28")["attempts"] == ""
+                   "earlier_attempts_s": 20.25, "attempts": 2, "attempt_times_s": "12.0 8.2 61.5", "cores": 2,
+                   "date": "2026-11-28"}
+    assert provenance_row(_record(), "silo", "3.8", [1], "c", 1.0, [], "2026-11-28")["attempts"] == ""
     # the time of all its attempts; a record written before earlier attempts were timed gives the last one's only
     assert run_wall_time(got) == 81.75
     assert run_wall_time({key: value for key, value in got.items() if key != "earlier_attempts_s"}) == 61.5
@@ -95,7 +96,7 @@ def test_a_run_record_s_names_are_matched_whole(key, value):
 
 def test_a_group_record_round_trips_and_replaces_its_old_plots(tmp_path):
     plot = _png(tmp_path / "source.png")
-    runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, 0.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1, 2, 3], "0123456789", 60.0, [], "2026-11-28")]
     folder = tmp_path / "silo"
     folder.mkdir()
     _png(folder / "old.png")
@@ -140,7 +141,7 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
     such a plot and writes nothing, and `make validate GROUP=<name>` refuses such a configuration first."""
     plot = tmp_path / "profiles.pdf"
     plot.write_bytes(b"%PDF-1.4")
-    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, [], "2026-11-28")]
     message = r"the validation record keeps png plots .*, not pdf: make it with plots.format: png"
     with pytest.raises(ValueError, match=message):
         write_group_record(tmp_path / "silo", _rows(), runs, {"profiles.png": plot})
@@ -172,14 +173,14 @@ def test_a_table_written_by_older_row_code_is_read_with_no_verdict(tmp_path):
 def test_the_page_renders_status_runs_rows_and_both_verdicts():
     # the silo group ran in two parts: silo_1 made two runs side by side, silo_2 one
     # silo_2's run was interrupted once: its attempt before the last took 900 s, which counts
-    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, 0.0, "2026-11-28", 1),
-            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, 0.0, "2026-11-29", 1),
-            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, 900.0, "2026-11-29", 2)]
+    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, [], "2026-11-28", 1),
+            provenance_row(_record("sphere2-def"), "silo_1", "3.8", [2], "c0ffee", 1800.0, [], "2026-11-29", 1),
+            provenance_row(_record("sphere2-jkl"), "silo_2", "3.8", [3], "c0ffee", 900.0, [900.0], "2026-11-29", 2)]
     # the series' record also lists the base run it compares against, made by the silo group
     # and its record predates the time of earlier attempts
     series = [{key: value for key, value in
-               provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, 0.0, "2026-11-29").items()
-               if key not in ("earlier_attempts_s", "attempts")}, runs[0]]
+               provenance_row(_record("sphere2-ghi"), "silo_series", "3.8", [1], "c0ffee", 3600.0, [], "2026-11-29").items()
+               if key not in ("earlier_attempts_s", "attempts", "attempt_times_s")}, runs[0]]
     groups = {"silo": GroupRecord(rows=_rows(), runs=runs, plots=["profiles.png"]),
               "silo_series": GroupRecord(rows=_rows()[:1], runs=series)}
     status = {"calibration": "missing", "silo": "stale", "silo_series": "complete"}
@@ -226,12 +227,16 @@ def test_the_page_renders_status_runs_rows_and_both_verdicts():
     assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | - | - | - |" in text
     assert "runs this group in about" not in text  # no row of these groups is off the study's scale
     assert "![profiles.png](silo/profiles.png)" in lines
+    # with the findings' summary: it says which groups' rows are not those the configuration and the row code make
+    summary = record_page(groups, status, {}, wall, 2, "config/validation.yaml", "config/thesis.yaml", verdicts={})
+    assert ("Not complete against `config/validation.yaml` and today's row code: calibration, silo (see [The "
+            "groups](#the-groups))") in summary
 
 
 def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_path):
     workdir, record_dir = tmp_path / "work", tmp_path / "docs"
     plot = _png(tmp_path / "p.png")
-    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "silo", "3.8", [1], "c0ffee", 60.0, [], "2026-11-28")]
     recorded = write_group_record(workdir / "results" / "summary" / "record" / "silo", _rows(), runs,
                                   {"janssen.png": plot})
     write_group_record(record_dir / "blender", _rows(), runs, {})
@@ -249,7 +254,7 @@ def test_a_record_keeps_the_products_other_groups_read_and_restores_only_what_is
     for name, text in ((summary, '{"bulk_friction": 0.5}'), (run, '{"run_id": "sphere2-abc"}')):
         (workdir / name).parent.mkdir(parents=True, exist_ok=True)
         (workdir / name).write_text(text)
-    runs = [provenance_row(_record(), "calibration", "3.8", [1], "c0ffee", 60.0, 0.0, "2026-11-28")]
+    runs = [provenance_row(_record(), "calibration", "3.8", [1], "c0ffee", 60.0, [], "2026-11-28")]
     source = workdir / "results" / "summary" / "record" / "calibration"
     write_group_record(source, _rows(), runs, {}, {summary: workdir / summary, run: workdir / run})
     assert read_group_record(source).products == [summary, run]

@@ -300,6 +300,7 @@ def test_a_run_s_attempts_before_its_last_count_their_last_timed_marker(tmp_path
     (tmp_path / LOG_NAME).write_text("SILOFLOW opened cpu_s=4.25\n")
     (tmp_path / f"{RESUME_STEM}1.{LOG_NAME}").write_text("SILOFLOW resumed step=5\nSILOFLOW discharged cpu_s=8.0\n")
     assert engine_named("yade").earlier_attempts_seconds(tmp_path) == 20.5 + 4.25
+    assert engine_named("yade").earlier_attempt_seconds(tmp_path) == [20.5, 4.25]
     assert engine_named("yade").earlier_attempts_seconds(tmp_path / "elsewhere") == 0.0
 
 

@@ -264,11 +264,14 @@ def with_reference_spread(summaries: Sequence, run_ids: Sequence[str], reference
 
 
 def seed_note(reference: str, spread: SeedSpread, reference_row: bool) -> str:
-    """The evidence a row adds about the seeds: the reference configuration's mean over its seeds, or a single
-    seed's error that includes the reference's spread."""
+    """The evidence a row adds about the seeds, saying exactly how the spread between them enters its error: the
+    reference configuration's mean over its seeds, or a configuration run once whose error is floored by the
+    reference's spread (:func:`floor_errors`)."""
     if spread.seeds < 2:
         return "one seed: within-run error only"
+    dof = f"{spread.seeds - 1} degrees of freedom"
     if reference_row:
-        return (f"mean of {spread.seeds} seeds; error the larger of their spread and the within-run errors")
-    return (f"one seed; error includes the spread between the {spread.seeds} seeds of {reference}, relative to the "
-            "value")
+        return (f"mean of {spread.seeds} seeds; its error is the larger of the standard error of their mean and the "
+                f"within-run errors; {dof}")
+    return (f"one seed; its error is the larger of its within-run error and its value times the standard deviation "
+            f"between the {spread.seeds} seeds of {reference} relative to their mean; {dof}")

@@ -8,7 +8,6 @@ reads the engine's files back into the neutral objects of :mod:`model`. Its temp
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -169,9 +168,8 @@ class LiggghtsEngine(Engine):
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
         return work_from_logs(path.read_text(errors="replace") for path in attempt_logs(run_dir))
 
-    def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
-        logs = earlier_attempt_logs(run_dir, attempt_logs)
-        return math.fsum(elapsed_seconds(path.read_text(errors="replace")) for path in logs)
+    def earlier_attempt_seconds(self, run_dir: str | Path) -> list[float]:
+        return [elapsed_seconds(path.read_text(errors="replace")) for path in earlier_attempt_logs(run_dir, attempt_logs)]
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return list(read_frames(Path(run_dir) / "dumps", DUMP_PREFIX, record.timestep_s, on_damaged=on_damaged))

@@ -112,9 +112,8 @@ class YadeEngine(Engine):
     def measured_work(self, run_dir: str | Path) -> MeasuredWork | None:
         return work_from_logs(attempt_logs(run_dir))
 
-    def earlier_attempts_seconds(self, run_dir: str | Path) -> float:
-        logs = earlier_attempt_logs(run_dir, attempt_logs)
-        return elapsed_cpu_seconds(logs)
+    def earlier_attempt_seconds(self, run_dir: str | Path) -> list[float]:
+        return [elapsed_cpu_seconds([path]) for path in earlier_attempt_logs(run_dir, attempt_logs)]
 
     def read_frames(self, run_dir: str | Path, record: RunRecord, on_damaged: str = "error") -> list[ParticleFrame]:
         return read_frames(run_dir, DUMP_PREFIX, on_damaged)

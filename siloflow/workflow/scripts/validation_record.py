@@ -29,7 +29,7 @@ with logged_to(snakemake.log[0]) as log:
             commit, version = f"unknown (recorded by {writer})", versions[record.engine]
         finished = datetime.fromtimestamp(Path(record_path).stat().st_mtime, tz=timezone.utc).date().isoformat()
         runs.append(provenance_row(record, params.made_by[record.run_id], version, params.seeds[record.run_id], commit,
-                                   benchmark_wall_time(benchmark), engine_named(record.engine).earlier_attempts_seconds(run_dir),
+                                   benchmark_wall_time(benchmark), engine_named(record.engine).earlier_attempt_seconds(run_dir),
                                    finished, len(attempts) or None))
     derivation = {**params.derivation, "row_code": row_code_digest(), "written_by": writer}
     directory = write_group_record(Path(snakemake.output.runs).parent, read_validation_rows(inputs.rows), runs,

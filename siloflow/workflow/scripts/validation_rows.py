@@ -11,7 +11,10 @@ from siloflow.engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     kind, config = snakemake.params.kind, snakemake.config
-    data = read_group_products(kind, {key: list(snakemake.input[key]) for key in snakemake.input.keys()})
+    # a named input of one file is a string, of several a list
+    named = {key: snakemake.input[key] for key in snakemake.input.keys()}
+    data = read_group_products(kind, {key: [paths] if isinstance(paths, str) else list(paths)
+                                      for key, paths in named.items()})
     if kind == "jenike":
         data["points"] = point_table(data["summaries"])
     rows = judged_rows(kind, data, snakemake.params.rows, config["validation"],

@@ -1,12 +1,13 @@
 """The validation record kept in the repository (``docs/validation/``): each group's table rows, the runs behind
 them, and the page that renders them.
 
-A group's record is three things the pipeline writes (``make validate GROUP=<name>``): ``table.csv`` (its rows of
-the validation table, :data:`siloflow.analysis.studies.validation.rows.COLUMNS`), ``runs.csv`` (one provenance row per run,
-:data:`RUN_COLUMNS`) and a few plots. :func:`record_page` renders every group's record as one Markdown page, which
-opens with the study it compares with (:data:`STUDY_PARAGRAPH`), with each group's freshness against the
-configuration and, for the rows the scale does not show, what would show them and at what cost. Pure: the readers
-and writers are :mod:`siloflow.analysis.io.validation_record`.
+A group's record is what the pipeline writes (``make validate GROUP=<name>``): ``table.csv`` (its rows of the
+validation table, :data:`siloflow.analysis.studies.validation.rows.COLUMNS`), ``runs.csv`` (one provenance row per
+run, :data:`RUN_COLUMNS`), a few plots, the products its rows are computed from and what re-derives them.
+:func:`record_page` renders every group's record as one Markdown page: the study it compares with
+(:data:`STUDY_PARAGRAPH`), whether the study is reproduced (:func:`findings_section`), then each group's freshness
+against the configuration and its rows. Pure: the readers and writers are
+:mod:`siloflow.analysis.io.validation_record`.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ STUDY_PARAGRAPH = (
 
 #: The columns of a group's ``runs.csv``, in order.
 RUN_COLUMNS = ("run_id", "group", "case", "engine", "engine_version", "seeds", "commit", "simulated_time_s", "wall_time_s",
-               "earlier_attempts_s", "attempts", "cores", "date")
+               "earlier_attempts_s", "attempts", "attempt_times_s", "cores", "date")
 
 
 @dataclass(frozen=True)
@@ -86,7 +87,7 @@ def simulated_time(record: RunRecord) -> float:
 
 
 def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Sequence[int], commit: str, wall_time_s: float,
-                   earlier_attempts_s: float, date: str, attempts: int | None = None) -> dict:
+                   earlier_attempts_s: Sequence[float], date: str, attempts: int | None = None) -> dict:
     """One row of ``runs.csv`` for a finished run.
 
     Parameters
@@ -105,9 +106,10 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
         ``-dirty`` appended with uncommitted changes).
     wall_time_s : float
         Wall time of the run step (s), Snakemake's benchmark of it: its last attempt only.
-    earlier_attempts_s : float
-        Time its attempts before the last took (s): those resumed from its restart files and those set aside to
-        start afresh (:meth:`siloflow.engines.interface.Engine.earlier_attempts_seconds`); 0 when it ran in one go.
+    earlier_attempts_s : sequence of float
+        Time each of its attempts before the last took (s), oldest first: those set aside to start afresh and those
+        resumed from its restart files (:meth:`siloflow.engines.interface.Engine.earlier_attempt_seconds`); none when
+        it ran in one go.
     date : str
         When the run finished (ISO 8601 date).
     attempts : int, optional
@@ -116,8 +118,9 @@ def provenance_row(record: RunRecord, group: str, engine_version: str, seeds: Se
     return {"run_id": record.run_id, "group": group, "case": record.case, "engine": record.engine, "engine_version": engine_version,
             "seeds": " ".join(str(int(seed)) for seed in seeds), "commit": commit,
             "simulated_time_s": simulated_time(record), "wall_time_s": float(wall_time_s),
-            "earlier_attempts_s": float(earlier_attempts_s),
-            "attempts": "" if attempts is None else int(attempts), "cores": int(record.mpi_ranks), "date": date}
+            "earlier_attempts_s": math.fsum(earlier_attempts_s),
+            "attempts": "" if attempts is None else int(attempts),
+            "attempt_times_s": " ".join(f"{float(s):.1f}" for s in (*earlier_attempts_s, wall_time_s)), "cores": int(record.mpi_ranks), "date": date}
 
 
 def run_wall_time(run: Mapping) -> float:
@@ -275,7 +278,7 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
                 estimated_core_s: Mapping[str, float] | None = None,
                 verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
-    freshness, runs and rows, and for each row the scale does not show, what scale would show it and what that scale
+    freshness, runs and rows with their two verdicts, and for the rows not at the study's scale, what the study's scale
     costs.
 
     Parameters
@@ -324,8 +327,14 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     ]
     if verdicts is not None:
         rows = [row for record in groups.values() for row in record.rows]
-        lines += [*findings_section(finding_statuses(rows), verdicts, unmade or {}, config_name), "",
-                  "## The groups", ""]
+        section = findings_section(finding_statuses(rows), verdicts, unmade or {}, config_name)
+        stale = [name for name, state in status.items() if state != "complete"]
+        if stale:
+            # the summary counts what the record holds: say which of it the configuration no longer plans as recorded
+            section[4:4] = [f"Not complete against `{config_name}` and today's row code: {', '.join(stale)} "
+                            "(see [The groups](#the-groups)); the summary counts the rows their records hold, and a "
+                            "record written by older row code judges nothing until its group is recorded again.", ""]
+        lines += [*section, "", "## The groups", ""]
     lines += [
         f"| group | status | runs it makes | core time | estimated (estimate / recorded) | wall time on {cores} cores "
         "(per part) | rows | judged against a finding | at the study's scale |",
