@@ -1,6 +1,7 @@
 """The DEM verification suite on both engines (seconds per run): every closed form holds within its tolerance, except
-YADE's sphere-wall contact time, which is longer by exactly the factor its wall geometry implies (R* = r/2 instead of
-r: 2^(1/5))."""
+on YADE's sphere-wall contact, whose Hertz geometry is two spheres' (R* = r/2 instead of r): its contact time is longer
+by 2^(1/5), and at a given overlap its normal force, and with it the rolling torque of a sphere spun on the wall, is
+2^(-1/2) of a sphere-flat's."""
 
 from __future__ import annotations
 
@@ -37,15 +38,25 @@ def table(tmp_path_factory):
 
 def test_every_closed_form_holds_on_liggghts(table):
     liggghts = table[table["engine"] == "liggghts"]
-    assert len(liggghts) == 12
+    assert len(liggghts) == 14
     assert liggghts["passes"].all(), liggghts.to_string()
 
 
-def test_every_closed_form_holds_on_yade_but_the_sphere_wall_contact_time(table):
+def test_every_closed_form_holds_on_yade_but_the_sphere_wall_contact(table):
     yade = table[table["engine"] == "yade"]
     wall_time = (yade["problem"] == "wall_impact") & (yade["quantity"] == "contact_time")
-    assert yade[~wall_time]["passes"].all(), yade.to_string()
+    wall_spin = yade["problem"] == "wall_spin"
+    assert yade[~wall_time & ~wall_spin]["passes"].all(), yade.to_string()
     assert yade[wall_time]["error"].item() == pytest.approx(2 ** 0.2 - 1.0, abs=2e-3)
+    # the rolling cap on the wall is the pair's, eta r |Fn|, at YADE's own |Fn|
+    assert yade[wall_spin]["error"].item() == pytest.approx(2 ** -0.5 - 1.0, abs=2e-3)
+
+
+def test_the_study_s_rolling_torque_holds_between_spheres_on_both_engines(table):
+    """The pair contact every clump makes: LIGGGHTS' CDT with the mapped coefficient (2 mu_r for spheres) and YADE's
+    Mindlin cap give the study's mu_r |Fn| r within 2 %."""
+    pair = table[table["problem"] == "pair_spin"]
+    assert sorted(pair["engine"]) == ["liggghts", "yade"] and pair["passes"].all(), pair.to_string()
 
 
 @pytest.mark.parametrize("enabled", [True, False])

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import copy
+import hashlib
+import json
 import math
 
 import pytest
 
 from siloflow.engines.config import validate_config
 from siloflow.model.cases.common import material_table, run_id
+from siloflow.model.rolling import ROLLING_LAW
 from siloflow.model.cases import case_for_run
 from siloflow.model.cases.silo_flat import build_silo_case
 
@@ -131,7 +134,9 @@ def test_contact_pair_order_does_not_change_the_run_id(tiny_config):
 
 
 def test_run_id_hash_by_hand():
-    assert run_id("x", {"a": 1}) == "x-015abd7f5c"
+    # the first ten hex digits of the SHA-256 of the canonical JSON, the rolling law included
+    canonical = json.dumps({"a": 1, "rolling_law": ROLLING_LAW}, sort_keys=True, separators=(",", ":"))
+    assert run_id("x", {"a": 1}) == "x-" + hashlib.sha256(canonical.encode()).hexdigest()[:10] == "x-2403c2ea57"
 
 
 def test_unknown_run_is_reported_with_the_defined_ones(tiny_config):

@@ -12,6 +12,7 @@ from siloflow.engines.config import ConfigError, load_config, validate_config
 from siloflow.engines.liggghts.inputs import INNER_SPHERE_FRACTION, processor_grid, template_spheres
 from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context, write_silo_inputs
 from siloflow.model.cases.silo_flat import build_silo_case
+from siloflow.model.rolling import rolling_geometry
 from siloflow.engines.templating import (
     UnsafeDeckValue,
     check_context,
@@ -67,8 +68,14 @@ def test_every_wall_writes_its_force_and_the_gate_leaves_zeros():
 def test_material_matrices_are_rendered_row_major():
     deck = render_silo_deck(_golden_case())
     rolling = next(line for line in deck.splitlines() if "coefficientRollingFriction" in line)
-    # types: 1 hdpe, 2 aluminium, 3 perspex; wall-wall pairs get neutral zeros
-    assert rolling.endswith("peratomtypepair 3 0.1 0.1 0.05 0.1 0.0 0.0 0.05 0.0 0.0")
+    # types: 1 hdpe, 2 aluminium, 3 perspex; wall-wall pairs get neutral zeros; the study's coefficients 0.1 (pairs,
+    # aluminium) and 0.05 (perspex) as LIGGGHTS' CDT gives their torque for the two-sphere clump: pairs times 2 R / r,
+    # walls times R / r (siloflow.engines.liggghts.rolling)
+    ratio = rolling_geometry(_golden_case().particle.sphere_positions, _golden_case().particle.sphere_radii).ratio
+    values = [float(v) for v in rolling.split("peratomtypepair 3 ")[1].split()]
+    assert values == pytest.approx([0.2 * ratio, 0.1 * ratio, 0.05 * ratio, 0.1 * ratio, 0.0, 0.0, 0.05 * ratio, 0.0,
+                                    0.0], rel=1e-15)
+    assert ratio == pytest.approx(1.11510, abs=1e-5)
 
 
 def test_timestep_is_the_configured_fraction_of_the_rayleigh_time():

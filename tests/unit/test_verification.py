@@ -20,6 +20,8 @@ from siloflow.analysis.numerics.verification import (
     rolling_deceleration_cdt,
     sliding_to_rolling,
     zero_crossings,
+    hertz_normal_force,
+    spin_deceleration,
 )
 from siloflow.analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
 from siloflow.model.cases.verification import PROBLEMS, verification_cases
@@ -198,3 +200,24 @@ def test_the_suite_resolves_each_contact_and_lasts_long_enough():
         assert case.run_id.startswith(name)
         if "impact" in name:
             assert case.output_every == 1  # every step: the contact time is resolved to one time step
+
+
+@pytest.mark.parametrize("name, reduced", [("pair_spin", 0.5), ("wall_spin", 1.0)])
+def test_a_held_sphere_s_spin_decelerates_at_the_study_s_rolling_torque(name, reduced):
+    """Synthetic spin at exactly mu_r |Fn| r / I, with |Fn| Hertz's at the held sphere's overlap: measured exactly."""
+    p = _params(name)
+    r, m, mu_r = p["radius"], p["mass_kg"], p["rolling_friction"]
+    overlap = 0.002 * r
+    force = 4.0 / 3.0 * 5e6 / (2 * (1 - 0.16)) * math.sqrt(reduced * r) * overlap**1.5
+    alpha = mu_r * force * r / (0.4 * m * r * r)
+    assert hertz_normal_force(5e6 / (2 * (1 - 0.16)), reduced * r, overlap) == pytest.approx(force, rel=1e-15)
+    assert spin_deceleration(mu_r, force, r, 0.4 * m * r * r) == pytest.approx(alpha, rel=1e-15)
+    t = np.linspace(0.0, 0.8 * 50.0 / alpha, 401)
+    held = (0.0, 0.0, (2.0 * r if name == "pair_spin" else r) - overlap)
+    position = np.array([[(0.0, 0.0, 0.0), held] if name == "pair_spin" else [held]] * t.size)
+    angular = np.zeros_like(position)
+    angular[:, -1, 0] = 50.0 - alpha * t
+    (row,) = measure_problem(name, p, Trajectories(t, position, np.zeros_like(position), angular))
+    assert row.quantity == "spin_deceleration" and row.closed_form == pytest.approx(alpha, rel=1e-9)
+    assert row.measured == pytest.approx(alpha, rel=1e-9) and row.passes
+    assert verification_cases()[name].spheres[-1].motion == "held"

@@ -42,7 +42,9 @@ def test_the_script_takes_the_fill_contacts_first_and_the_test_contacts_under_th
     test = {(p["i"], p["j"]): p["sliding_friction"] for p in context["materials"]["pairs"]}
     assert fill[(0, 0)] == 0.1 and test[(0, 0)] == 0.3  # jenike.fill.sliding_friction, the point's
     assert context["fill_contacts"]["rolling_friction"] == 0.0 and context["fill_contacts"]["rolling_stiffness"] == 0.0
-    assert context["materials"]["rolling_friction"] == 0.1 and context["materials"]["rolling_stiffness"] > 0.0
+    # eta is the study's 0.1 times the two-sphere clump's lever arm over its spheres' radius (siloflow.model.rolling)
+    assert context["materials"]["rolling_friction"] == pytest.approx(0.1 * 1.11510, abs=1e-6)
+    assert context["materials"]["rolling_stiffness"] > 0.0
     # restitution is the same in both: the script refuses to change it on contacts that exist
     assert [p["restitution"] for p in context["fill_contacts"]["pairs"]] == \
         [p["restitution"] for p in context["materials"]["pairs"]]

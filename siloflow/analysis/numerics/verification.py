@@ -9,6 +9,9 @@ Closed forms (SI units):
   ``5/7 v0`` (solid sphere, I = 2/5 m r^2, no rolling resistance).
 - A sphere rolling without slip against a constant directional torque ``mu_r r |Fn|``: it decelerates at
   ``(5/7) mu_r g``.
+- A sphere held in place against a fixed sphere or a flat at overlap delta, spinning across the contact normal: the
+  study's rolling torque ``mu_r |Fn| r`` (:mod:`siloflow.model.rolling`) decelerates its spin at
+  ``mu_r |Fn| r / I``, with Hertz's ``|Fn| = (4/3) E* sqrt(R*) delta^(3/2)`` and ``I = (2/5) m r^2``.
 - A block on a flat under gravity tilted by theta, friction mu: it slides at ``g (sin theta - mu cos theta)`` when
   ``tan theta > mu`` and stays put otherwise.
 - A free symmetric top (principal moments ``I_axis, I_perp, I_perp``) spinning at ``omega`` (body axes = space axes
@@ -35,6 +38,8 @@ __all__ = [
     "linear_slope",
     "precession_rate",
     "rolling_deceleration_cdt",
+    "hertz_normal_force",
+    "spin_deceleration",
     "sliding_to_rolling",
     "zero_crossings",
 ]
@@ -76,6 +81,21 @@ def sliding_to_rolling(speed: float, friction: float, gravity: float) -> tuple[f
 def rolling_deceleration_cdt(rolling_friction: float, gravity: float) -> float:
     """Deceleration [m/s^2] of a solid sphere rolling without slip against a constant directional torque."""
     return 5.0 / 7.0 * _positive("rolling_friction", rolling_friction) * _positive("gravity", gravity)
+
+
+def hertz_normal_force(modulus: float, radius: float, overlap: float) -> float:
+    """Hertz's elastic normal force [N], ``(4/3) E* sqrt(R*) delta^(3/2)``, from the effective modulus E* [Pa] and
+    radius R* [m] of the contact (see :func:`hertz_contact_time`) and its overlap delta [m]."""
+    return 4.0 / 3.0 * _positive("modulus", modulus) * math.sqrt(_positive("radius", radius)) * _positive(
+        "overlap", overlap) ** 1.5
+
+
+def spin_deceleration(rolling_friction: float, normal_force: float, lever_arm: float, inertia: float) -> float:
+    """Angular deceleration [rad/s^2] of a particle spinning against the study's rolling torque, ``mu_r |Fn| R / I``:
+    coefficient (-), normal force [N], distance from the contact point to the centre of mass [m], moment of inertia
+    about the spin axis [kg m^2]."""
+    return (_positive("rolling_friction", rolling_friction) * _positive("normal_force", normal_force)
+            * _positive("lever_arm", lever_arm) / _positive("inertia", inertia))
 
 
 def incline_acceleration(angle_deg: float, friction: float, gravity: float) -> float:

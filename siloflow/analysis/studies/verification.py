@@ -21,7 +21,9 @@ from siloflow.analysis.numerics.verification import (
     linear_slope,
     precession_rate,
     rolling_deceleration_cdt,
+    hertz_normal_force,
     sliding_to_rolling,
+    spin_deceleration,
     zero_crossings,
 )
 
@@ -31,7 +33,8 @@ __all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "
 #: Relative tolerance of each measured quantity (the time step resolves a contact in 100 steps; frames of the
 #: impacts are every step).
 TOLERANCES = {"restitution": 0.02, "contact_time": 0.03, "rolling_time": 0.02, "rolling_speed": 0.01,
-              "rolling_deceleration": 0.03, "precession_rate": 0.01, "incline_acceleration": 0.02}
+              "rolling_deceleration": 0.03, "precession_rate": 0.01, "incline_acceleration": 0.02,
+              "spin_deceleration": 0.02}
 
 
 @dataclass(frozen=True)
@@ -139,6 +142,19 @@ def measure_problem(problem: str, p: dict, run: Trajectories) -> list[Verificati
         inertia, spin = np.asarray(p["clump_inertia"]), np.asarray(p["initial_angular_velocity"])
         slope, _ = linear_slope(t, axis_precession_angle(axis, inertia * spin))
         return [_row(problem, "precession_rate", precession_rate(inertia, spin), abs(slope))]
+    if problem in ("pair_spin", "wall_spin"):
+        # the held sphere is the last; its overlap with the fixed sphere (or the floor) at the start sets |Fn|
+        gap = (np.linalg.norm(x[0, -1] - x[0, 0]) - 2.0 * r) if problem == "pair_spin" else x[0, -1, 2] - r
+        force = hertz_normal_force(_flat_modulus(p), r / 2.0 if problem == "pair_spin" else r, -gap)
+        spin = w[:, -1, 0]
+        # while it still spins at more than a fifth of its start (the elastic start of an EPSD moment, a few steps,
+        # left out with the first twentieth)
+        spinning = (t > 0.05 * t[-1]) & (spin > 0.2 * spin[0])
+        if spinning.sum() < 3:
+            raise ValueError("too few frames of the spinning phase")
+        slope, _ = linear_slope(t[spinning], spin[spinning])
+        closed = spin_deceleration(p["rolling_friction"], force, r, 0.4 * m * r * r)
+        return [_row(problem, "spin_deceleration", closed, -slope)]
     if problem in ("incline_slide", "incline_stick"):
         # the block's centre of mass along the slope, after it has settled on the floor (two fifths of the run)
         along = v[:, :, 0].mean(axis=1)

@@ -8,7 +8,9 @@ from pathlib import Path
 
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.geometry import write_stl
+from siloflow.model.rolling import RollingGeometry, rolling_geometry
 from siloflow.engines.layout import write_text_atomic
+from siloflow.engines.liggghts.rolling import cdt_matrix
 
 #: The engine's registry name (engine.kind), written into every run record.
 ENGINE_NAME = "liggghts"
@@ -67,6 +69,11 @@ def template_spheres(positions, radii) -> list[list[float]]:
     return spheres
 
 
+def particle_rolling(particle) -> RollingGeometry:
+    """The rolling geometry of a particle template (:func:`siloflow.model.rolling.rolling_geometry`)."""
+    return rolling_geometry(particle.sphere_positions, particle.sphere_radii)
+
+
 def flat_matrix(matrix) -> list[float]:
     return [float(value) for row in matrix for value in row]
 
@@ -83,7 +90,8 @@ def common_context(case) -> dict:
             "poisson_ratio": list(table.poisson_ratio),
             "restitution": flat_matrix(table.restitution),
             "sliding_friction": flat_matrix(table.sliding_friction),
-            "rolling_friction": flat_matrix(table.rolling_friction),
+            # the study's coefficients, as LIGGGHTS' CDT gives their torque (siloflow.engines.liggghts.rolling)
+            "rolling_friction": flat_matrix(cdt_matrix(table.rolling_friction, particle_rolling(particle))),
         },
         "switches": {
             "soft_particles": min(moduli) < SOFT_LIMIT,

@@ -38,7 +38,10 @@ from siloflow.engines.layout import RUN_RECORD
 from siloflow.engines.liggghts.contacts import parse_local_table
 from siloflow.engines.liggghts.dumps import list_dumps
 from siloflow.engines.layout import write_text_atomic
-from siloflow.engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix, processor_grid
+from siloflow.engines.liggghts.inputs import (DECK_NAME, ENGINE_NAME, common_context, flat_matrix, particle_rolling,
+                                             processor_grid)
+from siloflow.engines.liggghts.rolling import cdt_matrix
+from siloflow.model.rolling import RollingGeometry
 from siloflow.engines.markers import parse_markers
 from siloflow.engines.liggghts.run import (
     DUMP_PREFIX,
@@ -77,12 +80,13 @@ CONTACT_COLUMNS = (
 )  # fmt: skip
 
 
-def _contact_context(contacts: ContactSet, n_types: int) -> dict:
+def _contact_context(contacts: ContactSet, n_types: int, geometry: RollingGeometry) -> dict:
     return {
         "n_types": n_types,
         "restitution": flat_matrix(contacts.restitution),
         "sliding_friction": flat_matrix(contacts.sliding_friction),
-        "rolling_friction": flat_matrix(contacts.rolling_friction),
+        # the study's coefficients, as LIGGGHTS' CDT gives their torque (siloflow.engines.liggghts.rolling)
+        "rolling_friction": flat_matrix(cdt_matrix(contacts.rolling_friction, geometry)),
     }
 
 
@@ -94,7 +98,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
     """
     context = common_context(case)
     n_types = len(case.materials.names)
-    context["materials"].update(_contact_context(case.fill_contacts, n_types))
+    context["materials"].update(_contact_context(case.fill_contacts, n_types, particle_rolling(case.particle)))
     geometry = case.geometry
     base_type = PLATE_TYPE if geometry.wall_test else RING_TYPE
     meshes = {
@@ -137,7 +141,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
             "title": f"siloflow-jenike-{case.run_id}",
             "boundary": ["f", "f", "f"],
             "domain": {"x": [x0, x1], "y": [y0, y1], "z": [z0, z1]},
-            "test_materials": _contact_context(case.test_contacts, n_types),
+            "test_materials": _contact_context(case.test_contacts, n_types, particle_rolling(case.particle)),
             "shear_plane": geometry.shear_plane,
             "ring_centre": list(geometry.ring_centre),
             "clump_sphere_mass": case.clump_sphere_mass,

@@ -6,17 +6,20 @@ per material pair, and the pair's sliding friction) with Mindlin's rolling momen
 tangential dashpot (``es = 1``), unlike the LIGGGHTS decks: YADE sizes the dashpot with the masses of the two contacting
 spheres, while the mass a tangential force moves at the contact point of a clump is smaller (the clump turns), and at
 the study's restitution 0.1 the dashpot went unstable under the Jenike lid's load (a consolidated sample exploded;
-without it, or at e = 0.5, it did not). A sliding contact has no tangential dashpot in either engine. Rolling:
-an elastic-plastic spring of stiffness ``krot`` capped at ``eta R |Fn|``, with ``eta`` the rolling friction. YADE
-2023.02 has no constant directional torque (CDT), the model of the LIGGGHTS decks; the two agree where rolling is
-fully mobilised (the moment sits at its cap, ``mu_r R |Fn|`` against the rolling direction, in both), and differ
-where it is not: CDT's moment is at its cap as soon as the sphere turns, EPSD's grows with the rolled angle and
-pushes back elastically. ``krot`` is a constant in YADE: it is set to the EPSD rule ``2.25 kn mu_r^2 R^2`` with
-``kn`` the Hertz stiffness of a particle-particle contact carrying one clump's weight. ``eta`` is one number for
-all contacts in YADE, so a case whose contacts have different rolling frictions is refused
-(:func:`rolling_friction`). YADE caps the moment at ``eta`` times the mean of the two reference radii: for a sphere on a
-facet (a mesh wall) the facet's is twice the sphere's, so the cap there is ``1.5 eta r |Fn|`` where CDT's is
-``mu_r r |Fn|``.
+without it, or at e = 0.5, it did not). A sliding contact has no tangential dashpot in either engine.
+
+Rolling: Mindlin's moment is an elastic-plastic spring of stiffness ``krot`` capped at ``eta (refR1 + refR2) / 2
+|Fn|``, along the contact's relative rolling. For two clump spheres the reference radii are the spheres' radii, so
+the cap is ``eta r |Fn|``; the study's torque is ``mu_r R |Fn|`` at the distance R from the contact point to the
+clump's centre of mass (:mod:`siloflow.model.rolling`). ``eta`` is therefore the study's coefficient times the clump's
+mean lever arm over its contact sphere's radius (1.115 for the two-sphere clump, 1 for a sphere). On a facet (a mesh
+wall) YADE's reference radius of the facet is twice the sphere's, so the cap there is 1.5 times the pair's; on a
+``utils.wall`` plane it is the pair's. YADE 2023.02 has no constant directional torque (CDT): its moment reaches the
+cap once the contact has rolled ``cap / krot`` and pushes back elastically before, where the study's (EDEM's CDT)
+sits at the cap as soon as the particle spins. ``krot`` is a constant in YADE: it is set to the EPSD rule
+``2.25 kn eta^2 r^2`` with ``kn`` the Hertz stiffness of a particle-particle contact carrying one clump's weight.
+``eta`` is one number for all contacts in YADE, so a case whose contacts with a particle have different rolling
+frictions is refused (:func:`rolling_friction`).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ import numpy as np
 
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.particles import clump_inertia
+from siloflow.model.rolling import rolling_geometry
 from siloflow.engines.interface import CaseNotSupported
 from siloflow.engines.layout import write_text_atomic
 
@@ -79,10 +83,14 @@ def principal_clump(particle) -> tuple[np.ndarray, np.ndarray]:
 
 def materials_context(case, table, wall_density: float = 1000.0, gravity: float = GRAVITY) -> dict:
     """The materials of ``table``: each material's elastic constants and density, each pair's sliding friction and
-    restitution, and the one rolling law (eta, krot) of its particle contacts, whose stiffness is the Hertz
-    stiffness under a clump's weight at ``gravity`` (m/s^2)."""
+    restitution, and the one rolling law (eta, krot) of its particle contacts: eta the study's coefficient times the
+    clump's lever arm over its contact sphere's radius, the stiffness the EPSD rule at the Hertz stiffness under a
+    clump's weight at ``gravity`` (m/s^2)."""
     particle = case.particle
-    rolling = rolling_friction(table, f"run {case.run_id}")
+    # the study's coefficient, as Mindlin's cap eta r |Fn| (r the contact sphere's radius) gives its torque
+    # mu_r R |Fn| at the clump's mean lever arm R (siloflow.model.rolling)
+    geometry = rolling_geometry(particle.sphere_positions, particle.sphere_radii)
+    rolling = rolling_friction(table, f"run {case.run_id}") * geometry.ratio
     radius = float(particle.sphere_radii.min())
     kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * gravity)
     n = len(table.names)

@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 from siloflow.model.cases.particles import ParticleTemplate
+from siloflow.model.rolling import ROLLING_LAW
 from siloflow.model.cases.physics import check_steps, free_fall_time, free_fall_velocity, steps_for
 
 
@@ -213,8 +214,10 @@ def defining_settle(settle: dict, threshold: float) -> dict:
 
 
 def run_id(prefix: str, parameters: dict) -> str:
-    """Stable run directory name: ``<prefix>-<first 10 hex digits of sha256 of canonical JSON>``."""
-    canonical = json.dumps(parameters, sort_keys=True, separators=(",", ":"))
+    """Stable run directory name: ``<prefix>-<first 10 hex digits of sha256 of canonical JSON>`` of ``parameters``
+    and the rolling law the engines are given (:data:`siloflow.model.rolling.ROLLING_LAW`): a run made under another
+    law is another run."""
+    canonical = json.dumps({**parameters, "rolling_law": ROLLING_LAW}, sort_keys=True, separators=(",", ":"))
     return f"{prefix}-{hashlib.sha256(canonical.encode()).hexdigest()[:10]}"
 
 

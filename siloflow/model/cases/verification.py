@@ -13,6 +13,11 @@ two free spheres of the study's HDPE, a flat floor (or none) and gravity (or non
   rolls at 5/7 of its speed, at t = 2 v0 / (7 mu g) (no rolling resistance).
 - ``rolling``: a sphere rolls on the floor without slip: rolling resistance slows it; for a constant directional
   torque (CDT) at (5/7) mu_r g.
+- ``pair_spin``, ``wall_spin``: a sphere held in place (its translation blocked, its rotation free) presses on a fixed
+  sphere, or on the floor, at a set overlap, without gravity or sliding friction, and spins about an axis across the
+  contact normal: the study's rolling torque ``mu_r |Fn| R`` (R = r for a sphere, :mod:`siloflow.model.rolling`)
+  decelerates its spin at ``mu_r |Fn| r / I``, ``|Fn|`` Hertz's force at the overlap. The pair contact is the one the
+  clumps of every case make; the wall contact shows the engines' mapping keeps the wall's torque.
 - ``incline_slide``, ``incline_stick``: a block (four spheres in a square, 3 r apart) on the floor under gravity
   tilted by 30 and 15 degrees: above the friction angle (tan 30 deg > mu) it slides at g (sin theta - mu cos theta),
   below it stays put.
@@ -35,20 +40,31 @@ from siloflow.model.cases.common import run_id
 from siloflow.model.cases.particles import clump_inertia, clump_volume
 from siloflow.model.cases.stages import Stage
 
-__all__ = ["MATERIAL", "PROBLEMS", "VerificationCase", "VerificationSphere", "verification_cases"]
+__all__ = ["MATERIAL", "PROBLEMS", "FREE", "HELD", "FIXED", "SPIN_OVERLAP", "VerificationCase", "VerificationSphere",
+           "verification_cases"]
 
 #: The study's HDPE pellet material and its contacts (E [Pa], nu, density [kg/m3], mu, mu_r, e), one sphere size.
 MATERIAL = {"youngs_modulus": 5.0e6, "poisson_ratio": 0.4, "density": 950.0, "radius": 1.5e-3}
 GRAVITY = 9.81
 
 
+#: How a sphere moves: freely, with its translation blocked (it still turns), or not at all.
+FREE, HELD, FIXED = "free", "held", "fixed"
+
+
 @dataclass(frozen=True)
 class VerificationSphere:
-    """A free sphere: centre [m], velocity [m/s], angular velocity [rad/s]."""
+    """A sphere: centre [m], velocity [m/s], angular velocity [rad/s] and how it moves (:data:`FREE`,
+    :data:`HELD`: translation blocked, or :data:`FIXED`)."""
 
     position: tuple[float, float, float]
     velocity: tuple[float, float, float]
     angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    motion: str = FREE
+
+    def __post_init__(self):
+        if self.motion not in (FREE, HELD, FIXED):
+            raise ValueError(f"motion must be {FREE!r}, {HELD!r} or {FIXED!r}, got {self.motion!r}")
 
 
 @dataclass(frozen=True)
@@ -122,7 +138,12 @@ PROBLEMS = {
     "incline_slide": {"angle_deg": 30.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "incline_stick": {"angle_deg": 15.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
     "clump_rotation": {"speed": 100.0, "restitution": 0.5, "sliding_friction": 0.35, "rolling_friction": 0.0},
+    # spin [rad/s]; no sliding friction, so that the rolling torque alone acts on the spin
+    "pair_spin": {"speed": 50.0, "restitution": 0.5, "sliding_friction": 0.0, "rolling_friction": 0.1},
+    "wall_spin": {"speed": 50.0, "restitution": 0.5, "sliding_friction": 0.0, "rolling_friction": 0.1},
 }
+#: The overlap of the spin problems' contact, as a fraction of the radius: about four times the weight's (-).
+SPIN_OVERLAP = 0.002
 #: The study's two-sphere clump: centres along x, 0.75 mm apart.
 CLUMP_HALF_SPACING = 0.375e-3
 
@@ -170,6 +191,18 @@ def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCa
     mu_r = PROBLEMS["rolling"]["rolling_friction"]
     case("rolling", [VerificationSphere((0.0, 0.0, r), (v, 0.0, 0.0), (0.0, v / r, 0.0))], True,
          (0.0, 0.0, -GRAVITY), resting, 0.8 * v / (5.0 / 7.0 * mu_r * GRAVITY))
+    # a sphere held above a fixed one (or the floor) at the set overlap, spinning about x across the normal z; the run
+    # lasts 0.8 of the time the closed form stops it in
+    inertia = 0.4 * mass * r * r
+    for name, floor, reduced in (("pair_spin", False, r / 2.0), ("wall_spin", True, r)):
+        spin = PROBLEMS[name]["speed"]
+        overlap = SPIN_OVERLAP * r
+        force = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu**2)) * math.sqrt(reduced) * overlap**1.5
+        stop = spin * inertia / (PROBLEMS[name]["rolling_friction"] * force * r)
+        held = VerificationSphere((0.0, 0.0, (2.0 * r if not floor else r) - overlap), (0.0, 0.0, 0.0),
+                                  (spin, 0.0, 0.0), HELD)
+        spheres = [held] if floor else [VerificationSphere((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), motion=FIXED), held]
+        case(name, spheres, floor, (0.0, 0.0, 0.0), resting, 0.8 * stop)
     # a free clump spinning at 100 rad/s about an axis 30 degrees off its long axis (no contacts: the time step only
     # resolves the rotation, 2000 steps a turn)
     centres = np.array([[-CLUMP_HALF_SPACING, 0.0, 0.0], [CLUMP_HALF_SPACING, 0.0, 0.0]])

@@ -29,6 +29,11 @@ VERIFICATION_EXPLANATIONS = {
                      "g sin 15.",
     "clump_rotation": "The two-sphere clump spins freely at 100 rad/s, 30 degrees off its long axis: the axis precesses "
                       "about the angular momentum L at |L| / I_perp, with the inertia of the union of the spheres.",
+    "pair_spin": "A sphere held in place presses on a fixed sphere at an overlap of 0.002 r and spins at 50 rad/s "
+                 "across the normal, without sliding friction: the study's rolling torque mu_r |Fn| r (mu_r = 0.1, "
+                 "|Fn| Hertz's at the overlap) slows its spin at mu_r |Fn| r / I. The contact every clump makes; "
+                 "LIGGGHTS' CDT gets the mapped coefficient 2 mu_r (docs/engines.md, The rolling law).",
+    "wall_spin": "The same sphere on the floor: the wall's torque mu_r |Fn| r, with LIGGGHTS' coefficient mu_r.",
 }
 
 #: Rows that differ on an engine, and why ("<engine>/<problem>/<quantity>"): the report says it beside the row.
@@ -36,6 +41,9 @@ VERIFICATION_KNOWN_DIFFERENCES = {
     "yade/wall_impact/contact_time": "YADE's sphere-wall geometry (Ig2_Wall_Sphere_ScGeom) gives both radii as r, so "
     "Hertz-Mindlin takes R* = r/2 as for two spheres instead of r for a flat: a softer contact that lasts 2^(1/5) = "
     "1.149 times the flat's. Every sphere-wall contact on YADE is softer than on LIGGGHTS in the same way.",
+    "yade/wall_spin/spin_deceleration": "YADE's sphere-wall geometry takes R* = r/2 (see wall_impact): at the same "
+    "overlap its normal force is 2^(-1/2) = 0.707 of a flat's, and the rolling moment, capped at eta r |Fn| as on a "
+    "pair, with it.",
 }
 
 
