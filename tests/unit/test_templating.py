@@ -168,3 +168,21 @@ def test_a_one_sphere_template_gets_a_concentric_inner_sphere_and_others_are_as_
     assert INNER_SPHERE_FRACTION == 0.01
     two = template_spheres([(0.0, 0.0, -0.001), (0.0, 0.0, 0.001)], [0.0015, 0.0015])
     assert two == [[0.0, 0.0, -0.001, 0.0015], [0.0, 0.0, 0.001, 0.0015]]
+
+
+def test_a_silo_poured_at_its_own_friction_switches_to_the_run_s_contacts_before_the_outlet_opens():
+    raw = load_config(GOLDEN / "silo_flat_config.yaml")
+    raw["silo_flat"].setdefault("fill", {})["sliding_friction"] = 0.15
+    case = build_silo_case(validate_config(raw))
+    assert case.fill_materials.sliding_friction[0][0] == 0.15
+    assert case.fill_materials.sliding_friction[0][1:] == case.materials.sliding_friction[0][1:]
+    assert case.fill_materials.rolling_friction == case.materials.rolling_friction
+    assert case.run_id != _golden_case().run_id and _golden_case().fill_materials is None
+    deck = render_silo_deck(case)
+    friction = [line for line in deck.splitlines() if line.startswith("fix material_friction all property/global")]
+    # the run's at the top (as every deck), the fill's before the pour, the run's again before the outlet opens
+    run, fill, again = friction
+    assert fill.split()[7] == "0.15" and run.split()[7] == again.split()[7] != "0.15"
+    assert deck.index(fill) < deck.index("fix pour all insert/rate/region") < deck.index(again, deck.index(fill) + 1) \
+        < deck.index("unfix floor_wall")
+    assert "fix material_friction" not in render_silo_deck(_golden_case()).split("fix pour")[1]

@@ -309,3 +309,17 @@ def test_measured_work_skips_markers_with_unusable_timing(tmp_path):
     log.write_text("SILOFLOW filled cpu_s=10.0 sphere_steps=1000000\nSILOFLOW opened cpu_s=nan sphere_steps=4000000\n"
                    "SILOFLOW settled cpu_s=12.0 sphere_steps=-1\n")
     assert measured_work([log]) == MeasuredWork(10.0, 1e6)
+
+
+def test_a_silo_poured_at_its_own_friction_switches_to_the_run_s_contacts_before_the_gate_goes():
+    raw = _raw_golden()
+    raw["silo_flat"].setdefault("fill", {})["sliding_friction"] = 0.15
+    script = render_silo_script(build_silo_case(validate_config(raw)))
+    ast.parse(script)
+    fill_pairs = next(line for line in script.splitlines() if line.startswith("FILL_PAIRS = "))
+    assert fill_pairs.startswith("FILL_PAIRS = [(0, 0, 0.15, ")
+    assert script.index("set_engines(MATERIAL_IDS, FILL_PAIRS)") < script.index("use_contacts(MATERIAL_IDS, PAIRS, "
+                                                                                "ROLLING_FRICTION, ROLLING_STIFFNESS)") \
+        < script.index("# --- open the outlet")
+    plain = render_silo_script(_golden_case())
+    assert "FILL_PAIRS" not in plain and "use_contacts(" not in plain.split("def use_contacts")[1].split("\n\n\n", 1)[1]

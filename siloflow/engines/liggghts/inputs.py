@@ -78,6 +78,18 @@ def flat_matrix(matrix) -> list[float]:
     return [float(value) for row in matrix for value in row]
 
 
+def contact_coefficients(table, particle) -> dict:
+    """The per-type-pair contact coefficients of ``table`` as the deck's ``contact_coefficients`` macro takes them:
+    restitution, sliding friction, and the rolling friction as LIGGGHTS' CDT gives the study's torque for
+    ``particle`` (:mod:`siloflow.engines.liggghts.rolling`)."""
+    return {
+        "n_types": len(table.names),
+        "restitution": flat_matrix(table.restitution),
+        "sliding_friction": flat_matrix(table.sliding_friction),
+        "rolling_friction": flat_matrix(cdt_matrix(table.rolling_friction, particle_rolling(particle))),
+    }
+
+
 def common_context(case) -> dict:
     table = case.materials
     moduli = table.youngs_modulus
@@ -85,13 +97,9 @@ def common_context(case) -> dict:
     spheres = template_spheres(particle.sphere_positions, particle.sphere_radii)
     return {
         "materials": {
-            "n_types": len(table.names),
             "youngs_modulus": list(moduli),
             "poisson_ratio": list(table.poisson_ratio),
-            "restitution": flat_matrix(table.restitution),
-            "sliding_friction": flat_matrix(table.sliding_friction),
-            # the study's coefficients, as LIGGGHTS' CDT gives their torque (siloflow.engines.liggghts.rolling)
-            "rolling_friction": flat_matrix(cdt_matrix(table.rolling_friction, particle_rolling(particle))),
+            **contact_coefficients(table, particle),
         },
         "switches": {
             "soft_particles": min(moduli) < SOFT_LIMIT,

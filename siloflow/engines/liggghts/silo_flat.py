@@ -10,7 +10,8 @@ import numpy as np
 from siloflow.model.record import RunRecord
 from siloflow.model.cases.silo_flat import SiloCase, silo_meshes
 from siloflow.engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
-from siloflow.engines.liggghts.inputs import ENGINE_NAME, common_context, processor_grid, write_case_inputs
+from siloflow.engines.liggghts.inputs import (ENGINE_NAME, common_context, contact_coefficients, processor_grid,
+                                             write_case_inputs)
 from siloflow.engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
 from siloflow.engines.liggghts.run import WALL_FORCES_NAME
 from siloflow.engines.liggghts.run import (
@@ -38,6 +39,9 @@ def silo_deck_context(case: SiloCase) -> dict:
     front_back_type = table.type_of(case.wall_materials["front_back"]) if case.front_back_walls else None
     half_width = 0.5 * case.width
     context = common_context(case)
+    # poured and settled at the fill's contacts, the run's switched on before the outlet opens
+    context["fill_materials"] = (contact_coefficients(case.fill_materials, case.particle)
+                                 if case.fill_materials is not None else None)
     dump_every = case.dump_every
     context.update(
         {

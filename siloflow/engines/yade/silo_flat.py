@@ -15,7 +15,7 @@ from siloflow.engines.interface import CaseNotSupported
 from siloflow.engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from siloflow.engines.templating import render_deck
 from siloflow.engines.yade.inputs import (
-    ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, rolling_friction, write_script_inputs,
+    ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, materials_context, rolling_friction, write_script_inputs,
 )
 from siloflow.engines.yade.run import (
     DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
@@ -50,6 +50,10 @@ def silo_script_context(case: SiloCase, gravity: float = GRAVITY) -> dict:
     side, bottom, front_back = (table.type_of(case.wall_materials[key]) - 1 for key in ("side", "bottom", "front_back"))
     half_width = 0.5 * case.width
     context = common_context(case, table, gravity=gravity)
+    # poured and settled at the fill's contacts (their pairs; its rolling law is the run's), the run's switched on
+    # before the outlet opens
+    fill = case.fill_materials
+    context["fill_pairs"] = (materials_context(case, fill, gravity=gravity)["pairs"] if fill is not None else None)
     context.update({
         "title": f"siloflow-silo_flat-{case.run_id}",
         "exploded_speed": exploded_speed(case.domain_top + case.sink_depth, case.fill.insertion_velocity),

@@ -9,6 +9,7 @@ from pathlib import Path
 from siloflow.model.constants import GRAVITY
 from siloflow.model.record import RunRecord
 from siloflow.model.cases.verification import VerificationCase
+from siloflow.model.rolling import rolling_geometry
 from siloflow.engines.templating import render_deck
 from siloflow.engines.verification_checks import check_verification_run, verification_record
 from siloflow.engines.yade.inputs import ENGINE_NAME, hertz_stiffness_at_load, write_script_inputs
@@ -19,6 +20,8 @@ def verification_script_context(case: VerificationCase) -> dict:
     """The rendering context of ``siloflow/templates/yade/verification.py.j2``."""
     material = {"youngs_modulus": case.youngs_modulus, "poisson_ratio": case.poisson_ratio, "density": case.density}
     kn = hertz_stiffness_at_load(case.radius, case.youngs_modulus, case.poisson_ratio, case.mass * GRAVITY)
+    centres = case.clump_spheres or ((0.0, 0.0, 0.0),)
+    eta = case.rolling_friction * rolling_geometry(centres, [case.radius] * len(centres)).ratio
     return {
         "title": f"siloflow-verification-{case.run_id}",
         "timestep": case.timestep,
@@ -28,8 +31,10 @@ def verification_script_context(case: VerificationCase) -> dict:
             "list": [material, material],
             "pairs": [{"i": i, "j": j, "sliding_friction": case.sliding_friction, "restitution": case.restitution}
                       for i, j in ((0, 0), (0, 1), (1, 1))],
-            "rolling_friction": case.rolling_friction,
-            "rolling_stiffness": 2.25 * kn * case.rolling_friction**2 * case.radius**2,
+            # the study's coefficient, as Mindlin's cap eta r |Fn| gives its torque at the particle's mean lever arm
+            # (siloflow.engines.yade.inputs)
+            "rolling_friction": eta,
+            "rolling_stiffness": 2.25 * kn * eta**2 * case.radius**2,
         },
         "radius": case.radius,
         "spheres": [asdict(sphere) for sphere in case.spheres],

@@ -40,8 +40,8 @@ from siloflow.model.cases.particles import model_parameters, particle_template
 from siloflow.model.cases.physics import engine_seeds, free_fall_velocity, stable_timestep, steps_for
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.common import (
-    MaterialTable, SettleCriterion, clump_energy_scale, defining_settle, engine_kind, largest_impact_velocity, material_table,
-    plan_fill, run_id, without_fill_checks,
+    MaterialTable, SettleCriterion, clump_energy_scale, defining_settle, engine_kind, fill_table, largest_impact_velocity,
+    material_table, plan_fill, run_id, without_fill_checks,
 )
 from siloflow.model.cases.silo_flat import SiloCase
 
@@ -337,6 +337,7 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         domain_top=domain_top,
         seeds=tuple(engine_seeds(blender["seed"], 3)),
         defining_parameters=defining,
+        fill_materials=fill_table(table, blender["fill"]),
     )
     return BlenderCase(
         configuration=configuration,

@@ -6,6 +6,7 @@ engine is the engine's business.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -44,6 +45,19 @@ class MaterialTable:
 
 
 NEUTRAL_CONTACT = {"sliding_friction": 0.0, "rolling_friction": 0.0, "restitution": 0.5}
+
+
+def fill_table(table: MaterialTable, fill: dict) -> MaterialTable | None:
+    """The contacts a silo is poured and settled with: ``table`` with the particle-particle sliding friction of
+    ``fill["sliding_friction"]`` (-), or None when that is null (the run's own contacts throughout). The study packs its
+    silo at 0.15 and switches to the run's frictions afterwards (thesis §5.3); whether it changed other contacts
+    while filling it does not say, so they stay the run's."""
+    friction = fill.get("sliding_friction")
+    if friction is None:
+        return None
+    rows = [list(row) for row in table.sliding_friction]
+    rows[0][0] = float(friction)
+    return dataclasses.replace(table, sliding_friction=tuple(tuple(row) for row in rows))
 
 
 def material_table(config: dict, particle_material: str, wall_materials: list[str]) -> MaterialTable:

@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, field
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.common import (
     FillPlan, MaterialTable, SettleCriterion, defining_settle, engine_kind, fill_zone, largest_impact_velocity,
-    material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
+    fill_table, material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
 )
 from siloflow.model.cases.geometry import horizontal_rectangle
 from siloflow.model.cases.particles import ParticleTemplate, model_parameters, particle_template
@@ -58,6 +58,9 @@ class SiloCase(ChosenTimestep):
     domain_top: float
     seeds: tuple[int, ...]
     defining_parameters: dict = field(repr=False)
+    #: the contacts it is poured and settled with, where they differ from ``materials``
+    #: (:func:`siloflow.model.cases.common.fill_table`); the run's are switched on before the outlet opens
+    fill_materials: MaterialTable | None = None
 
     @property
     def settle_threshold(self) -> float:
@@ -218,6 +221,7 @@ def silo_case_from_section(config: dict, silo: dict, section: str, reentry_veloc
         domain_top=domain_top,
         seeds=tuple(engine_seeds(silo["seed"], 3)),
         defining_parameters=defining,
+        fill_materials=fill_table(table, silo["fill"]),
     )
 
 
