@@ -222,7 +222,7 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
-                       verdicts, UNMADE)
+                       verdicts, UNMADE, {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)})
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.

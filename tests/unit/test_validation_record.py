@@ -227,6 +227,10 @@ def test_the_page_renders_status_runs_rows_and_both_verdicts():
     assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | - | - | - |" in text
     assert "runs this group in about" not in text  # no row of these groups is off the study's scale
     assert "![profiles.png](silo/profiles.png)" in lines
+    # a configuration that plans none of a group's recorded runs: the estimate of those it plans, said to be others
+    others = record_page(groups, status, {}, wall, 2, "config/validation.yaml", "config/thesis.yaml",
+                         planned_core_s={"silo": 7200.0})
+    assert "| silo | stale | 3 | 2.50 h | 2.00 h for the runs now planned, none recorded |" in others
     # with the findings' summary: it says which groups' rows are not those the configuration and the row code make
     summary = record_page(groups, status, {}, wall, 2, "config/validation.yaml", "config/thesis.yaml", verdicts={})
     assert ("Not complete against `config/validation.yaml` and today's row code: calibration, silo (see [The "

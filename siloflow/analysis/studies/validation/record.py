@@ -144,12 +144,13 @@ def _attempts_sentence(runs: Sequence[Mapping]) -> str:
     return " ".join(sentences)
 
 
-def _estimated(made: Sequence[Mapping], estimates: Mapping[str, float]) -> str:
+def _estimated(made: Sequence[Mapping], estimates: Mapping[str, float], planned: float = math.nan) -> str:
     """The cost model's estimate of a group's recorded runs beside their recorded core time: like with like, over the
-    recorded runs the configuration still plans (a run whose id changed is another run); "-" when it plans none."""
+    recorded runs the configuration still plans (a run whose id changed is another run). When it plans none of them,
+    the estimate of the runs it plans instead (``planned``, CPU s), said to be of other runs; "-" without either."""
     held = [run for run in made if run["run_id"] in estimates]
     if not held:
-        return "-"
+        return "-" if not math.isfinite(planned) else f"{_hours(planned)} for the runs now planned, none recorded"
     estimate = math.fsum(estimates[run["run_id"]] for run in held)
     recorded = math.fsum(run_wall_time(run) * int(run["cores"]) for run in held)
     shown = f"{_hours(estimate)} ({estimate / recorded:.2f})" if recorded > 0 else _hours(estimate)
@@ -276,7 +277,8 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None,
                 estimated_core_s: Mapping[str, float] | None = None,
-                verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None) -> str:
+                verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None,
+                planned_core_s: Mapping[str, float] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows with their two verdicts, and for the rows not at the study's scale, what the study's scale
     costs.
@@ -309,6 +311,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         :func:`findings_section`.
     unmade : mapping, optional
         ``{part id: why no row measures it}`` for that summary.
+    planned_core_s : mapping, optional
+        ``{group: CPU s}`` of the runs ``config_name`` plans for each group, shown where it plans none of the recorded
+        runs.
 
     Returns
     -------
@@ -347,7 +352,7 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         judged = sum(row["finding"] != NO_FINDING for row in record.rows)
         shown = sum(row["scale"] == AT_SCALE for row in record.rows)
         wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
-        estimated = _estimated(made, estimated_core_s or {})
+        estimated = _estimated(made, estimated_core_s or {}, (planned_core_s or {}).get(name, math.nan))
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | {estimated} | "
                      f"{wall if made else '-'} | {len(record.rows)} | {judged} | {shown} |")
     for name, state in status.items():
