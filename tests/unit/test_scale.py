@@ -28,6 +28,9 @@ AT_STUDY_SCALE = {
     "blender": {"width": 0.45, "depth": 0.04, "vertical_height": 1.5, "hopper_half_angle": 30.0, "outlet_width": 0.04,
                 "tube_width": 0.04, "fill_height": 1.125, "wall_thickness": 0.005},
     "jenike": {"cell": {"inner_diameter": 0.095}, "sweep": {"shapes": ["sphere", "sphere2", "sphere4"]}},
+    # the study's G = 1e8 Pa as Young's modulus (§4.2)
+    "materials": {**validate_config({})["materials"],
+                  "hdpe": {"youngs_modulus": 2.8e8, "poisson_ratio": 0.4, "density": 950.0}},
 }
 SHRINK = 0.85
 D = STUDY_PARTICLE_DIAMETER
@@ -98,6 +101,14 @@ SHRUNK = [
     (_shrink("jenike", "cell", "inner_diameter"), "jenike", "C1", "cell_diameter", 0.08075, SHRINK, 0.08075 / SPHERE,
      None),
     (_shrink("jenike", "cell", "inner_diameter"), "jenike", "C7", "cell_diameter", 0.08075, SHRINK, 0.08075 / D, None),
+    # the tier's soft particles: the Jenike cell's bulk friction and the fills' densities move with the stiffness,
+    # the flow rate and the residence time do not (docs/validation.md, Stiffness)
+    (lambda raw: raw["materials"]["hdpe"].update(youngs_modulus=5e6), "jenike", "C2", "youngs_modulus", 5e6,
+     5e6 / 2.8e8, None, None),
+    (lambda raw: raw["materials"]["hdpe"].update(youngs_modulus=5e6), "silo_flat", "S2", "youngs_modulus", 5e6,
+     5e6 / 2.8e8, None, "S3"),
+    (lambda raw: raw["materials"]["hdpe"].update(youngs_modulus=5e6), "silo_recirculation", "B1", "youngs_modulus",
+     5e6, 5e6 / 2.8e8, None, "B7"),
 ]
 
 
@@ -122,7 +133,7 @@ def test_a_shrunk_dimension_is_named_with_its_ratio_and_diameters(change, kind, 
     else:
         assert difference.run_diameters == pytest.approx(diameters, rel=1e-9)
     assert difference.reason
-    assert f"{difference.ratio:.2g} of the study's" in verdict.text and name.replace("_", " ") in verdict.text
+    assert f"{difference.ratio:.2g} of the study's" in verdict.text and difference.label in verdict.text
     if unaffected is not None:
         other = scale_verdict(unaffected, kind, config, True)
         assert other.at_study_scale, other.text

@@ -185,7 +185,7 @@ def _hours(seconds: float) -> str:
 def _difference_brief(difference) -> str:
     """A dimension that differs, in a table cell: its ratio to the study's, and its particle diameters where a floor in
     particle diameters bears on it (``fill height 0.37``, ``depth 0.31, 3.8 particle diameters``)."""
-    brief = f"{difference.name.replace('_', ' ')} {difference.ratio:.2g}"
+    brief = f"{difference.label} {difference.ratio:.2g}"
     if difference.run_diameters is not None and "particle diameters" in difference.threshold:
         brief += f", {difference.run_diameters:.1f} particle diameters"
     return brief

@@ -65,18 +65,23 @@ def _study_bed(insert: str) -> float:
     return _STUDY_BLENDER_FILL - _top_of_internals(blender_geometry(**_STUDY_BLENDER, insert=insert))
 
 
+#: The study's particle stiffness: its material input 1e8 Pa is EDEM's shear modulus (its quoted Rayleigh time only
+#: follows from G = 1e8 Pa), Young's modulus 2 (1 + 0.4) 1e8 = 2.8e8 Pa (§4.2, METHODS §1).
+_STIFFNESS = StudyDimension(2.8e8, "§4.2", "Pa", "Young's modulus from the study's shear modulus 1e8 Pa")
 _SILO = {"width": StudyDimension(0.15, "§5.2"), "depth": StudyDimension(0.04, "§5.2"),
          "fill_height": StudyDimension(0.27, "§6.2.2", note="the DEM fill (the experiment's 280-300 mm, §5.2)"),
          "outlet": StudyDimension(0.04, "§5.2"),
          "particle_diameter": StudyDimension(STUDY_PARTICLE_DIAMETER, "§4.2, §4.6"),
-         "particle_count": StudyDimension(53492, "§5.3", "clumps", "at the end of filling")}
+         "particle_count": StudyDimension(53492, "§5.3", "clumps", "at the end of filling"),
+         "youngs_modulus": _STIFFNESS}
 #: The study's dimensions per case kind.
 STUDY: Mapping[str, Mapping[str, StudyDimension]] = MappingProxyType({
     "jenike": MappingProxyType({
         "cell_diameter": StudyDimension(0.095, "§4.3, §4.3.1.1", note="13 mm bottom and 16 mm shear ring"),
         "particle_count": StudyDimension(6589, "§4.3.1.3", "clumps",
                                          "two-sphere clumps (sphere 4085, four-sphere 5513); not judged: it follows "
-                                         "from the cell, its rings and the shape's packing")}),
+                                         "from the cell, its rings and the shape's packing"),
+        "youngs_modulus": _STIFFNESS}),
     "silo_flat": MappingProxyType(dict(_SILO)),
     "silo_recirculation": MappingProxyType({
         **_SILO, "depth": StudyDimension(0.04, "§6.2.2", note="implied: the ch. 5 silo"),
@@ -111,6 +116,9 @@ REASONS: Mapping[str, str] = MappingProxyType({
     "bed_above_insert": "the head above the insert and the tube inlet sets the flow entering the passages",
     "particle_count": "the VRR and the RTD count particles in outlet samples and tracers: fewer, more counting noise",
     "particle_diameter": "B, Beverloo's empty annulus and every wall layer scale with the particle size",
+    "youngs_modulus": "the contact stiffness sets the overlaps and the packing: E = 5e6 Pa against the study's "
+                      "2.8e8 Pa moved the Jenike cell's bulk friction and the fills' densities beyond their errors "
+                      "(docs/validation.md, Stiffness); the flow rates and the residence time it did not",
 })
 #: The diameter floor (a key of the ``validation`` section) of each dimension that has one.
 FLOORS: Mapping[str, str] = MappingProxyType({"depth": "min_depth_diameters", "outlet": "min_outlet_diameters",
@@ -132,7 +140,7 @@ class FindingScale:
 
 
 _ALL_SHAPES, _CLUMP = ("sphere", "sphere2", "sphere4"), ("sphere2",)
-_CELL = ("cell_diameter",)
+_CELL = ("cell_diameter", "youngs_modulus")
 _SILO_ALL = ("width", "depth", "fill_height", "outlet", "particle_diameter")
 _VRR = _SILO_ALL + ("particle_count",)
 _RTD = _VRR + ("channel_length",)
@@ -158,7 +166,8 @@ FINDING_SCALES: Mapping[str, FindingScale] = MappingProxyType({
     "S1": FindingScale("silo_flat", ("width", "depth", "fill_height", "particle_diameter"), "vertical stress at the "
                        "end of filling averaged over the cross-section against depth, against Janssen with the active "
                        "K and eq. 5.4's z_c (§5.4.1)"),
-    "S2": FindingScale("silo_flat", ("depth", "particle_diameter"), "total particle mass over the filled volume of "
+    "S2": FindingScale("silo_flat", ("depth", "particle_diameter", "youngs_modulus"), "total particle mass over the "
+                       "filled volume of "
                        "the settled fill (§5.4.2)"),
     "S3": FindingScale("silo_flat", ("width", "depth", "outlet", "particle_diameter"), "time-averaged mass and "
                        "volumetric flow rates of the discharge (§5.4.2)"),
@@ -169,7 +178,8 @@ FINDING_SCALES: Mapping[str, FindingScale] = MappingProxyType({
                        "profile at Z = 20, 40, 80 and 120 mm (§5.4.3.4)"),
     "S6": FindingScale("silo_flat", _SILO_ALL, "stress at the end of filling and Z = 120 mm profiles (t = 0.5-0.7 s) "
                        "at front/back wall friction 0 to 1 (§5.5)"),
-    "B1": FindingScale("silo_recirculation", _SILO_ALL, "bulk density of the fill while it recirculates against the "
+    "B1": FindingScale("silo_recirculation", _SILO_ALL + ("youngs_modulus",), "bulk density of the fill while it "
+                       "recirculates against the "
                        "settled fill's, per flow pattern (§6.3.1)"),
     "B2": FindingScale("silo_recirculation", _VRR, f"{_VRR_TEXT}, at Nr = 0 to 4 (§6.4.1, §6.4.2)"),
     "B3": FindingScale("silo_recirculation", _VRR, f"{_VRR_TEXT}, batches of 13, 25 and 50 % (§6.4, §6.4.2)"),
@@ -221,7 +231,7 @@ class DimensionDifference:
     name : str
         The dimension (a key of :data:`STUDY`).
     run_m, study_m : float
-        The run's and the study's value, in m (the particle count: in clumps).
+        The run's and the study's value, in m (the particle count: in clumps; Young's modulus: in Pa).
     ratio : float
         run_m / study_m (-).
     run_diameters : float or None
@@ -241,11 +251,18 @@ class DimensionDifference:
     reason: str
 
     @property
+    def label(self) -> str:
+        """The dimension as a reader names it (``fill height``, ``Young's modulus``)."""
+        return "Young's modulus" if self.name == "youngs_modulus" else self.name.replace("_", " ")
+
+    @property
     def text(self) -> str:
         """E.g. ``depth 12.5 mm = 0.31 of the study's 40 mm (3.8 particle diameters; at least 0.9 of the study's)``."""
-        label = self.name.replace("_", " ")
+        label = self.label
         if self.name == "particle_count":
             run, study = f"{self.run_m:.0f}", f"{self.study_m:.0f}"
+        elif self.name == "youngs_modulus":
+            run, study = f"{self.run_m:.3g} Pa", f"{self.study_m:.3g} Pa"
         else:
             run, study = f"{self.run_m * 1000:.4g} mm", f"{self.study_m * 1000:.4g} mm"
         diameters = "" if self.run_diameters is None else f"{self.run_diameters:.1f} particle diameters; "
@@ -287,6 +304,11 @@ def _particle(config: Mapping, section: Mapping, model: str | None = None):
                              config["materials"][section["particle_material"]]["density"])
 
 
+def _modulus(config: Mapping, section: Mapping) -> float:
+    """The particle material's Young's modulus (Pa) as configured."""
+    return float(config["materials"][section["particle_material"]]["youngs_modulus"])
+
+
 def _silo_values(width, depth, fill_height, outlet, particle, count) -> dict[str, float]:
     return {"width": width, "depth": depth, "fill_height": fill_height, "outlet": outlet,
             "particle_diameter": particle.equivalent_diameter, "particle_count": float(count)}
@@ -301,12 +323,14 @@ def _run_values(kind: str, source, finding: FindingScale) -> tuple[dict[str, flo
             swept = jenike["sweep"]["shapes"]
             shapes = [shape for shape in finding.shapes if shape in swept] or list(swept)
             diameter = max(_particle(source, jenike, shape).equivalent_diameter for shape in shapes)
-            return {"cell_diameter": float(jenike["cell"]["inner_diameter"])}, diameter
+            return {"cell_diameter": float(jenike["cell"]["inner_diameter"]),
+                    "youngs_modulus": _modulus(source, jenike)}, diameter
         section = source[kind]
         particle = _particle(source, section)
         width, depth, fill = section["width"], section["depth"], section["fill_height"]
         count = round(section["fill"]["bulk_density_estimate"] * width * depth * fill / particle.mass)
         values = _silo_values(width, depth, fill, section["outlet_width"], particle, count)
+        values["youngs_modulus"] = _modulus(source, section)
         if kind == "silo_recirculation":
             values["channel_length"] = section["channel_length"]
         elif kind == "blender":
@@ -314,10 +338,12 @@ def _run_values(kind: str, source, finding: FindingScale) -> tuple[dict[str, flo
             values.update(tube_width=section["tube_width"], bed_above_insert=fill - max(tops))
         return values, particle.equivalent_diameter
     if kind == "jenike":
-        return {"cell_diameter": 2.0 * source.geometry.inner_radius}, source.particle.equivalent_diameter
+        return ({"cell_diameter": 2.0 * source.geometry.inner_radius,
+                 "youngs_modulus": float(source.materials.youngs_modulus[0])}, source.particle.equivalent_diameter)
     silo = source if kind == "silo_flat" else source.silo
     values = _silo_values(silo.width, silo.depth, silo.fill_height, silo.outlet_width, silo.particle,
                           silo.fill.n_clumps)
+    values["youngs_modulus"] = float(silo.materials.youngs_modulus[0])
     if kind == "silo_recirculation":
         values["channel_length"] = source.channel_length
     elif kind == "blender":
@@ -341,7 +367,7 @@ def _difference(name: str, run: float, study: float, diameter: float,
         failed.append(f"at least {thresholds.min_dimension_ratio:g} of the study's")
     if ratio > thresholds.max_dimension_ratio and name != "particle_count":
         failed.append(f"at most {thresholds.max_dimension_ratio:g} of the study's")
-    length = name not in ("particle_count", "particle_diameter")
+    length = name not in ("particle_count", "particle_diameter", "youngs_modulus")
     diameters = run / diameter if length else None
     floor = getattr(thresholds, FLOORS[name]) if name in FLOORS else None
     if floor is not None and diameters < floor:
