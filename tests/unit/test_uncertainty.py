@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from siloflow.analysis.numerics.uncertainty import (
+    line_slope,
     Estimate,
     SeedSpread,
     Significance,
@@ -336,3 +337,18 @@ def test_windows_sized_for_a_target_vrr():
         window_clumps_for_precision(60, factor=0.9)
     with pytest.raises(ValueError, match="throughput must be a finite number > 0"):
         window_duration_for_precision(60, throughput=0.0)
+
+
+def test_line_slope_weighted_unweighted_and_two_points():
+    # weighted: y = 1 + 10 x with sigma 0.1 at x = 0, 0.1, 0.2: slope error sigma / sqrt(sum (x - mean)^2)
+    slope, error = line_slope([0.0, 0.1, 0.2], [1.0, 2.0, 3.0], [0.1, 0.1, 0.1])
+    assert slope == pytest.approx(10.0, rel=1e-12) and error == pytest.approx(0.1 / math.sqrt(0.02), rel=1e-12)
+    # unweighted: residuals -1/6, +1/3, -1/6 about the line y = 1/6 + x give s^2 = (1/6) / 1, error s / sqrt(2)
+    slope, error = line_slope([0.0, 1.0, 2.0], [0.0, 1.5, 2.0])
+    assert slope == pytest.approx(1.0, rel=1e-12) and error == pytest.approx(math.sqrt(1.0 / 6.0 / 2.0), rel=1e-12)
+    two = line_slope([0.0, 0.5], [1.0, 2.0])
+    assert two[0] == 2.0 and math.isnan(two[1])
+    with pytest.raises(ValueError, match="two distinct x"):
+        line_slope([1.0, 1.0], [0.0, 1.0])
+    with pytest.raises(ValueError, match="finite standard error"):
+        line_slope([0.0, 1.0], [0.0, 1.0], [0.0, 1.0])

@@ -12,7 +12,7 @@ from siloflow.analysis.studies.validation.findings_summary import (NOT_AT_SCALE,
                                                                    finding_status, finding_statuses)
 from siloflow.analysis.studies.validation.group_rows import MADE, UNMADE, seed_dof
 from siloflow.analysis.studies.validation.rows import (AT_SCALE, NO_FINDING, NOT_AT_SCALE as ROW_NOT_AT_SCALE,
-                                                       precise, resolution, resolved, row, row_dof, with_scale)
+                                                       precise, resolution, resolved, row, with_scale)
 from siloflow.analysis.studies.validation.scale import scale_verdict
 from siloflow.analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows, stress_gradient
 from siloflow.analysis.studies.validation.table import against_the_study, page_sections
@@ -40,7 +40,6 @@ def test_a_row_names_its_finding_part_and_takes_the_part_s_statement_as_the_stud
         row("G", "f", "c", 1.0, 0.1, "-", "e", finding="S2")
     with pytest.raises(KeyError):
         row("G", "f", "c", 1.0, 0.1, "-", "e", finding="S9", agreement=Agreement(REPRODUCED, ""))
-    assert row_dof({"dof": ""}) is None and row_dof({"dof": "2.0"}) == 2.0
 
 
 def test_the_scale_verdict_is_the_same_whatever_the_row_s_value():

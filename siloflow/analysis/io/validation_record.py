@@ -23,7 +23,7 @@ from pathlib import Path
 from PIL import Image
 
 from siloflow.model.checks import number_or_nan
-from siloflow.analysis.io.tables import write_flow_table
+from siloflow.analysis.io.tables import write_flow_table, write_json
 from siloflow.analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from siloflow.analysis.studies.validation.rows import COLUMNS, NO_FINDING
 
@@ -100,7 +100,7 @@ def write_group_record(directory: str | os.PathLike, rows: Sequence[Mapping], ru
     # a record written before a provenance column existed leaves it empty
     write_flow_table(directory / RUNS, [{column: run.get(column, "") for column in RUN_COLUMNS} for run in runs])
     if derivation is not None:
-        (directory / DERIVATION).write_text(json.dumps(derivation, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+        write_json(directory / DERIVATION, derivation)
     for stale in directory.glob(f"*.{RECORD_PLOT_FORMAT}"):
         if stale.name not in plots:
             stale.unlink()

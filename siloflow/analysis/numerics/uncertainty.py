@@ -48,6 +48,7 @@ __all__ = [
     "seed_spread",
     "combine_independent",
     "difference_significant",
+    "line_slope",
 ]
 
 
@@ -498,3 +499,32 @@ def difference_significant(a: float, ua: float, b: float, ub: float, k: float = 
     if math.isnan(combined):
         return Significance.UNKNOWN
     return Significance.SIGNIFICANT if abs(a - b) > k * combined else Significance.NOT_SIGNIFICANT
+
+
+def line_slope(x, y, sigma=None) -> tuple[float, float]:
+    """Least-squares slope of ``y`` on ``x`` and its standard error (unit of y over unit of x).
+
+    With ``sigma``, the standard errors of ``y`` (all finite and > 0), a fit weighted by them as known errors
+    (:func:`numpy.polyfit`, unscaled covariance). Without, an unweighted fit whose error comes from the scatter about
+    the line (:func:`scipy.stats.linregress`, ``n - 2`` degrees of freedom), NaN for two points.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Equal 1-D arrays, ``x`` with two distinct values at least.
+    sigma : array_like, optional
+        Standard error of each ``y``.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.ndim != 1 or x.shape != y.shape or np.unique(x).size < 2:
+        raise ValueError("x and y must be equal 1-D arrays with two distinct x at least")
+    if sigma is not None:
+        sigma = np.asarray(sigma, dtype=float)
+        if sigma.shape != y.shape or not (np.all(np.isfinite(sigma)) and np.all(sigma > 0)):
+            raise ValueError("sigma must be one finite standard error > 0 for each y")
+        coefficients, covariance = np.polyfit(x, y, 1, w=1.0 / sigma, cov="unscaled")
+        return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
+    if x.size == 2:
+        return float((y[1] - y[0]) / (x[1] - x[0])), math.nan
+    fit = stats.linregress(x, y)
+    return float(fit.slope), float(fit.stderr)

@@ -8,7 +8,6 @@ from pathlib import Path
 
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.geometry import write_stl
-from siloflow.model.rolling import RollingGeometry, rolling_geometry
 from siloflow.engines.layout import write_text_atomic
 from siloflow.engines.liggghts.rolling import cdt_matrix
 
@@ -69,11 +68,6 @@ def template_spheres(positions, radii) -> list[list[float]]:
     return spheres
 
 
-def particle_rolling(particle) -> RollingGeometry:
-    """The rolling geometry of a particle template (:func:`siloflow.model.rolling.rolling_geometry`)."""
-    return rolling_geometry(particle.sphere_positions, particle.sphere_radii)
-
-
 def flat_matrix(matrix) -> list[float]:
     return [float(value) for row in matrix for value in row]
 
@@ -86,7 +80,7 @@ def contact_coefficients(table, particle) -> dict:
         "n_types": len(table.names),
         "restitution": flat_matrix(table.restitution),
         "sliding_friction": flat_matrix(table.sliding_friction),
-        "rolling_friction": flat_matrix(cdt_matrix(table.rolling_friction, particle_rolling(particle))),
+        "rolling_friction": flat_matrix(cdt_matrix(table.rolling_friction, particle.rolling)),
     }
 
 

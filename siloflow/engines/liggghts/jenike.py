@@ -38,8 +38,7 @@ from siloflow.engines.layout import RUN_RECORD
 from siloflow.engines.liggghts.contacts import parse_local_table
 from siloflow.engines.liggghts.dumps import list_dumps
 from siloflow.engines.layout import write_text_atomic
-from siloflow.engines.liggghts.inputs import (DECK_NAME, ENGINE_NAME, common_context, flat_matrix, particle_rolling,
-                                             processor_grid)
+from siloflow.engines.liggghts.inputs import DECK_NAME, ENGINE_NAME, common_context, flat_matrix, processor_grid
 from siloflow.engines.liggghts.rolling import cdt_matrix
 from siloflow.model.rolling import RollingGeometry
 from siloflow.engines.markers import parse_markers
@@ -98,7 +97,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
     """
     context = common_context(case)
     n_types = len(case.materials.names)
-    context["materials"].update(_contact_context(case.fill_contacts, n_types, particle_rolling(case.particle)))
+    context["materials"].update(_contact_context(case.fill_contacts, n_types, case.particle.rolling))
     geometry = case.geometry
     base_type = PLATE_TYPE if geometry.wall_test else RING_TYPE
     meshes = {
@@ -141,7 +140,7 @@ def jenike_deck_context(case: JenikeCase) -> dict:
             "title": f"siloflow-jenike-{case.run_id}",
             "boundary": ["f", "f", "f"],
             "domain": {"x": [x0, x1], "y": [y0, y1], "z": [z0, z1]},
-            "test_materials": _contact_context(case.test_contacts, n_types, particle_rolling(case.particle)),
+            "test_materials": _contact_context(case.test_contacts, n_types, case.particle.rolling),
             "shear_plane": geometry.shear_plane,
             "ring_centre": list(geometry.ring_centre),
             "clump_sphere_mass": case.clump_sphere_mass,

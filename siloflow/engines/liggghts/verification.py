@@ -11,7 +11,6 @@ from siloflow.model.record import RunRecord
 from siloflow.model.cases.verification import VerificationCase
 from siloflow.engines.liggghts.inputs import ENGINE_NAME, flat_matrix, processor_grid, write_case_inputs
 from siloflow.engines.liggghts.rolling import cdt_matrix
-from siloflow.model.rolling import RollingGeometry, rolling_geometry
 from siloflow.engines.liggghts.run import DUMP_PREFIX, run_checked
 from siloflow.engines.templating import render_deck
 from siloflow.engines.verification_checks import check_verification_run, verification_record
@@ -19,12 +18,6 @@ from siloflow.engines.verification_checks import check_verification_run, verific
 #: What the verification decks dump per sphere: the state the closed forms need, spin included.
 VERIFICATION_DUMP_FIELDS = ("id", "type", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz", "radius",
                             "mass")
-
-
-def _rolling(case: VerificationCase) -> RollingGeometry:
-    """The rolling geometry of the problem's particle: its clump, or one sphere."""
-    centres = case.clump_spheres or ((0.0, 0.0, 0.0),)
-    return rolling_geometry(centres, [case.radius] * len(centres))
 
 
 def verification_deck_context(case: VerificationCase) -> dict:
@@ -41,7 +34,7 @@ def verification_deck_context(case: VerificationCase) -> dict:
         "materials": {"n_types": 2, "youngs_modulus": [case.youngs_modulus] * 2, "poisson_ratio": [case.poisson_ratio] * 2,
                       "restitution": pair(case.restitution), "sliding_friction": pair(case.sliding_friction),
                       # the study's coefficient, as LIGGGHTS' CDT gives its torque (siloflow.engines.liggghts.rolling)
-                      "rolling_friction": flat_matrix(cdt_matrix([[case.rolling_friction] * 2] * 2, _rolling(case)))},
+                      "rolling_friction": flat_matrix(cdt_matrix([[case.rolling_friction] * 2] * 2, case.rolling))},
         "timestep": case.timestep,
         "gravity": _magnitude(case.gravity),
         "gravity_direction": [g / _magnitude(case.gravity) for g in case.gravity] if any(case.gravity) else [0.0, 0.0, -1.0],

@@ -8,7 +8,6 @@ from the LIGGGHTS decks' (:mod:`siloflow.engines.yade.inputs` says how).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable

@@ -33,7 +33,6 @@ import numpy as np
 
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.particles import clump_inertia
-from siloflow.model.rolling import rolling_geometry
 from siloflow.engines.interface import CaseNotSupported
 from siloflow.engines.layout import write_text_atomic
 
@@ -89,8 +88,7 @@ def materials_context(case, table, wall_density: float = 1000.0, gravity: float 
     particle = case.particle
     # the study's coefficient, as Mindlin's cap eta r |Fn| (r the contact sphere's radius) gives its torque
     # mu_r R |Fn| at the clump's mean lever arm R (siloflow.model.rolling)
-    geometry = rolling_geometry(particle.sphere_positions, particle.sphere_radii)
-    rolling = rolling_friction(table, f"run {case.run_id}") * geometry.ratio
+    rolling = rolling_friction(table, f"run {case.run_id}") * particle.rolling.ratio
     radius = float(particle.sphere_radii.min())
     kn = hertz_stiffness_at_load(radius, table.youngs_modulus[0], table.poisson_ratio[0], particle.mass * gravity)
     n = len(table.names)

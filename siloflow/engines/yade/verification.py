@@ -9,7 +9,6 @@ from pathlib import Path
 from siloflow.model.constants import GRAVITY
 from siloflow.model.record import RunRecord
 from siloflow.model.cases.verification import VerificationCase
-from siloflow.model.rolling import rolling_geometry
 from siloflow.engines.templating import render_deck
 from siloflow.engines.verification_checks import check_verification_run, verification_record
 from siloflow.engines.yade.inputs import ENGINE_NAME, hertz_stiffness_at_load, write_script_inputs
@@ -20,8 +19,7 @@ def verification_script_context(case: VerificationCase) -> dict:
     """The rendering context of ``siloflow/templates/yade/verification.py.j2``."""
     material = {"youngs_modulus": case.youngs_modulus, "poisson_ratio": case.poisson_ratio, "density": case.density}
     kn = hertz_stiffness_at_load(case.radius, case.youngs_modulus, case.poisson_ratio, case.mass * GRAVITY)
-    centres = case.clump_spheres or ((0.0, 0.0, 0.0),)
-    eta = case.rolling_friction * rolling_geometry(centres, [case.radius] * len(centres)).ratio
+    eta = case.rolling_friction * case.rolling.ratio
     return {
         "title": f"siloflow-verification-{case.run_id}",
         "timestep": case.timestep,

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import math
 
 import numpy as np
 
 from siloflow.model.checks import finite_array
+from siloflow.model.rolling import RollingGeometry, rolling_geometry
 
 #: A particle model's ``timestep_scale`` when it gives none.
 DEFAULT_TIMESTEP_SCALE = 1.0
@@ -67,6 +68,12 @@ class ParticleTemplate:
     def bounding_radius(self) -> float:
         """Radius of the smallest centroid-centred sphere enclosing the clump (m)."""
         return float((np.linalg.norm(self.sphere_positions, axis=1) + self.sphere_radii).max())
+
+    @cached_property
+    def rolling(self) -> RollingGeometry:
+        """What the engines' rolling laws need of the clump to give the study's torque
+        (:func:`siloflow.model.rolling.rolling_geometry`), computed once per template."""
+        return rolling_geometry(self.sphere_positions, self.sphere_radii)
 
 
 def particle_template(name: str, model: dict, density: float) -> ParticleTemplate:

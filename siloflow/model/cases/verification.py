@@ -39,6 +39,7 @@ import numpy as np
 from siloflow.model.cases.common import run_id
 from siloflow.model.cases.particles import clump_inertia, clump_volume
 from siloflow.model.cases.stages import Stage
+from siloflow.model.rolling import RollingGeometry, rolling_geometry
 
 __all__ = ["MATERIAL", "PROBLEMS", "FREE", "HELD", "FIXED", "SPIN_OVERLAP", "VerificationCase", "VerificationSphere",
            "verification_cases"]
@@ -102,6 +103,12 @@ class VerificationCase:
         """Directory name: the problem's name plus a hash of everything that defines it."""
         parameters = {key: value for key, value in self.__dict__.items() if key != "name"}
         return run_id(self.name, {key: repr(value) for key, value in parameters.items()})
+
+    @property
+    def rolling(self) -> RollingGeometry:
+        """The rolling geometry of the problem's particle, its clump or one sphere (:mod:`siloflow.model.rolling`)."""
+        centres = self.clump_spheres or ((0.0, 0.0, 0.0),)
+        return rolling_geometry(centres, [self.radius] * len(centres))
 
     @property
     def mass(self) -> float:

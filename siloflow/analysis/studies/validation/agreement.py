@@ -24,12 +24,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from siloflow.analysis.numerics.uncertainty import Estimate, combine_independent
+from siloflow.analysis.numerics.uncertainty import Estimate, combine_independent, line_slope
 from siloflow.analysis.studies.validation.findings import NEGLIGIBLE, ORDER, POWER_LAW, RATIO, SIGN, VALUE, Part
 
 __all__ = ["REPRODUCED", "NOT_REPRODUCED", "NOT_RESOLVED", "CONFIDENCE", "Agreement", "AgreementTolerances",
            "quantile", "interval", "study_band", "value_in_band", "ratio_in_band", "sign_of_change", "in_order",
-           "negligible", "power_law_exponent", "power_law", "ratio"]
+           "negligible", "power_law_exponent", "power_law", "ratio", "relative_error", "capped"]
 
 REPRODUCED, NOT_REPRODUCED, NOT_RESOLVED = "reproduced", "not reproduced", "not resolved"
 #: Confidence level of every interval (-).
@@ -102,10 +102,11 @@ def ratio(a: float, ua: float, b: float, ub: float) -> tuple[float, float]:
     if b == 0.0:
         return math.nan, math.nan
     value = a / b
-    return value, abs(value) * combine_independent([_relative(ua, a), _relative(ub, b)])
+    return value, abs(value) * combine_independent([relative_error(ua, a), relative_error(ub, b)])
 
 
-def _relative(error: float, value: float) -> float:
+def relative_error(error: float, value: float) -> float:
+    """``error / |value|`` (-): 0 for an exact zero, NaN for an error on a zero value."""
     if value == 0.0:
         return math.nan if error else 0.0
     return error / abs(value)
@@ -223,6 +224,14 @@ def ratio_in_band(numerator: float, numerator_error: float, denominator: float, 
     return _against_band(part, value, error, dof, study_band(part, tolerances), tolerances, steady)
 
 
+def capped(agreement: Agreement, why: str) -> Agreement:
+    """The verdict at most "not resolved" when ``why`` says that a figure it rests on is only a bound (a VRR at its
+    counting-noise ceiling), whichever way it went; unchanged when ``why`` is empty."""
+    if not why or agreement.verdict == NOT_RESOLVED:
+        return agreement
+    return Agreement(NOT_RESOLVED, f"{agreement.reason}; not resolved: {why}")
+
+
 def _steady_or_not_resolved(agreement: Agreement, steady: bool) -> Agreement:
     """A "reproduced" of a figure that was not steady is "not resolved"; any other verdict stands."""
     if steady or agreement.verdict != REPRODUCED:
@@ -317,18 +326,15 @@ def power_law_exponent(factors: Sequence[float], values: Sequence[float],
         raise ValueError("factors and values must be equal 1-D lists of positive numbers, with two factors at least")
     x, y = np.log(f), np.log(v)
     if errors is None:
-        if f.size == 2:
-            return float((y[1] - y[0]) / (x[1] - x[0])), math.nan
-        fit = stats.linregress(x, y)
-        return float(fit.slope), float(fit.stderr)
+        return line_slope(x, y)
     sigma = np.asarray(errors, dtype=float)
     if sigma.shape != v.shape or np.any(sigma < 0) or np.any(np.isinf(sigma)):
         raise ValueError("errors must be one standard error >= 0 (or NaN, unknown) for each value")
     sigma = sigma / v
     if np.any(np.isnan(sigma)) or np.any(sigma == 0):
-        return float(np.polyfit(x, y, 1)[0]), math.nan
-    coefficients, covariance = np.polyfit(x, y, 1, w=1.0 / sigma, cov="unscaled")
-    return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
+        # an unknown error leaves the exponent's unknown too
+        return line_slope(x, y)[0], math.nan
+    return line_slope(x, y, sigma)
 
 
 def power_law(factors: Sequence[float], values: Sequence[float], errors: Sequence[float] | None,

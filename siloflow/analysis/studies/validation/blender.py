@@ -35,9 +35,9 @@ from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent
 from siloflow.analysis.numerics.vrr_noise import vrr_near_ceiling
 from siloflow.analysis.studies.validation import agreement as rules
-from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances, capped, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
-from siloflow.analysis.studies.validation.rows import capped, plus_minus, precise, resolution, resolved, row, smallest_dof
+from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, resolved, row, smallest_dof
 
 __all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "smallest_dof", "capped", "section_mean", "blender_rows",
            "gravity_rows"]

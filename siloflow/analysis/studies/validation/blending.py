@@ -32,9 +32,9 @@ import numpy as np
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent
 from siloflow.analysis.studies.validation import agreement as rules
-from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances, capped, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
-from siloflow.analysis.studies.validation.rows import capped, plus_minus, row, smallest_dof
+from siloflow.analysis.studies.validation.rows import plus_minus, row, smallest_dof
 
 __all__ = ["RECIRCULATION_GROUP", "MADE", "UNMADE", "rtd_peak", "recirculation_rows"]
 

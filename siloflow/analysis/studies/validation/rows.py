@@ -27,12 +27,11 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 
 from siloflow.model.checks import number_or_nan
-from siloflow.analysis.studies.validation.agreement import (NOT_REPRODUCED, NOT_RESOLVED, REPRODUCED, Agreement,
-                                                            AgreementTolerances, quantile, ratio)
+from siloflow.analysis.studies.validation.agreement import Agreement, AgreementTolerances, quantile, relative_error
 from siloflow.analysis.studies.validation.findings import PARTS
 
-__all__ = ["COLUMNS", "NO_FINDING", "AT_SCALE", "NOT_AT_SCALE", "AGREEMENTS", "row", "with_scale", "row_dof", "ratio",
-           "precise", "plus_minus", "resolved", "resolution", "smallest_dof", "capped"]
+__all__ = ["COLUMNS", "NO_FINDING", "AT_SCALE", "NOT_AT_SCALE", "row", "with_scale", "precise", "plus_minus", "resolved",
+           "resolution", "smallest_dof"]
 
 #: The columns of a group's rows, in order.
 COLUMNS = ("group", "figure", "case", "finding", "value", "value_error", "dof", "unit", "study", "agreement",
@@ -40,8 +39,6 @@ COLUMNS = ("group", "figure", "case", "finding", "value", "value_error", "dof", 
 #: The agreement and the scale of a row that no finding of the study states.
 NO_FINDING = "-"
 AT_SCALE, NOT_AT_SCALE = "at scale", "not at scale"
-#: The agreement words, worst first.
-AGREEMENTS = (NOT_REPRODUCED, NOT_RESOLVED, REPRODUCED)
 
 
 def row(group: str, figure: str, case: str, value, error, unit: str, evidence: str, *, dof: float | None = None,
@@ -100,12 +97,6 @@ def with_scale(rows: Sequence[Mapping], judge: Callable[[str, bool], object]) ->
     return judged
 
 
-def row_dof(entry: Mapping) -> float | None:
-    """A row's degrees of freedom as read back (CSV strings fine): None for a within-run error."""
-    dof = number_or_nan(entry.get("dof") or None)
-    return dof if math.isfinite(dof) else None
-
-
 def resolved(difference: float, error: float, dof: float | None) -> bool | None:
     """Whether ``|difference|`` exceeds its 95 % reach ``q error`` (Student t with ``dof``, normal for None);
     None when the error is not known."""
@@ -128,15 +119,9 @@ def precise(value: float, error: float, tolerances: AgreementTolerances) -> tupl
     limit = f"(at most {tolerances.max_relative_error * 100:g} %)"
     if not math.isfinite(error) or not math.isfinite(value):
         return None, f"relative error not known {limit}"
-    relative = _relative(error, value)
+    relative = relative_error(error, value)
     shown = f"{relative * 100:.2g} %" if math.isfinite(relative) else "unbounded"
     return error <= tolerances.max_relative_error * abs(value), f"relative error {shown} {limit}"
-
-
-def _relative(error: float, value: float) -> float:
-    if value == 0.0:
-        return math.nan if error else 0.0
-    return error / abs(value)
 
 
 def plus_minus(value: float, error: float, digits: int = 3) -> str:
@@ -152,10 +137,3 @@ def smallest_dof(*dofs: float | None) -> float | None:
     known = [d for d in dofs if d is not None]
     return min(known) if known else None
 
-
-def capped(agreement: Agreement, why: str) -> Agreement:
-    """The verdict at most "not resolved" when ``why`` says that a figure it rests on is only a bound (a VRR at its
-    counting-noise ceiling); unchanged when ``why`` is empty."""
-    if not why or agreement.verdict == NOT_RESOLVED:
-        return agreement
-    return Agreement(NOT_RESOLVED, f"{agreement.reason}; not resolved: {why}")

@@ -25,7 +25,7 @@ from types import MappingProxyType
 import numpy as np
 
 from siloflow.model.checks import number_or_nan
-from siloflow.analysis.numerics.uncertainty import combine_independent
+from siloflow.analysis.numerics.uncertainty import combine_independent, line_slope
 from siloflow.analysis.studies.validation import agreement as rules
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
@@ -83,8 +83,9 @@ def _column(entries: Sequence[Mapping], key: str) -> np.ndarray:
 def stress_gradient(depth, stress, error) -> tuple[float, float]:
     """The slope of the vertical stress against the depth below the surface and its standard error (Pa/m).
 
-    A straight-line fit weighted by the stresses' standard errors (:func:`numpy.polyfit`, unscaled covariance, as
-    known sigmas); unweighted with the scatter's error when an error is unknown or zero (NaN error for two points).
+    A straight-line fit weighted by the stresses' standard errors as known errors; unweighted with the scatter's
+    error when an error is unknown or zero (NaN error for two points):
+    :func:`siloflow.analysis.numerics.uncertainty.line_slope`.
 
     Parameters
     ----------
@@ -96,13 +97,8 @@ def stress_gradient(depth, stress, error) -> tuple[float, float]:
     x, y, e = (np.asarray(a, dtype=float) for a in (depth, stress, error))
     if x.ndim != 1 or x.shape != y.shape or x.shape != e.shape or np.unique(x).size < 2:
         raise ValueError("depth, stress and error must be equal 1-D arrays with two distinct depths at least")
-    if np.all(np.isfinite(e)) and np.all(e > 0):
-        coefficients, covariance = np.polyfit(x, y, 1, w=1.0 / e, cov="unscaled")
-        return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
-    if x.size == 2:
-        return float((y[1] - y[0]) / (x[1] - x[0])), math.nan
-    coefficients, covariance = np.polyfit(x, y, 1, cov=True)
-    return float(coefficients[0]), float(math.sqrt(covariance[0, 0]))
+    known = bool(np.all(np.isfinite(e)) and np.all(e > 0))
+    return line_slope(x, y, e if known else None)
 
 
 def _ends(entries: Sequence[Mapping]) -> tuple[list, list]:
@@ -168,14 +164,12 @@ def _janssen_rows(run: SiloRun, case_name: str, settled: bool, settled_text: str
         return []
     top, bottom = _ends(run.janssen)
     dem_top = _gradient(top, "sigma_v_dem_Pa", "sigma_v_dem_Pa_error")
+    deepest = bottom[-1]
     # rho g h is linear in the depth: its slope is rho g, with the bulk density's relative error
-    deepest_entry = max(run.janssen, key=lambda entry: float(entry["depth_below_surface_m"]))
-    depth = float(deepest_entry["depth_below_surface_m"])
-    unit_weight = (float(deepest_entry["hydrostatic_pa"]) / depth,
-                   number_or_nan(deepest_entry.get("hydrostatic_pa_error")) / depth)
+    depth = float(deepest["depth_below_surface_m"])
+    unit_weight = (float(deepest["hydrostatic_pa"]) / depth, number_or_nan(deepest.get("hydrostatic_pa_error")) / depth)
     dem_bottom = _gradient(bottom, "sigma_v_dem_Pa", "sigma_v_dem_Pa_error")
     change = dem_bottom[0] - dem_top[0], combine_independent([dem_bottom[1], dem_top[1]])
-    deepest = max(run.janssen, key=lambda entry: float(entry["depth_below_surface_m"]))
     sigma, sigma_error = float(deepest["sigma_v_dem_Pa"]), number_or_nan(deepest.get("sigma_v_dem_Pa_error"))
     janssen = float(deepest["sigma_v_janssen_Pa"])
     hydrostatic = float(deepest["hydrostatic_pa"]), number_or_nan(deepest.get("hydrostatic_pa_error"))
