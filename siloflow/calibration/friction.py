@@ -572,7 +572,7 @@ def combined_window_method(methods) -> str:
 
 def shear_test_summary(point: dict, run_id: str, n_clumps: int, friction: BulkFriction, window_method: str) -> dict:
     """The record of one Jenike shear test (``metrics/bulk_friction.json``): its point (shape, test, wall material,
-    rolling friction, restitution, rotation, lid, particle friction, shear velocity in m/s), the bulk friction
+    rolling friction, restitution, rotation, lid, particle friction, shear velocity in m/s, pour), the bulk friction
     figures of :func:`bulk_friction_summary` and the clumps sheared."""
     test = "internal" if point["test"] == "internal" else "wall"
     return {
@@ -586,6 +586,7 @@ def shear_test_summary(point: dict, run_id: str, n_clumps: int, friction: BulkFr
         "lid": point["lid"],
         "particle_friction": point["sliding_friction"],
         "shear_velocity": point["shear_velocity"],
+        "pour": point["pour"],
         **bulk_friction_summary(friction, window_method),
         "n_clumps": n_clumps,
     }

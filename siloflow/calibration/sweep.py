@@ -11,13 +11,16 @@ A sweep point is a plain dict (it keys the run and travels through Snakemake unc
 
 from __future__ import annotations
 
+from siloflow.model.cases.jenike_sweep import configured_pour
+
 INTERNAL = "internal"
 
 def chart_rows(rows, base_restitution: float, lid: str, shear_velocity: float) -> list[dict]:
     """Rows of the calibration table (as read from CSV) that belong on the chart.
 
-    The chart holds the base restitution, free rotation, the configured lid and the configured shear velocity (m/s);
-    the sensitivity, rotation-blocked, lid-comparison and shear-speed rows are left out.
+    The chart holds the base restitution, free rotation, the configured lid, the configured shear velocity (m/s) and
+    the configured pour; the sensitivity, rotation-blocked, lid-comparison, shear-speed and pour-variant rows are left
+    out.
     """
     return [
         row
@@ -26,6 +29,7 @@ def chart_rows(rows, base_restitution: float, lid: str, shear_velocity: float) -
         and str(row["rotation_blocked"]) == "False"
         and row["lid"] == lid
         and float(row["shear_velocity"]) == shear_velocity
+        and configured_pour(row)
     ]
 
 
@@ -49,7 +53,7 @@ def lid_comparison(rows, base_restitution: float, shear_velocity: float) -> list
     """
     by_lid: dict[tuple, dict[str, float]] = {}
     for row in rows:
-        if row["test"] != "internal" or str(row["rotation_blocked"]) != "False":
+        if row["test"] != "internal" or str(row["rotation_blocked"]) != "False" or not configured_pour(row):
             continue
         if float(row["restitution"]) != base_restitution or float(row["shear_velocity"]) != shear_velocity:
             continue

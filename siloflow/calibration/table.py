@@ -18,7 +18,7 @@ __all__ = ["POINT_COLUMNS", "point_table"]
 
 #: The columns that name a sweep point in the table.
 POINT_COLUMNS = ("shape", "test", "wall_material", "lid", "rolling_friction", "restitution", "rotation_blocked",
-                 "particle_friction", "shear_velocity")
+                 "particle_friction", "shear_velocity", "pour")
 #: The columns the table puts first, where a row has them.
 LEADING = ("shape", "test", "wall_material", "lid", "rolling_friction", "restitution", "rotation_blocked",
            "particle_friction", "bulk_friction", "bulk_friction_error", "bulk_friction_stderr",

@@ -144,3 +144,32 @@ def test_each_sweep_point_has_one_role_and_only_chart_points_are_on_a_chart():
     assert all(p["shape"] == "sphere2" for p in checks)
     # the diagnostics take chart points only: not the reference point's other seed
     assert not any("replicate" in p for p in diagnostic_points(points, sweep, "rigid"))
+
+
+def test_the_pour_variant_pours_the_internal_sensitivity_points_at_their_own_friction():
+    sweep = {**validate_config({})["jenike"]["sweep"], "lid_comparison": False, "own_pour_variant": True,
+             "sliding_friction": [0.1, 0.3, 0.5]}
+    points = sweep_points(sweep, pour_friction=0.1)
+    variant = [p for p in points if "pour" in p]
+    # the point at 0.1 poured at its own friction is the chart's own point, poured at 0.1
+    assert [(p["sliding_friction"], p["rolling_friction"], p["test"]) for p in variant] == [
+        (0.3, 0.0, "internal"), (0.5, 0.0, "internal")]
+    assert {p["pour"] for p in variant} == {"own_friction"}
+    assert not any(is_chart_point(p, sweep["restitution"]) for p in variant)
+    assert all(point_role(p, sweep["restitution"], "sphere2") == CHECK for p in variant)
+    assert sweep_points(sweep, pour_friction=None) == [p for p in points if "pour" not in p]
+
+
+def test_the_pour_variant_needs_a_configured_pour_friction():
+    with pytest.raises(ConfigError, match="jenike.sweep.own_pour_variant.*jenike.fill.sliding_friction"):
+        validate_config({"jenike": {"fill": {"sliding_friction": None}, "sweep": {"own_pour_variant": True}}})
+
+
+def test_the_chart_rows_and_the_lid_comparison_leave_out_the_pour_variant():
+    row = {"shape": "sphere2", "test": "internal", "lid": "rigid", "rolling_friction": "0.0", "restitution": "0.1",
+           "rotation_blocked": "False", "shear_velocity": "0.03", "particle_friction": "0.3", "bulk_friction": "0.5"}
+    variant = {**row, "pour": "own_friction", "lid": "servo"}
+    legacy = {key: value for key, value in row.items() if key != "pour"}
+    assert chart_rows([{**row, "pour": "configured"}, variant, legacy], 0.1, "rigid", 0.03) == [
+        {**row, "pour": "configured"}, legacy]
+    assert lid_comparison([row, variant], 0.1, 0.03) == []

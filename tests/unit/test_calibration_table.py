@@ -10,7 +10,8 @@ from siloflow.calibration.table import POINT_COLUMNS, point_table
 def _summary(mu, bulk, error, window="steady", lid="rigid", speed=0.03, run="r"):
     return {"run_id": run, "shape": "sphere2", "test": "internal", "wall_material": "", "lid": lid,
             "rolling_friction": 0.0, "restitution": 0.1, "rotation_blocked": False, "particle_friction": mu,
-            "shear_velocity": speed, "bulk_friction": bulk, "bulk_friction_error": error, "window_method": window,
+            "shear_velocity": speed, "pour": "configured", "bulk_friction": bulk, "bulk_friction_error": error,
+            "window_method": window,
             "n_clumps": 100}
 
 

@@ -238,6 +238,20 @@ def test_a_sample_poured_at_its_own_friction_fills_with_the_test_s_particle_fric
         _case(fill={**fill, "sliding_friction": "own"})
 
 
+def test_the_pour_variant_pours_at_the_point_s_friction_whatever_the_configured_pour():
+    """A point of the pour variant (``"pour": "own_friction"``) is the run of ``jenike.fill.sliding_friction`` null:
+    same contacts, same run id; the configured point pours at the configured 0.1 and says so."""
+    fill = copy.deepcopy(_config()["jenike"]["fill"])
+    variant, configured = _case({"pour": "own_friction"}), _case()
+    own = _case(fill={**fill, "sliding_friction": None})
+    assert variant.fill_contacts == own.fill_contacts and variant.run_id == own.run_id != configured.run_id
+    assert configured.fill_contacts.sliding_friction[PARTICLE_TYPE - 1] == (0.1, 0.1, 0.1)
+    assert (variant.summary_point["pour"], configured.summary_point["pour"]) == ("own_friction", "configured")
+    assert variant.summary()["pour"] == "own_friction" and variant.summary()["point"] == configured.summary()["point"]
+    with pytest.raises(ValueError, match="pour must be one of configured, own_friction, got 'dense'"):
+        _case({"pour": "dense"})
+
+
 def test_a_sample_poured_at_a_set_restitution_is_sheared_at_the_point_s_own():
     """jenike.fill.restitution: every particle contact pours at it and tests at the point's restitution; a value
     equal to the point's is the same run as null, and another value another run."""

@@ -102,6 +102,14 @@ def test_reference_replicates_add_seeds_of_the_first_configuration_only(raw_defa
     assert reference_runs(plain, kind) == [next(iter(before))]
 
 
+@pytest.mark.parametrize("kind", ["silo_recirculation", "blender"])
+def test_a_case_switched_off_has_no_runs_and_no_reference_whatever_its_seeds(raw_default_config, kind):
+    raw_default_config["defaults"]["reference_replicates"] = 3
+    raw_default_config[kind] = {"enabled": False}
+    config = validate_config(raw_default_config)
+    assert cases_of(config, kind) == {} and reference_runs(config, kind) == []
+
+
 def test_the_jenike_reference_point_runs_with_more_seeds_and_at_a_slower_shear(raw_default_config):
     sweep = raw_default_config.setdefault("jenike", {}).setdefault("sweep", {})
     sweep.update(sliding_friction=[0.1, 0.3, 0.5], rolling_friction=[0.0, 0.1], reference_replicates=3,

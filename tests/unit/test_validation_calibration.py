@@ -16,13 +16,13 @@ TARGETS = {"internal": (29.0, 31.0), "aluminium": (8.5, 10.5), "perspex": (10.0,
 
 
 def _bulk(shape, mu, bulk, error=0.01, test="internal", rolling=0.0, restitution=0.1, blocked=False, lid="rigid",
-          speed=0.03, window="steady"):
+          speed=0.03, window="steady", pour="configured"):
     """A row of calibration/bulk_friction.csv as read back: strings, a wall test named by its material."""
     return {"shape": shape, "test": "internal" if test == "internal" else "wall",
             "wall_material": "" if test == "internal" else test, "lid": lid, "rolling_friction": str(rolling),
             "restitution": str(restitution), "rotation_blocked": str(blocked), "shear_velocity": str(speed),
             "particle_friction": str(mu), "bulk_friction": str(bulk), "bulk_friction_error": str(error),
-            "window_method": window}
+            "window_method": window, "pour": pour}
 
 
 def _curve(shape, points, **kwargs):
@@ -227,6 +227,21 @@ def test_the_checks_judge_c4_and_c5_and_quote_the_other_lid_and_speed_with_no_fi
         "resolved at 95 % (q 1.96, normal)")
     assert speed["figure"] == "Bulk friction, shear velocity 0.015 - 0.03 m/s"
     assert speed["study"] == "the study sheared at 3 mm/s only (§4.3.1.3)"
+
+
+def test_the_pour_variant_is_quoted_against_the_configured_pour_with_no_finding():
+    """Poured at their own friction 0.3 and 0.5, the samples' bulk friction is 0.02 and 0.04 below the chart's
+    (0.50, 0.54): mean -0.03 +- sqrt(2 x 2 x 0.01^2) / 2 = 0.01414; the chart itself is unchanged by the variant."""
+    own = [_bulk("sphere2", 0.3, 0.48, pour="own_friction"), _bulk("sphere2", 0.5, 0.50, pour="own_friction")]
+    checks = _rows(_curve("sphere2", INTERNAL_0) + own, None, sections=("comparisons",))
+    (variant,) = checks
+    assert variant["figure"] == "Bulk friction, poured at its own friction - as configured"
+    assert variant["value"] == pytest.approx(-0.03, abs=1e-15)
+    assert variant["value_error"] == pytest.approx(math.sqrt(4 * 0.01 ** 2) / 2, rel=1e-12)
+    assert variant["finding"] == NO_FINDING and "§4.3.1.2-§4.3.1.3" in variant["study"]
+    assert "0.3: poured at its own friction 0.48 ± 0.01, as configured 0.5 ± 0.01" in variant["evidence"]
+    curves = _rows(_curve("sphere2", INTERNAL_0) + own, None, sections=("curves",))
+    assert curves == _rows(_curve("sphere2", INTERNAL_0), None, sections=("curves",))
 
 
 def test_errors_with_two_degrees_of_freedom_use_t_4_303():

@@ -75,8 +75,8 @@ def test_the_validation_config_s_runs_fall_into_their_groups():
     made = group_runs(config, config_estimates(config))
     counts = {name: len(runs) for name, runs in made.items()}
     # 8 sphere2 internal + 8 aluminium + 2 more seeds of its reference point; 8 sphere + 8 sphere4 + 2 more seeds of
-    # each one's; 4 blocked + 4 servo + 1 restitution + 1 slower
-    assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 10, "silo": 3,
+    # each one's; 4 blocked + 4 servo + 1 restitution + 2 other speeds + 3 poured at their own friction (not 0.1)
+    assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 14, "silo": 3,
                       "silo_series": 4, "blending": 5, "blender": 7}
 
 

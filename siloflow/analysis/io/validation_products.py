@@ -20,6 +20,7 @@ import yaml
 
 from siloflow.analysis.io.tables import read_table
 from siloflow.analysis.studies.validation.group_rows import ROW_CODE
+from siloflow.model.cases.jenike_sweep import CONFIGURED_POUR
 
 __all__ = ["read_group_products", "row_code_digest"]
 
@@ -50,7 +51,8 @@ def read_group_products(kind: str, inputs: Mapping[str, Sequence[str | os.PathLi
     """
     if kind == "jenike":
         parameters = list(inputs.get("parameters") or [])
-        return {"summaries": [_json(path) for path in inputs["summaries"]],
+        # a shear test recorded before the pour variant existed has no "pour": its sample was poured as configured
+        return {"summaries": [{"pour": CONFIGURED_POUR, **_json(path)} for path in inputs["summaries"]],
                 "parameters": yaml.safe_load(Path(parameters[0]).read_text(encoding="utf-8")) if parameters else None}
     if kind == "silo_flat":
         runs = []

@@ -48,6 +48,9 @@ def _runs_and_reference(config: dict, case: str) -> tuple[dict, list[str]]:
     if kind.build is None:
         raise KeyError(f"case kind {case!r} has no config section; its runs are not built from a configuration")
     runs = kind.build(config)
+    if not runs:
+        # a case switched off (its ``enabled: false``) has no reference to reseed
+        return runs, []
     # the builders list the reference configuration first
     reference = list(runs)[:1]
     replicates, seeds = _replicates(config, case)

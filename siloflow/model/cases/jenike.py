@@ -39,7 +39,7 @@ from siloflow.model.cases.physics import (
     ChosenTimestep, TimestepChoice, engine_seeds, free_fall_velocity, stable_timestep, steps_for,
 )
 from siloflow.model.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
-from siloflow.model.cases.jenike_sweep import sweep_points
+from siloflow.model.cases.jenike_sweep import CONFIGURED_POUR, POURS, sweep_points
 from siloflow.model.cases.stages import Stage
 
 CASE_NAME = "jenike"
@@ -163,6 +163,14 @@ class JenikeCase(ChosenTimestep):
     #: The point as the sweep designed it (:func:`siloflow.model.cases.jenike_sweep.sweep_points`): ``point`` with ``lid``,
     #: ``replicate`` and ``shear_velocity`` where the sweep set them.
     sweep_point: dict = field(default_factory=dict, repr=False)
+    #: How the sample was poured (:data:`~siloflow.model.cases.jenike_sweep.POURS`).
+    pour: str = CONFIGURED_POUR
+
+    @property
+    def summary_point(self) -> dict:
+        """The point as the shear test's summary records it: ``point`` with the lid, the shear velocity (m/s) and the
+        pour it ran with."""
+        return {**self.point, "lid": self.lid_kind, "shear_velocity": self.shear_velocity, "pour": self.pour}
 
     @property
     def fill_height(self) -> float:
@@ -225,6 +233,7 @@ class JenikeCase(ChosenTimestep):
             "case": CASE_NAME,
             "run_id": self.run_id,
             "point": dict(self.point),
+            "pour": self.pour,
             "particle_model": self.particle.name,
             "spheres_per_clump": self.particle.n_spheres,
             "clump_mass_kg": self.particle.mass,
@@ -455,7 +464,9 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         "rolling_friction": float, "restitution": float, "rotation_blocked": bool}``, optionally with
         ``"lid": "rigid" | "servo"`` overriding ``jenike.lid`` (used to compare the two lids on the same points)
         ``"replicate": k`` adding k to ``jenike.seed`` (the reference point's extra seeds) and
-        ``"shear_velocity"`` overriding ``jenike.shear.velocity`` (m/s, the shear-speed study).
+        ``"shear_velocity"`` overriding ``jenike.shear.velocity`` (m/s, the shear-speed study) and ``"pour"``
+        (:data:`~siloflow.model.cases.jenike_sweep.POURS`): ``"own_friction"`` pours the sample at the test's particle
+        friction whatever ``jenike.fill.sliding_friction`` says (the pour variant).
 
     Raises
     ------
@@ -473,9 +484,15 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     velocity = float(point.get("shear_velocity", config["jenike"]["shear"]["velocity"]))
     if not velocity > 0.0:
         raise ValueError(f"jenike point: shear_velocity must be > 0 m/s, got {velocity!r}")
-    point = _check_point({key: value for key, value in point.items() if key not in ("lid", "replicate", "shear_velocity")})
+    pour = point.get("pour", CONFIGURED_POUR)
+    if pour not in POURS:
+        raise ValueError(f"jenike point: pour must be one of {', '.join(POURS)}, got {pour!r}")
+    point = _check_point({key: value for key, value in point.items()
+                          if key not in ("lid", "replicate", "shear_velocity", "pour")})
+    fill = config["jenike"]["fill"] if pour == CONFIGURED_POUR else {**config["jenike"]["fill"], "sliding_friction": None}
     jenike = {**config["jenike"], "lid": lid, "seed": config["jenike"]["seed"] + replicate,
-              "shear": {**config["jenike"]["shear"], "velocity": velocity}}
+              "shear": {**config["jenike"]["shear"], "velocity": velocity}, "fill": fill}
+    config = {**config, "jenike": jenike}
     cell = jenike["cell"]
     materials = config["materials"]
     particle_material = jenike["particle_material"]
@@ -593,6 +610,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
         seeds=tuple(engine_seeds(jenike["seed"], 3)),
         defining_parameters=defining,
         sweep_point=sweep_point,
+        pour=pour,
     )
 
 
@@ -605,7 +623,8 @@ def jenike_cases(config: dict) -> dict[str, JenikeCase]:
         Naming the sweep point whose cell cannot be built (e.g. a plate too small for the ring's travel).
     """
     cases = {}
-    for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"]):
+    for point in sweep_points(config["jenike"]["sweep"], lid=config["jenike"]["lid"],
+                              pour_friction=config["jenike"]["fill"]["sliding_friction"]):
         try:
             case = build_jenike_case(config, point)
         except ValueError as error:

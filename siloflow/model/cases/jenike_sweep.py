@@ -6,7 +6,8 @@ A sweep point is a plain dict (it keys the run and travels through Snakemake unc
      "rolling_friction": 0.1, "restitution": 0.1, "rotation_blocked": False}
 
 with ``"lid"`` on the lid comparison's points, ``"replicate"`` (>= 1, added to the seed) on the reference point's
-extra seeds and ``"shear_velocity"`` (m/s) on its shear-speed study.
+extra seeds, ``"shear_velocity"`` (m/s) on its shear-speed study and ``"pour": "own_friction"`` (:data:`OWN_POUR`) on the
+points of the pour variant.
 """
 
 from __future__ import annotations
@@ -16,6 +17,17 @@ from typing import Mapping
 from siloflow.model.cases.config_checks import ConfigError, require, require_subset
 
 INTERNAL = "internal"
+
+#: The pour of a sample: as ``jenike.fill`` configures it, or at the test's own particle friction (the variant of
+#: ``jenike.sweep.own_pour_variant``, a critically consolidated sample).
+CONFIGURED_POUR, OWN_POUR = "configured", "own_friction"
+POURS = (CONFIGURED_POUR, OWN_POUR)
+
+
+def configured_pour(row) -> bool:
+    """Whether a calibration table row's sample was poured as ``jenike.fill`` configures, not by the pour variant (a
+    table written before the variant has no ``pour`` column: every row was)."""
+    return row.get("pour", CONFIGURED_POUR) in ("", CONFIGURED_POUR)
 
 #: The role of a sweep point (:func:`point_role`): a point of the calibration shape's charts, of another shape's
 #: charts, or of a check against a chart (rotation blocked, the other lid, another restitution or shear speed, another
@@ -35,7 +47,7 @@ def other_lid(lid: str) -> str:
     return "servo" if lid == "rigid" else "rigid"
 
 
-def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
+def sweep_points(sweep: dict, lid: str = "rigid", pour_friction: float | None = None) -> list[dict]:
     """Expand the ``jenike.sweep`` section into the list of distinct sweep points.
 
     The grid is every shape x test x sliding friction x rolling friction at the base restitution (wall tests only
@@ -49,7 +61,10 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
     stable. With ``reference_replicates: M`` the reference point (:func:`reference_point`) and each other shape's
     (:func:`replicated_points`) run M times: the copies carry ``"replicate": 1 ... M - 1``, which the case adds to
     its seed, so that every chart carries the spread between seeds of a point of its own. The shear-speed study runs
-    the reference point at each velocity of ``shear_velocity_sensitivity`` (key ``"shear_velocity"``, m/s).
+    the reference point at each velocity of ``shear_velocity_sensitivity`` (key ``"shear_velocity"``, m/s). The pour
+    variant (``own_pour_variant``) pours the sensitivity shapes' internal test, if a sensitivity test, at each sliding
+    friction and the first rolling friction at that particle friction (key ``"pour"``: :data:`OWN_POUR`), except where that
+    friction is the configured pour's: there the variant is the chart's own point.
 
     Parameters
     ----------
@@ -57,6 +72,9 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
         The validated ``jenike.sweep`` configuration section.
     lid : str
         The configured lid (``jenike.lid``); the comparison uses the other one.
+    pour_friction : float or None
+        The configured pour's particle friction (``jenike.fill.sliding_friction``, -); None pours every sample at its
+        own friction already, and the sweep has no pour variant.
 
     Returns
     -------
@@ -97,6 +115,12 @@ def sweep_points(sweep: dict, lid: str = "rigid") -> list[dict]:
             if sweep["rotation_blocked"]:
                 for mu in sliding:
                     add(shape, test, mu, rolling[0], base_restitution, blocked=True)
+            if sweep.get("own_pour_variant") and pour_friction is not None and test == INTERNAL:
+                for mu in sliding:
+                    if mu != pour_friction:
+                        points.append({"shape": shape, "test": test, "sliding_friction": float(mu),
+                                       "rolling_friction": float(rolling[0]), "restitution": float(base_restitution),
+                                       "rotation_blocked": False, "pour": OWN_POUR})
         if sweep["lid_comparison"] and INTERNAL in sweep["tests"] and shape in sensitivity_shapes:
             for mu in sliding:
                 point = {
@@ -153,10 +177,10 @@ def reference_point(sweep: dict) -> dict | None:
 
 
 def is_chart_point(point: dict, base_restitution: float) -> bool:
-    """Whether a sweep point belongs on a calibration chart: base restitution, rotation free, the configured lid and
-    shear velocity, the first seed."""
+    """Whether a sweep point belongs on a calibration chart: base restitution, rotation free, the configured lid,
+    shear velocity and pour, the first seed."""
     return (point["restitution"] == base_restitution and not point["rotation_blocked"]
-            and not {"lid", "shear_velocity", "replicate"} & set(point))
+            and not {"lid", "shear_velocity", "replicate", "pour"} & set(point))
 
 
 def point_role(point: dict, base_restitution: float, calibration_shape: str) -> str:
@@ -215,6 +239,9 @@ def check_jenike_config(config: Mapping, contact_pairs: Mapping) -> None:
             raise ConfigError(
                 f"config key 'contacts': no contact parameters for the pair [{particle}, {material}] used by jenike"
             )
+    if sweep["own_pour_variant"] and jenike["fill"]["sliding_friction"] is None:
+        raise ConfigError("config key 'jenike.sweep.own_pour_variant': needs jenike.fill.sliding_friction set; with "
+                          "null every sample is poured at its own particle friction already")
     calibration = config["calibration"]
     if calibration["shape"] not in sweep["shapes"]:
         raise ConfigError(

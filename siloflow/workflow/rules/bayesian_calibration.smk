@@ -152,8 +152,7 @@ rule bayes_friction:
     output:
         summary=bayes_run_file("metrics/bulk_friction.json"),
     params:
-        point=lambda wildcards: (lambda case: {**case.point, "lid": case.lid_kind, "shear_velocity": case.shear_velocity})(
-            bayes_case(wildcards.engine, wildcards.run)),
+        point=lambda wildcards: bayes_case(wildcards.engine, wildcards.run).summary_point,
     wildcard_constraints:
         engine="|".join(ENGINE_KINDS),
         run="[^/]+",

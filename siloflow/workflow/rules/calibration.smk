@@ -6,9 +6,8 @@ JENIKE_CASES = cases("jenike")
 
 
 def jenike_point(run):
-    """The sweep point of a Jenike run, with the lid and shear velocity (m/s) it ran with."""
-    case = JENIKE_CASES[run]
-    return {**case.point, "lid": case.lid_kind, "shear_velocity": case.shear_velocity}
+    """The sweep point of a Jenike run, with the lid, shear velocity (m/s) and pour it ran with."""
+    return JENIKE_CASES[run].summary_point
 
 
 def _on_chart(case):

@@ -8,7 +8,8 @@ Rows (see :mod:`siloflow.analysis.studies.validation.rows`), by section (:data:`
   value, the mobilised wall friction at 0.1, the two clumps' plateaus alike); on the two-sphere clump's internal
   charts at rolling friction 0 and 0.1, C6;
 - ``comparisons``: C5 (rotation blocked against free), C4 (each extra restitution against the base one), and the
-  other lid and the other shear velocities against the configured ones (no finding);
+  other lid, the other shear velocities and the pour variant (samples poured at their own particle friction) against
+  the configured ones (no finding);
 - ``calibrated``: C7 (the bulk friction angles at the study's chosen inputs), with the calibrated particle sliding
   friction coefficients and the chart's angle nearest an unreachable target (no finding).
 
@@ -31,6 +32,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType
 
+from siloflow.model.cases.jenike_sweep import configured_pour
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent
 from siloflow.analysis.studies.validation import agreement as rules
@@ -191,7 +193,8 @@ def calibration_rows(bulk_rows: Sequence[Mapping], parameters: Mapping | None, b
         raise ValueError("the calibrated rows need the calibration's parameters")
     configured = {"rotation": lambda e: not _flag(e["rotation_blocked"]), "lid": lambda e: e["lid"] == lid,
                   "restitution": lambda e: _same(float(e["restitution"]), base_restitution),
-                  "speed": lambda e: _same(float(e["shear_velocity"]), shear_velocity)}
+                  "speed": lambda e: _same(float(e["shear_velocity"]), shear_velocity),
+                  "pour": configured_pour}
 
     def on_chart(entry, varied=()):
         """Whether an entry is on the chart in every dimension but the ``varied`` ones (a check varies one)."""
@@ -407,6 +410,10 @@ def _comparison_rows(bulk_rows: Sequence[Mapping], charts: Mapping[tuple, list],
             rows += _difference_rows(key, charts.get(key, []), entries,
                                      (f"shear velocity {speed:g}", f"{shear_velocity:g} m/s"),
                                      "the study sheared at 3 mm/s only (§4.3.1.3)", dof)
+    for key, entries in _curves(bulk_rows, lambda e: not configured_pour(e) and on_chart(e, ("pour",))).items():
+        rows += _difference_rows(key, charts.get(key, []), entries, ("poured at its own friction", "as configured"),
+                                 "the study poured every sample at particle friction 0.1 without rolling friction "
+                                 "(§4.3.1.2-§4.3.1.3)", dof)
     return rows
 
 
