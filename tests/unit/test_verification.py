@@ -17,14 +17,16 @@ from siloflow.analysis.numerics.verification import (
     contact_interval,
     hertz_contact_time,
     linear_slope,
+    moment_about_axis,
     rolling_deceleration_cdt,
     sliding_to_rolling,
     zero_crossings,
     hertz_normal_force,
+    sphere_contacts,
     spin_deceleration,
 )
 from siloflow.analysis.studies.verification import Trajectories, measure_problem, trajectories_from_frames, verification_table
-from siloflow.model.cases.verification import PROBLEMS, verification_cases
+from siloflow.model.cases.verification import CLUMP_HALF_SPACING, PROBLEMS, verification_cases
 
 
 def test_hertz_time_constant_is_the_integral_it_names():
@@ -221,3 +223,51 @@ def test_a_held_sphere_s_spin_decelerates_at_the_study_s_rolling_torque(name, re
     assert row.quantity == "spin_deceleration" and row.closed_form == pytest.approx(alpha, rel=1e-9)
     assert row.measured == pytest.approx(alpha, rel=1e-9) and row.passes
     assert verification_cases()[name].spheres[-1].motion == "held"
+
+
+def test_sphere_contacts_and_the_moment_about_an_axis_by_hand():
+    overlaps, points = sphere_contacts([[0.0, 0.0, 1.9], [4.0, 0.0, 0.0]], [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]], 1.0)
+    assert overlaps.tolist() == pytest.approx([0.1, 1.0], rel=1e-14)
+    assert points.tolist() == [[0.0, 0.0, 0.95], [3.5, 0.0, 0.0]]
+    overlaps, points = sphere_contacts([[0.0, 0.0, 3.0]], [[0.0, 0.0, 0.0]], 1.0)
+    assert overlaps.shape == (0,) and points.shape == (0, 3)
+    # I = (1, 2, 4) about (1, 1, 0): (1 + 2) / 2
+    assert moment_about_axis([1.0, 2.0, 4.0], [3.0, 3.0, 0.0]) == pytest.approx(1.5, rel=1e-15)
+    with pytest.raises(ValueError, match="non-zero axis"):
+        moment_about_axis([1.0, 2.0, 4.0], [0.0, 0.0, 0.0])
+
+
+def test_a_held_clump_s_spin_on_a_fixed_clump_against_the_study_s_torque_and_the_mapping_s():
+    """Synthetic spin at the deceleration the engines' mapping gives (the torque at the clump's mean lever arm R):
+    the closed form is the study's, 2 mu_r |Fn| R_i / I with R_i the distance from each contact point to the centre
+    of mass and I the moment of the union of the two spheres about their line of centres, by hand; the spin row
+    differs from it by R / R_i, and the torque ratio row finds R / R_i."""
+    p = _params("clump_pair_spin")
+    case = verification_cases()["clump_pair_spin"]
+    r, mu_r, a, rho = p["radius"], p["rolling_friction"], CLUMP_HALF_SPACING, p["density"]
+    overlap = 0.002 * r
+    assert [s.motion for s in case.spheres] == ["fixed", "held"] and case.spheres[1].angular_velocity == (50.0, 0, 0)
+    force = 4.0 / 3.0 * 5e6 / (2 * (1 - 0.16)) * math.sqrt(r / 2.0) * overlap**1.5
+    arm = math.hypot(a, r - overlap / 2.0)
+    # the union's disc of radius^2 r^2 - (|x| - a)^2 at each x along the axis: I = rho int pi R^4 / 2 dx
+    value, _ = integrate.quad(lambda x: math.pi / 2.0 * (r * r - (x - a) ** 2) ** 2, 0.0, a + r, epsrel=1e-12)
+    inertia = 2.0 * rho * value
+    study = 2.0 * mu_r * force * arm / inertia
+    lever = p["rolling_lever_arm_m"]
+    assert lever == pytest.approx(1.6726e-3, rel=1e-4)
+    # the engines are given the case's inertia, the quadrature of clump_inertia: 1e-5 of the exact union's
+    assert p["clump_inertia"][0] == pytest.approx(inertia, rel=3e-5)
+    mapped = 2.0 * mu_r * force * lever / p["clump_inertia"][0]
+    t = np.linspace(0.0, 0.8 * 50.0 / mapped, 401)
+    clump = np.array([[-a, 0.0, 0.0], [a, 0.0, 0.0]])
+    position = np.array([np.concatenate([clump, clump + [0.0, 0.0, 2.0 * r - overlap]])] * t.size)
+    angular = np.zeros_like(position)
+    angular[:, 2:, 0] = (50.0 - mapped * t)[:, None]
+    spin, ratio = measure_problem("clump_pair_spin", p, Trajectories(t, position, np.zeros_like(position), angular))
+    assert spin.quantity == "spin_deceleration" and spin.closed_form == pytest.approx(study, rel=3e-5)
+    assert spin.measured == pytest.approx(mapped, rel=1e-9)
+    assert spin.error == pytest.approx(lever / arm - 1.0, rel=1e-8) and not spin.passes
+    assert ratio.quantity == "torque_ratio" and ratio.closed_form == pytest.approx(lever / arm, rel=1e-12)
+    assert ratio.measured == pytest.approx(lever / arm, rel=1e-9) and ratio.passes
+    # a contact between the tip (the mapping gives it 0.892 of the study's torque) and the waist (1.152)
+    assert 0.892 < lever / arm < 1.152

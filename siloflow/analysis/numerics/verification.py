@@ -12,6 +12,10 @@ Closed forms (SI units):
 - A sphere held in place against a fixed sphere or a flat at overlap delta, spinning across the contact normal: the
   study's rolling torque ``mu_r |Fn| r`` (:mod:`siloflow.model.rolling`) decelerates its spin at
   ``mu_r |Fn| r / I``, with Hertz's ``|Fn| = (4/3) E* sqrt(R*) delta^(3/2)`` and ``I = (2/5) m r^2``.
+- A clump held in place against a fixed one, spinning about a principal axis across its contact normals without
+  moving its contacts: the study's torques decelerate it at ``sum_k mu_r |Fn_k| R_k / I``, R_k the distance from
+  contact k's point (the middle of the overlap, :func:`sphere_contacts`) to the clump's centre of mass and I its
+  moment of inertia about the spin axis (:func:`moment_about_axis`).
 - A block on a flat under gravity tilted by theta, friction mu: it slides at ``g (sin theta - mu cos theta)`` when
   ``tan theta > mu`` and stays put otherwise.
 - A free symmetric top (principal moments ``I_axis, I_perp, I_perp``) spinning at ``omega`` (body axes = space axes
@@ -39,8 +43,10 @@ __all__ = [
     "precession_rate",
     "rolling_deceleration_cdt",
     "hertz_normal_force",
+    "moment_about_axis",
     "spin_deceleration",
     "sliding_to_rolling",
+    "sphere_contacts",
     "zero_crossings",
 ]
 
@@ -96,6 +102,47 @@ def spin_deceleration(rolling_friction: float, normal_force: float, lever_arm: f
     about the spin axis [kg m^2]."""
     return (_positive("rolling_friction", rolling_friction) * _positive("normal_force", normal_force)
             * _positive("lever_arm", lever_arm) / _positive("inertia", inertia))
+
+
+def sphere_contacts(first, second, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """The contacts between two sets of spheres of one radius.
+
+    Parameters
+    ----------
+    first, second : array_like, shape (k, 3) and (l, 3)
+        Sphere centres [m].
+    radius : float
+        The spheres' radius [m].
+
+    Returns
+    -------
+    overlaps : numpy.ndarray, shape (m,)
+        ``2 radius`` less the distance between the centres [m], of every pair (a sphere of ``first``, one of
+        ``second``) that overlaps, pairs in the order of ``first`` then ``second``.
+    points : numpy.ndarray, shape (m, 3)
+        Each contact's point [m]: the middle of the overlap, on the line of centres (halfway between the centres).
+    """
+    a = finite_array("first", first, ndim=2)
+    b = finite_array("second", second, ndim=2)
+    radius = _positive("radius", radius)
+    if a.shape[1] != 3 or b.shape[1] != 3:
+        raise ValueError(f"centres must be (k, 3), got {a.shape} and {b.shape}")
+    pairs = [(i, j) for i in range(len(a)) for j in range(len(b))
+             if np.linalg.norm(a[i] - b[j]) < 2.0 * radius]
+    overlaps = np.array([2.0 * radius - np.linalg.norm(a[i] - b[j]) for i, j in pairs]).reshape(-1)
+    points = np.array([(a[i] + b[j]) / 2.0 for i, j in pairs]).reshape(-1, 3)
+    return overlaps, points
+
+
+def moment_about_axis(inertia, axis) -> float:
+    """Moment of inertia [kg m2] of a body about an axis through its centre of mass: the principal moments ``inertia``
+    (3,) [kg m2] along the principal axes, and the axis's direction ``axis`` (3,) in those axes, of any length > 0."""
+    moments = finite_array("inertia", inertia)
+    direction = finite_array("axis", axis)
+    if moments.shape != (3,) or direction.shape != (3,) or np.any(moments <= 0) or not np.any(direction):
+        raise ValueError(f"inertia (3 moments > 0) and a non-zero axis (3,) expected, got {moments} and {direction}")
+    direction = direction / np.linalg.norm(direction)
+    return float(moments @ direction**2)
 
 
 def incline_acceleration(angle_deg: float, friction: float, gravity: float) -> float:

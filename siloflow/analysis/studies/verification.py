@@ -19,10 +19,12 @@ from siloflow.analysis.numerics.verification import (
     hertz_contact_time,
     incline_acceleration,
     linear_slope,
+    moment_about_axis,
     precession_rate,
     rolling_deceleration_cdt,
     hertz_normal_force,
     sliding_to_rolling,
+    sphere_contacts,
     spin_deceleration,
     zero_crossings,
 )
@@ -34,7 +36,7 @@ __all__ = ["TOLERANCES", "Trajectories", "VerificationRow", "measure_problem", "
 #: impacts are every step).
 TOLERANCES = {"restitution": 0.02, "contact_time": 0.03, "rolling_time": 0.02, "rolling_speed": 0.01,
               "rolling_deceleration": 0.03, "precession_rate": 0.01, "incline_acceleration": 0.02,
-              "spin_deceleration": 0.02}
+              "spin_deceleration": 0.02, "torque_ratio": 0.02}
 
 
 @dataclass(frozen=True)
@@ -105,9 +107,14 @@ def _flat_modulus(p: dict) -> float:
 
 def measure_problem(problem: str, p: dict, run: Trajectories) -> list[VerificationRow]:
     """The rows of problem ``problem`` (``wall_impact``, ``pair_impact``, their ``_damped`` variants,
-    ``slide_to_roll``, ``rolling``, ``incline_slide``, ``incline_stick``, ``clump_rotation``) from its
-    parameters ``p`` (``radius``, ``mass_kg``, ``youngs_modulus``, ``poisson_ratio``, ``restitution``,
-    ``sliding_friction``, ``rolling_friction``, ``gravity``) and the run's trajectories.
+    ``slide_to_roll``, ``rolling``, ``incline_slide``, ``incline_stick``, ``clump_rotation``, ``pair_spin``,
+    ``wall_spin``, ``clump_pair_spin``) from its parameters ``p`` (``radius``, ``mass_kg``, ``youngs_modulus``,
+    ``poisson_ratio``, ``restitution``, ``sliding_friction``, ``rolling_friction``, ``gravity``; a clump problem's
+    ``clump_spheres`` and ``clump_inertia``; ``rolling_lever_arm_m``) and the run's trajectories.
+
+    ``clump_pair_spin`` has two rows: the spin's deceleration against the study's torque, and the engine's torque
+    over the study's (the measured deceleration over the study's closed form) against the ratio the engines' rolling
+    law gives it, the clump's mean lever arm over each contact's own (:mod:`siloflow.model.rolling`).
 
     Raises
     ------
@@ -155,6 +162,30 @@ def measure_problem(problem: str, p: dict, run: Trajectories) -> list[Verificati
         slope, _ = linear_slope(t[spinning], spin[spinning])
         closed = spin_deceleration(p["rolling_friction"], force, r, 0.4 * m * r * r)
         return [_row(problem, "spin_deceleration", closed, -slope)]
+    if problem == "clump_pair_spin":
+        # the held clump's spheres are the last of its frames; its contacts with the fixed clump's, the overlaps and
+        # the lever arms at the start, set the closed form (the spin about the clump's long axis moves neither)
+        k = len(p["clump_spheres"])
+        held, fixed = x[0, -k:], x[0, :-k]
+        # the clump starts at its template's orientation
+        centre = held.mean(axis=0) - np.mean(p["clump_spheres"], axis=0)
+        overlaps, points = sphere_contacts(held, fixed, r)
+        if not len(overlaps):
+            raise ValueError("the held clump does not touch the fixed one")
+        forces = [hertz_normal_force(_flat_modulus(p), r / 2.0, overlap) for overlap in overlaps]
+        arms = np.linalg.norm(points - centre, axis=1)
+        spin = w[:, -1]
+        inertia = moment_about_axis(p["clump_inertia"], spin[0])
+        speed = spin @ (spin[0] / np.linalg.norm(spin[0]))
+        # while it still spins at more than a fifth of its start, the first twentieth left out (as pair_spin)
+        spinning = (t > 0.05 * t[-1]) & (speed > 0.2 * speed[0])
+        if spinning.sum() < 3:
+            raise ValueError("too few frames of the spinning phase")
+        slope, _ = linear_slope(t[spinning], speed[spinning])
+        study = sum(spin_deceleration(p["rolling_friction"], f, arm, inertia) for f, arm in zip(forces, arms))
+        mapped = sum(spin_deceleration(p["rolling_friction"], f, p["rolling_lever_arm_m"], inertia) for f in forces)
+        return [_row(problem, "spin_deceleration", study, -slope),
+                _row(problem, "torque_ratio", mapped / study, -slope / study)]
     if problem in ("incline_slide", "incline_stick"):
         # the block's centre of mass along the slope, after it has settled on the floor (two fifths of the run)
         along = v[:, :, 0].mean(axis=1)

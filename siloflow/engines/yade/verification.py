@@ -1,5 +1,6 @@
-"""YADE scripts of the verification problems (``siloflow/templates/yade/verification.py.j2``): free spheres of one material,
-the floor as an infinite wall of a second material of the same properties, every sphere's state saved."""
+"""YADE scripts of the verification problems (``siloflow/templates/yade/verification.py.j2``): free spheres or clumps
+of one material, the floor as an infinite wall of a second material of the same properties, every sphere's state
+saved."""
 
 from __future__ import annotations
 
@@ -40,7 +41,8 @@ def verification_script_context(case: VerificationCase) -> dict:
         "steps": case.steps,
         "output_every": case.output_every,
         "frame_prefix": DUMP_PREFIX,
-        # a clump problem's clump: centres in its principal frame, the exact mass and principal inertia
+        # a clump problem's clump (one at each of its spheres): centres in its principal frame, the exact mass and
+        # principal inertia
         "clump": ({"centres": [list(c) for c in case.clump_spheres], "mass": case.clump_mass,
                    "inertia": list(case.clump_inertia)} if case.clump_spheres else None),
     }

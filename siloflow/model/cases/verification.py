@@ -18,6 +18,14 @@ two free spheres of the study's HDPE, a flat floor (or none) and gravity (or non
   contact normal: the study's rolling torque ``mu_r |Fn| R`` (R = r for a sphere, :mod:`siloflow.model.rolling`)
   decelerates its spin at ``mu_r |Fn| r / I``, ``|Fn|`` Hertz's force at the overlap. The pair contact is the one the
   clumps of every case make; the wall contact shows the engines' mapping keeps the wall's torque.
+- ``clump_pair_spin``: the study's two-sphere clump, held in place, lies on a fixed one, the two side by side and
+  parallel, so that each sphere of the one presses on the sphere below it at the set overlap; it spins about its own
+  long axis, across the two contact normals. Spinning leaves the contacts where they are (the clump is symmetric about
+  that axis), and the normal forces, through the sphere centres, have no moment about it: the study's torque
+  ``mu_r |Fn| R_i`` at each contact, R_i the distance from the contact point to the clump's centre of mass (1.545 mm,
+  neither a tip nor the waist), decelerates its spin at ``sum mu_r |Fn| R_i / I``, I its moment of inertia about the
+  long axis. The engines' mapping gives each contact the torque at the clump's mean lever arm R instead (1.673 mm,
+  :mod:`siloflow.engines.liggghts.rolling`): their spin slows at R / R_i = 1.083 times the study's.
 - ``incline_slide``, ``incline_stick``: a block (four spheres in a square, 3 r apart) on the floor under gravity
   tilted by 30 and 15 degrees: above the friction angle (tan 30 deg > mu) it slides at g (sin theta - mu cos theta),
   below it stays put.
@@ -27,6 +35,8 @@ two free spheres of the study's HDPE, a flat floor (or none) and gravity (or non
 
 Every problem is a :class:`VerificationCase`: engine-neutral data, written and run by an engine like any other case;
 its frames (every sphere's position, velocity and spin) are what :mod:`siloflow.analysis.numerics.verification` measures.
+A clump problem's ``spheres`` are its clumps (each one's centre of mass, velocity, spin and motion), and its frames
+hold their spheres clump by clump, in that order.
 """
 
 from __future__ import annotations
@@ -70,7 +80,8 @@ class VerificationSphere:
 
 @dataclass(frozen=True)
 class VerificationCase:
-    """One verification problem: spheres, the floor (the plane z = 0, or none), gravity, contact law, duration."""
+    """One verification problem: spheres (or clumps), the floor (the plane z = 0, or none), gravity, contact law,
+    duration."""
 
     name: str
     spheres: tuple[VerificationSphere, ...]
@@ -87,16 +98,17 @@ class VerificationCase:
     steps: int
     output_every: int
     domain: tuple[float, float, float, float, float, float]
-    #: a clump instead of free spheres: its sphere centres relative to its centre of mass [m] (principal axes along
-    #: x, y, z), its principal moments of inertia [kg m2] and mass [kg] (the exact union of the spheres)
+    #: clumps instead of spheres, one at each of ``spheres`` (its centre of mass) with the orientation of the template:
+    #: the sphere centres relative to the centre of mass [m] (principal axes along x, y, z), the principal moments of
+    #: inertia [kg m2] and mass [kg] (the exact union of the spheres)
     clump_spheres: tuple[tuple[float, float, float], ...] = ()
     clump_inertia: tuple[float, float, float] = (0.0, 0.0, 0.0)
     clump_mass: float = 0.0
 
     @property
     def n_spheres(self) -> int:
-        """Spheres in the problem (those of the clump, or the free ones)."""
-        return len(self.clump_spheres) or len(self.spheres)
+        """Spheres in the problem (those of its clumps, or the free ones)."""
+        return len(self.spheres) * (len(self.clump_spheres) or 1)
 
     @property
     def run_id(self) -> str:
@@ -124,6 +136,8 @@ class VerificationCase:
         return {"case": "verification", "run_id": self.run_id, "problem": self.name, "timestep_s": self.timestep,
                 "steps": self.steps, "frame_interval_s": self.output_every * self.timestep,
                 "mass_kg": self.mass, "initial_angular_velocity": self.spheres[0].angular_velocity,
+                # the lever arm the engines' rolling law is given (siloflow.model.rolling), the radius for a sphere
+                "rolling_lever_arm_m": self.rolling.lever_arm,
                 **{key: value for key, value in self.__dict__.items() if key not in ("spheres", "name")}}
 
 
@@ -148,6 +162,7 @@ PROBLEMS = {
     # spin [rad/s]; no sliding friction, so that the rolling torque alone acts on the spin
     "pair_spin": {"speed": 50.0, "restitution": 0.5, "sliding_friction": 0.0, "rolling_friction": 0.1},
     "wall_spin": {"speed": 50.0, "restitution": 0.5, "sliding_friction": 0.0, "rolling_friction": 0.1},
+    "clump_pair_spin": {"speed": 50.0, "restitution": 0.5, "sliding_friction": 0.0, "rolling_friction": 0.1},
 }
 #: The overlap of the spin problems' contact, as a fraction of the radius: about four times the weight's (-).
 SPIN_OVERLAP = 0.002
@@ -210,10 +225,34 @@ def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCa
                                   (spin, 0.0, 0.0), HELD)
         spheres = [held] if floor else [VerificationSphere((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), motion=FIXED), held]
         case(name, spheres, floor, (0.0, 0.0, 0.0), resting, 0.8 * stop)
-    # a free clump spinning at 100 rad/s about an axis 30 degrees off its long axis (no contacts: the time step only
-    # resolves the rotation, 2000 steps a turn)
     centres = np.array([[-CLUMP_HALF_SPACING, 0.0, 0.0], [CLUMP_HALF_SPACING, 0.0, 0.0]])
     tensor = clump_inertia(centres, [r, r], rho)
+    clump = {"clump_spheres": tuple(tuple(map(float, c)) for c in centres),
+             "clump_inertia": tuple(float(v) for v in np.diag(tensor)),
+             "clump_mass": rho * clump_volume(centres, [r, r])}
+    # the clump held above a fixed one, both along x, at the set overlap of each sphere with the one below it,
+    # spinning about its long axis x (across the normals z), a turn that moves no sphere of it. Neither a tip nor the
+    # waist would do: spun across the normal, a clump standing on its tip tilts away from it, the tip's normal force
+    # gaining a moment about the centre of mass, and a sphere at the waist touches both spheres, along normals not
+    # across the spin. The run lasts 0.8 of the time the study's torque stops it in.
+    problem = PROBLEMS["clump_pair_spin"]
+    spin, overlap = problem["speed"], SPIN_OVERLAP * r
+    force = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu**2)) * math.sqrt(r / 2.0) * overlap**1.5
+    arm = math.hypot(CLUMP_HALF_SPACING, r - overlap / 2.0)
+    stop = spin * clump["clump_inertia"][0] / (2.0 * problem["rolling_friction"] * force * arm)
+    timestep = resting / steps_per_contact
+    steps = int(math.ceil(0.8 * stop / timestep))
+    cases["clump_pair_spin"] = VerificationCase(
+        name="clump_pair_spin", spheres=(VerificationSphere((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), motion=FIXED),
+                                         VerificationSphere((0.0, 0.0, 2.0 * r - overlap), (0.0, 0.0, 0.0),
+                                                            (spin, 0.0, 0.0), HELD)),
+        floor=False, gravity=(0.0, 0.0, 0.0), radius=r, density=rho, youngs_modulus=e_mod, poisson_ratio=nu,
+        sliding_friction=problem["sliding_friction"], rolling_friction=problem["rolling_friction"],
+        restitution=problem["restitution"], timestep=timestep, steps=steps,
+        output_every=1 if 0.8 * stop < 20 * resting else max(1, steps // 400),
+        domain=(-box, box, -box, box, -box, box), **clump)
+    # a free clump spinning at 100 rad/s about an axis 30 degrees off its long axis (no contacts: the time step only
+    # resolves the rotation, 2000 steps a turn)
     spin = PROBLEMS["clump_rotation"]["speed"]
     omega = (spin * math.cos(math.radians(30.0)), spin * math.sin(math.radians(30.0)), 0.0)
     turn = 2.0 * math.pi / spin
@@ -223,9 +262,7 @@ def verification_cases(steps_per_contact: int = 100) -> dict[str, VerificationCa
         name="clump_rotation", spheres=(VerificationSphere((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), omega),), floor=False,
         gravity=(0.0, 0.0, 0.0), radius=r, density=rho, youngs_modulus=e_mod, poisson_ratio=nu,
         sliding_friction=problem["sliding_friction"], rolling_friction=0.0, restitution=problem["restitution"],
-        timestep=turn / 2000.0, steps=steps, output_every=20, domain=(-box, box, -box, box, -box, box),
-        clump_spheres=tuple(tuple(map(float, c)) for c in centres),
-        clump_inertia=tuple(float(v) for v in np.diag(tensor)), clump_mass=rho * clump_volume(centres, [r, r]))
+        timestep=turn / 2000.0, steps=steps, output_every=20, domain=(-box, box, -box, box, -box, box), **clump)
     # a block of four spheres on the floor, gravity tilted about y: it slides along +x or sticks
     block = np.array([[sx * 1.5 * r, sy * 1.5 * r, 0.0] for sx in (-1, 1) for sy in (-1, 1)])
     block_tensor = clump_inertia(block, [r] * 4, rho)

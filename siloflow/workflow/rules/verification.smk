@@ -34,6 +34,13 @@ VERIFICATION_EXPLANATIONS = {
                  "|Fn| Hertz's at the overlap) slows its spin at mu_r |Fn| r / I. The contact every clump makes; "
                  "LIGGGHTS' CDT gets the mapped coefficient 2 mu_r (docs/engines.md, The rolling law).",
     "wall_spin": "The same sphere on the floor: the wall's torque mu_r |Fn| r, with LIGGGHTS' coefficient mu_r.",
+    "clump_pair_spin": "The two-sphere clump, held in place, lies on a fixed one, side by side and parallel, each "
+                       "sphere pressing on the one below at an overlap of 0.002 r, and spins at 50 rad/s about its long "
+                       "axis, across the normals, without sliding friction: the study's torque mu_r |Fn| R_i at each "
+                       "contact (R_i = 1.545 mm from the contact point to the centre of mass) slows it at "
+                       "sum mu_r |Fn| R_i / I. The engines' mapping gives each contact the torque at the clump's mean "
+                       "lever arm R = 1.673 mm: torque_ratio is the measured deceleration over the study's, against "
+                       "R / R_i (docs/engines.md, The rolling law).",
 }
 
 #: Rows that differ on an engine, and why ("<engine>/<problem>/<quantity>"): the report says it beside the row.
@@ -44,6 +51,12 @@ VERIFICATION_KNOWN_DIFFERENCES = {
     "yade/wall_spin/spin_deceleration": "YADE's sphere-wall geometry takes R* = r/2 (see wall_impact): at the same "
     "overlap its normal force is 2^(-1/2) = 0.707 of a flat's, and the rolling moment, capped at eta r |Fn| as on a "
     "pair, with it.",
+    "liggghts/clump_pair_spin/spin_deceleration": "The mapping's: LIGGGHTS' CDT is given the study's torque at the "
+    "clump's mean lever arm R = 1.673 mm, this contact's own is R_i = 1.545 mm, so the spin slows at R / R_i = 1.083 "
+    "times the study's (the torque_ratio row checks that it does).",
+    "yade/clump_pair_spin/spin_deceleration": "The mapping's: YADE's eta gives the study's torque at the clump's mean "
+    "lever arm R = 1.673 mm, this contact's own is R_i = 1.545 mm, so the spin slows at R / R_i = 1.083 times the "
+    "study's (the torque_ratio row checks that it does).",
 }
 
 
