@@ -18,13 +18,15 @@ __all__ = ["SILO_STAGE_MARKERS", "check_silo_run", "expected_simulated_time", "s
 
 def check_silo_run(
     case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged",
-    clumps_conserved: bool = False,
+    clumps_conserved: bool = False, then: str | None = None,
 ) -> dict:
     """Check that a finished silo run did what the case asked; returns the stage record.
 
     ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
     drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
     ``clumps_conserved`` (periodic runs, where nothing may leave) the clump count must be unchanged at its end.
+    ``then`` names the marker of a stage after it (the recirculating silo's discharge after its recirculations,
+    ``discharged``), which must be there too; the record keeps it under that name.
 
     The ``settled`` stage carries, besides the marker's values, the settling criterion: ``ke_threshold_J`` (J),
     ``ke_threshold_ratio`` (the threshold over the clump's m g d, -) and ``ke_ratio`` (the settled fill's kinetic
@@ -39,7 +41,7 @@ def check_silo_run(
     by_event = {}
     for marker in markers:
         by_event.setdefault(marker.event, []).append(marker)
-    for event in ("filled", "settled", "opened", last_stage):
+    for event in ("filled", "settled", "opened", last_stage) + ((then,) if then else ()):
         if event not in by_event:
             raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
     filled = by_event["filled"][-1].values
@@ -75,6 +77,7 @@ def check_silo_run(
         "settled": settled,
         "opened": opened,
         last_stage: by_event[last_stage][-1].values,
+        **({then: by_event[then][-1].values} if then else {}),
         "settle_checks": [m.values for m in by_event.get("settle", [])],
         "open_step": int(round(opened["step"])),
         "open_time_s": opened["time"],

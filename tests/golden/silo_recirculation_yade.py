@@ -369,14 +369,32 @@ CHANNEL_BOTTOM = -0.04
 FEEDER_ZONE = (-0.012, 0.012, -0.04, -0.02, )
 FEEDER_VELOCITY = 0.4
 FEEDER_EVERY = 10
+#: Steps of the discharge after the recirculations at the end of the run (0: none): the re-entry stops that many
+#: steps before FINAL_STEP
+FINAL_DISCHARGE_STEPS = 0
+#: the step this attempt's discharge began at, and whether the re-entry has stopped in it
+ATTEMPT = {"start": None, "recirculated": False}
 
 
 def outflow():
     """Periodic in z, as the LIGGGHTS deck's boundary: a clump below the channel bottom re-enters at the top of the
-    domain, whole, with its x, y and velocity."""
+    domain, whole, with its x, y and velocity; in the discharge after the recirculations (the study's, §6.4.2) it is
+    gone, as the LIGGGHTS deck's boundary turned fixed."""
+    reentry_end = FINAL_STEP - FINAL_DISCHARGE_STEPS
+    discharging = FINAL_DISCHARGE_STEPS and O.iter >= reentry_end
+    if ATTEMPT["start"] is None:
+        ATTEMPT["start"] = O.iter
+    if discharging and not ATTEMPT["recirculated"]:
+        ATTEMPT["recirculated"] = True
+        # an attempt resumed past the end of the re-entry has its marker in an earlier attempt's log
+        if ATTEMPT["start"] < reentry_end:
+            say_stage("recirculated")
     for b in clumps():
         if b.state.pos[2] < CHANNEL_BOTTOM:
-            b.state.pos = b.state.pos + Vector3(0.0, 0.0, DOMAIN_TOP - CHANNEL_BOTTOM)
+            if discharging:
+                O.bodies.erase(b.id, True)
+            else:
+                b.state.pos = b.state.pos + Vector3(0.0, 0.0, DOMAIN_TOP - CHANNEL_BOTTOM)
 
 
 def feed():

@@ -128,3 +128,20 @@ def test_a_periodic_run_that_lost_clumps_is_reported(tiny_config, tmp_path):
         check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path, clumps_conserved=True)
     conserved = log.replace(f"clumps={n - 3}", f"clumps={n}")
     assert check_silo_run(case, parse_markers(conserved), _dumps(tmp_path, 3), tmp_path, clumps_conserved=True)
+
+
+def test_a_discharge_after_the_recirculations_needs_its_marker_and_keeps_the_recirculation_conserved(tiny_config,
+                                                                                                       tmp_path):
+    """The recirculating silo with a discharge after it: the clumps are counted at 'recirculated' (all there), the
+    'discharged' stage after it drains and is kept in the record; without its marker the run did not finish."""
+    case = build_silo_case(tiny_config)
+    n = case.fill.n_clumps
+    log = LOG.replace("clumps=1395", f"clumps={n}").replace("clumps=355", "clumps=40").replace(
+        "SILOFLOW discharged", f"SILOFLOW recirculated step=60000 time=0.7 clumps={n} ke_per_clump=1e-7\nSILOFLOW discharged")
+    checked = check_silo_run(case, parse_markers(log), _dumps(tmp_path, 3), tmp_path, last_stage="recirculated",
+                             clumps_conserved=True, then="discharged")
+    assert checked["recirculated"]["clumps"] == n and checked["discharged"]["clumps"] == 40
+    unfinished = log.split("SILOFLOW discharged")[0]
+    with pytest.raises(EngineRunError, match="the log has no 'discharged' stage marker"):
+        check_silo_run(case, parse_markers(unfinished), _dumps(tmp_path, 3), tmp_path, last_stage="recirculated",
+                       clumps_conserved=True, then="discharged")

@@ -8,7 +8,7 @@ import pytest
 
 from siloflow.model.cases.blender import build_blender_case
 from siloflow.model.cases.silo_recirculation import build_recirculation_case
-from siloflow.engines.config import load_config
+from siloflow.engines.config import load_config, validate_config
 from siloflow.engines.liggghts.run import Resume, attempt_logs, restart_every, restart_files
 from siloflow.engines.liggghts.silo_flat import silo_deck_context
 from siloflow.engines.liggghts.blender import blender_deck_context
@@ -47,6 +47,18 @@ def test_recirculation_resume_deck_keeps_the_feeder_and_loses_no_clump():
     _check_common(deck)
     assert "fix feeder all setforce NULL NULL v_feeder_force_z region feeder" in deck
     assert "thermo_modify lost error" in deck.split("# --- recirculate")[1]
+
+
+def test_a_resumed_recirculation_with_a_discharge_after_it_ends_the_re_entry_at_its_step():
+    """The resume deck runs to the end of both stages (step 77952); the re-entry ends final_discharge_steps before
+    it, and a restart file past that step goes straight on with the discharge."""
+    raw = load_config(GOLDEN / "silo_recirculation_config.yaml")
+    raw["silo_recirculation"]["final_discharge"] = 1.0
+    case = build_recirculation_case(validate_config(raw), "internal_flow")
+    deck = _resume_deck("liggghts/silo_recirculation.lmp.j2", recirculation_deck_context(case), case.silo.discharge_steps)
+    assert f"variable reentry_end equal {77952 - case.final_discharge_steps}\n" in deck
+    assert 'if "$(step) < ${reentry_end}" then "run ${reentry_end} upto"' in deck
+    assert deck.split("change_box all boundary")[1].count("run 77952 upto") == 1
 
 
 def test_blender_resume_deck_has_the_open_walls():

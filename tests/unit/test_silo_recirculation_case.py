@@ -92,6 +92,45 @@ def test_recirculation_time_covers_the_asked_recirculations(golden_config):
     assert case.silo.sink_depth == 0.04
 
 
+def _with_final_discharge(config, residence_times):
+    raw = copy.deepcopy(config)
+    raw["silo_recirculation"]["final_discharge"] = residence_times
+    return validate_config(raw)
+
+
+def test_the_discharge_after_the_recirculations_follows_them_for_its_residence_times(golden_config):
+    """final_discharge 1.5: the discharge stage lasts 1.5 a-priori residence times after the 2 recirculations, the
+    recirculation itself is unchanged, and a run without it keeps its id."""
+    plain = build_recirculation_case(golden_config, "internal_flow")
+    case = build_recirculation_case(_with_final_discharge(golden_config, 1.5), "internal_flow")
+    dt, t_res = case.silo.timestep, case.estimated_residence_time
+    assert case.final_discharge_steps == round(1.5 * t_res / dt)
+    assert case.final_discharge_time == pytest.approx(case.final_discharge_steps * dt, rel=1e-15)
+    assert case.recirculation_steps + case.final_discharge_steps == case.silo.discharge_steps
+    assert abs(case.recirculation_steps - plain.silo.discharge_steps) <= 1
+    assert [stage.kind for stage in case.stages()] == ["fill", "settle", "open", "recirculate", "discharge"]
+    assert case.stages()[-1].controls["duration_s"] == case.final_discharge_time
+    assert case.summary()["final_discharge_time_s"] == case.final_discharge_time
+    assert case.run_id != plain.run_id
+    assert build_recirculation_case(_with_final_discharge(golden_config, 0.0), "internal_flow").run_id == plain.run_id
+    assert plain.final_discharge_steps == 0 and [s.kind for s in plain.stages()][-1] == "recirculate"
+    thin = build_recirculation_case(_with_final_discharge(golden_config, 1.5), "internal_flow", "verification")
+    assert thin.final_discharge_steps == 0
+
+
+def test_the_deck_stops_the_re_entry_then_discharges(golden_config):
+    case = build_recirculation_case(_with_final_discharge(golden_config, 1.5), "internal_flow")
+    deck = render_recirculation_deck(case)
+    tail = deck.split("# --- recirculate")[1]
+    assert f"variable reentry_end equal $(step+{case.recirculation_steps})" in tail
+    assert 'if "$(step) < ${reentry_end}" then "run ${reentry_end} upto"' in tail
+    assert tail.index("SILOFLOW recirculated") < tail.index("change_box all boundary f f f")
+    discharge = tail.split("change_box all boundary f f f")[1]
+    assert "thermo_modify lost ignore" in discharge and f"run {case.final_discharge_steps}\n" in discharge
+    assert discharge.rstrip().endswith('print "SILOFLOW discharged step=$(step) time=$(time) clumps=${n_clumps} '
+                                       'ke_per_clump=${ke_per_clump}"')
+
+
 def test_channel_meshes_face_into_the_channel(golden_config):
     meshes = recirculation_meshes(build_recirculation_case(golden_config, "internal_flow"))
     np.testing.assert_allclose(meshes["channel_left"].normals(), [[1.0, 0.0, 0.0]] * 2)

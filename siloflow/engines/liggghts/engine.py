@@ -139,9 +139,11 @@ class LiggghtsEngine(Engine):
         """
         name, adapter = _adapter(case)
         kinds = tuple(stage.kind for stage in case.stages())
-        if kinds != case_kind(name).stages:
+        kind = case_kind(name)
+        if not kind.runs_stages(kinds):
+            runs = " or ".join(str(stages) for stages in dict.fromkeys((kind.stages, kind.stages + kind.final_stages)))
             raise CaseNotSupported(f"{name} run {case.run_id}: LIGGGHTS has no deck for the stages {kinds}; "
-                                   f"it runs {case_kind(name).stages}")
+                                   f"it runs {runs}")
         for a, b, value, key in adapter.restitution_pairs(case):
             if not value > MIN_RESTITUTION:
                 raise CaseNotSupported(

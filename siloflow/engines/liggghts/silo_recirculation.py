@@ -37,6 +37,8 @@ def recirculation_deck_context(case: RecirculationCase) -> dict:
         # the atoms of one clump as the deck inserts them (a one-sphere model's has an inner sphere)
         "spheres_per_clump": len(context["particle"]["spheres"]),
     }
+    # the discharge after the recirculations: the last final_discharge steps of the discharge stage
+    context["final_discharge"] = {"steps": case.final_discharge_steps} if case.final_discharge_steps else None
     return context
 
 
@@ -51,14 +53,16 @@ def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) ->
 
 
 def check_recirculation_run(case: RecirculationCase, markers, dump_files, run_dir: Path) -> dict:
-    """Check a finished recirculation run: the batch silo's checks, then no clump lost while recirculating.
+    """Check a finished recirculation run: the batch silo's checks, then no clump lost while recirculating, and the
+    discharge after the recirculations finished where the case has one.
 
     Raises
     ------
     EngineRunError
         As :func:`siloflow.engines.liggghts.run.check_silo_run`, or when the clump count changed during recirculation.
     """
-    return check_silo_run(case.silo, markers, dump_files, run_dir, last_stage="recirculated", clumps_conserved=True)
+    return check_silo_run(case.silo, markers, dump_files, run_dir, last_stage="recirculated", clumps_conserved=True,
+                          then="discharged" if case.final_discharge_steps else None)
 
 
 def run_recirculation(

@@ -106,13 +106,13 @@ def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
 
 def run_silo_type(silo: SiloCase, case_kind: str, run_id: str, run_dir: str | Path, options: YadeOptions,
                   last_stage: str = "discharged", clumps_conserved: bool = False, labels: dict | None = None,
-                  domain_z: list | None = None) -> RunRecord:
+                  domain_z: list | None = None, then: str | None = None) -> RunRecord:
     """Run a rendered silo-type script (flat-bottom, recirculating, blender), check it as every engine's silo-type
     runs are (:func:`siloflow.engines.silo_checks.check_silo_run`) and write ``run.json``; returns the record."""
     return run_script_checked(
         run_dir, options, expected_simulated_time(silo),
         lambda markers, dumps: check_silo_run(silo, markers, dumps, Path(run_dir), last_stage=last_stage,
-                                              clumps_conserved=clumps_conserved),
+                                              clumps_conserved=clumps_conserved, then=then),
         lambda checked: silo_run_record(ENGINE_NAME, case_kind, run_id, checked, labels, domain_z),
     )
 

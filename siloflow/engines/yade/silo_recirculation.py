@@ -35,7 +35,11 @@ def recirculation_script_context(case: RecirculationCase) -> dict:
         "meshes": [{"id": name, "material": bottom} for name in recirculation_meshes(case)],
         "channel_bottom": -case.channel_length,
         "feeder": {"zone": list(case.feeder_zone), "velocity": case.feeder_velocity, "every": FEEDER_EVERY},
-        "discharge": {**context["discharge"], "stage": "recirculate", "marker": "recirculated"},
+        # with a discharge after the recirculations, the script says "recirculated" when the re-entry stops and
+        # "discharged" at the end
+        "discharge": {**context["discharge"], "stage": "recirculate",
+                      "marker": "discharged" if case.final_discharge_steps else "recirculated"},
+        "final_discharge_steps": case.final_discharge_steps,
     })
     return context
 
@@ -52,10 +56,11 @@ def write_recirculation_inputs(case: RecirculationCase, deck_dir: str | Path) ->
 
 
 def run_recirculation(case: RecirculationCase, run_dir: str | Path, options: YadeOptions) -> RunRecord:
-    """Run a rendered recirculation script, check it (the batch silo's checks, and no clump lost while
-    recirculating) and write ``run.json``; returns the record."""
+    """Run a rendered recirculation script, check it (the batch silo's checks, no clump lost while recirculating,
+    the discharge after the recirculations finished where the case has one) and write ``run.json``; returns the
+    record."""
     return run_silo_type(case.silo, "silo_recirculation", case.run_id, run_dir, options, last_stage="recirculated",
-                         clumps_conserved=True,
+                         clumps_conserved=True, then="discharged" if case.final_discharge_steps else None,
                          labels={"flow_pattern": case.pattern, "role": case.role,
                                  "estimated_residence_time_s": case.estimated_residence_time},
                          domain_z=[-case.channel_length, case.silo.domain_top])

@@ -51,6 +51,9 @@ class CaseKind:
         The folder of its runs under ``results/`` (:mod:`siloflow.engines.layout`).
     stages : tuple of str
         The stage kinds its decks run, in order (:data:`siloflow.model.cases.stages.STAGE_KINDS`).
+    final_stages : tuple of str
+        Stage kinds a run may add after ``stages``, all or none (the recirculating silo's discharge after its
+        recirculations).
     build : callable or None
         ``build(config) -> {run id: case}`` from a validated configuration, the reference configuration first;
         None for a kind no config section defines (the verification suite builds its own problems).
@@ -93,6 +96,12 @@ class CaseKind:
     run_role: Callable[[Mapping, object], str] | None = None
     rules: str | None = None
     walls: Callable[[object], dict] | None = None
+    final_stages: tuple[str, ...] = ()
+
+    def runs_stages(self, kinds: tuple[str, ...]) -> bool:
+        """Whether ``kinds`` is a stage sequence this kind's decks run: ``stages``, or ``stages`` then
+        ``final_stages``."""
+        return tuple(kinds) in (self.stages, self.stages + self.final_stages)
 
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or not self.name.islower():
@@ -151,7 +160,7 @@ register_case_kind(CaseKind(
     "silo_recirculation", RecirculationCase, "silo_recirculation", ("fill", "settle", "open", "recirculate"),
     recirculation_cases, estimate_recirculation_case, SCHEMA_FRAGMENTS / "silo_recirculation.schema.yaml",
     inherits_defaults=True, replicated=True, fill_balance=True, check_config=check_recirculation_config,
-    rules="silo_recirculation.smk", walls=recirculation_meshes))
+    rules="silo_recirculation.smk", walls=recirculation_meshes, final_stages=("discharge",)))
 register_case_kind(CaseKind(
     "blender", BlenderCase, "blender", ("fill", "settle", "open", "discharge"), blender_cases, estimate_blender_case,
     SCHEMA_FRAGMENTS / "blender.schema.yaml", inherits_defaults=True, replicated=True, fill_balance=True,

@@ -8,7 +8,8 @@ back onto it, so the silo is fed with its own outflow (thesis ch. 6).
 
 Stages: pour and settle exactly as the batch silo (the gate closes the outlet, the channel is empty), open the
 outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times
-(:func:`estimated_residence_time`).
+(:func:`estimated_residence_time`); then, with ``final_discharge`` > 0, discharge for that many more: the re-entry
+stops and a clump leaving the channel bottom is gone, the study's discharge after Nr recirculations (§6.4.2).
 
 A flow pattern is a named preset of friction coefficients (``silo_recirculation.presets``); it replaces the particle-
 particle and particle-wall friction of the contacts for this run. The front and back walls get their own copy
@@ -24,9 +25,10 @@ import copy
 from dataclasses import dataclass, field
 
 from siloflow.model.cases.common import run_id
-from siloflow.model.cases.config_checks import ConfigError, require, require_subset
+from siloflow.model.cases.config_checks import ConfigError, require
 from siloflow.model.cases.geometry import vertical_rectangle_x
 from siloflow.model.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
+from siloflow.model.cases.stages import Stage
 
 CASE_NAME = "silo_recirculation"
 #: The config section of the case.
@@ -66,7 +68,9 @@ class RecirculationCase:
     estimated_residence_time : float
         ``W H / (B0 V_out)`` (s).
     recirculation_time : float
-        Simulated time of the recirculation stage (s).
+        Simulated time of the recirculation stage (s): from the opening to the end of the re-entry.
+    final_discharge_time : float
+        Simulated time of the discharge after the recirculations (s); 0 when the run ends recirculating.
     """
 
     pattern: str
@@ -78,6 +82,7 @@ class RecirculationCase:
     estimated_residence_time: float
     recirculation_time: float
     defining_parameters: dict = field(repr=False)
+    final_discharge_time: float = 0.0
 
     @property
     def fill_height(self) -> float:
@@ -105,9 +110,29 @@ class RecirculationCase:
         """Bottom and top of the periodic domain (m): the return channel below the outlet up to the silo's top."""
         return (-self.channel_length, self.silo.domain_top)
 
+    @property
+    def recirculation_steps(self) -> int:
+        """Steps of the recirculation stage (from the opening to the end of the re-entry) [-]."""
+        return self.silo.discharge_steps - self.final_discharge_steps
+
+    @property
+    def final_discharge_steps(self) -> int:
+        """Steps of the discharge after the recirculations [-]; 0 without one."""
+        return int(round(self.final_discharge_time / self.silo.timestep))
+
     def stages(self):
-        """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`)."""
-        return self.silo.stages(last="recirculate")
+        """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`), then the discharge after
+        the recirculations where there is one."""
+        stages = self.silo.stages(last="recirculate")
+        if not self.final_discharge_steps:
+            return stages
+        *before, recirculate = stages
+        frames = recirculate.controls["frame_interval_s"]
+        return (*before,
+                Stage("recirculate", {"duration_s": self.recirculation_time, "frame_interval_s": frames},
+                      recirculate.outputs),
+                Stage("discharge", {"duration_s": self.final_discharge_time, "frame_interval_s": frames},
+                      recirculate.outputs))
 
     def summary(self) -> dict:
         """Plain-data summary for ``case.json``."""
@@ -123,6 +148,7 @@ class RecirculationCase:
                 "feeder_zone": list(self.feeder_zone),
                 "estimated_residence_time_s": self.estimated_residence_time,
                 "recirculation_time_s": self.recirculation_time,
+                "final_discharge_time_s": self.final_discharge_time,
                 "domain_z": list(self.domain_z),
                 "parameters": self.defining_parameters,
             }
@@ -213,6 +239,8 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
     # by the pattern's measured ratio, so that every pattern reaches the same number of measured recirculations.
     ratio = section["residence_time_ratios"].get(pattern, 1.0) if role == "blending" else 1.0
     recirculations = geometry["recirculations"] * ratio
+    # the thin verification silo checks the recirculation itself: it ends recirculating
+    final_discharge = section["final_discharge"] * ratio if role == "blending" else 0.0
     t_res = estimated_residence_time(
         geometry["width"], geometry["fill_height"], section["outlet_width"], section["feeder_velocity"],
         section["channel_density_ratio"],
@@ -226,7 +254,7 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         outlet_width=section["outlet_width"],
         front_back_walls=True,
         sink_depth=section["channel_length"],
-        discharge_time=recirculations * t_res,
+        discharge_time=(recirculations + final_discharge) * t_res,
         dump_interval=section["dump_interval"],
     )
     silo_case = silo_case_from_section(changed, silo, SECTION, reentry_velocity=section["feeder_velocity"])
@@ -241,6 +269,11 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         "channel_length": channel,
         "feeder_velocity": section["feeder_velocity"],
     }
+    timestep = silo_case.timestep
+    final_steps = int(round(final_discharge * t_res / timestep))
+    if final_steps:
+        # only then: a run that ends recirculating keeps the id it had before the discharge existed
+        defining["final_discharge_steps"] = final_steps
     return RecirculationCase(
         pattern=pattern,
         role=role,
@@ -249,8 +282,9 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         feeder_velocity=section["feeder_velocity"],
         feeder_zone=feeder_zone,
         estimated_residence_time=t_res,
-        recirculation_time=silo_case.discharge_steps * silo_case.timestep,
+        recirculation_time=(silo_case.discharge_steps - final_steps) * timestep,
         defining_parameters=defining,
+        final_discharge_time=final_steps * timestep,
     )
 
 
