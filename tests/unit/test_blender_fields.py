@@ -9,14 +9,19 @@ from siloflow.analysis.studies.blender.window_fields import (
     discharged_mass_history,
     frame_fields,
     frames_in_window,
+    WALL_LAYER_DIAMETERS,
     mean_velocity_history,
+    wall_layer_depth,
+    wall_layer_positions,
     window_average_field,
 )
 from siloflow.analysis.studies.blender.window_fields_io import (
     read_frame_fields,
     read_planar_fields,
+    read_wall_layer_fields,
     write_frame_fields,
     write_planar_fields,
+    write_wall_layer_fields,
 )
 from siloflow.analysis.numerics.clump_tracks import ClumpTracks
 from siloflow.analysis.numerics.eulerian_rtd import silo_bins
@@ -154,3 +159,39 @@ def test_mean_velocity_history_weights_the_clumps_above_the_outlet_by_mass():
     history = mean_velocity_history(tracks, velocity, [1.0, 3.0, 2.0])
     # frame 0: clump 2 is below the outlet, (1 * -1 + 3 * -2) / 4; frame 1: clump 0 absent, (3 * -0.5 + 2 * -1) / 5
     np.testing.assert_allclose(history, [-1.75, -0.7])
+
+
+def test_the_wall_layer_is_one_diameter_from_either_wall_folded_onto_the_front():
+    assert WALL_LAYER_DIAMETERS == 1.0 and wall_layer_depth(0.0033) == 0.0033
+    with pytest.raises(ValueError, match="equivalent_diameter"):
+        wall_layer_depth(0.0)
+    # depth 12 mm: y 1, 11 and 6 mm fold onto 1, 1 and 6 mm; x, z and an absent clump are kept
+    positions = np.array([[[0.01, 0.001, 0.02], [-0.01, 0.011, 0.03], [0.0, 0.006, 0.04], [np.nan] * 3]])
+    folded = wall_layer_positions(positions, 0.012)
+    np.testing.assert_allclose(folded[0, :3], [[0.01, 0.001, 0.02], [-0.01, 0.001, 0.03], [0.0, 0.006, 0.04]],
+                               rtol=0, atol=1e-15)
+    assert np.isnan(folded[0, 3]).all() and positions[0, 1, 1] == 0.011  # a copy
+    with pytest.raises(ValueError, match="last axis of 3"):
+        wall_layer_positions(np.zeros((2, 2)), 0.012)
+    # binned on a grid one layer (3.3 mm) deep: the front clump (-1 m/s) and the back one (-3 m/s) pool in the left
+    # bin's layer; the mid-depth clump (6 mm from both walls) is left out of the right bin
+    grid = silo_bins(width=0.04, depth=wall_layer_depth(0.0033), top=0.04, bin_size=0.02)
+    positions = np.array([[[-0.01, 0.001, 0.01], [-0.01, 0.0115, 0.01], [0.01, 0.006, 0.01]]])
+    velocities = np.array([[[0.0, 0.0, -1.0], [0.0, 0.0, -3.0], [0.0, 0.0, -7.0]]])
+    field = window_average_field(wall_layer_positions(positions, 0.012), velocities, [1e-3, 1e-3, 1e-3], [0.0], grid,
+                                 (0.0, 1.0), 1000.0)
+    assert field.v_z[0, 0] == pytest.approx(-2.0) and np.isnan(field.v_z[1, 0])
+
+
+def test_wall_layer_fields_round_trip(tmp_path):
+    def field(value, window):
+        return PlanarField(x=np.array([-0.5, 0.5]), z=np.array([0.1]), v_x=np.zeros((2, 1)),
+                           v_z=np.full((2, 1), value), solid_fraction=np.full((2, 1), 0.5), window=window, n_frames=1)
+
+    steady, frames = field(-1.0, (0.0, 0.2)), [field(-0.9, (0.0, 0.0)), field(-1.1, (0.2, 0.2))]
+    loaded, loaded_frames = read_wall_layer_fields(write_wall_layer_fields(tmp_path / "wall_layer.npz", steady, frames))
+    assert loaded.window == (0.0, 0.2) and [f.window for f in loaded_frames] == [(0.0, 0.0), (0.2, 0.2)]
+    np.testing.assert_array_equal(loaded_frames[1].v_z, frames[1].v_z)
+    with pytest.raises(ValueError, match="at least one"):
+        write_wall_layer_fields(tmp_path / "bad.npz", steady, [])
+    assert not (tmp_path / "bad.npz").exists()

@@ -111,6 +111,12 @@ def test_blender_summary_adds_the_case_flow_rtd_curve_and_history_to_the_study_s
     assert summary["discontinuous"] == {"homogenised_after": 3.0, "pass_mean": [0.5, 0.25], "tracer_fraction": 0.2,
                                         "n_not_exited": 1}
     assert summary["metrics"]["vrr_by_period"] == {"1": 4.0}
+    # the PIV figures of the vertical section and the wall layer: null unless given, else as given
+    assert summary["vertical_section"] is None and summary["wall_layer"] is None
+    given = blender_summary(FLOW, STUDY, METRICS, **RUN, vertical_section={"0.5": {"largest_deviation": 0.1}},
+                            wall_layer={"depth_m": 0.0033})
+    assert given["vertical_section"] == {"0.5": {"largest_deviation": 0.1}}
+    assert given["wall_layer"] == {"depth_m": 0.0033}
 
 
 def test_blender_summary_round_trips_through_json_to_the_comparison_inputs(tmp_path):

@@ -10,6 +10,7 @@ import math
 import pytest
 
 from siloflow.engines.config import validate_config
+from siloflow.model.cases.config_checks import ConfigError
 from siloflow.model.cases.common import material_table, run_id
 from siloflow.model.rolling import ROLLING_LAW
 from siloflow.model.cases import case_for_run
@@ -124,7 +125,22 @@ def test_run_id_is_stable_and_changes_with_any_defining_parameter(tiny_config):
     # analysis-only settings do not define the simulation
     analysis_only = copy.deepcopy(tiny_config)
     analysis_only["silo_flat"]["steady_window"] = [0.1, 0.9]
+    analysis_only["silo_flat"]["fields"]["average_window"] = [0.5, 0.7]
     assert build_silo_case(analysis_only).run_id == case.run_id
+
+
+def test_the_fields_averaging_window_must_lie_within_the_discharge():
+    # discharge_time 3 s by default: the study's 0.5-0.7 s and the whole discharge pass
+    for window in ([0.5, 0.7], [0.0, 3.0]):
+        assert validate_config({"silo_flat": {"fields": {"average_window": window}}})["silo_flat"]["fields"][
+            "average_window"] == window
+    for window in ([0.5, 3.5], [0.7, 0.5], [0.5, 0.5]):
+        with pytest.raises(ConfigError, match=r"config key 'silo_flat.fields.average_window': \[.*\] s must be an "
+                                              r"increasing window within the discharge.*discharge_time \(3.0 s\)"):
+            validate_config({"silo_flat": {"fields": {"average_window": window}}})
+    # a longer discharge holds a later window
+    longer = validate_config({"silo_flat": {"discharge_time": 4.0, "fields": {"average_window": [0.5, 3.5]}}})
+    assert longer["silo_flat"]["fields"]["average_window"] == [0.5, 3.5]
 
 
 def test_contact_pair_order_does_not_change_the_run_id(tiny_config):

@@ -27,6 +27,7 @@ from siloflow.analysis.studies.silo_flat.field_comparisons import (
     parametric_profiles,
     parametric_rows,
 )
+from siloflow.analysis.studies.silo_flat.field_clock import WINDOW_CONFIGURED, WINDOW_STEADY, averaging_window
 from siloflow.analysis.studies.silo_flat.field_study import (
     COVERED_DENSITY_FRACTION,
     FIELD_BATCHES,
@@ -406,6 +407,34 @@ def test_silo_field_study_contact_stress_janssen_and_force_chains(lattice_study)
     np.testing.assert_allclose(study.segments.normal_force, [FORCES[0], FORCES[1]], rtol=1e-12)  # 1 N is outside
     np.testing.assert_array_equal(study.segments.start, contacts.position_i[:2])
     assert study.n_contacts == 3
+
+
+def test_the_averaging_window_is_the_configured_times_else_the_steady_window():
+    assert averaging_window([0.5, 0.7], (0.31, 1.24)) == ((0.5, 0.7), WINDOW_CONFIGURED)
+    assert averaging_window(None, (0.31, 1.24)) == ((0.31, 1.24), WINDOW_STEADY)
+    assert (WINDOW_CONFIGURED, WINDOW_STEADY) == ("silo_flat.fields.average_window", "silo_flat.steady_window")
+    for bad in ((0.7, 0.5), (-0.1, 0.5), (0.5,)):
+        with pytest.raises(ValueError, match="averaging window"):
+            averaging_window(bad, (0.31, 1.24))
+
+
+def test_a_configured_window_in_seconds_after_opening_picks_its_frames(lattice_study):
+    frames, contacts, steady = lattice_study
+    options = SiloFieldOptions.from_config({**FIELD_SECTION, "average_window": [0.0, 0.01]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", OptimizeWarning)
+        study = analyse_silo_fields(frames, None, SiloDimensions.from_case(CASE), options, STEADY_WINDOW,
+                                    BULK_DENSITY)
+    # the frames at 0 and 0.01 s after opening, not the steady window's at 0.01 and 0.02 s; the second frame's time,
+    # 1.01 - 1.0, lies a round-off above the window's end and still counts
+    assert study.times[1] > 0.01
+    assert study.window == (0.0, 0.01) and study.window_source == WINDOW_CONFIGURED
+    np.testing.assert_allclose(study.profiles.v_z, -0.5 * (SPEEDS[0] + SPEEDS[1]), rtol=1e-12)
+    summary = field_summary(study, outflow_rate=2.0)
+    assert summary["average_window_s"] == [0.0, 0.01]
+    assert summary["average_window_source"] == "silo_flat.fields.average_window"
+    assert steady.window_source == WINDOW_STEADY
+    assert field_summary(steady, outflow_rate=2.0)["average_window_source"] == "silo_flat.steady_window"
 
 
 def test_silo_field_study_needs_a_frame():

@@ -116,6 +116,7 @@ def test_the_discharge_after_the_recirculations_follows_them_for_its_residence_t
     assert plain.final_discharge_steps == 0 and [s.kind for s in plain.stages()][-1] == "recirculate"
     thin = build_recirculation_case(_with_final_discharge(golden_config, 1.5), "internal_flow", "verification")
     assert thin.final_discharge_steps == 0
+    assert case.reentry_stop(2.0) == 2.0 + case.recirculation_time and plain.reentry_stop(2.0) is None
 
 
 def test_the_deck_stops_the_re_entry_then_discharges(golden_config):

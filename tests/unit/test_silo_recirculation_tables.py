@@ -423,7 +423,8 @@ def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
                              "residence_time_s_error", "t_s_over_t_d_error", "rtd_mean_ids_s_error",
                              "rtd_mean_eulerian_s_error", "vrr_nr1_error", "vrr_nr2_error", "vrr_nr3_error",
                              "transit_residence_time_s", "transit_residence_time_s_error", "rtd_mean_ids_transit_s",
-                             "rtd_mean_ids_transit_s_error"]
+                             "rtd_mean_ids_transit_s_error", "final_discharge_recirculations", "final_discharge_vrr",
+                             "final_discharge_vrr_error", "final_discharge_vrr_at_ceiling"]
     np.testing.assert_equal(rows[0], {
         "flow_pattern": "semi", "layout": "blue13", "run_id": "r1", "residence_time_s": 2.0, "t_s_over_t_d": 0.25,
         "rtd_mean_ids_s": 1.5, "rtd_mean_eulerian_s": 1.6, "vrr_nr1": 2.0, "vrr_nr2": NAN, "vrr_nr3": 1.9,
@@ -436,6 +437,9 @@ def test_summary_rows_one_per_run_and_layout_with_vrr_columns_and_curves():
         # nor the transit figures
         "transit_residence_time_s": NAN, "transit_residence_time_s_error": NAN, "rtd_mean_ids_transit_s": NAN,
         "rtd_mean_ids_transit_s_error": NAN,
+        # nor a discharge after the recirculations
+        "final_discharge_recirculations": NAN, "final_discharge_vrr": NAN, "final_discharge_vrr_error": NAN,
+        "final_discharge_vrr_at_ceiling": False,
     })
     ((label, nr, values, ceiling, errors),) = curves
     assert (label, nr, ceiling) == ("semi blue13", [0.5, 1.5, 2.5], 4.0)
@@ -458,6 +462,7 @@ def test_summary_rows_carry_the_errors_the_summary_holds():
         "residence_time_s_error": 0.05, "t_s_over_t_d_error": 0.02, "rtd_mean_ids_s_error": 0.1,
         "rtd_mean_eulerian_s_error": 0.125, "vrr_nr1_error": 1.0, "vrr_nr2_error": NAN, "vrr_nr3_error": 0.5,
         "transit_residence_time_s_error": NAN, "rtd_mean_ids_transit_s_error": NAN,
+        "final_discharge_vrr_error": NAN,
     })
     np.testing.assert_equal(curves[0][4], [1.0, NAN, 0.5])
 

@@ -38,8 +38,9 @@ def test_every_part_of_chapters_6_and_7_is_made_or_unmade_with_a_reason():
     assert not any(part.startswith("B") for part in UNMADE)  # every part of ch. 6 can be made
     assert all(UNMADE[part] for part in UNMADE)
     assert "blender.gravity_factors" in UNMADE["M4.mass_flow"] and "fixed" in UNMADE["M4.mass_flow"]
-    assert set(UNMADE) == {"M2.vertical_uniform", "M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates",
-                           "M4.interior_deviates", "M4.inlet_differential_decreases"}
+    assert set(UNMADE) == {"M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates", "M4.interior_deviates",
+                           "M4.inlet_differential_decreases"}
+    assert "M2.vertical_uniform" in MADE
 
 
 def test_no_row_reads_a_mass_flow_ratio_threshold():
@@ -99,7 +100,9 @@ def test_the_vrr_is_taken_at_nr_4_and_judged_against_the_pattern_s_band():
     # entry 4 of vrr_by_recirculation is the pass after 4 recirculations (4 <= Nr < 5), not entry 3 or the last
     assert (small["value"], medium["value"], half["value"]) == (12.0, 10.0, 3.0)
     assert small["value_error"] == pytest.approx(0.12) and small["figure"].startswith("VRR at Nr = 4")
-    assert small["agreement"] == REPRODUCED and small["differs"] == "" and small["study"] == "8 to 13"
+    assert small["agreement"] == REPRODUCED and small["study"] == "8 to 13"
+    # no final discharge in the summary: the pass at constant head, and the row says it is not the study's discharge
+    assert small["differs"] == blending.CONSTANT_HEAD and "§6.4.2" in small["differs"]
     # 3.0 +- 0.03 lies below 8-13: not reproduced, said without any word of scale (added later, from the config)
     assert half["agreement"] == NOT_REPRODUCED and "lies outside" in half["agreement_reason"]
     assert "scale" not in half["agreement_reason"] and half["scale"] == NO_FINDING and half["scale_reason"] == ""
@@ -212,7 +215,7 @@ def test_a_pattern_the_study_did_not_run_gives_rows_with_no_finding():
 
 
 def _blender(configuration, tube, interior, exterior, factor=1.0, error=0.001, flow=0.01, vrr=10.0, ceiling=1000.0,
-             bins=(2, 4, 4), inlet=(-1.0, -1.1), mode="continuous"):
+             bins=(2, 4, 4), inlet=(-1.0, -1.1), mode="continuous", wall=None, vertical=None):
     metrics = {"tube_v_z_m_s": tube, "tube_v_z_m_s_error": error, "interior_v_z_m_s": interior,
                "interior_v_z_m_s_error": error, "exterior_v_z_m_s": exterior, "exterior_v_z_m_s_error": error,
                "mass_flow_rate_kg_s": flow, "mass_flow_rate_kg_s_error": 0.0001, "rtd_mean_s": 5.0,
@@ -224,7 +227,28 @@ def _blender(configuration, tube, interior, exterior, factor=1.0, error=0.001, f
             "geometry": {"clear_widths": {"exterior annulus": 0.05, "interior annulus": 0.02, "tube": 0.02}},
             "passages_at_insert_outlet": {"n_bins": dict(zip(("tube", "interior", "exterior"), bins))},
             "passages_at_insert_inlet": {"mean_v_z_m_s": {"interior": inlet[0], "exterior": inlet[1]},
-                                         "n_bins": {"interior": 5, "exterior": 5}}}
+                                         "n_bins": {"interior": 5, "exterior": 5}},
+            **({} if wall is None else {"wall_layer": wall}),
+            **({} if vertical is None else {"vertical_section": vertical})}
+
+
+def _passages(means, errors, bins):
+    names = ("tube", "interior", "exterior")[-len(means):]
+    return {"mean_v_z_m_s": dict(zip(names, means)), "mean_v_z_m_s_error": dict(zip(names, errors)),
+            "n_bins": dict(zip(names, bins))}
+
+
+def _section(height, deviation, error, name="100 mm above"):
+    return {f"{height:g}": {"name": name, "height_m": height, "mean_v_z_m_s": -0.05, "mean_v_z_m_s_error": 0.001,
+                            "largest_deviation": deviation, "largest_deviation_error": error, "deviation_x_m": -0.105,
+                            "exclusion_m": 0.02, "n_bins": 40, "excluded_bins": 6, "batches": 10}}
+
+
+def _wall(outlet=(-2.0, -1.6, -0.4), inlet=(-1.0, -1.02), vertical=None):
+    return {"depth_m": 0.0033, "walls": "front and back walls, folded onto the front",
+            "passages_at_insert_outlet": _passages(outlet, (0.01, 0.01, 0.01), (2, 4, 4)),
+            "passages_at_insert_inlet": _passages(inlet, (0.01, 0.01), (5, 5)),
+            "vertical_section": vertical or {}}
 
 
 def _brun(summary, note="one seed: within-run error only", dof=None):
@@ -236,7 +260,9 @@ def test_m1_is_each_passage_of_the_diverging_insert_over_the_mean_of_the_bins_at
     rows = blender_rows([_brun(_blender("diverging", -1.8, -1.5, -0.1))], TOLERANCES)
     tube, interior, exterior = (_one(rows, f"M1.{key}") for key in ("tube", "interior", "exterior"))
     assert (tube["value"], interior["value"], exterior["value"]) == pytest.approx((1.8, 1.5, 0.1))
-    assert tube["agreement"] == interior["agreement"] == REPRODUCED and tube["differs"] == ""
+    assert tube["agreement"] == interior["agreement"] == REPRODUCED
+    # no wall layer in the summary: the depth average, which is not the plane the PIV sees
+    assert tube["differs"] == blender.DEPTH_AVERAGED and "front wall" in tube["differs"]
     assert exterior["agreement"] == NOT_REPRODUCED and "scale" not in exterior["agreement_reason"]
     assert tube["evidence"].endswith("one seed: within-run error only")
     # a summary without the bins falls back on the narrowest clear widths, and says that it is not the study's mean
@@ -247,6 +273,73 @@ def test_m1_is_each_passage_of_the_diverging_insert_over_the_mean_of_the_bins_at
     assert fallback["value"] == pytest.approx(-1.8 / mean) and "narrowest clear widths" in fallback["differs"]
     batch = _one(blender_rows([_brun(_blender("diverging", -1.8, -1.5, -0.1, mode="batch"))], TOLERANCES), "M1.tube")
     assert "continuous" in batch["differs"]
+
+
+def test_m1_judges_the_wall_layer_the_piv_sees_and_quotes_the_depth_average():
+    # wall layer, bins 2, 4, 4: mean = (2 * -2.0 + 4 * -1.6 + 4 * -0.4) / 10 = -1.2
+    summary = _blender("diverging", -1.8, -1.5, -0.1, wall=_wall())
+    rows = blender_rows([_brun(summary)], TOLERANCES)
+    tube, interior, exterior = (_one(rows, f"M1.{key}") for key in ("tube", "interior", "exterior"))
+    assert (tube["value"], interior["value"], exterior["value"]) == pytest.approx((2.0 / 1.2, 1.6 / 1.2, 0.4 / 1.2))
+    # 0.01 m/s on each passage: tube / mean has the error of both, the passages independent
+    mean_error = math.sqrt(2 ** 2 + 4 ** 2 + 4 ** 2) * 0.01 / 10
+    assert tube["value_error"] == pytest.approx(2.0 / 1.2 * math.hypot(0.01 / 2.0, mean_error / 1.2))
+    assert tube["agreement"] == REPRODUCED and exterior["agreement"] == NOT_REPRODUCED  # 0.33 against 0.16 +- 10 %
+    assert {entry["differs"] for entry in (tube, interior, exterior)} == {""}
+    assert tube["evidence"].startswith("wall layer (3.3 mm from the front and back walls, folded onto the front), the "
+                                       "plane the study's PIV sees: tube -2 ± 0.01 m/s")
+    # the depth average's figure beside it: -1.8 / -1.0
+    assert "depth-averaged 1.8 ± " in tube["evidence"]
+    assert "weighted by their bins at the insert outlet" in tube["evidence"]
+    # a batch discharge still says it is not the study's constant head
+    batch = _one(blender_rows([_brun(_blender("diverging", -1.8, -1.5, -0.1, wall=_wall(), mode="batch"))],
+                              TOLERANCES), "M1.tube")
+    assert batch["differs"].startswith("batch discharge")
+
+
+def test_m2_vertical_uniform_is_the_largest_deviation_per_height_of_the_wall_layer_else_the_depth_average():
+    depth = {**_section(0.5, 0.3, 0.02), **_section(0.3, 0.1, 0.01, "tube inlet")}
+    wall = _wall(vertical=_section(0.5, 0.05, 0.01))
+    rows = _rows(blender_rows([_brun(_blender("converging", -3.0, -2.0, -1.0, wall=wall, vertical=depth))],
+                              TOLERANCES), "M2.vertical_uniform")
+    # the wall layer's heights only; 0.05 +- 1.96 x 0.01 lies within +- 0.2 (uniform_relative) of the mean
+    (uniform,) = rows
+    assert (uniform["value"], uniform["value_error"]) == (0.05, 0.01) and uniform["agreement"] == REPRODUCED
+    assert uniform["figure"] == ("Largest deviation of v_z across the vertical section / its mean, z = 500 mm "
+                                 "(100 mm above)")
+    assert uniform["differs"] == "" and uniform["unit"] == "-"
+    assert "6 bins within 20 mm of the tube left out" in uniform["evidence"]
+    assert "; depth-averaged: largest deviation 0.3 ± 0.02 at x = -105 mm" in uniform["evidence"]
+    # without the wall layer: one row per height of the depth average, ordered by height, not the PIV's plane
+    rows = _rows(blender_rows([_brun(_blender("converging", -3.0, -2.0, -1.0, vertical=depth))], TOLERANCES),
+                 "M2.vertical_uniform")
+    assert [entry["value"] for entry in rows] == [0.1, 0.3]
+    assert [entry["agreement"] for entry in rows] == [REPRODUCED, NOT_REPRODUCED]  # 0.1 + 0.0196 < 0.2 < 0.3 - 0.04
+    assert {entry["differs"] for entry in rows} == {blender.DEPTH_AVERAGED}
+    # 0.15 +- 1.96 x 0.05 reaches past 0.2: not resolved
+    wide = _wall(vertical=_section(0.5, 0.15, 0.05))
+    (unsure,) = _rows(blender_rows([_brun(_blender("converging", -3.0, -2.0, -1.0, wall=wide))], TOLERANCES),
+                      "M2.vertical_uniform")
+    assert unsure["agreement"] == NOT_RESOLVED and "partly outside" in unsure["agreement_reason"]
+    # an older summary without either: no row; another insert: no row (M2 is the converging insert's)
+    assert _rows(blender_rows([_brun(_blender("converging", -3.0, -2.0, -1.0))], TOLERANCES),
+                 "M2.vertical_uniform") == []
+    assert _rows(blender_rows([_brun(_blender("straight", -3.0, -2.0, -1.0, vertical=depth))], TOLERANCES),
+                 "M2.vertical_uniform") == []
+
+
+def test_m2_outlet_order_and_inlet_uniform_take_the_wall_layer_with_its_errors():
+    wall = _wall(outlet=(-3.0, -2.0, -1.0), inlet=(-1.0, -1.02))
+    rows = blender_rows([_brun(_blender("converging", -1.0, -2.0, -3.0, wall=wall))], TOLERANCES)
+    order = _one(rows, "M2.outlet_order")
+    # the wall layer's order, not the depth average's reversed one
+    assert order["value"] == 3.0 and order["agreement"] == REPRODUCED and order["differs"] == ""
+    inlet = _one(rows, "M2.inlet_uniform")
+    mean = -1.01
+    assert inlet["value"] == pytest.approx(0.02 / mean)
+    assert inlet["value_error"] == pytest.approx(abs(0.02 / mean) * math.hypot(
+        math.hypot(0.01, 0.01) / 0.02, math.hypot(5 * 0.01, 5 * 0.01) / 10 / 1.01))
+    assert inlet["differs"] == "" and "not measured" not in inlet["evidence"]
 
 
 def test_m2_orders_the_converging_insert_s_passages_and_the_inlet_row_has_no_measured_error():

@@ -202,8 +202,9 @@ def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("runs in 3 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
-            "GROUP=blending_3" in capsys.readouterr().err)
+    assert ("runs in 5 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
+            "GROUP=blending_3 then make validate GROUP=blending_4 then make validate GROUP=blending_5"
+            in capsys.readouterr().err)
     assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
 

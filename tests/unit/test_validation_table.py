@@ -14,7 +14,8 @@ from siloflow.analysis.studies.validation.group_rows import MADE, UNMADE, seed_d
 from siloflow.analysis.studies.validation.rows import (AT_SCALE, NO_FINDING, NOT_AT_SCALE as ROW_NOT_AT_SCALE,
                                                        precise, resolution, resolved, row, with_scale)
 from siloflow.analysis.studies.validation.scale import scale_verdict
-from siloflow.analysis.studies.validation.silo import SiloRun, front_wall_series_rows, silo_rows, stress_gradient
+from siloflow.analysis.studies.validation.silo import (SiloRun, front_wall_series_rows, heights_clause, silo_rows,
+                                                       stress_gradient, window_clause)
 from siloflow.analysis.studies.validation.table import against_the_study, page_sections
 from siloflow.analysis.numerics.reference_spread import SeedSpread
 from siloflow.engines.config import validate_config
@@ -91,15 +92,19 @@ def _janssen(depths, stress, hydrostatic, janssen=None, error=1.0):
             for i, (d, s, h) in enumerate(zip(depths, stress, hydrostatic))]
 
 
-def _silo(density=650.0, problems=(), index=(0.5, 0.02), run_id="base", b=(0.008, 0.006)):
+STUDY_FIELDS = {"average_window_s": [0.5, 0.7], "average_window_source": "silo_flat.fields.average_window"}
+
+
+def _silo(density=650.0, problems=(), index=(0.5, 0.02), run_id="base", b=(0.008, 0.006), window=STUDY_FIELDS):
     case = {"run_id": run_id, "depth_m": 0.04, "width_m": 0.15, "outlet_width_m": 0.04,
             "equivalent_diameter_m": 0.004}
     flow = {"filling_bulk_density_kg_m3": density, "filling_bulk_density_kg_m3_error": 2.0,
             "mass_flow_rate_kg_s": 0.3, "mass_flow_rate_kg_s_error": 0.006, "beverloo_mass_flow_rate_kg_s": 0.25,
             "beverloo_ratio": 1.2, "beverloo_ratio_error": 0.03,
-            "beverloo": {"discharge_coefficient": 0.58, "shape_coefficient": 1.5}}
+            "beverloo": {"discharge_coefficient": 0.58, "shape_coefficient": 1.5},
+            "steady_window": [0.2, 0.8], "steady_window_start_s": 0.31, "steady_window_end_s": 1.24}
     fields = {"flow_pattern_index": {"0.02": 0.1, "0.04": index[0]},
-              "flow_pattern_index_error": {"0.02": 0.01, "0.04": index[1]}}
+              "flow_pattern_index_error": {"0.02": 0.01, "0.04": index[1]}, **window}
     balance = {"support_ratio": 0.999, "problems": list(problems)}
     depths = [0.01 * k for k in range(1, 7)]
     # rho g = 6000 Pa/m; the DEM follows it near the surface (slope 6000) and saturates below (slope 1500)
@@ -144,6 +149,46 @@ def test_silo_rows_judge_density_stress_and_b_against_the_study():
     assert rising["S5.dem"]["agreement"] == NOT_REPRODUCED
 
 
+def test_the_window_clause_is_empty_for_the_study_s_window_and_names_any_other():
+    flow = {"steady_window": [0.2, 0.8], "steady_window_start_s": 0.31, "steady_window_end_s": 1.24}
+    assert window_clause(STUDY_FIELDS, flow) == ""
+    # the steady window, recorded as such: its mass fractions and their times
+    steady = {"average_window_s": [0.31, 1.24], "average_window_source": "silo_flat.steady_window"}
+    assert window_clause(steady, flow) == ("profiles averaged over the discharged-mass window 0.2-0.8 "
+                                           "(t = 0.31-1.24 s), not the study's 0.5-0.7 s (§5.4.3.4)")
+    configured = {"average_window_s": [0.4, 0.9], "average_window_source": "silo_flat.fields.average_window"}
+    assert window_clause(configured, flow, "velocities", "§5.5.2") == (
+        "velocities averaged over t = 0.4-0.9 s after opening, not the study's 0.5-0.7 s (§5.5.2)")
+    # a fields.json written before the source was recorded: the steady window where its times are the flow's
+    assert window_clause({"average_window_s": [0.31, 1.24]}, flow) == window_clause(steady, flow)
+    assert window_clause({"average_window_s": [0.4, 0.9]}, flow) == window_clause(configured, flow)
+    assert window_clause({}, flow) == ("profiles averaged over a window fields.json does not record, not the study's "
+                                       "0.5-0.7 s (§5.4.3.4)")
+
+
+def test_the_heights_clause_is_empty_for_the_study_s_profile_heights_in_any_order():
+    assert heights_clause([0.12, 0.02, 0.08, 0.04]) == ""
+    assert heights_clause([0.02, 0.04, 0.06], "B fitted at") == (
+        "B fitted at 20, 40, 60 mm, not the study's 20, 40, 80, 120 mm (§5.4.3.4)")
+    assert heights_clause([0.02, 0.04, 0.08, 0.12, 0.16]).startswith("at 20, 40, 80, 120, 160 mm, not")
+
+
+def test_the_rows_of_the_averaged_fields_say_when_their_window_and_heights_are_not_the_study_s():
+    steady = {"average_window_s": [0.31, 1.24], "average_window_source": "silo_flat.steady_window"}
+    table = {r["figure"]: r for r in silo_rows(_silo(window=steady), TOLERANCES, None)}
+    b = table["Change of the kinematic constant B, z = 60 - 20 mm"]
+    assert b["differs"] == ("profiles averaged over the discharged-mass window 0.2-0.8 (t = 0.31-1.24 s), not the "
+                            "study's 0.5-0.7 s (§5.4.3.4); B fitted at 20, 60 mm, not the study's 20, 40, 80, 120 mm "
+                            "(§5.4.3.4)")
+    channel = table["Flow channel half-width (0.1 of centreline v_z) at z = 20 mm"]
+    assert channel["differs"].startswith("velocities averaged over the discharged-mass window 0.2-0.8")
+    # at the study's window only the heights differ
+    study = {r["figure"]: r for r in silo_rows(_silo(), TOLERANCES, None)}
+    assert study["Change of the kinematic constant B, z = 60 - 20 mm"]["differs"] == (
+        "B fitted at 20, 60 mm, not the study's 20, 40, 80, 120 mm (§5.4.3.4)")
+    assert study["Flow channel half-width (0.1 of centreline v_z) at z = 20 mm"]["differs"] == ""
+
+
 def test_a_fill_that_fails_its_balance_is_never_reproduced():
     table = {r["finding"]: r for r in silo_rows(_silo(density=622.0, problems=["planes"]), TOLERANCES, None)}
     assert table["S2"]["agreement"] == NOT_RESOLVED and "planes" in table["S2"]["evidence"]
@@ -159,6 +204,13 @@ def test_front_wall_series_judges_the_index_change_and_the_frictionless_stress()
     change = next(r for r in rows if r["finding"] == "S6.towards_internal_flow")
     assert change["value"] == pytest.approx(-0.5) and change["value_error"] == pytest.approx(0.05)
     assert change["agreement"] == REPRODUCED and change["differs"] == "at z = 40 mm, not 120 mm"
+    # a run of the series averaged over another window says so, on its own row and on the change it enters
+    series[2] = ("mu_fw=1", _silo(index=(0.3, 0.04), window={"average_window_s": [0.4, 0.9]}), "one seed")
+    rows = front_wall_series_rows(series, 0.045, TOLERANCES, None)
+    change = next(r for r in rows if r["finding"] == "S6.towards_internal_flow")
+    other = "velocities averaged over t = 0.4-0.9 s after opening, not the study's 0.5-0.7 s (§5.5.2)"
+    assert change["differs"] == f"at z = 40 mm, not 120 mm; {other}"
+    assert [r["differs"] for r in rows[:4]] == ["", "", other, ""]
     hydrostatic = next(r for r in rows if r["finding"] == "S6.hydrostatic")
     assert hydrostatic["case"] == "mu_fw=0" and hydrostatic["value"] == pytest.approx(210.0 / 360.0)
     assert hydrostatic["agreement"] == NOT_REPRODUCED

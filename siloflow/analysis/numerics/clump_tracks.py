@@ -7,8 +7,9 @@ masses in kg, times in s.
 :func:`tracks_from_frames` does the same from the frames an engine reads, grouping their spheres into clumps
 (:func:`siloflow.model.frames.clumps_from_frame`). A run whose domain is periodic in z (the recirculating silo, the blender in
 recirculation) gives its ``domain_z``: a clump that straddles the periodic boundary is put back together and its
-centre wrapped into the domain. When each clump leaves through an outlet plane is
-:mod:`siloflow.analysis.numerics.exit_times`.
+centre wrapped into the domain. :meth:`ClumpTracks.until` and :meth:`TrackedClumps.until` keep the frames up to a
+time (:func:`frames_until`), the part of a run before it changes what it does. When each clump leaves through an
+outlet plane is :mod:`siloflow.analysis.numerics.exit_times`.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import numpy as np
 from siloflow.model.checks import finite_number, increasing_times
 from siloflow.model.frames import ClumpFrame, ParticleFrame, clumps_from_frame
 
-__all__ = ["ClumpTracks", "TrackedClumps", "checked_tracks", "clump_tracks", "tracks_from_frames"]
+__all__ = ["ClumpTracks", "TrackedClumps", "checked_tracks", "clump_tracks", "frames_until", "tracks_from_frames"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,6 +63,19 @@ class ClumpTracks:
         """Heights of the clump centres, shape (n_t, n_c) [m] (NaN where absent)."""
         return self.position[:, :, 2]
 
+    def until(self, t_last: float) -> ClumpTracks:
+        """The frames at or before ``t_last`` [s], every clump column kept (:func:`frames_until`).
+
+        Examples
+        --------
+        >>> tracks = clump_tracks([0.0, 0.1, 0.2], [[7], [7], [7]], [[[0, 0, 0.3]], [[0, 0, 0.2]], [[0, 0, 0.1]]])
+        >>> tracks.until(0.1).times.tolist(), tracks.until(0.1).z.tolist()
+        ([0.0, 0.1], [[0.3], [0.2]])
+        """
+        keep = frames_until(self.times, t_last)
+        return ClumpTracks(times=np.asarray(self.times)[:keep], clump_id=self.clump_id,
+                           position=np.asarray(self.position)[:keep])
+
 
 @dataclass(frozen=True, eq=False)
 class TrackedClumps:
@@ -80,6 +94,47 @@ class TrackedClumps:
     tracks: ClumpTracks
     velocity: np.ndarray
     mass: np.ndarray
+
+    def until(self, t_last: float) -> TrackedClumps:
+        """The frames at or before ``t_last`` [s], tracks and velocities alike, every clump and its mass kept
+        (:func:`frames_until`)."""
+        keep = frames_until(self.tracks.times, t_last)
+        return TrackedClumps(tracks=self.tracks.until(t_last), velocity=np.asarray(self.velocity)[:keep],
+                             mass=self.mass)
+
+
+def frames_until(times, t_last: float) -> int:
+    """How many of the leading frames lie at or before ``t_last``: ``times[:n] <= t_last`` [-].
+
+    The cut of a run that changes what it does at ``t_last`` (a recirculating silo whose re-entry stops): the frame
+    at exactly ``t_last`` is kept, as the last one of the part before. No tolerance is added, so a frame saved a
+    round-off after ``t_last`` is left out; with frames far apart compared with the round-off that loses at most
+    that one frame.
+
+    Parameters
+    ----------
+    times : array_like, shape (n_t,)
+        Frame times, strictly increasing [s].
+    t_last : float
+        Time of the last frame wanted [s].
+
+    Returns
+    -------
+    int
+        The number of frames kept, >= 2 [-].
+
+    Raises
+    ------
+    ValueError
+        If ``t_last`` is not a finite number or leaves fewer than 2 frames (the tracks of a run need 2).
+    """
+    t = _increasing_times("times", times)
+    t_last = finite_number("t_last", t_last)
+    keep = int(np.searchsorted(t, t_last, side="right"))
+    if keep < 2:
+        raise ValueError(f"the frames at or before t = {t_last!r} s are {keep}; at least 2 are needed "
+                         f"(the run starts at {t[0]!r} s)")
+    return keep
 
 
 def _clump_ids(name: str, values) -> np.ndarray:

@@ -25,7 +25,7 @@ from siloflow.model.cases.jenike import JenikeCase, jenike_cases
 from siloflow.model.cases.jenike_cost import estimate_jenike_case
 from siloflow.model.cases.jenike_sweep import check_jenike_config, jenike_run_role
 from siloflow.model.cases.silo_cost import estimate_blender_case, estimate_recirculation_case, estimate_silo_case
-from siloflow.model.cases.silo_flat import SiloCase, silo_cases, silo_meshes
+from siloflow.model.cases.silo_flat import SiloCase, check_silo_config, silo_cases, silo_meshes
 from siloflow.model.cases.silo_recirculation import (RecirculationCase, check_recirculation_config, recirculation_cases,
                                             recirculation_meshes)
 from siloflow.model.cases.verification import VerificationCase
@@ -155,7 +155,7 @@ register_case_kind(CaseKind(
 register_case_kind(CaseKind(
     "silo_flat", SiloCase, "silo_flat", ("fill", "settle", "open", "discharge"), silo_cases, estimate_silo_case,
     SCHEMA_FRAGMENTS / "silo_flat.schema.yaml", inherits_defaults=True, replicated=True, fill_balance=True,
-    rules="silo.smk", walls=silo_meshes))
+    check_config=check_silo_config, rules="silo.smk", walls=silo_meshes))
 register_case_kind(CaseKind(
     "silo_recirculation", RecirculationCase, "silo_recirculation", ("fill", "settle", "open", "recirculate"),
     recirculation_cases, estimate_recirculation_case, SCHEMA_FRAGMENTS / "silo_recirculation.schema.yaml",

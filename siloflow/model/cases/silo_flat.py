@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 
 from siloflow.model.constants import GRAVITY
@@ -21,6 +22,7 @@ from siloflow.model.cases.common import (
     FillPlan, MaterialTable, SettleCriterion, defining_settle, engine_kind, fill_zone, largest_impact_velocity,
     fill_table, material_table, plan_fill, run_id, settle_criterion, without_fill_checks,
 )
+from siloflow.model.cases.config_checks import ConfigError
 from siloflow.model.cases.geometry import horizontal_rectangle
 from siloflow.model.cases.particles import ParticleTemplate, model_parameters, particle_template
 from siloflow.model.cases.physics import ChosenTimestep, TimestepChoice, engine_seeds, stable_timestep, steps_for
@@ -289,6 +291,29 @@ def parametric_variants(config: dict) -> dict[str, list[tuple[str, dict]]]:
             for mu_r in study["rolling_friction"]
         ]
     return studies
+
+
+def check_silo_config(config: Mapping, contact_pairs: Mapping) -> None:
+    """The flat-bottom silo's own checks: its fields' averaging window ``silo_flat.fields.average_window`` (times
+    after the outlet opens, s) lies within the discharge, ``0 <= start < end <= silo_flat.discharge_time``, so that
+    the profiles are never averaged over frames the run does not save. Its outlet is checked with every silo-type
+    section's (:mod:`siloflow.engines.config`).
+
+    Raises
+    ------
+    ConfigError
+        Naming ``silo_flat.fields.average_window``, the window and the discharge time.
+    """
+    silo = config[CASE_NAME]
+    window = silo["fields"]["average_window"]
+    if window is None:
+        return
+    start, end = window
+    if not 0.0 <= start < end <= silo["discharge_time"]:
+        raise ConfigError(
+            f"config key 'silo_flat.fields.average_window': {list(window)} s must be an increasing window within the "
+            f"discharge, from the opening of the outlet (0 s) to silo_flat.discharge_time ({silo['discharge_time']} s)"
+        )
 
 
 def silo_cases(config: dict) -> dict[str, SiloCase]:

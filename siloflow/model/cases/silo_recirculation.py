@@ -120,6 +120,11 @@ class RecirculationCase:
         """Steps of the discharge after the recirculations [-]; 0 without one."""
         return int(round(self.final_discharge_time / self.silo.timestep))
 
+    def reentry_stop(self, opening_time: float) -> float | None:
+        """When the re-entry stops (s) on a clock that reads ``opening_time`` (s) when the outlet opens; None when the
+        run ends recirculating (no discharge after the recirculations)."""
+        return float(opening_time) + self.recirculation_time if self.final_discharge_steps else None
+
     def stages(self):
         """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`), then the discharge after
         the recirculations where there is one."""

@@ -78,6 +78,8 @@ rule blender_fields:
         flow=f"{run_dir('blender')}/metrics/flow.json",
         # each frame of the steady window: the series whose batch means give the passage velocities' errors
         frames=f"{run_dir('blender')}/fields/steady_frames.npz",
+        # the same of the layer at the front and back walls: what the study's PIV sees
+        wall_layer=f"{run_dir('blender')}/fields/wall_layer.npz",
     params:
         case=typed_case("blender"),
         bin_size=config["blender"]["bin_size"],
@@ -93,6 +95,7 @@ rule blender_analysis:
         fields=rules.blender_fields.output.fields,
         flow=rules.blender_fields.output.flow,
         frames=rules.blender_fields.output.frames,
+        wall_layer=rules.blender_fields.output.wall_layer,
         case=rules.blender_deck.output.case,
     output:
         summary=f"{run_dir('blender')}/metrics/blender.json",

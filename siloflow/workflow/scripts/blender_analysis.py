@@ -1,4 +1,6 @@
-"""Snakemake adapter: the blender study of one run (profiles, passages, flow channel, pathlines, RTD, modes)."""
+"""Snakemake adapter: the blender study of one run (profiles, passages, flow channel, pathlines, RTD, modes), and the
+figures the study's PIV gives on the depth average and on the wall layer (the vertical section's uniformity, the
+passages at the insert outlet)."""
 
 import json
 from functools import partial
@@ -6,7 +8,18 @@ from pathlib import Path
 
 from siloflow.analysis.studies.blender.steady_field import BlenderField
 from siloflow.analysis.studies.blender.errors import steady_flow_rate_estimate
-from siloflow.analysis.studies.blender.window_fields_io import read_frame_fields, read_planar_fields
+from siloflow.analysis.studies.blender.sections import (
+    exclusion_of,
+    section_heights,
+    section_uniformity,
+    wall_layer_summary,
+)
+from siloflow.analysis.studies.blender.window_fields import wall_layer_depth
+from siloflow.analysis.studies.blender.window_fields_io import (
+    read_frame_fields,
+    read_planar_fields,
+    read_wall_layer_fields,
+)
 from siloflow.analysis.studies.blender.plots import (
     plot_channel_boundary,
     plot_continuous_mode,
@@ -16,7 +29,13 @@ from siloflow.analysis.studies.blender.plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from siloflow.analysis.studies.blender.study import BlenderSettings, analyse_blender, key_heights, study_metrics
+from siloflow.analysis.studies.blender.study import (
+    BlenderSettings,
+    analyse_blender,
+    key_heights,
+    study_metrics,
+    top_internal,
+)
 from siloflow.analysis.studies.blender.tables import (
     blender_summary,
     profile_rows,
@@ -46,10 +65,23 @@ with logged_to(snakemake.log[0]) as log:
     frames = [BlenderField.from_planar(frame) for frame in read_frame_fields(snakemake.input.frames)]
     metrics = study_metrics(case.configuration, study, flow["mass_flow_rate_kg_s"], settings.comparison_fractions,
                             mass_flow_rate_error=rate.std_error, frames=frames, resolution=settings.integration_step)
+    # the vertical section above every internal wall; "close to the tube" is within one tube width of its outline
+    section = section_heights(heights, insert["z_transition"], top_internal(insert))
+    tube = ((geometry.tube_half_width + 0.5 * geometry.wall_thickness, geometry.z_tube_inlet)
+            if geometry.has_tube else None)
+    exclusion = exclusion_of(insert["tube_width"])
+    wall_steady, wall_frames = read_wall_layer_fields(snakemake.input.wall_layer)
+    levels = {name: (heights[name], annulus_bounds(geometry, heights[name]))
+              for name in ("insert outlet", "insert inlet") if name in heights}
+    wall_layer = wall_layer_summary(
+        BlenderField.from_planar(wall_steady), [BlenderField.from_planar(frame) for frame in wall_frames],
+        wall_layer_depth(case.silo.particle.equivalent_diameter), levels, section, tube, exclusion)
     write_json(snakemake.output.summary, blender_summary(
         flow, study, metrics, run_id=case.run_id, configuration=case.configuration,
         gravity_factor=case.gravity_factor, geometry=insert, mode=case.mode, n_clumps=case.silo.fill.n_clumps,
-        steady_window=case.steady_window))
+        steady_window=case.steady_window,
+        vertical_section=section_uniformity(BlenderField.from_planar(steady), frames, section, tube, exclusion),
+        wall_layer=wall_layer))
     write_flow_table(snakemake.output.profiles, profile_rows(study.profiles))
     write_flow_table(snakemake.output.residence, residence_rows(study.pathlines))
     write_flow_table(snakemake.output.rtd, rtd_rows(study.rtd.rtd))

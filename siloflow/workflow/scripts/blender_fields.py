@@ -1,6 +1,6 @@
 """Snakemake adapter: steady and windowed depth-averaged fields, the field of every frame of the steady window (the
-series whose batch means give the errors of the steady passage velocities) and the discharge rate of one blender
-run."""
+series whose batch means give the errors of the steady passage velocities), the same steady field and frames of the
+layer at the front and back walls (what the study's PIV sees) and the discharge rate of one blender run."""
 
 from pathlib import Path
 
@@ -10,9 +10,15 @@ from siloflow.analysis.studies.blender.window_fields import (
     discharged_mass_history,
     frame_fields,
     mean_velocity_history,
+    wall_layer_depth,
+    wall_layer_positions,
     window_average_field,
 )
-from siloflow.analysis.studies.blender.window_fields_io import write_frame_fields, write_planar_fields
+from siloflow.analysis.studies.blender.window_fields_io import (
+    write_frame_fields,
+    write_planar_fields,
+    write_wall_layer_fields,
+)
 from siloflow.model.record import read_run_record
 from siloflow.analysis.numerics.clump_tracks import tracks_from_frames
 from siloflow.analysis.numerics.eulerian_rtd import silo_bins
@@ -44,6 +50,14 @@ with logged_to(snakemake.log[0]) as log:
     steady_frames = frame_fields(tracks.position, recorded.velocity, recorded.mass, since_open, grid, steady_window,
                                  density)
     write_frame_fields(snakemake.output.frames, steady_frames)
+    # the clumps within a diameter of either wall, on bins one layer deep
+    layer = wall_layer_depth(silo.particle.equivalent_diameter)
+    folded = wall_layer_positions(tracks.position, silo.depth)
+    layer_grid = silo_bins(silo.width, layer, silo.fill_height, snakemake.params.bin_size)
+    write_wall_layer_fields(
+        snakemake.output.wall_layer,
+        window_average_field(folded, recorded.velocity, recorded.mass, since_open, layer_grid, steady_window, density),
+        frame_fields(folded, recorded.velocity, recorded.mass, since_open, layer_grid, steady_window, density))
 
     time, discharged = discharged_mass_history(tracks, recorded.mass, case.mode, case.outlet_z, case.domain_z)
     fit = steady_flow_rate(time - record.open_time_s, discharged, window=steady_window)
@@ -54,6 +68,6 @@ with logged_to(snakemake.log[0]) as log:
         "time_since_open_s": (time - record.open_time_s).tolist(), "discharged_mass_kg": discharged.tolist(),
         "mean_v_z_m_s": mean_velocity_history(tracks, recorded.velocity, recorded.mass, case.outlet_z).tolist(),
     })
-    log.info("%s: %d frames, steady window %s s (%d frames, %d frame fields), mass flow rate %.5g +- %.2g kg/s",
-             case.run_id, tracks.n_times, steady_window, steady.n_frames, len(steady_frames), fit.mass_flow_rate,
-             fit.standard_error)
+    log.info("%s: %d frames, steady window %s s (%d frames, %d frame fields), wall layer %.4g m deep, mass flow rate "
+             "%.5g +- %.2g kg/s", case.run_id, tracks.n_times, steady_window, steady.n_frames, len(steady_frames),
+             layer, fit.mass_flow_rate, fit.standard_error)

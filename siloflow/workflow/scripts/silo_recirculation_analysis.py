@@ -1,4 +1,5 @@
-"""Snakemake adapter: direct blending measurement, RTDs (particle ids and Eulerian) and LTI predictions of one run."""
+"""Snakemake adapter: direct blending measurement, RTDs (particle ids and Eulerian) and LTI predictions of one run,
+and the VRR of the discharge after its recirculations when it has one."""
 
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from siloflow.analysis.studies.silo_recirculation.rtd_plots import (
     plot_vrr_versus_period,
 )
 from siloflow.analysis.studies.silo_recirculation.configured import analyse_configured
+from siloflow.analysis.studies.silo_recirculation.final_discharge import final_discharge
 from siloflow.analysis.studies.silo_recirculation.study import main_run_eulerian_rtd, snapshot_frames
 from siloflow.analysis.studies.silo_recirculation.tables import (
     blending_summary,
@@ -38,10 +40,14 @@ with logged_to(snakemake.log[0]) as log:
     case = snakemake.params.case
     plot_format = snakemake.params.plot_format  # plots.format, the suffix of the plots named here
     silo = case.silo
-    loaded = load_tracks(snakemake.input.tracks)
-    tracks = loaded.tracks
+    whole = load_tracks(snakemake.input.tracks)
     bottom, top = case.domain_z
     lti = settings["lti"]
+    # with a discharge after the recirculations, every figure but that discharge's is of the recirculating part:
+    # the frames up to the stop of the re-entry (the tracks' clock starts at the opening)
+    t_stop = case.reentry_stop(whole.tracks.times[0])
+    loaded = whole if t_stop is None else whole.until(t_stop)
+    tracks = loaded.tracks
     result = analyse_configured(tracks, bottom, top, settings)
     timing = result.timing
     log.info("t_res %.4g +- %.2g s (holdup %.1f +- %.2g clumps, throughput %.1f +- %.2g clumps/s), run covers "
@@ -76,8 +82,17 @@ with logged_to(snakemake.log[0]) as log:
     )
     log.info("bulk density in the slab %s m: settled %.1f, flowing %.1f +- %.2g kg/m3, drop %.4f +- %.2g",
              density.slab, density.settled, density.flowing, density.flowing_error, density.drop, density.drop_error)
+    discharge = None if t_stop is None else final_discharge(whole.tracks, result, t_stop, bottom, top)
+    if discharge is not None:
+        used = discharge.windows
+        log.info("discharge after Nr = %.2f from t = %.4g s: %d windows (%d clumps) to %.4g s (%s), %.1f %% of its "
+                 "%d crossings left out, %d re-entries after the stop; VRR %s", discharge.recirculations, t_stop,
+                 used.n_windows, used.clumps, used.end, "faded" if used.faded else "the record ended first",
+                 100.0 * used.left_out_fraction, used.crossings, discharge.reentries,
+                 {name: round(layout.vrr, 2) for name, layout in discharge.layouts.items()})
     summary = blending_summary(result, eulerian_rtd, eulerian["bin_size"], run_id=case.run_id,
-                               flow_pattern=case.pattern, estimated_residence_time=case.estimated_residence_time)
+                               flow_pattern=case.pattern, estimated_residence_time=case.estimated_residence_time,
+                               final_discharge=discharge)
     write_json(out.summary, {**summary, **density.summary()})
 
     # --- plots

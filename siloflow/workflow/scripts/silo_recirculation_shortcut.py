@@ -13,6 +13,9 @@ with logged_to(snakemake.log[0]) as log:
     settings = snakemake.params.blending
     case = snakemake.params.case
     tracks = load_tracks(snakemake.input.tracks).tracks
+    # the recirculating part only, as the analysis rule takes it: the discharge after it is no recirculation
+    reentry_stop = case.reentry_stop(tracks.times[0])
+    tracks = tracks if reentry_stop is None else tracks.until(reentry_stop)
     bottom, top = case.domain_z
     tracer = settings["tracer"]
     # the full run again, without what the shortcut cannot have: a few seconds, and the analysis rule's product

@@ -34,8 +34,8 @@ from siloflow.analysis.studies.blender.profiles import (
 from siloflow.analysis.studies.blender.steady_field import BlenderField
 from siloflow.analysis.studies.blender.tracers import TracerPathlines, VirtualTracerRTD, tracer_pathlines, virtual_tracer_rtd
 
-__all__ = ["BlenderSettings", "BlenderStudy", "key_heights", "analyse_blender", "study_metrics", "study_summary",
-           "metrics_from_summary", "rtd_from_summary"]
+__all__ = ["BlenderSettings", "BlenderStudy", "key_heights", "top_internal", "analyse_blender", "study_metrics",
+           "study_summary", "metrics_from_summary", "rtd_from_summary"]
 
 #: Samples of the shortest input period in the continuous mode.
 SAMPLES_PER_SHORTEST_PERIOD = 8
@@ -121,15 +121,27 @@ def key_heights(insert: Mapping, bin_size: float, fill_height: float, heights_ab
     """
     step = positive_number("bin_size", bin_size)
     heights = {"insert outlet": insert["z_insert_outlet"] + step}
-    insert_inlet = insert["inlet"][1] if insert.get("inlet") is not None else None
-    if insert_inlet is not None:
-        heights["insert inlet"] = insert_inlet - step
-    top_internal = max(z for z in (insert.get("z_tube_inlet"), insert_inlet, insert["z_insert_outlet"]) if z is not None)
+    if insert.get("inlet") is not None:
+        heights["insert inlet"] = insert["inlet"][1] - step
     if insert.get("z_tube_inlet") is not None:
         heights["tube inlet"] = insert["z_tube_inlet"] + step
     for extra in heights_above_tube:
-        heights[f"{extra * 1000:g} mm above"] = top_internal + step + extra
+        heights[f"{extra * 1000:g} mm above"] = top_internal(insert) + step + extra
     return {name: float(z) for name, z in heights.items() if 0.0 < z <= fill_height - step}
+
+
+def top_internal(insert: Mapping) -> float:
+    """The highest end of an internal wall [m]: the tube inlet, the insert inlet or the insert outlet (the reference
+    outlet level without an insert), whichever is highest; above it no internal wall crosses the section.
+
+    Parameters
+    ----------
+    insert : mapping
+        ``z_insert_outlet``, ``inlet`` ((x, z) or None) and ``z_tube_inlet`` (or None), as in
+        :func:`siloflow.model.cases.blender_passages.geometry_summary` [m].
+    """
+    insert_inlet = insert["inlet"][1] if insert.get("inlet") is not None else None
+    return float(max(z for z in (insert.get("z_tube_inlet"), insert_inlet, insert["z_insert_outlet"]) if z is not None))
 
 
 @dataclass(frozen=True, eq=False)

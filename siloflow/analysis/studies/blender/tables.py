@@ -45,7 +45,8 @@ GRAVITY_QUANTITIES = ("mass_flow_rate_kg_s", "exterior_v_z_m_s", "interior_v_z_m
 
 def blender_summary(flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics, *, run_id: str, configuration: str,
                     gravity_factor: float, geometry: Mapping, mode: str, n_clumps: int,
-                    steady_window: Sequence[float]) -> dict:
+                    steady_window: Sequence[float], vertical_section: Mapping | None = None,
+                    wall_layer: Mapping | None = None) -> dict:
     """The summary of one blender run (``blender.json``).
 
     Parameters
@@ -71,13 +72,20 @@ def blender_summary(flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics,
         Clumps of the fill [-].
     steady_window : sequence of float
         (start, end) of the steady window after opening [s].
+    vertical_section : mapping, optional
+        The depth-averaged field's uniformity across the vertical section
+        (:func:`siloflow.analysis.studies.blender.sections.section_uniformity`); None when not computed.
+    wall_layer : mapping, optional
+        The wall layer's figures (:func:`siloflow.analysis.studies.blender.sections.wall_layer_summary`); None when
+        not computed.
 
     Returns
     -------
     dict
         ``run_id``, ``configuration``, ``gravity_factor``, ``geometry``, ``mode``, ``n_clumps``,
         ``steady_window_s`` (a list), ``mass_flow_rate_standard_error_kg_s``, the keys of
-        :func:`~siloflow.analysis.studies.blender.study.study_summary`, ``rtd_curve`` (the RTD as
+        :func:`~siloflow.analysis.studies.blender.study.study_summary`, ``vertical_section`` and ``wall_layer`` (null
+        when not given), ``rtd_curve`` (the RTD as
         :func:`~siloflow.analysis.studies.blender.study.rtd_summary`, which
         :func:`~siloflow.analysis.studies.blender.study.rtd_from_summary` reads back) and ``flow_history``.
     """
@@ -87,6 +95,8 @@ def blender_summary(flow: Mapping, study: BlenderStudy, metrics: BlenderMetrics,
         "steady_window_s": list(steady_window), "mass_flow_rate_standard_error_kg_s":
             flow["mass_flow_rate_standard_error_kg_s"],
         **study_summary(study, metrics),
+        "vertical_section": None if vertical_section is None else dict(vertical_section),
+        "wall_layer": None if wall_layer is None else dict(wall_layer),
         "rtd_curve": rtd_summary(study.rtd.rtd),
         "flow_history": {"time_since_open_s": flow["time_since_open_s"],
                          "discharged_mass_kg": flow["discharged_mass_kg"], "mean_v_z_m_s": flow["mean_v_z_m_s"]},

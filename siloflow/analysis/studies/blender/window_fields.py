@@ -10,6 +10,12 @@ that is often empty still gets the mean of the clumps that passed through it), a
 mean clump mass in the bin over the window divided by ``rho_s`` times the bin volume. The fields of the single
 frames of a window (:func:`frame_fields`) give the series whose batch means carry the errors of the steady figures.
 
+The wall layer (:func:`wall_layer_positions`, :data:`WALL_LAYER_DIAMETERS`): what the study's PIV sees through the front
+wall (thesis §7.2, §7.8.2.1), the clumps whose centre lies within one particle diameter of the front or the back
+wall, both walls folded onto one; binned on a grid one layer deep
+(:func:`siloflow.analysis.numerics.eulerian_rtd.silo_bins` with the layer's depth), the same functions give its
+fields.
+
 Discharged mass: in batch mode the mass above the outlet plane at the first frame minus that at each frame
 (clumps leave the domain below the outlet); in continuous mode the mass that crossed the outlet plane so far
 (clumps re-enter at the top, the mass above the outlet stays about constant).
@@ -28,7 +34,14 @@ from siloflow.analysis.numerics.clump_tracks import ClumpTracks
 from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
 
 __all__ = ["PlanarField", "window_average_field", "frame_fields", "discharged_mass_history", "frames_in_window",
-           "mean_velocity_history"]
+           "mean_velocity_history", "WALL_LAYER_DIAMETERS", "wall_layer_depth", "wall_layer_positions"]
+
+WALL_LAYER_DIAMETERS = 1.0
+"""Depth of the wall layer, in volume-equivalent particle diameters (-). A clump touching a flat wall has its centre
+between its sphere radius and half its length from it (1.5 to 1.875 mm for the study's two-sphere clump, whose
+volume-equivalent diameter is about 3.3 mm), while the centres of the next layer lie about a radius plus a layer
+spacing out (about 4 mm): a cut at one diameter keeps the clumps a camera sees through the wall and leaves the next
+layer out. The study does not say how deep its DEM front-wall layer was (§5.4.3.4, §7.7)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,6 +158,39 @@ def frame_fields(positions, velocities, masses, times, grid: Grid, window: tuple
     times = np.asarray(times, dtype=float)
     return [_pooled_field(positions, velocities, masses, times, grid, np.array([index]), rho)
             for index in frames_in_window(times, window)]
+
+
+def wall_layer_depth(equivalent_diameter: float) -> float:
+    """The wall layer's depth: :data:`WALL_LAYER_DIAMETERS` volume-equivalent particle diameters [m]."""
+    return WALL_LAYER_DIAMETERS * positive_number("equivalent_diameter", equivalent_diameter)
+
+
+def wall_layer_positions(positions, depth: float) -> np.ndarray:
+    """Clump centres with the back half of the depth folded onto the front: ``y -> min(y, T - y)`` [m].
+
+    The front and back walls are alike (one wall material, mirror images through the mid-depth plane), so the layer
+    at the back wall is a second sample of what a camera sees at the front; folded, the clumps within ``d`` of either
+    wall are those with ``0 <= y < d``, the bins of a grid from the front wall ``d`` deep. x, z and absent clumps
+    (NaN) are kept as they are.
+
+    Parameters
+    ----------
+    positions : array_like, shape (..., 3)
+        Clump centres [m], y from the front wall (y = 0) to the back wall (y = T).
+    depth : float
+        The silo's depth T between the walls [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        The centres with y folded, a new array of the same shape [m].
+    """
+    folded = np.array(positions, dtype=float)
+    if folded.ndim < 1 or folded.shape[-1] != 3:
+        raise ValueError(f"positions must have a last axis of 3 (x, y, z), got shape {folded.shape}")
+    depth = positive_number("depth", depth)
+    folded[..., 1] = np.minimum(folded[..., 1], depth - folded[..., 1])
+    return folded
 
 
 def discharged_mass_history(tracks: ClumpTracks, masses, mode: str, outlet_z: float = 0.0,

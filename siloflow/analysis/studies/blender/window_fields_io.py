@@ -1,4 +1,5 @@
-"""Reader and writer of the blender's window-averaged planar fields as ``.npz``.
+"""Reader and writer of the blender's window-averaged planar fields as ``.npz``: the depth-averaged steady and window
+fields, the fields of the steady window's frames, and the wall layer's steady and frame fields.
 
 The only place the blender analysis touches files besides :mod:`siloflow.analysis.studies.silo_recirculation.tracks_io`
 (clump tracks).
@@ -68,3 +69,20 @@ def write_frame_fields(path: str | os.PathLike, frames: Sequence[PlanarField]) -
 def read_frame_fields(path: str | os.PathLike) -> list[PlanarField]:
     """Load what :func:`write_frame_fields` wrote, in time order."""
     return _read_fields(path)
+
+
+def write_wall_layer_fields(path: str | os.PathLike, steady: PlanarField, frames: Sequence[PlanarField]) -> Path:
+    """Save the wall layer's steady field and the fields of its single frames of the steady window (same bins, at
+    least one frame) as a compressed ``.npz``
+    (:func:`siloflow.analysis.studies.blender.window_fields.wall_layer_positions`)."""
+    frames = list(frames)
+    if not frames:
+        raise ValueError("frames must hold at least one PlanarField")
+    return _write_fields(path, [steady, *frames],
+                         "the wall layer's frame fields must have the bins of its steady field")
+
+
+def read_wall_layer_fields(path: str | os.PathLike) -> tuple[PlanarField, list[PlanarField]]:
+    """Load what :func:`write_wall_layer_fields` wrote: the steady field and the frame fields, in time order."""
+    fields = _read_fields(path)
+    return fields[0], fields[1:]

@@ -34,6 +34,7 @@ from siloflow.analysis.numerics.flow import column_surface_heights
 from siloflow.analysis.numerics.force_chains import ForceChainSegments, force_chain_segments
 from siloflow.analysis.numerics.grid import Fields, Grid
 from siloflow.analysis.numerics.profiles import profile_flow_rate, velocity_profile
+from siloflow.analysis.studies.silo_flat.field_clock import averaging_window
 from siloflow.analysis.studies.silo_flat.fields import (
     FieldSettings,
     JanssenComparison,
@@ -299,7 +300,11 @@ class SiloFieldStudy:
     fields : list of Fields
         Fields of each frame.
     window : tuple of float
-        Time window of the average (s).
+        Time window of the average, since the first frame after opening (s).
+    window_source : str
+        Where ``window`` came from (:func:`~siloflow.analysis.studies.silo_flat.field_clock.averaging_window`):
+        ``"silo_flat.fields.average_window"`` (``options.average_window``) or ``"silo_flat.steady_window"`` (the
+        steady flow window).
     averaged : Fields
         Time average over ``window``.
     averaged_depth : Fields
@@ -341,6 +346,7 @@ class SiloFieldStudy:
     times: np.ndarray
     fields: list[Fields]
     window: tuple[float, float]
+    window_source: str
     averaged: Fields
     averaged_depth: Fields
     surface: np.ndarray
@@ -403,7 +409,7 @@ def analyse_silo_fields(
     grid = silo_grid(silo.width, silo.depth, top, settings.spacing)
     times = np.array([frame.time for frame in frames]) - frames[0].time
     fields = [clump_fields(frame, grid, settings) for frame in frames]
-    window = tuple(options.average_window or steady_window)
+    window, window_source = averaging_window(options.average_window, steady_window)
     averaged = time_average(fields, times, window)
     averaged_depth = depth_average(averaged)
 
@@ -427,9 +433,9 @@ def analyse_silo_fields(
         contacts, grid, settings, surface, bulk_density, bulk_density_error, silo, options)
     return SiloFieldStudy(
         settings=settings, grid=grid, steps=tuple(frame.step for frame in frames), times=times, fields=fields,
-        window=window, averaged=averaged, averaged_depth=averaged_depth, surface=surface, top=top, heights=heights,
-        profiles=profiles, front=front, depth_series=depth_series, centreline=centre, profile_rate=profile_rate,
-        bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments,
+        window=window, window_source=window_source, averaged=averaged, averaged_depth=averaged_depth,
+        surface=surface, top=top, heights=heights, profiles=profiles, front=front, depth_series=depth_series,
+        centreline=centre, profile_rate=profile_rate, bulk_rate=bulk_rate, stress=stress, janssen=janssen, segments=segments,
         n_contacts=None if contacts is None else len(contacts), uncertainty=uncertainty,
     )
 
@@ -520,16 +526,19 @@ def janssen_rows(comparison: JanssenComparison) -> list[dict]:
 
 
 def field_summary(study: SiloFieldStudy, outflow_rate: float) -> dict:
-    """The contents of ``fields.json``: grid, kernel, window, heights, the profile flow rates against the
-    measured outflow ``outflow_rate`` (kg/s), B and the flow-pattern index (wall over centreline v_z) per height with
-    their errors, surface height and number of contacts (the Janssen bins and the contacts null for a study made
-    without contacts)."""
+    """The contents of ``fields.json``: grid, kernel, the averaging window (its start and end in seconds after the
+    outlet opened, ``average_window_s``, and the key it came from, ``average_window_source``:
+    :func:`~siloflow.analysis.studies.silo_flat.field_clock.averaging_window`), heights, the profile flow rates
+    against the measured outflow ``outflow_rate`` (kg/s), B and the flow-pattern index (wall over centreline v_z) per
+    height with their errors, surface height and number of contacts (the Janssen bins and the contacts null for a
+    study made without contacts)."""
     return {
         "grid_shape": list(study.grid.shape),
         "grid_spacing_m": list(study.grid.spacing),
         "kernel": study.settings.kernel,
         "kernel_width_m": study.settings.width,
         "average_window_s": list(study.window),
+        "average_window_source": study.window_source,
         "profile_heights_m": study.heights,
         "profile_flow_height_m": study.heights[0],
         "profile_mass_flow_rate_kg_s": study.profile_rate,

@@ -416,7 +416,10 @@ def analyse_blending(tracks: ClumpTracks, layouts, domain_bottom: float, domain_
     Parameters
     ----------
     tracks : ClumpTracks
-        Clump centres from the outlet opening (first frame) to the end of the run [m].
+        Clump centres from the outlet opening (first frame) to the end of the run [m]; of a run with a discharge
+        after its recirculations, to the stop of the re-entry (:meth:`ClumpTracks.until`): every figure here is of
+        the recirculating silo, and the discharge's VRR is
+        :func:`siloflow.analysis.studies.silo_recirculation.final_discharge.final_discharge`.
     layouts : sequence of Layout
         Batch colourings.
     domain_bottom, domain_top : float

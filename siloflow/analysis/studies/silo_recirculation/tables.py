@@ -23,7 +23,8 @@ in its unit, beside it (NaN, written null or empty, when not known). Their sourc
 - RTD means: ``s / sqrt(n)`` over the tracers that left (:attr:`siloflow.analysis.numerics.rtd.RTD.t_mean_error`), or
   that left within the transit horizon (``t_mean_transit_s``);
 - VRR: ``sqrt(2 / (N - 1)) VRR`` over the ``N`` windows of the recirculation
-  (:func:`siloflow.analysis.studies.silo_recirculation.vrr.vrr_standard_error`).
+  (:func:`siloflow.analysis.studies.silo_recirculation.vrr.vrr_standard_error`), or of the discharge after the
+  recirculations (``final_discharge``, :mod:`siloflow.analysis.studies.silo_recirculation.final_discharge`).
 
 Two residence times
 -------------------
@@ -48,6 +49,7 @@ from siloflow.analysis.numerics.rtd import RTD, johanson_rtd
 from siloflow.analysis.numerics.residence_statistics import appearance_times, residence_time_resolution
 from siloflow.analysis.numerics.uncertainty import Significance, combine_independent, difference_significant
 from siloflow.analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_near_ceiling
+from siloflow.analysis.studies.silo_recirculation.final_discharge import FinalDischarge
 from siloflow.analysis.studies.silo_recirculation.study import BlendingResult, VerificationResult, residence_summary
 from siloflow.analysis.studies.silo_recirculation.vrr import sampling_noise_vrr_limit
 
@@ -251,7 +253,7 @@ def clumps_per_window(result: BlendingResult) -> float:
 
 def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float, *, run_id: str,
                      flow_pattern: str, estimated_residence_time: float, factor: float = CEILING_FACTOR,
-                     k: float = 2.0) -> dict:
+                     k: float = 2.0, final_discharge: FinalDischarge | None = None) -> dict:
     """The summary of one recirculation run (``blending.json``).
 
     Parameters
@@ -273,6 +275,10 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
     k : float, optional
         Coverage factor of the Little's law check (:func:`siloflow.analysis.numerics.uncertainty.difference_significant`),
         > 0 [-].
+    final_discharge : FinalDischarge or None, optional
+        The discharge after the recirculations of a run that has one
+        (:func:`siloflow.analysis.studies.silo_recirculation.final_discharge.final_discharge`); ``result`` is then the
+        study of the recirculating part.
 
     Returns
     -------
@@ -302,6 +308,13 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
         ``littles_law_difference_s`` (``transit_residence_time_s - t_mean_transit_s`` [s]) with its error
         (the two independent) and ``littles_law_significance`` (beyond ``k`` errors: ``"significant"``,
         ``"not significant"`` or ``"unknown"``) with ``littles_law_coverage_factor`` ``k`` [-].
+
+        With a ``final_discharge``, its
+        :meth:`~siloflow.analysis.studies.silo_recirculation.final_discharge.FinalDischarge.summary` under
+        ``"final_discharge"``: the study's VRR after the recirculations (§6.4.2) per layout, ``vrr`` with
+        ``vrr_error``, the ``windows`` and ``clumps`` it used, the ``left_out_fraction`` of the outflow and
+        ``at_ceiling``, with the discharge's ``recirculations`` (Nr), ``start_s`` and ``end_s``. A run without one has
+        no such key.
     """
     timing = result.timing
     silo_rtd = result.rtd.silo
@@ -344,6 +357,7 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
             for layout in result.layouts
         },
         **transit,
+        **({} if final_discharge is None else {"final_discharge": final_discharge.summary()}),
     }
 
 
@@ -509,7 +523,9 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
         (holdup of the passes lasting at most the transit horizon over their throughput [s]) and
         ``rtd_mean_ids_transit_s`` (the tracer's mean up to that horizon [s]), each with its ``_error`` (NaN
         for a summary without them). ``residence_time_s`` is the holdup residence time, stagnant zones
-        included; ``rtd_mean_ids_s`` the mean of the tracers that left in the run.
+        included; ``rtd_mean_ids_s`` the mean of the tracers that left in the run. Last, the discharge after the
+        recirculations (NaN and False for a summary without one): ``final_discharge_recirculations`` (its Nr [-]),
+        ``final_discharge_vrr`` with ``final_discharge_vrr_error`` [-] and ``final_discharge_vrr_at_ceiling``.
     curves : list of tuple
         ``(label, recirculation at mid-window, VRR, ceiling, VRR error)`` per row, for
         :func:`siloflow.analysis.studies.silo_recirculation.plots.plot_vrr_versus_recirculations` (``ceiling`` None if the
@@ -548,7 +564,18 @@ def summary_rows(summaries: Sequence[Mapping], factor: float = CEILING_FACTOR) -
                 "transit_residence_time_s_error": number_or_nan(summary.get("transit_residence_time_s_error")),
                 "rtd_mean_ids_transit_s": number_or_nan(particle_rtd.get("t_mean_transit_s")),
                 "rtd_mean_ids_transit_s_error": number_or_nan(particle_rtd.get("t_mean_transit_s_error")),
+                **_final_discharge_columns(summary.get("final_discharge"), name),
             })
     return rows, curves
+
+
+def _final_discharge_columns(discharge: Mapping | None, name: str) -> dict:
+    """The summary table's columns of the discharge after the recirculations of one layout (NaN and False
+    without one)."""
+    layout = (discharge or {}).get("layouts", {}).get(name) or {}
+    return {"final_discharge_recirculations": number_or_nan((discharge or {}).get("recirculations")),
+            "final_discharge_vrr": number_or_nan(layout.get("vrr")),
+            "final_discharge_vrr_error": number_or_nan(layout.get("vrr_error")),
+            "final_discharge_vrr_at_ceiling": bool(layout.get("at_ceiling", False))}
 
 

@@ -4,8 +4,10 @@ states one, else a measurement with no finding; and the gravity series, a simila
 Rows, from the runs at 1 g (see :mod:`siloflow.analysis.studies.validation.rows`):
 
 - M1: the diverging insert's steady velocity of each passage at the insert outlet over the cross-section mean;
-- M2: the converging insert's order tube > interior > exterior annulus at the insert outlet (downward speeds), and
-  the interior minus the exterior annulus velocity at the insert inlet over the cross-section mean there;
+- M2: the converging insert's order tube > interior > exterior annulus at the insert outlet (downward speeds), the
+  interior minus the exterior annulus velocity at the insert inlet over the cross-section mean there, and per height
+  in the vertical section above the internals the largest deviation of a bin's velocity across the width from their
+  mean, relative to it, the bins within one tube width of the tube left out (:func:`_vertical_rows`);
 - M3: the VRR of the continuous mode at one input period (``metrics.vrr_by_period["1"]``, LTI of the RTD),
   converging over straight and over diverging;
 - the other inserts' passage velocities over the cross-section mean, and every insert's mean residence time and
@@ -14,6 +16,12 @@ Rows, from the runs at 1 g (see :mod:`siloflow.analysis.studies.validation.rows`
 The cross-section mean at a height is the mean over the bins of all its passages (each passage's mean weighted by
 its bins there: equal bins, so by its width at that height), as the study normalised its profiles by the mean
 across the section (§7.4, §7.5).
+
+M1 and M2 are the study's PIV, which sees the front wall (§7.2; its DEM gave both the front wall and the depth
+average, §7.7, §7.8.2.1). Where ``blender.json`` has the wall layer (``wall_layer``: the clumps within a particle
+diameter of the front and back walls, :func:`siloflow.analysis.studies.blender.window_fields.wall_layer_positions`)
+their rows judge its figures and quote the depth average's beside them; a summary without it gives the depth
+average's, and ``differs`` says that it is not the PIV's plane (:data:`DEPTH_AVERAGED`).
 
 Gravity series (:func:`gravity_rows`): a run at ``f g`` scales every Young's modulus by ``f`` and every time by
 ``1 / sqrt(f)`` (:mod:`siloflow.model.cases.blender`), so its flow is similar to the 1 g run's and every rate scales
@@ -39,8 +47,8 @@ from siloflow.analysis.studies.validation.agreement import AgreementTolerances, 
 from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, resolved, row, smallest_dof
 
-__all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "smallest_dof", "capped", "section_mean", "blender_rows",
-           "gravity_rows"]
+__all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "DEPTH_AVERAGED", "smallest_dof", "capped",
+           "section_mean", "blender_rows", "gravity_rows"]
 
 BLENDER_GROUP = "Multi-flow blender"
 GRAVITY_GROUP = "Blender gravity series: similarity check of the code (scaled moduli)"
@@ -56,8 +64,11 @@ GRAVITY_STUDY = ("identity: with every modulus scaled by g and every time by 1/s
                  "scales with sqrt(g) by construction; a check of the code's similarity, not the study's M4 (fixed "
                  "material, §7.9)")
 #: The finding parts of ch. 7 these rows make (given the runs each needs).
-MADE = ("M1.exterior", "M1.interior", "M1.tube", "M2.outlet_order", "M2.inlet_uniform", "M3.over_straight",
-        "M3.over_diverging")
+MADE = ("M1.exterior", "M1.interior", "M1.tube", "M2.outlet_order", "M2.inlet_uniform", "M2.vertical_uniform",
+        "M3.over_straight", "M3.over_diverging")
+#: The ``differs`` clause of a PIV figure (M1, M2) taken from the depth average: the summary has no wall layer.
+DEPTH_AVERAGED = ("averaged over the depth, not in the layer at the front wall the study's PIV sees (§7.2, §7.5; "
+                  "its DEM gave both, §7.8.2.1)")
 _M4 = ("the study's series (§7.9) is at fixed material; this tier's (blender.gravity_factors, "
        "blender.gravity_configurations) multiplies every Young's modulus by the gravity factor "
        "(siloflow.model.cases.blender.gravity_scaled_stiffness): a similarity check of the code whose sqrt(g) scaling "
@@ -66,9 +77,6 @@ _M4 = ("the study's series (§7.9) is at fixed material; this tier's (blender.gr
        "blender.gravity_configurations [diverging] at fixed moduli, which no configuration key gives yet")
 #: The parts of ch. 7 these rows cannot make, and what would make them.
 UNMADE = MappingProxyType({
-    "M2.vertical_uniform": "needs the steady velocity across the width of the vertical section with its error: "
-                           "blender.json keeps the passages' means at the insert outlet and inlet only, and "
-                           "profiles.csv the window profiles at blender.profile_heights_above, without errors",
     **{part: _M4 for part in ("M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates", "M4.interior_deviates",
                               "M4.inlet_differential_decreases")},
 })
@@ -103,17 +111,15 @@ def section_mean(velocities: Mapping[str, tuple[float, float]], weights: Mapping
 
 
 def _outlet(summary: Mapping) -> tuple[dict, tuple[float, float], str, str]:
-    """The passages' (v_z, error) at the insert outlet (m/s), their cross-section mean, the evidence of its weights
-    and the ``differs`` clause when they are not the passages' widths at the insert outlet."""
+    """The passages' depth-averaged (v_z, error) at the insert outlet (m/s), their cross-section mean, the evidence of
+    its weights and the ``differs`` clause when they are not the passages' widths at the insert outlet."""
     metrics = summary["metrics"]
     velocities = {key: _metric(metrics, f"{key}_v_z_m_s") for key in PASSAGES}
     velocities = {key: value for key, value in velocities.items() if math.isfinite(value[0])}
     bins = ((summary.get("passages_at_insert_outlet") or {}).get("n_bins")) or {}
     if all(bins.get(key) for key in velocities):
         weights = {key: float(bins[key]) for key in velocities}
-        return velocities, section_mean(velocities, weights), (
-            "passages weighted by their bins at the insert outlet (" + ", ".join(
-                f"{key} {int(w)}" for key, w in weights.items()) + ")"), ""
+        return velocities, section_mean(velocities, weights), _weighting(weights, "outlet"), ""
     # An older summary has no bins: the narrowest clear widths stand in, each annulus crossed twice by a planar
     # section, the tube (and an interior passage without a tube, spanning both plates) once.
     widths = summary["geometry"]["clear_widths"]
@@ -123,65 +129,172 @@ def _outlet(summary: Mapping) -> tuple[dict, tuple[float, float], str, str]:
         "cross-section mean weighted by the passages' narrowest clear widths, not their widths at the insert outlet")
 
 
+def _weighting(bins: Mapping[str, float], level: str) -> str:
+    return (f"passages weighted by their bins at the insert {level} ("
+            + ", ".join(f"{key} {int(w)}" for key, w in bins.items()) + ")")
+
+
+def _wall_layer(summary: Mapping, level: str) -> tuple[dict, dict, str] | None:
+    """The wall layer's passages at the insert ``level`` (``"outlet"`` or ``"inlet"``): name -> (v_z, error) (m/s) of
+    those with a velocity and bins, name -> bins, and the evidence of the layer; None when the summary has none."""
+    layer = summary.get("wall_layer") or {}
+    passages = layer.get(f"passages_at_insert_{level}") or {}
+    means, errors, bins = (passages.get(key) or {} for key in ("mean_v_z_m_s", "mean_v_z_m_s_error", "n_bins"))
+    velocities = {key: (number_or_nan(means.get(key)), number_or_nan(errors.get(key))) for key in PASSAGES
+                  if key in means and bins.get(key)}
+    velocities = {key: value for key, value in velocities.items() if math.isfinite(value[0])}
+    if not velocities:
+        return None
+    return velocities, {key: float(bins[key]) for key in velocities}, _wall_layer_label(summary)
+
+
+def _wall_layer_label(summary: Mapping) -> str:
+    """The evidence's name of the wall layer: its depth and walls, and that it is the PIV's plane."""
+    layer = summary.get("wall_layer") or {}
+    depth = number_or_nan(layer.get("depth_m")) * 1000
+    return f"wall layer ({depth:.3g} mm from the {layer.get('walls') or 'front wall'}), the plane the study's PIV sees"
+
+
 def _steady(summary: Mapping) -> str:
     low, high = summary.get("steady_window_s") or (math.nan, math.nan)
     return f"steady window {float(low):g}-{float(high):g} s after opening"
 
 
 def _passage_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
-    """Each passage's v_z over the cross-section mean at the insert outlet: M1 for the diverging insert."""
+    """Each passage's v_z over the cross-section mean at the insert outlet: M1 for the diverging insert, of the wall
+    layer where the summary has it (the depth average's quoted beside), else of the depth average."""
     name = summary["configuration"]
-    velocities, (mean, mean_error), weighting, differs = _outlet(summary)
+    velocities, (mean, mean_error), weighting, depth_differs = _outlet(summary)
     if not {"interior", "exterior"} <= velocities.keys():
         return []
-    differs = "; ".join(filter(None, (differs, _continuous(summary))))
+    wall_velocities, wall_bins, plane = _wall_layer(summary, "outlet") or ({}, {}, "")
+    wall_mean = section_mean(wall_velocities, wall_bins) if wall_velocities else (math.nan, math.nan)
+    depth_clause = "; ".join(filter(None, (depth_differs, DEPTH_AVERAGED, _continuous(summary))))
     rows = []
     for key, (value, error) in velocities.items():
-        share = ratio(value, error, mean, mean_error)
-        evidence = (f"{PASSAGES[key]} {plus_minus(value, error)} m/s, cross-section mean {plus_minus(mean, mean_error)} "
-                    f"m/s ({weighting}); {_steady(summary)}; {precise(*share, tolerances)[1]}; {note}")
+        depth_share = ratio(value, error, mean, mean_error)
+        depth_text = (f"{PASSAGES[key]} {plus_minus(value, error)} m/s, cross-section mean "
+                      f"{plus_minus(mean, mean_error)} m/s ({weighting})")
+        if key in wall_velocities:
+            share, row_differs = ratio(*wall_velocities[key], *wall_mean), _continuous(summary)
+            evidence = (f"{plane}: {PASSAGES[key]} {plus_minus(*wall_velocities[key])} m/s, cross-section mean "
+                        f"{plus_minus(*wall_mean)} m/s ({_weighting(wall_bins, 'outlet')}); depth-averaged "
+                        f"{plus_minus(*depth_share)}: {depth_text}")
+        else:
+            share, row_differs, evidence = depth_share, depth_clause, f"depth-averaged: {depth_text}"
+        evidence += f"; {_steady(summary)}; {precise(*share, tolerances)[1]}; {note}"
         figure = f"{PASSAGES[key].capitalize()} v_z / cross-section mean at the insert outlet"
         if name == "diverging":
             part = PARTS[f"M1.{key}"]
             rows.append(row(BLENDER_GROUP, figure, name, *share, "-", evidence, dof=dof, finding=part.id,
-                            agreement=rules.value_in_band(*share, dof, part, tolerances), differs=differs))
+                            agreement=rules.value_in_band(*share, dof, part, tolerances), differs=row_differs))
         else:
-            rows.append(row(BLENDER_GROUP, figure, name, *share, "-", evidence, dof=dof, study="-", differs=differs))
+            rows.append(row(BLENDER_GROUP, figure, name, *share, "-", evidence, dof=dof, study="-",
+                            differs=row_differs))
     return rows
 
 
 def _converging_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
-    """M2.outlet_order (downward speeds, tube first) and M2.inlet_uniform of the converging insert."""
+    """M2.outlet_order (downward speeds, tube first), M2.inlet_uniform and M2.vertical_uniform of the converging
+    insert, of the wall layer where the summary has it."""
     name, rows = summary["configuration"], []
-    velocities, _, _, _ = _outlet(summary)
-    differs = _continuous(summary)
+    depth_velocities, _, _, _ = _outlet(summary)
+    wall = _wall_layer(summary, "outlet")
+    velocities, plane, differs = ((wall[0], wall[2], _continuous(summary)) if wall is not None else
+                                  (depth_velocities, "depth-averaged",
+                                   "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))))
     if {"tube", "interior", "exterior"} <= velocities.keys():
         # Downward speeds, so that "fastest" is the largest, as the study's order reads.
         speeds = [(-velocities[key][0], velocities[key][1]) for key in ("tube", "interior", "exterior")]
         values, errors = [s[0] for s in speeds], [s[1] for s in speeds]
         rows.append(row(BLENDER_GROUP, "Downward speed at the insert outlet, tube > interior > exterior annulus",
                         name, values[0], errors[0], "m/s",
-                        "; ".join(f"{PASSAGES[key]} {plus_minus(v, e)} m/s" for key, v, e in
-                                  zip(("tube", "interior", "exterior"), values, errors))
+                        f"{plane}: " + "; ".join(f"{PASSAGES[key]} {plus_minus(v, e)} m/s" for key, v, e in
+                                                  zip(("tube", "interior", "exterior"), values, errors))
                         + f" (value column: tube); {_steady(summary)}; {note}", dof=dof, finding="M2.outlet_order",
                         agreement=rules.in_order(values, errors, dof, PARTS["M2.outlet_order"]), differs=differs))
-    inlet = summary.get("passages_at_insert_inlet") or {}
-    means, bins = inlet.get("mean_v_z_m_s") or {}, inlet.get("n_bins") or {}
-    if {"interior", "exterior"} <= means.keys() and all(bins.get(key) for key in means):
-        # The summary keeps the inlet's means with no batch means behind them: an error only where one is written.
+    rows += _inlet_rows(summary, note, dof, tolerances)
+    rows += _vertical_rows(summary, note, dof, tolerances)
+    return rows
+
+
+def _inlet_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
+    """M2.inlet_uniform: the interior minus the exterior annulus velocity at the insert inlet over the cross-section
+    mean there."""
+    wall = _wall_layer(summary, "inlet")
+    if wall is not None:
+        passages, bins, plane = wall
+        measured, differs = "", _continuous(summary)
+    else:
+        inlet = summary.get("passages_at_insert_inlet") or {}
+        means, bins = inlet.get("mean_v_z_m_s") or {}, inlet.get("n_bins") or {}
+        if not ({"interior", "exterior"} <= means.keys() and all(bins.get(key) for key in means)):
+            return []
+        # The depth average's inlet means have no batch means behind them: an error only where one is written.
         errors = inlet.get("mean_v_z_m_s_error") or {}
         passages = {key: (float(v), number_or_nan(errors.get(key))) for key, v in means.items()}
-        mean, mean_error = section_mean(passages, bins)
-        (interior, e_i), (exterior, e_e) = passages["interior"], passages["exterior"]
-        change, change_error = ratio(interior - exterior, combine_independent([e_i, e_e]), mean, mean_error)
+        plane = "depth-averaged"
         measured = "" if errors else "; its error is not measured (blender.json has no error of the inlet's passages)"
-        rows.append(row(BLENDER_GROUP, "Interior minus exterior annulus v_z at the insert inlet / cross-section mean",
-                        name, change, change_error, "-",
-                        f"interior {plus_minus(interior, e_i)} m/s, exterior {plus_minus(exterior, e_e)} m/s, mean "
-                        f"{plus_minus(mean, mean_error)} m/s over {sum(int(b) for b in bins.values())} bins"
-                        f"{measured}; {_steady(summary)}; {note}", dof=dof, finding="M2.inlet_uniform",
-                        agreement=rules.negligible(change, change_error, dof, 1.0, PARTS["M2.inlet_uniform"],
-                                                   tolerances), differs=differs))
+        differs = "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))
+    if not {"interior", "exterior"} <= passages.keys():
+        return []
+    mean, mean_error = section_mean(passages, bins)
+    (interior, e_i), (exterior, e_e) = passages["interior"], passages["exterior"]
+    change, change_error = ratio(interior - exterior, combine_independent([e_i, e_e]), mean, mean_error)
+    return [row(BLENDER_GROUP, "Interior minus exterior annulus v_z at the insert inlet / cross-section mean",
+                summary["configuration"], change, change_error, "-",
+                f"{plane}: interior {plus_minus(interior, e_i)} m/s, exterior {plus_minus(exterior, e_e)} m/s, mean "
+                f"{plus_minus(mean, mean_error)} m/s over {sum(int(b) for b in bins.values())} bins"
+                f"{measured}; {_steady(summary)}; {note}", dof=dof, finding="M2.inlet_uniform",
+                agreement=rules.negligible(change, change_error, dof, 1.0, PARTS["M2.inlet_uniform"], tolerances),
+                differs=differs)]
+
+
+def _pair(entry: Mapping, key: str) -> tuple[float, float]:
+    """A figure of a summary entry and its error (NaN where absent)."""
+    return number_or_nan(entry.get(key)), number_or_nan(entry.get(f"{key}_error"))
+
+
+def _uniformity_text(entry: Mapping) -> str:
+    """Evidence of one height's uniformity figure (an entry of ``vertical_section``)."""
+    value = _pair(entry, "largest_deviation")
+    mean = _pair(entry, "mean_v_z_m_s")
+    excluded = (f", {int(entry['excluded_bins'])} bins within {number_or_nan(entry.get('exclusion_m')) * 1000:.3g} mm "
+                "of the tube left out" if entry.get("excluded_bins") else "")
+    at = number_or_nan(entry.get("deviation_x_m")) * 1000
+    return (f"largest deviation {plus_minus(*value)} at x = {at:.0f} mm from the mean v_z {plus_minus(*mean)} m/s of "
+            f"{int(entry.get('n_bins') or 0)} bins across the width{excluded} ({int(entry.get('batches') or 0)} "
+            "batches of frames)")
+
+
+def _vertical_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
+    """M2.vertical_uniform: per height of the vertical section, the largest deviation of a bin's v_z across the width
+    from the mean of the bins kept (those within one tube width of the tube left out), relative to the mean; of the
+    wall layer where the summary has it, the depth average's quoted beside. No row from a summary without
+    ``vertical_section`` (written before it was computed) or with no height above the internals."""
+    layer = (summary.get("wall_layer") or {}).get("vertical_section") or {}
+    depth = summary.get("vertical_section") or {}
+    chosen = layer or depth
+    if layer:
+        plane = _wall_layer_label(summary)
+        differs = _continuous(summary)
+    else:
+        plane = "depth-averaged"
+        differs = "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))
+    rows = []
+    for key in sorted(chosen, key=float):
+        entry = chosen[key]
+        value, error = _pair(entry, "largest_deviation")
+        evidence = f"{plane}: {_uniformity_text(entry)}"
+        if layer and key in depth:
+            evidence += f"; depth-averaged: {_uniformity_text(depth[key])}"
+        height = number_or_nan(entry.get("height_m")) * 1000
+        rows.append(row(BLENDER_GROUP, f"Largest deviation of v_z across the vertical section / its mean, z = "
+                                       f"{height:.0f} mm ({entry.get('name') or 'vertical section'})",
+                        summary["configuration"], value, error, "-", f"{evidence}; {_steady(summary)}; {note}",
+                        dof=dof, finding="M2.vertical_uniform",
+                        agreement=rules.negligible(value, error, dof, 1.0, PARTS["M2.vertical_uniform"], tolerances),
+                        differs=differs))
     return rows
 
 

@@ -10,10 +10,16 @@ Recirculation number and VRR
 The analysis (:func:`siloflow.analysis.studies.silo_recirculation.vrr.vrr_by_recirculation`) counts ``Nr = (t -
 t_open) / t_res`` in holdup residence times (the silo's contents over its throughput, the study's t_rm, §6.2.3.3)
 and writes one VRR per pass: entry ``k`` of ``vrr_by_recirculation`` is the VRR of the outlet windows with ``k <= Nr
-< k + 1``, the pass that follows ``k`` recirculations. The study's "Nr = 0" (without recirculation, B5) is entry 0 and
-its "Nr = 4" (the discharge after 4 recirculations, B2-B4, B6) is entry 4. A run that covers fewer passes gives its
-last one, and its rows say so in ``differs``. A VRR near the counting-noise ceiling of the outlet windows
-(``vrr_at_ceiling``) is a lower bound of the true VRR, not a measurement: every row it enters is at most "not
+< k + 1``, the pass that follows ``k`` recirculations, at the constant head the re-entry keeps. The study's "Nr = 0"
+(without recirculation, B5) is entry 0. Its VRR "at the end of Nr = 4 recirculations" (B3, B4, B6, and the end of the
+growth of B2.grows) is that of the outflow of the discharge after the recirculations, once the re-entry stops
+(§6.4.2, Fig. 6.9): a run with a final discharge writes it under ``final_discharge``
+(:mod:`siloflow.analysis.studies.silo_recirculation.final_discharge`), and those rows take it; the pass at constant
+head is then a row of its own with no finding. A run without one gives entry 4 (its last pass when it covers
+fewer, and says so), and the rows say in ``differs`` that it is a pass at constant head, not the discharge after
+the recirculations. B2.slower_after_2 needs Nr = 0, 2 and 4 of one kind and a run has one discharge, so it stays on
+the passes and says so. A VRR near the counting-noise ceiling of the outlet windows (``vrr_at_ceiling``, or the
+discharge's ``at_ceiling``) is a lower bound of the true VRR, not a measurement: every row it enters is at most "not
 resolved".
 
 Inputs are per-run mappings ``{"case": case.json, "summary": blending.json, "rtd": rtd.csv rows, "note": str, "dof":
@@ -26,6 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
+from typing import NamedTuple
 
 import numpy as np
 
@@ -45,6 +52,19 @@ PATTERNS = {"internal_flow": "internal", "semi_mass_flow": "semi_mass"}
 STUDY_BATCHES = (0.13, 0.25, 0.5)
 #: The Nr at which the study reads the VRR (B2-B4, B6) and its midpoint for the "slower after" part (B2).
 NR_STUDY, NR_MIDDLE = 4, 2
+#: How far the Nr of a run's final discharge may lie from :data:`NR_STUDY` and still be the study's (-): the study's
+#: own run is "about 4 recirculations" (12 s of a 2.75 s residence time, §6.2.3.3), so the nearest whole Nr counts.
+NR_DISCHARGE_TOLERANCE = 0.5
+#: ``differs`` of a VRR of a recirculation pass where the study's is of the discharge after the recirculations.
+CONSTANT_HEAD = ("VRR of the pass k <= Nr < k + 1 of the recirculating run, at constant head, not of the discharge "
+                 "after Nr recirculations (§6.4.2): the run has no final discharge "
+                 "(silo_recirculation.final_discharge > 0 adds it)")
+#: ``differs`` of B2.slower_after_2, which takes three passes of one run.
+SLOWER_PASSES = (f"gains of the VRR of the passes at constant head (k <= Nr < k + 1), not of the discharges after 0, "
+                 f"{NR_MIDDLE} and {NR_STUDY} recirculations (§6.4.2): a run has one final discharge")
+#: ``study`` of the row of the last pass at constant head beside the discharge's VRR.
+CONSTANT_HEAD_STUDY = ("- (siloflow's: the study reads the VRR of the discharge after the recirculations, "
+                       "§6.4.2)")
 #: The finding parts of ch. 6 these rows make (each given the runs it needs): all of them.
 MADE = ("B1.semi_mass", "B1.internal", "B2.grows", "B2.slower_after_2", "B3.internal",
         "B3.stronger_in_internal", "B4.semi_mass", "B4.internal", "B5", "B6", "B7.semi_mass",
@@ -82,8 +102,42 @@ def _tail(*notes: str) -> str:
     return f"; {text}" if text else ""
 
 
+class _End(NamedTuple):
+    """The VRR the study reads at the end of :data:`NR_STUDY` recirculations, as one run gives it (:meth:`_Run.end`).
+
+    ``nr`` is the Nr it is at: a pass's whole number, or the discharge's Nr; ``where`` and ``to`` name it in figures
+    ("VRR {where}", "from Nr = 0 to {to}"); ``bound`` says why it is only a lower bound ("" for a measurement);
+    ``evidence`` describes the discharge ("" for a pass).
+    """
+
+    value: float
+    error: float
+    nr: float
+    discharge: bool
+    where: str
+    to: str
+    bound: str
+    differs: str
+    evidence: str
+
+
+def _where(ends: Sequence[_End]) -> str:
+    """The figure text of where several VRRs at the end of the recirculations are read."""
+    if all(end.discharge for end in ends):
+        return f"of the discharge after Nr = {min(end.nr for end in ends):.2f}"
+    if not any(end.discharge for end in ends):
+        return f"at Nr = {min(int(end.nr) for end in ends)}"
+    return f"at the end of about {round(min(end.nr for end in ends))} recirculations (discharges and passes)"
+
+
+def _joined(texts) -> str:
+    """The non-empty texts, each once, in order."""
+    return "; ".join(dict.fromkeys(text for text in texts if text))
+
+
 class _Run:
-    """One recirculation run as the rows read it: its pattern, layouts, note and degrees of freedom."""
+    """One recirculation run as the rows read it: its pattern, layouts, final discharge, note and degrees of
+    freedom."""
 
     def __init__(self, run: Mapping):
         self.summary, self.rtd = run["summary"], list(run.get("rtd") or ())
@@ -91,6 +145,7 @@ class _Run:
         self.suffix = PATTERNS.get(self.pattern)
         self.note, self.dof = str(run.get("note") or ""), run.get("dof")
         self.layouts = self.summary["layouts"]
+        self.discharge = self.summary.get("final_discharge") or None
         limit, factor = float(self.summary["vrr_sampling_limit"]), float(self.summary["vrr_ceiling_factor"])
         self.windows = (f"outlet windows of {float(self.summary['clumps_per_window']):.0f} clumps: counting-noise "
                         f"ceiling {limit:.0f}, a VRR above {limit / factor:.0f} is a lower bound")
@@ -115,6 +170,40 @@ class _Run:
         bound = (f"the VRR at Nr = {taken} is at the counting-noise ceiling ({self.windows})"
                  if layout["vrr_at_ceiling"][taken] else "")
         return number_or_nan(values[taken]), number_or_nan(errors[taken]), taken, bound
+
+    def end(self, name: str, layout: Mapping) -> _End:
+        """The VRR at the end of :data:`NR_STUDY` recirculations: the final discharge's where the summary has it for
+        this layout (the study's, §6.4.2), else the pass's at constant head (:meth:`vrr`), with ``differs`` saying
+        so."""
+        discharge = (self.discharge or {}).get("layouts", {}).get(name)
+        if discharge is None:
+            value, error, nr, bound = self.vrr(layout, NR_STUDY)
+            return _End(value, error, nr, False, f"at Nr = {nr}", f"{nr}", bound, _joined((CONSTANT_HEAD,
+                        self.short(nr, NR_STUDY))), "")
+        common = self.discharge  # the figures every layout of the discharge shares
+        nr = float(common["recirculations"])
+        start, end = number_or_nan(common.get("start_s")), number_or_nan(common.get("end_s"))
+        ceiling = number_or_nan(discharge.get("vrr_ceiling"))
+        far = "" if abs(nr - NR_STUDY) <= NR_DISCHARGE_TOLERANCE else (
+            f"discharge after Nr = {nr:.2f} recirculations, not {NR_STUDY} (silo_recirculation.recirculations sets "
+            "it)")
+        cut = "" if common.get("faded", True) else (
+            f"the run ends before the discharge's outflow fades: its VRR is of the first {end - start:.3g} s of it (a "
+            "longer silo_recirculation.final_discharge sees it all)")
+        bound = (f"the VRR of the discharge is at the counting-noise ceiling of its windows ({ceiling:.0f})"
+                 if discharge.get("at_ceiling") else "")
+        evidence = (
+            f"discharge after Nr = {nr:.2f} recirculations from t = {start:.4g} s: "
+            f"{number_or_nan(discharge.get('windows')):.0f} windows of {number_or_nan(common.get('window_s')):.3g} s "
+            f"to t = {end:.4g} s, {number_or_nan(discharge.get('clumps')):.0f} clumps, "
+            f"{number_or_nan(discharge.get('left_out_fraction')):.1%} of its outflow left out (windows from the stop "
+            f"of the re-entry up to the first with fewer than {number_or_nan(common.get('threshold_clumps')):.1f} "
+            "clumps, "
+            f"{number_or_nan(common.get('fade_fraction')):g} of a recirculating window's "
+            f"{number_or_nan(common.get('reference_clumps_per_window')):.0f}); counting-noise ceiling {ceiling:.0f}")
+        return _End(number_or_nan(discharge["vrr"]), number_or_nan(discharge.get("vrr_error")), nr, True,
+                    f"of the discharge after Nr = {nr:.2f}", f"the discharge after Nr = {nr:.2f}", bound,
+                    _joined((far, cut)), evidence)
 
     def short(self, nr: int, wanted: int) -> str:
         """The ``differs`` clause of a VRR read at ``nr`` instead of ``wanted``."""
@@ -156,23 +245,32 @@ def _run_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
                "windows with k <= Nr < k + 1")
     for name, layout in run.layouts.items():
         label, listing = _label(layout, name), run.listing(layout)
+        end = run.end(name, layout)
         last, last_error, nr, bound = run.vrr(layout, NR_STUDY)
         first, first_error, _, first_bound = run.vrr(layout, 0)
         evidence = f"{listing}; {nr_text}; {run.windows}{tail}"
+        end_evidence = f"{end.evidence}; {evidence}" if end.evidence else evidence
         if int(layout["sublayers"]) == 1:
             batch = float(layout["blue_fraction"])
             other = "" if any(math.isclose(batch, b) for b in STUDY_BATCHES) else (
                 f"batch {batch * 100:g} %, not one of the study's 13, 25, 50 %")
             rows.append(_judged(
-                f"VRR at Nr = {nr} ({label})", case, last, last_error, "-", evidence, dof, run.part("B4"),
-                lambda p: capped(rules.value_in_band(last, last_error, dof, p, tolerances, steady=not bound), bound),
-                differs="; ".join(filter(None, (run.short(nr, NR_STUDY), other)))))
-        if nr >= 1:
-            change = last - first, combine_independent([last_error, first_error])
-            why = "; ".join(filter(None, (first_bound, bound)))
-            rows.append(_judged(f"Change of VRR from Nr = 0 to {nr} ({label})", case, *change, "-", evidence, dof,
-                                "B2.grows", lambda p: capped(rules.sign_of_change(*change, dof, p), why),
-                                differs=run.short(nr, NR_STUDY)))
+                f"VRR {end.where} ({label})", case, end.value, end.error, "-", end_evidence, dof, run.part("B4"),
+                # a VRR at its ceiling is capped with that reason, rather than called not steady
+                lambda p: capped(rules.value_in_band(end.value, end.error, dof, p, tolerances), end.bound),
+                differs=_joined((end.differs, other))))
+            if end.discharge:
+                # the pass at constant head stays, as siloflow's own measurement beside the study's figure
+                rows.append(row(RECIRCULATION_GROUP, f"VRR of the pass {nr} <= Nr < {nr + 1} at constant head, "
+                                f"siloflow's ({label})", case, last, last_error, "-",
+                                _joined((evidence, bound, run.short(nr, NR_STUDY))), dof=dof,
+                                study=CONSTANT_HEAD_STUDY))
+        if end.nr >= 1:
+            change = end.value - first, combine_independent([end.error, first_error])
+            why = _joined((first_bound, end.bound))
+            rows.append(_judged(f"Change of VRR from Nr = 0 to {end.to} ({label})", case, *change, "-", end_evidence,
+                                dof, "B2.grows", lambda p: capped(rules.sign_of_change(*change, dof, p), why),
+                                differs=end.differs))
         if nr > NR_MIDDLE:
             rows.append(_slower(run, layout, label, nr, evidence))
     rows += _batch_rows(run, tolerances, nr_text)
@@ -201,9 +299,9 @@ def _slower(run: _Run, layout: Mapping, label: str, nr: int, evidence: str) -> d
     change = scale * (vn - v2) - (v2 - v0)
     # v2 enters both gains: its error counts with the weight (scale + 1), the two ends' with theirs.
     error = combine_independent([scale * en, (scale + 1.0) * e2, e0])
-    differs = "" if nr == NR_STUDY else (
+    differs = _joined((SLOWER_PASSES, "" if nr == NR_STUDY else (
         f"gain from Nr = {NR_MIDDLE} to {nr} times {scale:g}, not from {NR_MIDDLE} to {NR_STUDY}: "
-        + run.short(nr, NR_STUDY))
+        + run.short(nr, NR_STUDY))))
     why = "; ".join(filter(None, (b0, b2, bn)))
     return _judged(f"VRR gain from Nr = {NR_MIDDLE} to {NR_STUDY} minus gain from 0 to {NR_MIDDLE} ({label})",
                    run.pattern, change, error, "-", evidence, dof, "B2.slower_after_2",
@@ -215,23 +313,25 @@ def _batch_rows(run: _Run, tolerances: AgreementTolerances, nr_text: str) -> lis
     rows, dof, tail = [], run.dof, _tail(run.note)
     small, half = run.layout(0.13, 1), run.layout(0.5, 1)
     if run.suffix == "internal" and small and half:
-        (a, ea, na, ba), (b, eb, nb, bb) = run.vrr(small[1], NR_STUDY), run.vrr(half[1], NR_STUDY)
-        change = b - a, combine_independent([ea, eb])
+        ends = a, b = run.end(*small), run.end(*half)
+        change = b.value - a.value, combine_independent([a.error, b.error])
         rows.append(_judged(
-            f"Change of VRR at Nr = {min(na, nb)} from the 13 % to the 50 % batch", run.pattern, *change, "-",
-            f"13 %: {plus_minus(a, ea)}, 50 %: {plus_minus(b, eb)}; {nr_text}; {run.windows}{tail}", dof,
-            "B3.internal", lambda p: capped(rules.sign_of_change(*change, dof, p), "; ".join(filter(None, (ba, bb)))),
-            differs=run.short(min(na, nb), NR_STUDY)))
+            f"Change of VRR {_where(ends)} from the 13 % to the 50 % batch", run.pattern, *change, "-",
+            _joined((f"13 %: {plus_minus(a.value, a.error)}, 50 %: {plus_minus(b.value, b.error)}",
+                     *(end.evidence for end in ends), nr_text, run.windows)) + tail, dof,
+            "B3.internal", lambda p: capped(rules.sign_of_change(*change, dof, p), _joined(end.bound for end in ends)),
+            differs=_joined(end.differs for end in ends)))
     layers = [run.layout(0.5, n) for n in (5, 3, 1)]
     if all(layers):
-        taken = [run.vrr(layout, NR_STUDY) for _, layout in layers]
-        values, errors = [t[0] for t in taken], [t[1] for t in taken]
-        nr, why = min(t[2] for t in taken), "; ".join(t[3] for t in taken if t[3])
+        taken = [run.end(*layer) for layer in layers]
+        values, errors = [t.value for t in taken], [t.error for t in taken]
+        why = _joined(t.bound for t in taken)
         rows.append(_judged(
-            f"VRR at Nr = {nr} of the 50 % batch in 5, 3 and 1 layers", run.pattern, values[0], errors[0], "-",
+            f"VRR {_where(taken)} of the 50 % batch in 5, 3 and 1 layers", run.pattern, values[0], errors[0], "-",
             "; ".join(f"{n}: {plus_minus(v, e)}" for n, v, e in zip((5, 3, 1), values, errors))
-            + f" (value column: 5 sub-layers); {nr_text}; {run.windows}{tail}", dof, "B6",
-            lambda p: capped(rules.in_order(values, errors, dof, p), why), differs=run.short(nr, NR_STUDY)))
+            + " (value column: 5 sub-layers); " + _joined((*(t.evidence for t in taken), nr_text, run.windows))
+            + tail, dof, "B6", lambda p: capped(rules.in_order(values, errors, dof, p), why),
+            differs=_joined(t.differs for t in taken)))
     return rows
 
 
@@ -277,25 +377,28 @@ def _pattern_rows(internal: _Run, semi: _Run, tolerances: AgreementTolerances) -
     case = f"{internal.pattern} vs {semi.pattern}"
     tail = _tail(f"{internal.pattern}: {internal.note}" if internal.note else "",
                  f"{semi.pattern}: {semi.note}" if semi.note else "")
-    effects, reads = [], []
+    effects, reads, ends = [], [], []
     for run in (internal, semi):
         small, half = run.layout(0.13, 1), run.layout(0.5, 1)
         if small and half:
-            (a, ea, na, ba), (b, eb, nb, bb) = run.vrr(small[1], NR_STUDY), run.vrr(half[1], NR_STUDY)
-            value, error = ratio(a, ea, b, eb)
-            effects.append((value - 1.0, error, min(na, nb), "; ".join(filter(None, (ba, bb))),
-                            run.short(min(na, nb), NR_STUDY) and f"{run.pattern}: {run.short(min(na, nb), NR_STUDY)}"))
-            reads.append(f"{run.pattern}: 13 % {plus_minus(a, ea)} / 50 % {plus_minus(b, eb)} - 1 = "
-                         f"{plus_minus(value - 1.0, error)}")
+            pair = a, b = run.end(*small), run.end(*half)
+            ends += pair
+            value, error = ratio(a.value, a.error, b.value, b.error)
+            differs = _joined(end.differs for end in pair)
+            effects.append((value - 1.0, error, _joined(end.bound for end in pair),
+                            differs and f"{run.pattern}: {differs}"))
+            reads.append(_joined((f"{run.pattern}: 13 % {plus_minus(a.value, a.error)} / 50 % "
+                                  f"{plus_minus(b.value, b.error)} - 1 = {plus_minus(value - 1.0, error)}",
+                                  *(end.evidence for end in pair))))
     if len(effects) == 2:
         values, errors = [e[0] for e in effects], [e[1] for e in effects]
-        nr, why = min(e[2] for e in effects), "; ".join(e[3] for e in effects if e[3])
-        rows.append(row(RECIRCULATION_GROUP, f"Batch effect VRR(13 %) / VRR(50 %) - 1 at Nr = {nr}, internal vs "
+        why = _joined(e[2] for e in effects)
+        rows.append(row(RECIRCULATION_GROUP, f"Batch effect VRR(13 %) / VRR(50 %) - 1 {_where(ends)}, internal vs "
                                              "semi-mass flow", case, values[0], errors[0], "-",
                         "; ".join(reads) + f" (value column: internal flow){tail}", dof=dof,
                         finding="B3.stronger_in_internal",
                         agreement=capped(rules.in_order(values, errors, dof, PARTS["B3.stronger_in_internal"]), why),
-                        differs="; ".join(e[4] for e in effects if e[4])))
+                        differs=_joined(e[3] for e in effects)))
     for name, layout in internal.layouts.items():
         if int(layout["sublayers"]) != 1:
             continue
@@ -314,7 +417,9 @@ def _pattern_rows(internal: _Run, semi: _Run, tolerances: AgreementTolerances) -
 
 
 def recirculation_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> list[dict]:
-    """The rows of the recirculating silo: per run B4 (VRR at Nr = 4 per batch), B2 (its growth, per layout),
+    """The rows of the recirculating silo: per run B4 (VRR at the end of 4 recirculations per batch: of the final
+    discharge when the run has one, with the last pass at constant head beside it as a row with no finding, else of
+    the pass at Nr = 4), B2 (its growth, per layout),
     B3.internal, B6, B7 (theta of the RTD's peak), B8 (t_s / t_d) and B1 (drop of bulk density); with both flow
     patterns, B3.stronger_in_internal and B5 (VRR at Nr = 0, internal over semi-mass flow, per batch).
 

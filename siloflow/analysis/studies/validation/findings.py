@@ -310,8 +310,10 @@ FINDINGS: tuple[Finding, ...] = (
                value=0.045, tolerance=_NO_BAND),
         _value("B1.internal", "drop of bulk density while recirculating, 1 - flowing / filling, internal flow",
                value=0.13, tolerance=_NO_BAND))),
-    # B2-B6: which discharge the study's VRR comes from (a falling-head discharge or a pass of the recirculating
-    # run) is unclear in the text (§6.4.2, §6.6.2).
+    # B2-B6: the study's VRR "at the end of Nr recirculations" is read from the outflow of the discharge after Nr
+    # recirculations (Fig. 6.9, §6.4.2); whether that discharge had a falling head is not stated (§6.6.2). The rows
+    # take the discharge after the recirculations where a run has one (silo_recirculation.final_discharge) and say
+    # so in ``differs`` where they fall back on a pass at constant head.
     Finding("B2", 6, "§6.4.2", DEM, "The VRR grows with the number of recirculations, more slowly after 2.", (
         _sign("B2.grows", "change of VRR from Nr = 0 to 4; one row per flow pattern and batch", +1),
         _sign("B2.slower_after_2", "VRR gain from Nr = 2 to 4 minus the gain from Nr = 0 to 2; one row per flow "

@@ -25,7 +25,9 @@ ROW_CODE = ("siloflow.analysis.studies.validation.rows", "siloflow.analysis.stud
             "siloflow.analysis.studies.validation.calibration", "siloflow.analysis.studies.validation.silo",
             "siloflow.analysis.studies.validation.blending", "siloflow.analysis.studies.validation.blender",
             "siloflow.analysis.studies.validation.group_rows",
-            "siloflow.analysis.numerics.reference_spread")
+            "siloflow.analysis.numerics.reference_spread",
+            # the averaging window's sources the silo's rows compare fields.json with
+            "siloflow.analysis.studies.silo_flat.field_clock")
 
 #: The finding parts the groups' rows can make, and those they cannot, each with what would make it.
 MADE = (*calibration.MADE, *silo.MADE, *blending.MADE, *blender.MADE)

@@ -11,7 +11,10 @@ Rows (see :mod:`siloflow.analysis.studies.validation.rows`):
   centreline vertical velocity, from front/back friction 0 to the highest run).
 
 A settled fill that does not carry its weight (the force balance of the physical fill) is not steady: its stress
-and density rows can then be "not resolved" at most. Inputs are the run's files as read: ``case.json``,
+and density rows can then be "not resolved" at most. The rows of the time-averaged fields (B, the flow channel, the
+flow-pattern index) say in ``differs`` when their averaging window is not the study's 0.5-0.7 s after the outlet
+opened (:func:`window_clause`, §5.4.3.4, §5.5.2) and when B's heights are not the study's profile heights
+(:func:`heights_clause`, §5.4.3.4). Inputs are the run's files as read: ``case.json``,
 ``flow.json``, ``fields.json``, ``fill_balance.json`` and the rows of ``janssen.csv``, ``kinematic.csv`` and
 ``flow_channel_boundary.csv``.
 """
@@ -26,12 +29,14 @@ import numpy as np
 
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.uncertainty import combine_independent, line_slope
+from siloflow.analysis.studies.silo_flat.field_clock import WINDOW_CONFIGURED, WINDOW_STEADY
 from siloflow.analysis.studies.validation import agreement as rules
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, row
 
-__all__ = ["SiloRun", "silo_rows", "front_wall_series_rows", "stress_gradient", "MADE", "UNMADE"]
+__all__ = ["SiloRun", "silo_rows", "front_wall_series_rows", "stress_gradient", "window_clause", "heights_clause",
+           "STUDY_WINDOW", "STUDY_HEIGHTS", "MADE", "UNMADE"]
 
 GROUP = "Flat-bottom silo"
 SERIES_GROUP = "Front-wall friction series"
@@ -50,6 +55,13 @@ UNMADE = MappingProxyType({
     "S6.uniform_velocity": "needs the velocity across the width at Z = 120 mm of the frictionless front/back run; "
                            "the series keeps no field of its runs and the tier's fill ends below 120 mm",
 })
+#: The study's averaging window of the steady profiles, B and the flow channel, after the outlet opened (s; §5.4.3.4,
+#: and §5.5.2 for the front-wall friction series).
+STUDY_WINDOW = (0.5, 0.7)
+#: The study's heights of the steady velocity profiles above the outlet (m; §5.4.3.4).
+STUDY_HEIGHTS = (0.02, 0.04, 0.08, 0.12)
+#: Two times or heights closer than this are the same (s or m): config values and their JSON round trip.
+_SAME = 1e-9
 #: The share of the Janssen profile's points, from either end, over which a stress gradient is fitted: the study
 #: says "near the surface" and "saturates" with no depths, so the shallowest and deepest thirds are taken.
 GRADIENT_SHARE = 1.0 / 3.0
@@ -74,6 +86,67 @@ class SiloRun:
         problems = list(self.balance.get("problems") or [])
         text = f"the settled fill's walls and floor carry {float(self.balance['support_ratio']):.4f} of its weight"
         return not problems, text + (f" ({'; '.join(problems)})" if problems else "")
+
+
+def _millimetres(heights: Sequence[float]) -> str:
+    return ", ".join(f"{height * 1000:.0f}" for height in heights)
+
+
+def window_clause(fields: Mapping, flow: Mapping, what: str = "profiles", section: str = "§5.4.3.4") -> str:
+    """The ``differs`` clause of a figure of the run's time-averaged fields: "" when they were averaged over the
+    study's 0.5-0.7 s after the outlet opened (:data:`STUDY_WINDOW`, §5.4.3.4), else how they were.
+
+    Parameters
+    ----------
+    fields : mapping
+        The run's ``fields.json``: ``average_window_s`` ([start, end], s after opening) and ``average_window_source``
+        (:data:`~siloflow.analysis.studies.silo_flat.field_clock.WINDOW_CONFIGURED` or ``WINDOW_STEADY``); a summary
+        written before the source was recorded is taken for the steady window where its times are the flow's.
+    flow : mapping
+        The run's ``flow.json``: ``steady_window`` (the discharged-mass fractions) and ``steady_window_start_s``,
+        ``steady_window_end_s`` (their times, s).
+    what : str
+        What was averaged, the clause's subject.
+    section : str
+        The thesis section that states the study's window for this figure.
+
+    Returns
+    -------
+    str
+        E.g. ``"profiles averaged over the discharged-mass window 0.2-0.8 (t = 0.31-1.2 s), not the study's 0.5-0.7 s
+        (§5.4.3.4)"``; a summary without ``average_window_s`` says that the window is not recorded.
+    """
+    study = f"not the study's {STUDY_WINDOW[0]:g}-{STUDY_WINDOW[1]:g} s ({section})"
+    window = fields.get("average_window_s")
+    if not window or len(window) != 2:
+        return f"{what} averaged over a window fields.json does not record, {study}"
+    start, end = float(window[0]), float(window[1])
+    if abs(start - STUDY_WINDOW[0]) <= _SAME and abs(end - STUDY_WINDOW[1]) <= _SAME:
+        return ""
+    source = fields.get("average_window_source")
+    if source is None:
+        steady = (number_or_nan(flow.get("steady_window_start_s")), number_or_nan(flow.get("steady_window_end_s")))
+        same = abs(start - steady[0]) <= _SAME and abs(end - steady[1]) <= _SAME
+        source = WINDOW_STEADY if same else WINDOW_CONFIGURED
+    fractions = flow.get("steady_window")
+    if source == WINDOW_STEADY and fractions and len(fractions) == 2:
+        return (f"{what} averaged over the discharged-mass window {float(fractions[0]):g}-{float(fractions[1]):g} "
+                f"(t = {start:.3g}-{end:.3g} s), {study}")
+    return f"{what} averaged over t = {start:.3g}-{end:.3g} s after opening, {study}"
+
+
+def heights_clause(heights: Sequence[float], what: str = "at") -> str:
+    """The ``differs`` clause of a figure taken at ``heights`` above the outlet (m): "" when they are the study's
+    profile heights 20, 40, 80 and 120 mm (:data:`STUDY_HEIGHTS`, §5.4.3.4), else e.g. ``"at 20, 40, 60 mm, not the
+    study's 20, 40, 80, 120 mm (§5.4.3.4)"`` (``what`` opens it)."""
+    ordered = sorted(float(height) for height in heights)
+    if len(ordered) == len(STUDY_HEIGHTS) and all(abs(a - b) <= _SAME for a, b in zip(ordered, STUDY_HEIGHTS)):
+        return ""
+    return f"{what} {_millimetres(ordered)} mm, not the study's {_millimetres(STUDY_HEIGHTS)} mm (§5.4.3.4)"
+
+
+def _joined(*clauses: str) -> str:
+    return "; ".join(clause for clause in clauses if clause)
 
 
 def _column(entries: Sequence[Mapping], key: str) -> np.ndarray:
@@ -199,7 +272,8 @@ def _janssen_rows(run: SiloRun, case_name: str, settled: bool, settled_text: str
 
 
 def _b_rows(run: SiloRun, case_name: str, tolerances: AgreementTolerances, dof: float | None, tail: str) -> list[dict]:
-    """S5.dem: B at the highest fitted height minus B at the lowest."""
+    """S5.dem: B at the highest fitted height minus B at the lowest (§5.4.3.4: each B fitted to the steady profile
+    averaged over 0.5-0.7 s)."""
     fitted = sorted((entry for entry in run.kinematic if math.isfinite(number_or_nan(entry["B_m"]))),
                     key=lambda entry: float(entry["z_m"]))
     if len(fitted) < 2:
@@ -209,18 +283,22 @@ def _b_rows(run: SiloRun, case_name: str, tolerances: AgreementTolerances, dof: 
               combine_independent([number_or_nan(high.get("B_m_error")), number_or_nan(low.get("B_m_error"))]))
     listing = "; ".join(f"z {float(entry['z_m']) * 1000:.0f} mm: B {plus_minus(float(entry['B_m']) * 1000, number_or_nan(entry.get('B_m_error')) * 1000)} mm "
                         f"({int(float(entry['batches']))} time batches)" for entry in fitted)
+    differs = _joined(window_clause(run.fields, run.flow),
+                      heights_clause([float(entry["z_m"]) for entry in fitted], "B fitted at"))
     return [row(GROUP, f"Change of the kinematic constant B, z = {float(high['z_m']) * 1000:.0f} - "
                        f"{float(low['z_m']) * 1000:.0f} mm", case_name, *change, "m",
                 f"{listing}; particle diameter {run.diameter * 1000:.2f} mm{tail}", dof=dof, finding="S5.dem",
-                agreement=rules.sign_of_change(*change, dof, PARTS["S5.dem"]))]
+                agreement=rules.sign_of_change(*change, dof, PARTS["S5.dem"]), differs=differs)]
 
 
 def _channel_rows(run: SiloRun, case_name: str, dof: float | None, tail: str) -> list[dict]:
-    """Half-width of the flow channel at the largest boundary fraction, per height: a measurement."""
+    """Half-width of the flow channel at the largest boundary fraction, per height: a measurement (§5.4.3.5, of the
+    velocities time-averaged as the profiles are)."""
     if not run.boundary:
         return []
     fraction = max(float(entry["fraction"]) for entry in run.boundary)
     half_silo = 0.5 * float(run.case["width_m"])
+    differs = window_clause(run.fields, run.flow, "velocities")
     rows = []
     for entry in run.boundary:
         if float(entry["fraction"]) != fraction:
@@ -233,7 +311,7 @@ def _channel_rows(run: SiloRun, case_name: str, dof: float | None, tail: str) ->
                                f"{float(entry['z_m']) * 1000:.0f} mm", case_name, half, error, "m",
                         f"the silo's half-width is {half_silo * 1000:.0f} mm: narrower "
                         f"{resolution(half_silo - half, error, dof)}{tail}", dof=dof,
-                        study="funnel flow: narrower than the silo (§5.4.3)"))
+                        study="funnel flow: narrower than the silo (§5.4.3.5)", differs=differs))
     return rows
 
 
@@ -266,7 +344,8 @@ def front_wall_series_rows(series: Sequence[tuple[str, SiloRun, str]], height: f
                         index, error, "-",
                         f"run {run.case['run_id']}, flow rate "
                         f"{plus_minus(run.flow['mass_flow_rate_kg_s'], number_or_nan(run.flow.get('mass_flow_rate_kg_s_error')))}"
-                        f" kg/s; {note}", dof=dof, study="-"))
+                        f" kg/s; {note}", dof=dof, study="-",
+                        differs=window_clause(run.fields, run.flow, "velocities", "§5.5.2")))
         if label.startswith("mu_fw="):
             walled.append((float(label.split("=", 1)[1]), index, error, at, run, note))
     walled.sort(key=lambda entry: entry[0])
@@ -276,6 +355,9 @@ def front_wall_series_rows(series: Sequence[tuple[str, SiloRun, str]], height: f
         differs = [f"at z = {at * 1000:.0f} mm, not {S6_HEIGHT * 1000:.0f} mm"] if abs(at - S6_HEIGHT) > 1e-9 else []
         if (low, high) != (0.0, 1.0):
             differs.append(f"front/back friction {low:g} to {high:g}, not 0 to 1")
+        # the study's profiles of the series are averaged over 0.5-0.7 s too (§5.5.2); each run says its own window
+        differs += list(dict.fromkeys(filter(None, (window_clause(run.fields, run.flow, "velocities", "§5.5.2")
+                                                    for run in (walled[0][4], walled[-1][4])))))
         rows.append(row(SERIES_GROUP, f"Change of the flow-pattern index, front-wall friction {high:g} - {low:g}",
                         "series", *change, "-", f"{low:g}: {note_low}; {high:g}: {note_high}", dof=dof,
                         finding="S6.towards_internal_flow", differs="; ".join(differs),
