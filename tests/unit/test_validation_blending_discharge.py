@@ -8,21 +8,10 @@ import pytest
 
 from siloflow.analysis.numerics.reference_spread import combine_seeds
 from siloflow.analysis.studies.validation import blending
-from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, NOT_RESOLVED, REPRODUCED, AgreementTolerances
+from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, NOT_RESOLVED, REPRODUCED
 from siloflow.analysis.studies.validation.blending import recirculation_rows
 from siloflow.analysis.studies.validation.rows import NO_FINDING
-
-TOLERANCES = AgreementTolerances()
-
-
-def _rows(rows, finding):
-    return [entry for entry in rows if entry["finding"] == finding]
-
-
-def _one(rows, finding, text=""):
-    found = [entry for entry in _rows(rows, finding) if text in entry["figure"]]
-    assert len(found) == 1, [entry["figure"] for entry in _rows(rows, finding)]
-    return found[0]
+from tests.unit.test_validation_blending import TOLERANCES, _one, _rows
 
 
 def _layout(fraction, sublayers, vrr, relative=0.01):
