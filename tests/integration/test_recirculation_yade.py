@@ -25,6 +25,7 @@ MICRO_RECIRCULATION = {
     "channel_length": 0.03,
     "feeder_velocity": 0.2,
     "recirculations": 0.6,   # about 0.3 s: t_res = W H / (B0 V r) = 0.5 s
+    "final_discharge": 0.3,  # then 0.15 s of the discharge after the recirculations
     "dump_interval": 0.01,
     "fill": FAST_POUR,
     "settle": TINY_SETTLE,
@@ -45,7 +46,22 @@ def test_the_run_recirculates_without_losing_a_clump(run):
     assert record.stage("recirculate")["clumps"] == record.n_clumps == record.stage("fill")["clumps"]
     assert record.domain_z == [-case.channel_length, case.silo.domain_top]
     frames = engine.read_frames(run_dir, record)
-    assert all(len(np.unique(frame.clump_id)) == record.n_clumps for frame in frames)
+    stop = record.open_step + case.recirculation_steps
+    assert all(len(np.unique(frame.clump_id)) == record.n_clumps for frame in frames if frame.step <= stop)
+
+
+def test_the_discharge_after_the_recirculations_lets_the_clumps_go(run):
+    """After the re-entry stops a clump leaving the channel bottom is gone: fewer clumps at the end, none re-entered."""
+    case, engine, run_dir, record = run
+    assert record.stage("recirculate")["step"] >= record.open_step + case.recirculation_steps
+    assert record.stage("discharge")["clumps"] < record.n_clumps
+    frames = [clumps_from_frame(frame) for frame in engine.read_frames(run_dir, record)
+              if frame.step > record.open_step + case.recirculation_steps + 10]
+    assert len(frames) >= 2 and len(frames[-1].clump_id) < len(frames[0].clump_id)
+    assert set(frames[-1].clump_id) <= set(frames[0].clump_id)
+    for before, after in zip(frames, frames[1:]):
+        common, i, j = np.intersect1d(before.clump_id, after.clump_id, return_indices=True)
+        assert not np.any(after.position[j, 2] - before.position[i, 2] > 0.5 * case.silo.domain_top)
 
 
 def test_the_feeder_holds_the_channels_lower_half_at_the_feeder_velocity(run):
@@ -66,7 +82,8 @@ def test_the_feeder_holds_the_channels_lower_half_at_the_feeder_velocity(run):
 
 def test_clumps_leaving_the_channel_bottom_reenter_at_the_top(run):
     case, engine, run_dir, record = run
-    frames = [clumps_from_frame(frame) for frame in engine.read_frames(run_dir, record) if frame.step > record.open_step]
+    frames = [clumps_from_frame(frame) for frame in engine.read_frames(run_dir, record)
+              if record.open_step < frame.step <= record.open_step + case.recirculation_steps]
     reentered = 0
     for before, after in zip(frames, frames[1:]):
         common, i, j = np.intersect1d(before.clump_id, after.clump_id, return_indices=True)

@@ -46,8 +46,9 @@ CONFIG = {
 BLENDING_ONLY = {**CONFIG, "silo_recirculation": {**TINY_BLENDING,
                                                   "verification": {**TINY_BLENDING["verification"], "enabled": False}}}
 #: the fast tier's run: the same on one rank (the run on 2 ranks, the domain split along the periodic direction, is
-#: the physics tier's study-step run below)
-ONE_RANK = {**BLENDING_ONLY, "engine": {"mpi_ranks": 1}}
+#: the physics tier's study-step run below), with the discharge after its recirculations
+ONE_RANK = {**BLENDING_ONLY, "engine": {"mpi_ranks": 1},
+            "silo_recirculation": {**BLENDING_ONLY["silo_recirculation"], "final_discharge": 0.6}}
 
 
 def _blending(workdir, config: dict):
@@ -107,14 +108,34 @@ def test_clump_count_is_conserved_over_more_than_one_recirculation(blending_pipe
     tracks = loaded.tracks
     record = read_run_record(runs["blending"] / "run.json")
     assert record.mpi_ranks == 1
-    # Every clump is in every dump, with its id: none lost or duplicated at the periodic boundary.
+    # Every clump is in every dump of the recirculation, with its id: none lost or duplicated at the periodic boundary.
     assert tracks.n_clumps == case["n_clumps"] == int(record.stage("recirculate")["clumps"])
-    assert tracks.present.all()
+    recirculating = tracks.until(tracks.times[0] + case["recirculation_time_s"])
+    assert recirculating.present.all()
     summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
     assert summary["recirculations"] >= 1.0
     events = recirculation_events(tracks, 0.0, *case["domain_z"])
     # More outlet crossings than clumps in the silo: the whole content has passed at least once on average.
     assert events.exit_times_all.size > summary["holdup_clumps"]
+
+
+def test_the_discharge_after_the_recirculations_empties_the_silo_and_gives_its_vrr(blending_pipeline):
+    """After the re-entry stops the clumps leaving the channel are gone, down to the stagnant zones; the outflow of
+    that discharge gives a VRR per layout (§6.4.2), and the recirculation's figures are of the part before it."""
+    _, runs, _ = blending_pipeline
+    loaded, case = _tracks_and_case(runs["blending"])
+    record = read_run_record(runs["blending"] / "run.json")
+    left = int(record.stage("discharge")["clumps"])
+    assert 0 < left < case["n_clumps"] and not loaded.tracks.present[-1].all()
+    summary = json.loads((runs["blending"] / "metrics" / "blending.json").read_text())
+    discharge = summary["final_discharge"]
+    assert discharge["start_s"] == pytest.approx(loaded.tracks.times[0] + case["recirculation_time_s"], abs=1e-9)
+    assert discharge["recirculations"] == pytest.approx(summary["recirculations"], rel=0.05)
+    # LIGGGHTS shows a clump whose sphere the fixed bottom took once at the top of the domain, then never again: a
+    # "re-entry" of one frame, rare, and no crossing of the outlet
+    assert discharge["crossings"] > 0 and discharge["reentries"] <= 0.02 * discharge["crossings"]
+    for name, layout in discharge["layouts"].items():
+        assert layout["windows"] >= 2 and layout["vrr"] > 0 and layout["vrr_error"] > 0, name
 
 
 def test_clumps_re_enter_at_the_top_and_fall_onto_the_pile(blending_pipeline):

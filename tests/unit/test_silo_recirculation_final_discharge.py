@@ -83,7 +83,7 @@ def discharge(whole, result):
 # --------------------------------------------------------------------------- the cut of the tracks
 
 
-def test_until_keeps_exactly_the_frames_at_or_before_the_time_and_every_clump():
+def test_until_keeps_exactly_the_frames_at_or_before_the_time_and_every_clump_seen_in_them():
     tracks = clump_tracks([0.0, 0.1, 0.2, 0.3], [[4, 9], [4, 9], [9], [4, 9]],
                           [[[0, 0, 0.4], [1, 0, 0.3]], [[0, 0, 0.3], [1, 0, 0.2]], [[1, 0, 0.1]],
                            [[0, 0, 0.1], [1, 0, 0.0]]])
@@ -102,6 +102,26 @@ def test_until_keeps_exactly_the_frames_at_or_before_the_time_and_every_clump():
         tracks.until(0.05)
     with pytest.raises(ValueError, match="t_last must be a finite number"):
         tracks.until(math.nan)
+
+
+def test_until_leaves_out_a_clump_first_seen_after_the_time():
+    """Clump 12 appears at 0.2 s (what LIGGGHTS leaves of a clump whose sphere a fixed boundary took gets a new id):
+    cut at 0.1 s it is no column, nor its velocity or mass."""
+    tracks = clump_tracks([0.0, 0.1, 0.2], [[4, 9], [4, 9], [9, 12]],
+                          [[[0, 0, 0.4], [1, 0, 0.3]], [[0, 0, 0.3], [1, 0, 0.2]], [[1, 0, 0.1], [0, 0, -0.1]]])
+    assert tracks.clump_id.tolist() == [4, 9, 12]
+    cut = tracks.until(0.1)
+    assert cut.clump_id.tolist() == [4, 9] and np.all(np.isfinite(cut.position))
+    velocity = np.arange(3 * 3 * 3, dtype=float).reshape(3, 3, 3)
+    kept = TrackedClumps(tracks=tracks, velocity=velocity, mass=np.array([1.0, 2.0, 3.0])).until(0.1)
+    assert kept.mass.tolist() == [1.0, 2.0]
+    np.testing.assert_array_equal(kept.velocity, velocity[:2, :2])
+    # the whole run of the part's clumps, in the part's order
+    whole = tracks.of_clumps(cut.clump_id[::-1])
+    assert whole.clump_id.tolist() == [9, 4] and whole.times.tolist() == [0.0, 0.1, 0.2]
+    np.testing.assert_array_equal(whole.position, tracks.position[:, [1, 0]])
+    with pytest.raises(ValueError, match=r"clump ids \[5\] are not clumps of the tracks"):
+        tracks.of_clumps([4, 5])
 
 
 def test_the_recirculating_part_is_the_frames_up_to_the_stop_of_the_re_entry(whole, result):

@@ -64,7 +64,9 @@ class ClumpTracks:
         return self.position[:, :, 2]
 
     def until(self, t_last: float) -> ClumpTracks:
-        """The frames at or before ``t_last`` [s], every clump column kept (:func:`frames_until`).
+        """The frames at or before ``t_last`` [s] (:func:`frames_until`) and the clumps seen in them: a clump that
+        first appears later (LIGGGHTS gives what is left of a clump a fixed boundary took a sphere from a new id)
+        is no part of the run before ``t_last``.
 
         Examples
         --------
@@ -72,9 +74,41 @@ class ClumpTracks:
         >>> tracks.until(0.1).times.tolist(), tracks.until(0.1).z.tolist()
         ([0.0, 0.1], [[0.3], [0.2]])
         """
+        keep, seen = self._kept(t_last)
+        return ClumpTracks(times=np.asarray(self.times)[:keep], clump_id=np.asarray(self.clump_id)[seen],
+                           position=np.asarray(self.position)[:keep][:, seen])
+
+    def of_clumps(self, clump_id) -> ClumpTracks:
+        """The columns of the clumps ``clump_id`` [-], in that order: the whole run's tracks of the clumps a part of it
+        (:meth:`until`) holds.
+
+        Raises
+        ------
+        ValueError
+            If an id is not a clump of the tracks.
+
+        Examples
+        --------
+        >>> tracks = clump_tracks([0.0, 0.1], [[7, 3], [7, 3, 5]], [[[0, 0, 0.3], [1, 0, 0.2]],
+        ...                                                        [[0, 0, 0.2], [1, 0, 0.1], [2, 0, -0.1]]])
+        >>> tracks.of_clumps([7, 3]).clump_id.tolist(), tracks.of_clumps([7, 3]).z.tolist()
+        ([7, 3], [[0.3, 0.2], [0.2, 0.1]])
+        """
+        ids = np.asarray(self.clump_id)
+        wanted = np.asarray(clump_id, dtype=ids.dtype)
+        order = np.argsort(ids, kind="stable")
+        at = np.searchsorted(ids, wanted, sorter=order)
+        found = at < ids.size
+        found[found] = ids[order[at[found]]] == wanted[found]
+        if not found.all():
+            raise ValueError(f"clump ids {wanted[~found][:5].tolist()} are not clumps of the tracks")
+        columns = order[at]
+        return ClumpTracks(times=self.times, clump_id=ids[columns], position=np.asarray(self.position)[:, columns])
+
+    def _kept(self, t_last: float) -> tuple[int, np.ndarray]:
+        """The frames :meth:`until` keeps and the mask of the clump columns present in at least one of them."""
         keep = frames_until(self.times, t_last)
-        return ClumpTracks(times=np.asarray(self.times)[:keep], clump_id=self.clump_id,
-                           position=np.asarray(self.position)[:keep])
+        return keep, np.isfinite(np.asarray(self.position)[:keep, :, 2]).any(axis=0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,11 +130,11 @@ class TrackedClumps:
     mass: np.ndarray
 
     def until(self, t_last: float) -> TrackedClumps:
-        """The frames at or before ``t_last`` [s], tracks and velocities alike, every clump and its mass kept
-        (:func:`frames_until`)."""
-        keep = frames_until(self.tracks.times, t_last)
-        return TrackedClumps(tracks=self.tracks.until(t_last), velocity=np.asarray(self.velocity)[:keep],
-                             mass=self.mass)
+        """The frames at or before ``t_last`` [s] and the clumps seen in them (:meth:`ClumpTracks.until`), tracks,
+        velocities and masses alike."""
+        keep, seen = self.tracks._kept(t_last)
+        return TrackedClumps(tracks=self.tracks.until(t_last), velocity=np.asarray(self.velocity)[:keep][:, seen],
+                             mass=np.asarray(self.mass)[seen])
 
 
 def frames_until(times, t_last: float) -> int:

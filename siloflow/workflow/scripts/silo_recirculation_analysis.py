@@ -82,7 +82,10 @@ with logged_to(snakemake.log[0]) as log:
     )
     log.info("bulk density in the slab %s m: settled %.1f, flowing %.1f +- %.2g kg/m3, drop %.4f +- %.2g",
              density.slab, density.settled, density.flowing, density.flowing_error, density.drop, density.drop_error)
-    discharge = None if t_stop is None else final_discharge(whole.tracks, result, t_stop, bottom, top)
+    # the whole run's tracks of the recirculating part's clumps: LIGGGHTS gives what the fixed boundary leaves of a
+    # clump a new id, below the outlet already
+    discharge = None if t_stop is None else final_discharge(whole.tracks.of_clumps(tracks.clump_id), result, t_stop,
+                                                            bottom, top)
     if discharge is not None:
         used = discharge.windows
         log.info("discharge after Nr = %.2f from t = %.4g s: %d windows (%d clumps) to %.4g s (%s), %.1f %% of its "
