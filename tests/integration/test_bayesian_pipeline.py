@@ -1,7 +1,7 @@
 """The joint Bayesian calibration with the real engines, tiny: one target (the internal angle), two parameters
 (particle sliding and rolling friction), single spheres in a 40 mm cell; a first design of three sets with one
-replicate, one further iteration of one set, one posterior draw run for the predictive check, on LIGGGHTS and on
-YADE, as a twin experiment (the targets are each engine's own mean angle of two runs at known parameters). The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
+replicate, one further iteration of one set, one posterior draw run for the predictive check, on LIGGGHTS (and, in
+the physics tier, on LIGGGHTS and YADE side by side), as a twin experiment (the targets are each engine's own mean angle of two runs at known parameters). The numerics are tested on exact answers in tests/unit/test_bayes_*.py; this checks that the runs, the
 iterations, the posterior and the report come out of `snakemake bayesian_calibration`, that the seed noise is measured
 from the replicate, and that both engines give a posterior; then that a small silo on LIGGGHTS runs at the posterior
 mean and at the posterior draw (``silo_flat.posterior_draws``).
@@ -18,7 +18,7 @@ import yaml
 
 from tests.conftest import NO_BLENDER, NO_BLENDING, NO_VERIFICATION, SMALL_SILO, TINY_JENIKE_SWEEP, require_liggghts, require_yade, run_snakemake
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(280)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(170)]
 
 TINY_BAYESIAN = {
     "jenike": {**TINY_JENIKE_SWEEP, "sweep": {**TINY_JENIKE_SWEEP["sweep"], "shapes": ["sphere"]}},
@@ -39,21 +39,39 @@ TINY_BAYESIAN = {
 }
 
 
-@pytest.fixture(scope="module")
-def calibrated(tmp_path_factory):
+#: the fast tier's calibration: LIGGGHTS alone (YADE's Jenike runs, the same orchestration on the other engine, are
+#: the physics tier's, with both engines side by side; test_jenike_yade.py runs a YADE shear test in the fast tier)
+ON_LIGGGHTS = {**TINY_BAYESIAN, "calibration": {**TINY_BAYESIAN["calibration"], "bayesian": {
+    **TINY_BAYESIAN["calibration"]["bayesian"], "engines": ["liggghts"]}}}
+
+
+def _calibrate(tmp_path_factory, config: dict):
     require_liggghts()
-    require_yade()
+    if "yade" in config["calibration"]["bayesian"]["engines"]:
+        require_yade()
     workdir = tmp_path_factory.mktemp("bayesian")
     config_path = workdir / "bayesian.yaml"
-    config_path.write_text(yaml.safe_dump(TINY_BAYESIAN))
+    config_path.write_text(yaml.safe_dump(config))
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path), targets=("bayesian_calibration",))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     return workdir / "results" / "calibration" / "bayesian"
 
 
-@pytest.mark.parametrize("engine", ["liggghts", "yade"])
-def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(calibrated, engine):
-    folder = calibrated / engine
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    """The calibration on LIGGGHTS alone; yields its results folder."""
+    return _calibrate(tmp_path_factory, ON_LIGGGHTS)
+
+
+@pytest.fixture(scope="module")
+def calibrated_on_both(tmp_path_factory):
+    """The calibration on LIGGGHTS and YADE (the physics tier); yields its results folder."""
+    return _calibrate(tmp_path_factory, TINY_BAYESIAN)
+
+
+@pytest.mark.parametrize("engine", ["liggghts", pytest.param("yade", marks=pytest.mark.physics)])
+def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(request, engine):
+    folder = request.getfixturevalue("calibrated" if engine == "liggghts" else "calibrated_on_both") / engine
     first = json.loads((folder / "iteration_0" / "design.json").read_text())
     assert len(first["sets"]) == 4 and [s["replicate"] for s in first["sets"]] == [0, 0, 0, 1]
     assert first["sets"][3]["theta"] == first["sets"][0]["theta"]
@@ -87,8 +105,9 @@ def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(calibrated, eng
     assert 1 <= len(ridge) <= 7 and all(float(row["predicted_internal_deg"]) > 0 for row in ridge)
 
 
-def test_the_engines_posteriors_stand_side_by_side(calibrated):
-    with open(calibrated / "engines.csv", newline="") as handle:
+@pytest.mark.physics
+def test_the_engines_posteriors_stand_side_by_side(calibrated_on_both):
+    with open(calibrated_on_both / "engines.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert {row["parameter"] for row in rows} >= {"sliding_friction", "rolling_friction"}
 
@@ -96,8 +115,8 @@ def test_the_engines_posteriors_stand_side_by_side(calibrated):
 def test_the_silo_runs_at_the_posterior_mean_and_at_each_draw(calibrated):
     workdir = calibrated.parents[2]
     config_path = workdir / "silo_draws.yaml"
-    config_path.write_text(yaml.safe_dump({**TINY_BAYESIAN, "silo_flat": {**SMALL_SILO, "parameters": "bayesian",
-                                                                          "posterior_draws": True}}))
+    config_path.write_text(yaml.safe_dump({**ON_LIGGGHTS, "silo_flat": {**SMALL_SILO, "parameters": "bayesian",
+                                                                         "posterior_draws": True}}))
     summary_path = workdir / "results" / "silo_flat" / "posterior_draws" / "summary.json"
     result = run_snakemake(workdir, "--cores", "2", "--configfile", str(config_path),
                            targets=(str(summary_path.relative_to(workdir)),))

@@ -262,9 +262,8 @@ def _run_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
             if end.discharge:
                 # the pass at constant head stays, as siloflow's own measurement beside the study's figure
                 rows.append(row(RECIRCULATION_GROUP, f"VRR of the pass {nr} <= Nr < {nr + 1} at constant head, "
-                                f"siloflow's ({label})", case, last, last_error, "-",
-                                _joined((evidence, bound, run.short(nr, NR_STUDY))), dof=dof,
-                                study=CONSTANT_HEAD_STUDY))
+                                f"siloflow's ({label})", case, last, last_error, "-", _joined((bound, evidence)),
+                                dof=dof, study=CONSTANT_HEAD_STUDY, differs=run.short(nr, NR_STUDY)))
         if end.nr >= 1:
             change = end.value - first, combine_independent([end.error, first_error])
             why = _joined((first_bound, end.bound))
