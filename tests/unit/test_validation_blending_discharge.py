@@ -11,25 +11,15 @@ from siloflow.analysis.studies.validation import blending
 from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, NOT_RESOLVED, REPRODUCED
 from siloflow.analysis.studies.validation.blending import recirculation_rows
 from siloflow.analysis.studies.validation.rows import NO_FINDING
-from tests.unit.test_validation_blending import TOLERANCES, _one, _rows
-
-
-def _layout(fraction, sublayers, vrr, relative=0.01):
-    return {"blue_fraction": fraction, "sublayers": sublayers, "vrr_by_recirculation": list(vrr),
-            "vrr_by_recirculation_error": [relative * v for v in vrr], "vrr_at_ceiling": [False] * len(vrr)}
+# _internal: the passes at constant head, entry 4 is 12, 10, 3 for the single layers
+from tests.unit.test_validation_blending import TOLERANCES, _internal, _layout, _one, _rows
+from tests.unit.test_validation_blending import _summary as _blending_summary
 
 
 def _summary(pattern, layouts, discharge=None, recirculations=6.1):
-    summary = {
-        "flow_pattern": pattern, "clumps_per_window": 400.0, "vrr_sampling_limit": 400.0, "vrr_ceiling_factor": 2.0,
-        "recirculations": recirculations, "residence_time_s": 2.0, "residence_time_s_error": 0.02,
-        "rtd_particle_ids": {"t_mean_s": 1.6, "t_mean_s_error": 0.05, "n_tracer": 200, "fraction_exited": 1.0,
-                             "t_s": 0.8, "t_s_error": 0.01, "t_d": 2.0, "t_d_error": 0.02, "t_s_over_t_d": 0.4,
-                             "t_s_over_t_d_error": 0.01},
-        "layouts": layouts}
-    if discharge is not None:
-        summary["final_discharge"] = discharge
-    return summary
+    """The blending rows' summary, with the discharge after the recirculations where given."""
+    extra = {} if discharge is None else {"final_discharge": discharge}
+    return _blending_summary(pattern, layouts, recirculations, **extra)
 
 
 def _discharge(vrr, nr=4.02, faded=True, at_ceiling=(), relative=0.1):
@@ -44,15 +34,6 @@ def _discharge(vrr, nr=4.02, faded=True, at_ceiling=(), relative=0.1):
 
 def _run(summary, dof=None):
     return {"case": {"run_id": summary["flow_pattern"]}, "summary": summary, "rtd": [], "note": "one seed", "dof": dof}
-
-
-def _internal():
-    # the passes at constant head: entry 4 is 12, 10, 3 for the single layers
-    return {"blue13": _layout(0.13, 1, [2.0, 5.0, 8.0, 10.0, 12.0, 12.5]),
-            "blue25": _layout(0.25, 1, [2.0, 4.0, 6.0, 8.0, 10.0, 11.0]),
-            "blue50": _layout(0.5, 1, [2.0, 2.5, 2.8, 2.9, 3.0, 3.0]),
-            "blue50_3layers": _layout(0.5, 3, [3.0, 5.0, 7.0, 8.0, 9.0, 9.5]),
-            "blue50_5layers": _layout(0.5, 5, [4.0, 8.0, 12.0, 14.0, 16.0, 17.0])}
 
 
 #: The discharge's VRR per layout: the single layers 9, 7.5 and 20, the sub-layers 6 (3) and 5 (5).
