@@ -59,7 +59,9 @@ from siloflow.analysis.numerics.vrr_noise import CEILING_FACTOR, vrr_ceiling, vr
 from siloflow.analysis.studies.silo_recirculation.study import BlendingResult
 from siloflow.analysis.studies.silo_recirculation.tracks import recirculation_events
 from siloflow.analysis.studies.silo_recirculation.validation import event_times, open_fraction
-from siloflow.analysis.studies.silo_recirculation.vrr import recirculation_number, vrr_standard_error
+from siloflow.analysis.studies.silo_recirculation.concentration import outlet_concentration
+from siloflow.analysis.studies.silo_recirculation.vrr import (recirculation_number, variance_reduction,
+                                                               vrr_standard_error)
 
 __all__ = ["FADE_FRACTION", "DischargeWindows", "DischargeVRR", "FinalDischarge", "flowing_windows", "discharge_vrr",
            "final_discharge"]
@@ -262,31 +264,18 @@ def discharge_vrr(exit_times, is_blue, blue_fraction: float, windows: DischargeW
     (True, 12, 1.0)
     """
     exits = event_times("exit_times", exit_times)
-    blue = np.asarray(is_blue)
-    if blue.shape != exits.shape:
-        raise ValueError(f"is_blue must have the shape of exit_times {exits.shape}, got {blue.shape}")
-    if not (blue.dtype == bool or (blue.dtype.kind in "iuf" and np.all((blue == 0) | (blue == 1)))):
-        raise ValueError("is_blue must be a boolean mask (True/False or 0/1)")
-    blue = blue.astype(bool)
+    if np.shape(is_blue) != exits.shape:
+        raise ValueError(f"is_blue must have the shape of exit_times {exits.shape}, got {np.shape(is_blue)}")
     p = open_fraction("blue_fraction", blue_fraction)
-    finite = np.isfinite(exits)
-    exits, blue = exits[finite], blue[finite]
     edges, n_total = windows.edges, windows.n_total
     if n_total.size:
-        # half-open windows: a crossing on the last kept edge belongs to the next (left-out) window
-        inside = exits < edges[-1]
-        n_blue = np.histogram(exits[inside & blue], bins=edges)[0].astype(np.int64)
+        # the kept windows are outlet_concentration's over [their first start, their last end]
+        measured = outlet_concentration(exits, is_blue, (edges[-1] - edges[0]) / n_total.size, edges[0], edges[-1])
+        n_blue, concentration = measured.n_blue, measured.concentration
     else:
-        n_blue = np.zeros(0, dtype=np.int64)
-    concentration = n_blue / np.where(n_total > 0, n_total, 1)
-    concentration = np.where(n_total > 0, concentration, np.nan)
-    values = concentration[np.isfinite(concentration)]
-    vrr = sigma_out = math.nan
-    if values.size >= 2:
-        variance = float(np.var(values))
-        sigma_out = math.sqrt(variance)
-        vrr = math.inf if variance == 0.0 else p * (1.0 - p) / variance
-    error = float(vrr_standard_error(vrr, values.size))
+        n_blue, concentration = np.zeros(0, dtype=np.int64), np.zeros(0)
+    vrr, sigma_out, n_windows = variance_reduction(concentration, p)
+    error = float(vrr_standard_error(vrr, n_windows))
     counts = n_total[n_total > 0]
     # the noise variance of windows of n_i clumps is p (1 - p) mean(1 / n_i): the harmonic mean is the exact n
     ceiling = (vrr_ceiling(counts.size / float(np.sum(1.0 / counts)), p * (1.0 - p), p) if counts.size

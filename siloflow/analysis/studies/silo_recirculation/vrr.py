@@ -43,6 +43,7 @@ __all__ = [
     "holdup_residence_time",
     "littles_law",
     "vrr_by_recirculation",
+    "variance_reduction",
     "vrr_standard_error",
     "sampling_noise_vrr_limit",
 ]
@@ -351,13 +352,7 @@ def vrr_by_recirculation(
     sigma_out = np.full(k_max, np.nan)
     n_windows = np.zeros(k_max, dtype=np.int64)
     for k in range(1, k_max + 1):
-        values = c[(nr >= k - 1) & (nr < k) & np.isfinite(c)]
-        n_windows[k - 1] = values.size
-        if values.size < 2:
-            continue
-        variance = float(np.var(values))
-        sigma_out[k - 1] = math.sqrt(variance)
-        vrr[k - 1] = math.inf if variance == 0.0 else sigma_in2 / variance
+        vrr[k - 1], sigma_out[k - 1], n_windows[k - 1] = variance_reduction(c[(nr >= k - 1) & (nr < k)], p)
     return RecirculationVRR(
         recirculation_number=np.arange(1, k_max + 1) - 0.5,
         vrr=vrr,
@@ -366,6 +361,19 @@ def vrr_by_recirculation(
         sigma_in=math.sqrt(sigma_in2),
         blue_fraction=p,
     )
+
+
+def variance_reduction(concentration, blue_fraction: float) -> tuple[float, float, int]:
+    """``(VRR, sigma_out, N)`` of one set of window concentrations: ``p (1 - p) / var(c)`` over the ``N`` windows
+    that are not NaN, with the population standard deviation ``sigma_out`` of their concentrations [-]; inf without
+    variance, NaN (VRR and sigma_out) with fewer than 2 windows."""
+    values = np.asarray(concentration, dtype=float)
+    values = values[np.isfinite(values)]
+    if values.size < 2:
+        return math.nan, math.nan, int(values.size)
+    variance = float(np.var(values))
+    p = float(blue_fraction)
+    return (math.inf if variance == 0.0 else p * (1.0 - p) / variance), math.sqrt(variance), int(values.size)
 
 
 def vrr_standard_error(vrr, n_windows):
