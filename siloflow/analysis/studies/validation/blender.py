@@ -45,7 +45,8 @@ from siloflow.analysis.numerics.vrr_noise import vrr_near_ceiling
 from siloflow.analysis.studies.validation import agreement as rules
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, capped, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
-from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, resolved, row, smallest_dof
+from siloflow.analysis.studies.validation.rows import (joined, plus_minus, precise, resolution, resolved, row,
+                                                      smallest_dof)
 
 __all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "DEPTH_AVERAGED", "smallest_dof", "capped",
            "section_mean", "blender_rows", "gravity_rows"]
@@ -169,7 +170,7 @@ def _passage_rows(summary: Mapping, note: str, dof, tolerances: AgreementToleran
         return []
     wall_velocities, wall_bins, plane = _wall_layer(summary, "outlet") or ({}, {}, "")
     wall_mean = section_mean(wall_velocities, wall_bins) if wall_velocities else (math.nan, math.nan)
-    depth_clause = "; ".join(filter(None, (depth_differs, DEPTH_AVERAGED, _continuous(summary))))
+    depth_clause = joined((depth_differs, DEPTH_AVERAGED, _continuous(summary)))
     rows = []
     for key, (value, error) in velocities.items():
         depth_share = ratio(value, error, mean, mean_error)
@@ -202,7 +203,7 @@ def _converging_rows(summary: Mapping, note: str, dof, tolerances: AgreementTole
     wall = _wall_layer(summary, "outlet")
     velocities, plane, differs = ((wall[0], wall[2], _continuous(summary)) if wall is not None else
                                   (depth_velocities, "depth-averaged",
-                                   "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))))
+                                   joined((DEPTH_AVERAGED, _continuous(summary)))))
     if {"tube", "interior", "exterior"} <= velocities.keys():
         # Downward speeds, so that "fastest" is the largest, as the study's order reads.
         speeds = [(-velocities[key][0], velocities[key][1]) for key in ("tube", "interior", "exterior")]
@@ -235,7 +236,7 @@ def _inlet_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerance
         passages = {key: (float(v), number_or_nan(errors.get(key))) for key, v in means.items()}
         plane = "depth-averaged"
         measured = "" if errors else "; its error is not measured (blender.json has no error of the inlet's passages)"
-        differs = "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))
+        differs = joined((DEPTH_AVERAGED, _continuous(summary)))
     if not {"interior", "exterior"} <= passages.keys():
         return []
     mean, mean_error = section_mean(passages, bins)
@@ -280,7 +281,7 @@ def _vertical_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolera
         differs = _continuous(summary)
     else:
         plane = "depth-averaged"
-        differs = "; ".join(filter(None, (DEPTH_AVERAGED, _continuous(summary))))
+        differs = joined((DEPTH_AVERAGED, _continuous(summary)))
     rows = []
     for key in sorted(chosen, key=float):
         entry = chosen[key]
@@ -330,7 +331,7 @@ def _m3_rows(at_1g: Mapping[str, Mapping]) -> list[dict]:
                                   for run, v, e in zip(runs, values, errors))
                         + " (value column: converging); sine input, LTI of the RTD of the steady field", dof=dof,
                         finding=f"M3.over_{other}", agreement=verdict,
-                        differs="; ".join(filter(None, (_continuous(run["summary"]) for run in runs)))))
+                        differs=joined((_continuous(run["summary"]) for run in runs))))
     return rows
 
 

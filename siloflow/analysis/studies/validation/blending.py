@@ -41,7 +41,7 @@ from siloflow.analysis.numerics.uncertainty import combine_independent
 from siloflow.analysis.studies.validation import agreement as rules
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, capped, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
-from siloflow.analysis.studies.validation.rows import plus_minus, row, smallest_dof
+from siloflow.analysis.studies.validation.rows import joined, plus_minus, row, smallest_dof
 
 __all__ = ["RECIRCULATION_GROUP", "MADE", "UNMADE", "rtd_peak", "recirculation_rows"]
 
@@ -130,11 +130,6 @@ def _where(ends: Sequence[_End]) -> str:
     return f"at the end of about {round(min(end.nr for end in ends))} recirculations (discharges and passes)"
 
 
-def _joined(texts) -> str:
-    """The non-empty texts, each once, in order."""
-    return "; ".join(dict.fromkeys(text for text in texts if text))
-
-
 class _Run:
     """One recirculation run as the rows read it: its pattern, layouts, final discharge, note and degrees of
     freedom."""
@@ -178,7 +173,7 @@ class _Run:
         discharge = (self.discharge or {}).get("layouts", {}).get(name)
         if discharge is None:
             value, error, nr, bound = self.vrr(layout, NR_STUDY)
-            return _End(value, error, nr, False, f"at Nr = {nr}", f"{nr}", bound, _joined((CONSTANT_HEAD,
+            return _End(value, error, nr, False, f"at Nr = {nr}", f"{nr}", bound, joined((CONSTANT_HEAD,
                         self.short(nr, NR_STUDY))), "")
         common = self.discharge  # the figures every layout of the discharge shares
         nr = float(common["recirculations"])
@@ -203,7 +198,7 @@ class _Run:
             f"{number_or_nan(common.get('reference_clumps_per_window')):.0f}); counting-noise ceiling {ceiling:.0f}")
         return _End(number_or_nan(discharge["vrr"]), number_or_nan(discharge.get("vrr_error")), nr, True,
                     f"of the discharge after Nr = {nr:.2f}", f"the discharge after Nr = {nr:.2f}", bound,
-                    _joined((far, cut)), evidence)
+                    joined((far, cut)), evidence)
 
     def short(self, nr: int, wanted: int) -> str:
         """The ``differs`` clause of a VRR read at ``nr`` instead of ``wanted``."""
@@ -258,15 +253,15 @@ def _run_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
                 f"VRR {end.where} ({label})", case, end.value, end.error, "-", end_evidence, dof, run.part("B4"),
                 # a VRR at its ceiling is capped with that reason, rather than called not steady
                 lambda p: capped(rules.value_in_band(end.value, end.error, dof, p, tolerances), end.bound),
-                differs=_joined((end.differs, other))))
+                differs=joined((end.differs, other))))
             if end.discharge:
                 # the pass at constant head stays, as siloflow's own measurement beside the study's figure
                 rows.append(row(RECIRCULATION_GROUP, f"VRR of the pass {nr} <= Nr < {nr + 1} at constant head, "
-                                f"siloflow's ({label})", case, last, last_error, "-", _joined((bound, evidence)),
+                                f"siloflow's ({label})", case, last, last_error, "-", joined((bound, evidence)),
                                 dof=dof, study=CONSTANT_HEAD_STUDY, differs=run.short(nr, NR_STUDY)))
         if end.nr >= 1:
             change = end.value - first, combine_independent([end.error, first_error])
-            why = _joined((first_bound, end.bound))
+            why = joined((first_bound, end.bound))
             rows.append(_judged(f"Change of VRR from Nr = 0 to {end.to} ({label})", case, *change, "-", end_evidence,
                                 dof, "B2.grows", lambda p: capped(rules.sign_of_change(*change, dof, p), why),
                                 differs=end.differs))
@@ -298,7 +293,7 @@ def _slower(run: _Run, layout: Mapping, label: str, nr: int, evidence: str) -> d
     change = scale * (vn - v2) - (v2 - v0)
     # v2 enters both gains: its error counts with the weight (scale + 1), the two ends' with theirs.
     error = combine_independent([scale * en, (scale + 1.0) * e2, e0])
-    differs = _joined((SLOWER_PASSES, "" if nr == NR_STUDY else (
+    differs = joined((SLOWER_PASSES, "" if nr == NR_STUDY else (
         f"gain from Nr = {NR_MIDDLE} to {nr} times {scale:g}, not from {NR_MIDDLE} to {NR_STUDY}: "
         + run.short(nr, NR_STUDY))))
     why = "; ".join(filter(None, (b0, b2, bn)))
@@ -316,21 +311,21 @@ def _batch_rows(run: _Run, tolerances: AgreementTolerances, nr_text: str) -> lis
         change = b.value - a.value, combine_independent([a.error, b.error])
         rows.append(_judged(
             f"Change of VRR {_where(ends)} from the 13 % to the 50 % batch", run.pattern, *change, "-",
-            _joined((f"13 %: {plus_minus(a.value, a.error)}, 50 %: {plus_minus(b.value, b.error)}",
+            joined((f"13 %: {plus_minus(a.value, a.error)}, 50 %: {plus_minus(b.value, b.error)}",
                      *(end.evidence for end in ends), nr_text, run.windows)) + tail, dof,
-            "B3.internal", lambda p: capped(rules.sign_of_change(*change, dof, p), _joined(end.bound for end in ends)),
-            differs=_joined(end.differs for end in ends)))
+            "B3.internal", lambda p: capped(rules.sign_of_change(*change, dof, p), joined(end.bound for end in ends)),
+            differs=joined(end.differs for end in ends)))
     layers = [run.layout(0.5, n) for n in (5, 3, 1)]
     if all(layers):
         taken = [run.end(*layer) for layer in layers]
         values, errors = [t.value for t in taken], [t.error for t in taken]
-        why = _joined(t.bound for t in taken)
+        why = joined(t.bound for t in taken)
         rows.append(_judged(
             f"VRR {_where(taken)} of the 50 % batch in 5, 3 and 1 layers", run.pattern, values[0], errors[0], "-",
             "; ".join(f"{n}: {plus_minus(v, e)}" for n, v, e in zip((5, 3, 1), values, errors))
-            + " (value column: 5 sub-layers); " + _joined((*(t.evidence for t in taken), nr_text, run.windows))
+            + " (value column: 5 sub-layers); " + joined((*(t.evidence for t in taken), nr_text, run.windows))
             + tail, dof, "B6", lambda p: capped(rules.in_order(values, errors, dof, p), why),
-            differs=_joined(t.differs for t in taken)))
+            differs=joined(t.differs for t in taken)))
     return rows
 
 
@@ -383,21 +378,21 @@ def _pattern_rows(internal: _Run, semi: _Run, tolerances: AgreementTolerances) -
             pair = a, b = run.end(*small), run.end(*half)
             ends += pair
             value, error = ratio(a.value, a.error, b.value, b.error)
-            differs = _joined(end.differs for end in pair)
-            effects.append((value - 1.0, error, _joined(end.bound for end in pair),
+            differs = joined(end.differs for end in pair)
+            effects.append((value - 1.0, error, joined(end.bound for end in pair),
                             differs and f"{run.pattern}: {differs}"))
-            reads.append(_joined((f"{run.pattern}: 13 % {plus_minus(a.value, a.error)} / 50 % "
+            reads.append(joined((f"{run.pattern}: 13 % {plus_minus(a.value, a.error)} / 50 % "
                                   f"{plus_minus(b.value, b.error)} - 1 = {plus_minus(value - 1.0, error)}",
                                   *(end.evidence for end in pair))))
     if len(effects) == 2:
         values, errors = [e[0] for e in effects], [e[1] for e in effects]
-        why = _joined(e[2] for e in effects)
+        why = joined(e[2] for e in effects)
         rows.append(row(RECIRCULATION_GROUP, f"Batch effect VRR(13 %) / VRR(50 %) - 1 {_where(ends)}, internal vs "
                                              "semi-mass flow", case, values[0], errors[0], "-",
                         "; ".join(reads) + f" (value column: internal flow){tail}", dof=dof,
                         finding="B3.stronger_in_internal",
                         agreement=capped(rules.in_order(values, errors, dof, PARTS["B3.stronger_in_internal"]), why),
-                        differs=_joined(e[3] for e in effects)))
+                        differs=joined(e[3] for e in effects)))
     for name, layout in internal.layouts.items():
         if int(layout["sublayers"]) != 1:
             continue

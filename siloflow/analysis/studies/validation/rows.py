@@ -30,8 +30,8 @@ from siloflow.model.checks import number_or_nan
 from siloflow.analysis.studies.validation.agreement import Agreement, AgreementTolerances, quantile, relative_error
 from siloflow.analysis.studies.validation.findings import PARTS
 
-__all__ = ["COLUMNS", "NO_FINDING", "AT_SCALE", "NOT_AT_SCALE", "row", "with_scale", "precise", "plus_minus", "resolved",
-           "resolution", "smallest_dof"]
+__all__ = ["COLUMNS", "NO_FINDING", "AT_SCALE", "NOT_AT_SCALE", "joined", "row", "with_scale", "precise", "plus_minus",
+           "resolved", "resolution", "smallest_dof"]
 
 #: The columns of a group's rows, in order.
 COLUMNS = ("group", "figure", "case", "finding", "value", "value_error", "dof", "unit", "study", "agreement",
@@ -39,6 +39,11 @@ COLUMNS = ("group", "figure", "case", "finding", "value", "value_error", "dof", 
 #: The agreement and the scale of a row that no finding of the study states.
 NO_FINDING = "-"
 AT_SCALE, NOT_AT_SCALE = "at scale", "not at scale"
+
+
+def joined(texts) -> str:
+    """The non-empty texts (clauses of a ``differs`` or ``evidence`` cell), each once, in order, joined by "; "."""
+    return "; ".join(dict.fromkeys(text for text in texts if text))
 
 
 def row(group: str, figure: str, case: str, value, error, unit: str, evidence: str, *, dof: float | None = None,

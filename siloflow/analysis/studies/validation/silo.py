@@ -33,7 +33,7 @@ from siloflow.analysis.studies.silo_flat.field_clock import WINDOW_CONFIGURED, W
 from siloflow.analysis.studies.validation import agreement as rules
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, ratio
 from siloflow.analysis.studies.validation.findings import PARTS
-from siloflow.analysis.studies.validation.rows import plus_minus, precise, resolution, row
+from siloflow.analysis.studies.validation.rows import joined, plus_minus, precise, resolution, row
 
 __all__ = ["SiloRun", "silo_rows", "front_wall_series_rows", "stress_gradient", "window_clause", "heights_clause",
            "STUDY_WINDOW", "STUDY_HEIGHTS", "MADE", "UNMADE"]
@@ -143,10 +143,6 @@ def heights_clause(heights: Sequence[float], what: str = "at") -> str:
     if len(ordered) == len(STUDY_HEIGHTS) and all(abs(a - b) <= _SAME for a, b in zip(ordered, STUDY_HEIGHTS)):
         return ""
     return f"{what} {_millimetres(ordered)} mm, not the study's {_millimetres(STUDY_HEIGHTS)} mm (§5.4.3.4)"
-
-
-def _joined(*clauses: str) -> str:
-    return "; ".join(clause for clause in clauses if clause)
 
 
 def _column(entries: Sequence[Mapping], key: str) -> np.ndarray:
@@ -283,8 +279,8 @@ def _b_rows(run: SiloRun, case_name: str, tolerances: AgreementTolerances, dof: 
               combine_independent([number_or_nan(high.get("B_m_error")), number_or_nan(low.get("B_m_error"))]))
     listing = "; ".join(f"z {float(entry['z_m']) * 1000:.0f} mm: B {plus_minus(float(entry['B_m']) * 1000, number_or_nan(entry.get('B_m_error')) * 1000)} mm "
                         f"({int(float(entry['batches']))} time batches)" for entry in fitted)
-    differs = _joined(window_clause(run.fields, run.flow),
-                      heights_clause([float(entry["z_m"]) for entry in fitted], "B fitted at"))
+    differs = joined((window_clause(run.fields, run.flow),
+                      heights_clause([float(entry["z_m"]) for entry in fitted], "B fitted at")))
     return [row(GROUP, f"Change of the kinematic constant B, z = {float(high['z_m']) * 1000:.0f} - "
                        f"{float(low['z_m']) * 1000:.0f} mm", case_name, *change, "m",
                 f"{listing}; particle diameter {run.diameter * 1000:.2f} mm{tail}", dof=dof, finding="S5.dem",
