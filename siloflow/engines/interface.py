@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import importlib
 import math
+import os
+import shutil
 import subprocess
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -155,11 +157,49 @@ class Engine(ABC):
         """
 
     @abstractmethod
-    def write_inputs(self, case, run_dir: str | Path) -> Path:
+    def write_inputs(self, case, run_dir: str | Path, assembly_dir: str | Path | None = None) -> Path:
         """Render the case into ``<run_dir>/deck/``; the neutral case summary ``deck/case.json`` is written last.
 
-        Returns the path of ``deck/case.json``.
+        ``assembly_dir`` is the folder of the run whose settled fill ``case`` starts from (its ``assembly``;
+        :meth:`place_assembly`), None for a case that makes its own. Returns the path of ``deck/case.json``.
         """
+
+    #: The file in a flat-bottom silo run's folder that keeps its settled fill (the engine's own restart format); a
+    #: run that starts from it reads a copy of the same name in its ``deck/``.
+    assembly_file: ClassVar[str]
+
+    def place_assembly(self, case, run_dir: str | Path, assembly_dir: str | Path | None) -> None:
+        """Put the settled fill ``case`` starts from (the :attr:`assembly_file` of the run in ``assembly_dir``) into
+        ``<run_dir>/deck/``, as a hard link where the file system allows one (else a copy): the deck keeps the fill it
+        was rendered for even when that run is made again. Nothing for a case without an ``assembly``.
+
+        Raises
+        ------
+        ValueError
+            When the case starts from an assembly and ``assembly_dir`` is None.
+        FileNotFoundError
+            When that run's folder holds no settled fill, naming the folder.
+        """
+        assembly = getattr(case, "assembly", None)
+        if assembly is None:
+            return
+        if assembly_dir is None:
+            raise ValueError(f"run {case.run_id} starts from the settled fill of run {assembly.run_id}: give that run's "
+                             "folder")
+        source = Path(assembly_dir) / self.assembly_file
+        if not source.is_file():
+            raise FileNotFoundError(
+                f"{source}: run {assembly.run_id} has no settled fill, which run {case.run_id} starts from; it failed "
+                f"or was made before its runs kept one: move its folder {assembly_dir} aside and make it again")
+        target = Path(run_dir) / "deck" / self.assembly_file
+        target.parent.mkdir(parents=True, exist_ok=True)
+        partial = target.with_name(target.name + ".partial")
+        partial.unlink(missing_ok=True)
+        try:
+            os.link(source, partial)
+        except OSError:
+            shutil.copyfile(source, partial)
+        os.replace(partial, target)
 
     @abstractmethod
     def run(self, case, run_dir: str | Path, options: EngineOptions) -> RunRecord:

@@ -25,12 +25,13 @@ def _check_kind(case_kind: str, case) -> None:
         raise TypeError(f"a {type(case).__name__} is no {case_kind} case")
 
 
-def render_run(config: dict, case_kind: str, case, run_dir: str | Path) -> Path:
+def render_run(config: dict, case_kind: str, case, run_dir: str | Path, assembly_dir: str | Path | None = None) -> Path:
     """Write the engine inputs of ``case`` (a run of ``case_kind`` of the validated ``config``) into
-    ``<run_dir>/deck/``; returns ``deck/case.json``."""
+    ``<run_dir>/deck/``, with the settled fill of the run in ``assembly_dir`` where the case starts from one
+    (:meth:`siloflow.engines.interface.Engine.place_assembly`); returns ``deck/case.json``."""
     _check_kind(case_kind, case)
     run = case.run_id
-    summary = engine_for(config, case_kind).write_inputs(case, run_dir)
+    summary = engine_for(config, case_kind).write_inputs(case, run_dir, assembly_dir)
     logging.getLogger("siloflow").info("%s inputs of %s run %s written; case summary %s",
                                        engine_kind(config, case_kind), case_kind, run, summary)
     return summary

@@ -8,19 +8,24 @@ from pathlib import Path
 
 from siloflow.model.record import RunRecord
 from siloflow.model.cases.silo_flat import SiloCase
+from siloflow.model.cases.silo_recirculation import RecirculationCase
 from siloflow.model.cost import CostModel
 from siloflow.model.cases.silo_cost import silo_run_steps
 from siloflow.engines.interface import EngineRunError
 from siloflow.engines.markers import Marker
 
-__all__ = ["SILO_STAGE_MARKERS", "check_silo_run", "expected_simulated_time", "silo_run_record"]
+__all__ = ["SILO_STAGE_MARKERS", "check_silo_run", "expected_simulated_time", "recirculation_labels", "silo_run_record"]
 
 
 def check_silo_run(
     case: SiloCase, markers: list[Marker], dump_files: list[Path], run_dir: Path, last_stage: str = "discharged",
-    clumps_conserved: bool = False, then: str | None = None,
+    clumps_conserved: bool = False, then: str | None = None, assembled: bool = False,
 ) -> dict:
     """Check that a finished silo run did what the case asked; returns the stage record.
+
+    With ``assembled`` the run started from another run's settled fill (the recirculating silo from the flat-bottom
+    silo's assembly): its log has an ``assembled`` marker with the fill's clumps instead of ``filled`` and
+    ``settled``, whose checks that run's own passed; the record keeps it under that name.
 
     ``last_stage`` names the marker of the stage after the opening (``discharged`` in the batch silo, which
     drains; ``recirculated`` in the recirculating one); the record keeps it under that name. With
@@ -41,9 +46,18 @@ def check_silo_run(
     by_event = {}
     for marker in markers:
         by_event.setdefault(marker.event, []).append(marker)
-    for event in ("filled", "settled", "opened", last_stage) + ((then,) if then else ()):
+    start = ("assembled",) if assembled else ("filled", "settled")
+    for event in start + ("opened", last_stage) + ((then,) if then else ()):
         if event not in by_event:
             raise EngineRunError(f"{run_dir}: the log has no '{event}' stage marker; the deck did not run to the end")
+    if assembled:
+        assembly = by_event["assembled"][-1].values
+        if int(round(assembly["clumps"])) != case.fill.n_clumps:
+            raise EngineRunError(f"{run_dir}: the settled fill it started from holds {int(round(assembly['clumps']))} "
+                                 f"clumps, the case {case.fill.n_clumps}")
+        return {"assembled": assembly,
+                **_after_opening(case, by_event, dump_files, run_dir, last_stage, clumps_conserved, then),
+                "settle_checks": []}
     filled = by_event["filled"][-1].values
     if int(round(filled["clumps"])) != case.fill.n_clumps:
         raise EngineRunError(
@@ -63,6 +77,14 @@ def check_silo_run(
     # The record keeps the criterion the fill was held to, in joules and in the clump's own scale.
     settled = {**settled, "ke_ratio": settled["ke_per_clump"] / criterion.energy_scale,
                "ke_threshold_J": criterion.threshold, "ke_threshold_ratio": criterion.ratio}
+    return {"filled": filled, "settled": settled,
+            **_after_opening(case, by_event, dump_files, run_dir, last_stage, clumps_conserved, then),
+            "settle_checks": [m.values for m in by_event.get("settle", [])]}
+
+
+def _after_opening(case: SiloCase, by_event: dict, dump_files: list[Path], run_dir: Path, last_stage: str,
+                   clumps_conserved: bool, then: str | None) -> dict:
+    """The checks and the stage record of a silo run from the opening of its outlet on (:func:`check_silo_run`)."""
     if len(dump_files) < 2:
         raise EngineRunError(f"{run_dir}: expected particle dumps of the discharge, found {len(dump_files)}")
     final = int(round(by_event[last_stage][-1].values["clumps"]))
@@ -73,12 +95,9 @@ def check_silo_run(
         )
     opened = by_event["opened"][-1].values
     return {
-        "filled": filled,
-        "settled": settled,
         "opened": opened,
         last_stage: by_event[last_stage][-1].values,
         **({then: by_event[then][-1].values} if then else {}),
-        "settle_checks": [m.values for m in by_event.get("settle", [])],
         "open_step": int(round(opened["step"])),
         "open_time_s": opened["time"],
         "timestep_s": case.timestep,
@@ -87,9 +106,12 @@ def check_silo_run(
     }
 
 
-def expected_simulated_time(silo: SiloCase) -> float:
+def expected_simulated_time(silo: SiloCase, assembled: bool = False) -> float:
     """Simulated time a silo-type deck is expected to reach (s): fill, the expected share of the settling time
-    (:class:`siloflow.engines.estimates.CostModel`), discharge; the target of its progress reports."""
+    (:class:`siloflow.engines.estimates.CostModel`), discharge, or the discharge alone for a run that starts from
+    another run's settled fill (``assembled``; its clock starts there); the target of its progress reports."""
+    if assembled:
+        return silo.discharge_steps * silo.timestep
     return silo_run_steps(silo, CostModel().settle_fraction) * silo.timestep
 
 
@@ -120,3 +142,11 @@ def silo_run_record(engine: str, case_kind: str, run_id: str, checked: dict, lab
         outlet_z=0.0,
         labels=dict(labels or {}),
     )
+
+
+def recirculation_labels(case: RecirculationCase) -> dict:
+    """The labels of a recirculation run's record: its flow pattern, role and a-priori residence time (s), and the
+    run whose settled fill it started from where it did not make its own."""
+    assembly = {"assembly_run_id": case.assembly.run_id} if case.assembly is not None else {}
+    return {"flow_pattern": case.pattern, "role": case.role,
+            "estimated_residence_time_s": case.estimated_residence_time, **assembly}

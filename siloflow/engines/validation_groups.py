@@ -47,14 +47,15 @@ class Group:
 #: its own runs and those it reads (`make estimate` flags a group over :data:`GROUP_BUDGET_S`): the calibration in three (the calibration shape's charts,
 #: the other shapes' charts, and the checks against the charts: rotation blocked, the other lid, restitution, shear
 #: speed, seeds), the flat-bottom silo in two (its base configuration over seeds, and the front-wall friction series
-#: compared against it).
+#: compared against it); the blending study reads the flat-bottom silo's base runs, whose settled fills it starts from.
 GROUPS: dict[str, Group] = {
     "calibration": Group("jenike", (CALIBRATION_CHART,)),
     "calibration_shapes": Group("jenike", (SHAPE_CHART,)),
     "calibration_checks": Group("jenike", (CHECK,), reads=("calibration", "calibration_shapes")),
     "silo": Group("silo_flat", (REFERENCE,)),
     "silo_series": Group("silo_flat", (VARIANT,), reads=("silo",)),
-    "blending": Group("silo_recirculation"),
+    # its flow patterns start from the flat-bottom silo's settled fills (silo_recirculation.assembly: silo_flat)
+    "blending": Group("silo_recirculation", reads=("silo",)),
     "blender": Group("blender"),
 }
 

@@ -330,9 +330,10 @@ WALLS.update(add_meshes('deck/geometry.npz', {'hopper_left': MATERIAL_IDS[1], 'h
 
 
 def inside(position):
-    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain."""
+    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain (by more than
+    TOP_MARGIN)."""
     return (abs(position[0]) <= HALF_WIDTH + BOUNDING_RADIUS and -BOUNDING_RADIUS <= position[1] <= DEPTH + BOUNDING_RADIUS
-            and position[2] <= DOMAIN_TOP)
+            and position[2] <= DOMAIN_TOP + TOP_MARGIN)
 
 
 def insert_clumps(rng, wanted):
@@ -433,6 +434,10 @@ if RESTART is None:
 else:
     # --- resume the discharge from a snapshot of an attempt that was killed ---
     O.load(RESTART)
+    # the walls added after an assembly was loaded (their ids follow its clumps')
+    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
+        name, ids = entry.split(":")
+        WALLS[name] = [int(i) for i in ids.split(",")]
     forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
     WALLS['outlet_gate'] = []
     say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))

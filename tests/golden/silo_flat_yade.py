@@ -332,9 +332,10 @@ WALLS.update(add_meshes('deck/geometry.npz', {'floor_left': MATERIAL_IDS[1], 'fl
 
 
 def inside(position):
-    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain."""
+    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain (by more than
+    TOP_MARGIN)."""
     return (abs(position[0]) <= HALF_WIDTH + BOUNDING_RADIUS and -BOUNDING_RADIUS <= position[1] <= DEPTH + BOUNDING_RADIUS
-            and position[2] <= DOMAIN_TOP)
+            and position[2] <= DOMAIN_TOP + TOP_MARGIN)
 
 
 def insert_clumps(rng, wanted):
@@ -363,6 +364,10 @@ def insert_clumps(rng, wanted):
         placed_radii.extend(CLUMP_RADII)
         placed += 1
     return placed
+
+
+#: how far above the domain's top a clump may be before it counts as lost (m)
+TOP_MARGIN = 0.0
 
 
 def outflow():
@@ -418,6 +423,8 @@ if RESTART is None:
         if kinetic_energy_per_clump() < SETTLE_THRESHOLD:
             break
     say_stage("settled")
+    # the settled fill, kept as the assembly other runs start from (the study's recirculating silo, §6.2.2)
+    save_atomic('assembly.yade', O.save)
     # --- the settled fill at the last two steps of a short run, for the force balance ---
     run_steps(SNAPSHOT_STEPS - 2)
     for _ in range(2):
@@ -434,6 +441,10 @@ if RESTART is None:
 else:
     # --- resume the discharge from a snapshot of an attempt that was killed ---
     O.load(RESTART)
+    # the walls added after an assembly was loaded (their ids follow its clumps')
+    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
+        name, ids = entry.split(":")
+        WALLS[name] = [int(i) for i in ids.split(",")]
     forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
     WALLS['outlet_gate'] = []
     say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))

@@ -332,9 +332,10 @@ WALLS.update(add_meshes('deck/geometry.npz', {'floor_left': MATERIAL_IDS[1], 'fl
 
 
 def inside(position):
-    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain."""
+    """A clump is lost when it is beyond a side wall (or the front and back walls) or above the domain (by more than
+    TOP_MARGIN)."""
     return (abs(position[0]) <= HALF_WIDTH + BOUNDING_RADIUS and -BOUNDING_RADIUS <= position[1] <= DEPTH + BOUNDING_RADIUS
-            and position[2] <= DOMAIN_TOP)
+            and position[2] <= DOMAIN_TOP + TOP_MARGIN)
 
 
 def insert_clumps(rng, wanted):
@@ -365,6 +366,9 @@ def insert_clumps(rng, wanted):
     return placed
 
 
+#: a clump re-enters just below the domain's top, where the next one to re-enter nearby may push it up before it falls
+#: (LIGGGHTS' periodic box would carry it on through the bottom): above by a clump's size it counts as lost
+TOP_MARGIN = 2.0 * BOUNDING_RADIUS
 CHANNEL_BOTTOM = -0.04
 FEEDER_ZONE = (-0.012, 0.012, -0.04, -0.02, )
 FEEDER_VELOCITY = 0.4
@@ -473,6 +477,10 @@ if RESTART is None:
 else:
     # --- resume the discharge from a snapshot of an attempt that was killed ---
     O.load(RESTART)
+    # the walls added after an assembly was loaded (their ids follow its clumps')
+    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
+        name, ids = entry.split(":")
+        WALLS[name] = [int(i) for i in ids.split(",")]
     forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
     WALLS['outlet_gate'] = []
     say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))

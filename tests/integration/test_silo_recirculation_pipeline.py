@@ -46,9 +46,15 @@ CONFIG = {
 BLENDING_ONLY = {**CONFIG, "silo_recirculation": {**TINY_BLENDING,
                                                   "verification": {**TINY_BLENDING["verification"], "enabled": False}}}
 #: the fast tier's run: the same on one rank (the run on 2 ranks, the domain split along the periodic direction, is
-#: the physics tier's study-step run below), with the discharge after its recirculations
+#: the physics tier's study-step run below), with the discharge after its recirculations, started as the study started
+#: its flow patterns (§6.2.2): from the settled fill of a flat-bottom silo of its geometry (briefly discharged), which the
+#: workflow makes first
 ONE_RANK = {**BLENDING_ONLY, "engine": {"mpi_ranks": 1},
-            "silo_recirculation": {**BLENDING_ONLY["silo_recirculation"], "final_discharge": 0.6}}
+            "silo_recirculation": {**BLENDING_ONLY["silo_recirculation"], "final_discharge": 0.6,
+                                   "assembly": "silo_flat"},
+            "silo_flat": {**{key: TINY_BLENDING[key] for key in ("width", "depth", "fill_height", "outlet_width",
+                                                                  "timestep_fraction")},
+                          "discharge_time": 0.05, "piv": {"enabled": False}}}
 
 
 def _blending(workdir, config: dict):
@@ -100,6 +106,25 @@ def thin_silo(tmp_path_factory):
 
 def _tracks_and_case(run_dir: Path):
     return load_tracks(run_dir / "tracks.npz"), json.loads((run_dir / "deck" / "case.json").read_text())
+
+
+def test_the_run_starts_from_the_flat_silos_settled_fill(blending_pipeline):
+    """The workflow made the flat-bottom silo's run first; the recirculating run read its settled fill as it was left
+    (the same clumps, at rest with the same kinetic energy to the last printed digit), poured none of its own, and
+    its frictions are the flow pattern's."""
+    workdir, runs, cases = blending_pipeline
+    case = next(case for case in cases.values() if case.role == "blending")
+    record = read_run_record(runs["blending"] / "run.json")
+    assert record.labels["assembly_run_id"] == case.assembly.run_id
+    assert "fill" not in record.stages and "settle" not in record.stages
+    flat = read_run_record(workdir / run_dir("silo_flat", case.assembly.run_id) / "run.json")
+    log = (runs["blending"] / "log.liggghts").read_text()
+    assembled = next(line for line in log.splitlines() if line.startswith("SILOFLOW assembled"))
+    assert f"clumps={flat.n_clumps} " in assembled
+    assert float(assembled.split("ke_per_clump=")[1].split()[0]) == flat.stage("settle")["ke_per_clump"]
+    assert record.n_clumps == flat.n_clumps and record.open_step == 0
+    deck = (runs["blending"] / "deck" / "in.liggghts").read_text()
+    assert "fix pour" not in deck and "read_restart deck/assembly.restart" in deck
 
 
 def test_clump_count_is_conserved_over_more_than_one_recirculation(blending_pipeline):
@@ -254,12 +279,15 @@ def test_the_recirculation_notebook_runs_on_the_tiny_run_and_its_checks_hold(ble
 
 def test_validation_rows_of_the_real_run_carry_errors_and_both_verdicts(blending_pipeline):
     """The validation table's recirculation rows from the run's own files: each judged against a finding of ch. 6;
-    a 12 mm deep silo (3.6 particle diameters) is not at the study's scale, whatever its figures; the fill dilates
-    while it flows, and the drop has an error."""
+    a 12 mm deep silo (3.6 particle diameters) is not at the study's scale, whatever its figures; the drop of the
+    flowing bulk density from the settled one has an error. (Its sign is the run's: a fill settled at the flat-bottom
+    silo's frictions may compact once the flow pattern's lower ones are switched on.)"""
     _, runs, _ = blending_pipeline
     run = runs["blending"]
     summary = json.loads((run / "metrics" / "blending.json").read_text())
-    assert summary["settled_bulk_density_kg_m3"] > summary["flowing_bulk_density_kg_m3"] > 0.0
+    settled, flowing = summary["settled_bulk_density_kg_m3"], summary["flowing_bulk_density_kg_m3"]
+    assert settled > 0.0 and flowing > 0.0
+    assert summary["bulk_density_drop"] == pytest.approx(1.0 - flowing / settled, rel=1e-12)
     assert summary["bulk_density_drop_error"] > 0.0
     case = json.loads((run / "deck" / "case.json").read_text())
     rows = recirculation_rows([{"case": case, "summary": summary, "rtd": read_table(run / "metrics" / "rtd.csv"),

@@ -77,7 +77,7 @@ def test_the_validation_config_s_runs_fall_into_their_groups():
     # 8 sphere2 internal + 8 aluminium + 2 more seeds of its reference point; 8 sphere + 8 sphere4 + 2 more seeds of
     # each one's; 4 blocked + 4 servo + 1 restitution + 2 other speeds + 3 poured at their own friction (not 0.1)
     assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 14, "silo": 3,
-                      "silo_series": 4, "blending": 5, "blender": 7}
+                      "silo_series": 4, "blending": 4, "blender": 7}
 
 
 def test_an_unknown_group_is_refused_with_the_groups_named():
@@ -142,7 +142,8 @@ def test_status_is_complete_stale_or_missing_against_the_plan():
     roles = {"j1": CALIBRATION_CHART, "j2": CALIBRATION_CHART, "s1": REFERENCE, "r1": REFERENCE, "b1": REFERENCE}
     planned = planned_runs(assign(estimates, roles))
     # no front-wall series: no series group
-    assert planned == {"calibration": {"j1", "j2"}, "silo": {"s1"}, "blending": {"r1"}, "blender": {"b1"}}
+    # the blending study's rows draw on the flat-bottom silo's base runs, whose settled fills its runs start from
+    assert planned == {"calibration": {"j1", "j2"}, "silo": {"s1"}, "blending": {"r1", "s1"}, "blender": {"b1"}}
     series = planned_runs(assign([*estimates, _estimate("v1", "silo_flat", 1.0)], {**roles, "v1": VARIANT}))
     # the series' rows draw on the base run too: its record holds both
     assert series["silo_series"] == {"v1", "s1"} and series["silo"] == {"s1"}
@@ -155,7 +156,7 @@ def test_status_is_complete_stale_or_missing_against_the_plan():
     lines = status_lines(planned, recorded)
     assert lines[0].split() == ["calibration", "complete", "2", "of", "2", "planned", "runs", "recorded"]
     assert lines[1].endswith("recorded but no longer planned: s0; planned but not recorded: s1")
-    assert lines[2].endswith("recorded but no longer planned: r2; planned but not recorded: none")
+    assert lines[2].endswith("recorded but no longer planned: r2; planned but not recorded: s1")
     assert lines[3].split()[:2] == ["blender", "missing"]
 
 
@@ -196,15 +197,18 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
 
 def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "blender", "--config", config, "--record", str(tmp_path)]) == 0
     assert record_main(["check", "--group", "silos", "--config", config, "--record", str(tmp_path)]) == 2
     assert "unknown validation group 'silos'; this configuration's groups and parts are calibration, " in (
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("runs in 5 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
-            "GROUP=blending_3 then make validate GROUP=blending_4 then make validate GROUP=blending_5"
-            in capsys.readouterr().err)
+    assert ("runs in 4 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
+            "GROUP=blending_3 then make validate GROUP=blending_4" in capsys.readouterr().err)
+    # the blending study starts from the flat-bottom silo's settled fills: it waits for that silo's record
+    assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 2
+    assert "compares against the runs of silo, whose record is missing: run make validate GROUP=silo first" in (
+        capsys.readouterr().err)
     assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
 

@@ -149,9 +149,9 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
     raw = load_config_file(REPO_ROOT / "config" / "validation.yaml")
     config = tmp_path / "validation_pdf.yaml"
     config.write_text(yaml.safe_dump({**raw, "plots": {"format": "pdf"}}, sort_keys=False))
-    assert record_main(["check", "--group", "blending_1", "--config", str(config), "--record", str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "blender", "--config", str(config), "--record", str(tmp_path)]) == 2
     assert re.search(message, capsys.readouterr().err)
-    assert record_main(["check", "--group", "blending_1", "--config", str(REPO_ROOT / "config" / "validation.yaml"), "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "blender", "--config", str(REPO_ROOT / "config" / "validation.yaml"), "--record", str(tmp_path)]) == 0
 
 
 def test_a_table_without_the_validation_columns_is_refused(tmp_path):

@@ -39,6 +39,7 @@ def blender_deck_context(case: BlenderCase) -> dict:
             "open_floor": walls,
             "gate_mesh": GATE,
             "continuous": case.mode == "continuous",
+            "assembly_restart": None,   # no run starts from a blender's fill
         }
     )
     context["processors"] = processor_grid(context["domain"])

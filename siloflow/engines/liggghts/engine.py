@@ -41,7 +41,7 @@ from siloflow.engines.liggghts.jenike import (
     write_jenike_inputs,
 )
 from siloflow.engines.liggghts.cost import elapsed_seconds, measured_work as work_from_logs
-from siloflow.engines.liggghts.run import CONTACT_PREFIX, DUMP_PREFIX, attempt_logs, check_programs
+from siloflow.engines.liggghts.run import ASSEMBLY_RESTART, CONTACT_PREFIX, DUMP_PREFIX, attempt_logs, check_programs
 from siloflow.engines.liggghts.settled import read_settled_fill
 from siloflow.model.cases.silo_flat import FLOOR_MESHES
 from siloflow.engines.liggghts.silo_flat import run_silo, write_silo_inputs
@@ -156,8 +156,11 @@ class LiggghtsEngine(Engine):
         check_programs(str(dict(options.settings or {}).get("executable", "liggghts")), options.mpi_ranks,
                        options.mpirun)
 
-    def write_inputs(self, case, run_dir: str | Path) -> Path:
+    assembly_file = ASSEMBLY_RESTART
+
+    def write_inputs(self, case, run_dir: str | Path, assembly_dir: str | Path | None = None) -> Path:
         self.check_case(case)
+        self.place_assembly(case, run_dir, assembly_dir)
         _adapter(case)[1].write(case, Path(run_dir) / "deck")
         return Path(run_dir) / CASE_SUMMARY
 

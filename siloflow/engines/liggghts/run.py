@@ -115,7 +115,10 @@ def _mpi_environment() -> dict:
 
 #: The force history of the walls the silo-type decks write (read by :mod:`siloflow.engines.liggghts.forces`).
 WALL_FORCES_NAME = "wall_forces.txt"
-RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart", WALL_FORCES_NAME)
+#: The settled fill of a flat-bottom silo run, which the recirculating silo's runs start from (its restart file, in the
+#: run's folder); a run that starts from it reads its copy in ``deck/``.
+ASSEMBLY_RESTART = "assembly.restart"
+RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart", WALL_FORCES_NAME, ASSEMBLY_RESTART)
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:

@@ -13,13 +13,14 @@ from siloflow.engines.liggghts.contacts import N_COLUMNS as N_CONTACT_COLUMNS
 from siloflow.engines.liggghts.inputs import (ENGINE_NAME, common_context, contact_coefficients, processor_grid,
                                              write_case_inputs)
 from siloflow.engines.liggghts.forces import RESUMED_WALL_FORCES_PREFIX
-from siloflow.engines.liggghts.run import WALL_FORCES_NAME
 from siloflow.engines.liggghts.run import (
+    ASSEMBLY_RESTART,
     CONTACT_PREFIX,
     DUMP_PREFIX,
     RESTART_DIR,
     RESTART_PREFIX,
     Resume,
+    WALL_FORCES_NAME,
     restart_every,
     run_checked,
     settled_fill_context,
@@ -94,6 +95,8 @@ def silo_deck_context(case: SiloCase) -> dict:
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
             "thermo_every": dump_every,
+            # the settled fill, kept for the runs that start from it (the recirculating silo's; the others set None)
+            "assembly_restart": ASSEMBLY_RESTART,
             # force and torque of every wall on the particles, one sample per dump interval (siloflow.engines.liggghts.forces)
             "wall_forces": {"every": dump_every, "timestep": case.timestep, "path": WALL_FORCES_NAME,
                             "resume_prefix": RESUMED_WALL_FORCES_PREFIX},

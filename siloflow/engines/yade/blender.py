@@ -39,6 +39,7 @@ def blender_script_context(case: BlenderCase) -> dict:
         "gate_mesh": GATE,
         "continuous": case.mode == "continuous",
         "reentry_every": REENTRY_EVERY,
+        "assembly_state": None,   # no run starts from a blender's fill
     })
     return context
 

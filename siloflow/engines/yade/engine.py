@@ -30,7 +30,8 @@ from siloflow.engines.yade.blender import run_blender, write_blender_inputs
 from siloflow.engines.yade.inputs import ENGINE_NAME
 from siloflow.engines.yade.jenike import FORCES_NAME, check_jenike_case, jenike_contacts, run_jenike, write_jenike_inputs
 from siloflow.engines.yade.outputs import read_frames, read_settled_fill, read_wall_forces
-from siloflow.engines.yade.run import DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs, check_programs
+from siloflow.engines.yade.run import (ASSEMBLY_STATE, DUMP_PREFIX, SETTLED_FILL_PREFIX, YadeOptions, attempt_logs,
+                                      check_programs)
 from siloflow.engines.yade.silo_flat import check_silo_case, run_silo, write_silo_inputs
 from siloflow.engines.yade.silo_recirculation import run_recirculation, write_recirculation_inputs
 from siloflow.engines.yade.verification import run_verification, write_verification_inputs
@@ -97,8 +98,11 @@ class YadeEngine(Engine):
     def check_installed(self, options: EngineOptions) -> None:
         check_programs(options_from(options))
 
-    def write_inputs(self, case, run_dir: str | Path) -> Path:
+    assembly_file = ASSEMBLY_STATE
+
+    def write_inputs(self, case, run_dir: str | Path, assembly_dir: str | Path | None = None) -> Path:
         self.check_case(case)
+        self.place_assembly(case, run_dir, assembly_dir)
         _adapter(case).write(case, Path(run_dir) / "deck")
         return Path(run_dir) / CASE_SUMMARY
 

@@ -46,7 +46,10 @@ SETTLED_FILL_PREFIX = "settled_fill"
 WALL_FORCES_NAME = "wall_force_history.txt"
 RESTART_DIR = "restart"
 RESUME_STEM = "resume"
-RUN_OUTPUTS = ("dumps", LOG_NAME, RESTART_DIR, WALL_FORCES_NAME)
+#: The settled fill of a flat-bottom silo run, which the recirculating silo's runs start from (YADE's saved scene, in
+#: the run's folder); a run that starts from it loads its copy in ``deck/``.
+ASSEMBLY_STATE = "assembly.yade"
+RUN_OUTPUTS = ("dumps", LOG_NAME, RESTART_DIR, WALL_FORCES_NAME, ASSEMBLY_STATE)
 #: Where Debian's libyade keeps YADE's Python modules (the scripts put it on sys.path).
 YADE_PYTHON_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"
 _RESTART = re.compile(r"^state_(\d+)\.yade$")

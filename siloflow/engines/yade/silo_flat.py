@@ -18,7 +18,7 @@ from siloflow.engines.yade.inputs import (
     ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, materials_context, rolling_friction, write_script_inputs,
 )
 from siloflow.engines.yade.run import (
-    DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
+    ASSEMBLY_STATE, DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
 )
 
 #: Restart snapshots per discharge: a killed run loses at most 1/20 of it.
@@ -87,6 +87,10 @@ def silo_script_context(case: SiloCase, gravity: float = GRAVITY) -> dict:
         "sample_every": case.dump_every,
         "restart_every": max(1, -(-case.discharge_steps // RESTARTS_PER_STAGE)),
         "wall_forces_path": WALL_FORCES_NAME,
+        # the settled fill, kept for the runs that start from it (the recirculating silo's; the others set None), and
+        # the assembly a run starts from (None: it pours its own)
+        "assembly_state": ASSEMBLY_STATE,
+        "assembly": None,
         "paths": {"dumps": DUMP_PREFIX, "settled": SETTLED_FILL_PREFIX, "restart": RESTART_DIR,
                   "resume_stem": RESUME_STEM},
     })
@@ -106,13 +110,14 @@ def write_silo_inputs(case: SiloCase, deck_dir: str | Path) -> Path:
 
 def run_silo_type(silo: SiloCase, case_kind: str, run_id: str, run_dir: str | Path, options: YadeOptions,
                   last_stage: str = "discharged", clumps_conserved: bool = False, labels: dict | None = None,
-                  domain_z: list | None = None, then: str | None = None) -> RunRecord:
+                  domain_z: list | None = None, then: str | None = None, assembled: bool = False) -> RunRecord:
     """Run a rendered silo-type script (flat-bottom, recirculating, blender), check it as every engine's silo-type
-    runs are (:func:`siloflow.engines.silo_checks.check_silo_run`) and write ``run.json``; returns the record."""
+    runs are (:func:`siloflow.engines.silo_checks.check_silo_run`; ``assembled``: it started from another run's
+    settled fill) and write ``run.json``; returns the record."""
     return run_script_checked(
-        run_dir, options, expected_simulated_time(silo),
+        run_dir, options, expected_simulated_time(silo, assembled),
         lambda markers, dumps: check_silo_run(silo, markers, dumps, Path(run_dir), last_stage=last_stage,
-                                              clumps_conserved=clumps_conserved, then=then),
+                                              clumps_conserved=clumps_conserved, then=then, assembled=assembled),
         lambda checked: silo_run_record(ENGINE_NAME, case_kind, run_id, checked, labels, domain_z),
     )
 

@@ -13,10 +13,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from siloflow.model.record import RunRecord
-from siloflow.model.cases.silo_recirculation import RecirculationCase, recirculation_meshes
+from siloflow.model.cases.silo_recirculation import CHANNEL_MESHES, RecirculationCase, recirculation_meshes
+from siloflow.engines.silo_checks import recirculation_labels
 from siloflow.engines.templating import render_deck
 from siloflow.engines.yade.inputs import write_script_inputs
-from siloflow.engines.yade.run import YadeOptions
+from siloflow.engines.yade.run import ASSEMBLY_STATE, YadeOptions
 from siloflow.engines.yade.silo_flat import check_silo_case, run_silo_type, silo_script_context
 
 __all__ = ["FEEDER_EVERY", "recirculation_script_context", "render_recirculation_script", "run_recirculation",
@@ -40,7 +41,13 @@ def recirculation_script_context(case: RecirculationCase) -> dict:
         "discharge": {**context["discharge"], "stage": "recirculate",
                       "marker": "discharged" if case.final_discharge_steps else "recirculated"},
         "final_discharge_steps": case.final_discharge_steps,
+        "assembly_state": None,   # its own fill serves no other run
     })
+    if case.assembly is not None:
+        # the scene is built as the assembly's run built it (so its walls keep their ids), the channel added once loaded
+        added = [mesh for mesh in context["meshes"] if mesh["id"] in CHANNEL_MESHES]
+        context["meshes"] = [mesh for mesh in context["meshes"] if mesh["id"] not in CHANNEL_MESHES]
+        context["assembly"] = {"state_file": f"deck/{ASSEMBLY_STATE}", "added_meshes": added}
     return context
 
 
@@ -61,6 +68,5 @@ def run_recirculation(case: RecirculationCase, run_dir: str | Path, options: Yad
     record."""
     return run_silo_type(case.silo, "silo_recirculation", case.run_id, run_dir, options, last_stage="recirculated",
                          clumps_conserved=True, then="discharged" if case.final_discharge_steps else None,
-                         labels={"flow_pattern": case.pattern, "role": case.role,
-                                 "estimated_residence_time_s": case.estimated_residence_time},
-                         domain_z=[-case.channel_length, case.silo.domain_top])
+                         labels=recirculation_labels(case), domain_z=[-case.channel_length, case.silo.domain_top],
+                         assembled=case.assembly is not None)

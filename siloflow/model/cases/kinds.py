@@ -26,8 +26,8 @@ from siloflow.model.cases.jenike_cost import estimate_jenike_case
 from siloflow.model.cases.jenike_sweep import check_jenike_config, jenike_run_role
 from siloflow.model.cases.silo_cost import estimate_blender_case, estimate_recirculation_case, estimate_silo_case
 from siloflow.model.cases.silo_flat import SiloCase, check_silo_config, silo_cases, silo_meshes
-from siloflow.model.cases.silo_recirculation import (RecirculationCase, check_recirculation_config, recirculation_cases,
-                                            recirculation_meshes)
+from siloflow.model.cases.silo_recirculation import (ASSEMBLY_STAGES, RecirculationCase, check_recirculation_config,
+                                                     recirculation_cases, recirculation_meshes)
 from siloflow.model.cases.verification import VerificationCase
 
 __all__ = ["CASE_KINDS", "CaseKind", "SCHEMA_FRAGMENTS", "case_kind", "configured_kinds", "kind_of_case",
@@ -54,6 +54,9 @@ class CaseKind:
     final_stages : tuple of str
         Stage kinds a run may add after ``stages``, all or none (the recirculating silo's discharge after its
         recirculations).
+    assembled_stages : tuple of str
+        Stage kinds a run leaves out when it starts from another run's settled fill (the recirculating silo from the
+        flat-bottom silo's assembly); empty: its runs make their own.
     build : callable or None
         ``build(config) -> {run id: case}`` from a validated configuration, the reference configuration first;
         None for a kind no config section defines (the verification suite builds its own problems).
@@ -97,11 +100,15 @@ class CaseKind:
     rules: str | None = None
     walls: Callable[[object], dict] | None = None
     final_stages: tuple[str, ...] = ()
+    assembled_stages: tuple[str, ...] = ()
 
     def runs_stages(self, kinds: tuple[str, ...]) -> bool:
         """Whether ``kinds`` is a stage sequence this kind's decks run: ``stages``, or ``stages`` then
-        ``final_stages``."""
-        return tuple(kinds) in (self.stages, self.stages + self.final_stages)
+        ``final_stages``; for a kind with ``assembled_stages``, either without those (a run that starts from another
+        run's settled fill)."""
+        full = (self.stages, self.stages + self.final_stages)
+        assembled = tuple(tuple(kind for kind in stages if kind not in self.assembled_stages) for stages in full)
+        return tuple(kinds) in full + (assembled if self.assembled_stages else ())
 
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or not self.name.islower():
@@ -160,7 +167,8 @@ register_case_kind(CaseKind(
     "silo_recirculation", RecirculationCase, "silo_recirculation", ("fill", "settle", "open", "recirculate"),
     recirculation_cases, estimate_recirculation_case, SCHEMA_FRAGMENTS / "silo_recirculation.schema.yaml",
     inherits_defaults=True, replicated=True, fill_balance=True, check_config=check_recirculation_config,
-    rules="silo_recirculation.smk", walls=recirculation_meshes, final_stages=("discharge",)))
+    rules="silo_recirculation.smk", walls=recirculation_meshes, final_stages=("discharge",),
+    assembled_stages=ASSEMBLY_STAGES))
 register_case_kind(CaseKind(
     "blender", BlenderCase, "blender", ("fill", "settle", "open", "discharge"), blender_cases, estimate_blender_case,
     SCHEMA_FRAGMENTS / "blender.schema.yaml", inherits_defaults=True, replicated=True, fill_balance=True,

@@ -10,7 +10,7 @@ import math
 
 from siloflow.model.cases.blender import BlenderCase
 from siloflow.model.cases.silo_flat import SiloCase
-from siloflow.model.cases.silo_recirculation import RecirculationCase
+from siloflow.model.cases.silo_recirculation import ASSEMBLY_STAGES, RecirculationCase
 from siloflow.model.cost import (CostModel, RunEstimate, StageWork, is_finite, beverloo_clump_rate, drain_sphere_steps,
                         dump_frames, estimate_run, pour_sphere_steps)
 
@@ -146,8 +146,11 @@ def estimate_recirculation_case(
     case: RecirculationCase, mpi_ranks: int = 1, model: CostModel = CostModel()
 ) -> RunEstimate:
     """Estimate a recirculating-silo run of the blending study: its silo's discharge is the recirculation, whose
-    clumps re-enter at the top, so the count holds."""
+    clumps re-enter at the top, so the count holds. A run that starts from another run's settled fill (its
+    ``assembly``) neither pours nor settles: that run's estimate counts them."""
     stages = silo_stage_work(case.silo, model.settle_fraction, "recirculate")
+    if case.assembly is not None:
+        stages = tuple(stage for stage in stages if stage.stage not in ASSEMBLY_STAGES)
     return _estimate_silo_deck(case.run_id, "silo_recirculation", case.silo, mpi_ranks, model, stages)
 
 

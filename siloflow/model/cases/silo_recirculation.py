@@ -6,8 +6,9 @@ In the lower half of the channel a feeder holds the clumps at the downward veloc
 periodic in z: a clump leaving the bottom z = -L re-enters at the top of the domain (above the pile) and falls
 back onto it, so the silo is fed with its own outflow (thesis ch. 6).
 
-Stages: pour and settle exactly as the batch silo (the gate closes the outlet, the channel is empty), open the
-outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times
+Stages: pour and settle exactly as the batch silo (the gate closes the outlet, the channel is empty), or, with
+``assembly: silo_flat`` (the study's procedure, §6.2.2), start from the settled fill of the flat-bottom silo's
+reference run with the same seed, the assembly that silo discharges; open the outlet and switch the feeder on, recirculate for ``recirculations`` a-priori mean residence times
 (:func:`estimated_residence_time`); then, with ``final_discharge`` > 0, discharge for that many more: the re-entry
 stops and a clump leaving the channel bottom is gone, the study's discharge after Nr recirculations (§6.4.2).
 
@@ -24,10 +25,10 @@ from typing import Mapping
 import copy
 from dataclasses import dataclass, field
 
-from siloflow.model.cases.common import run_id
+from siloflow.model.cases.common import engine_kind, run_id, without_fill_checks
 from siloflow.model.cases.config_checks import ConfigError, require
 from siloflow.model.cases.geometry import vertical_rectangle_x
-from siloflow.model.cases.silo_flat import SiloCase, silo_case_from_section, silo_meshes
+from siloflow.model.cases.silo_flat import SiloCase, build_silo_case, silo_case_from_section, silo_meshes
 from siloflow.model.cases.stages import Stage
 
 CASE_NAME = "silo_recirculation"
@@ -44,6 +45,18 @@ CHANNEL_MESHES = ("channel_left", "channel_right")
 
 #: Roles of a recirculation run: the blending study proper, or the one-particle-thick verification silo.
 ROLES = ("blending", "verification")
+
+#: Where a blending run's settled fill comes from (``silo_recirculation.assembly``): its own pour, or the flat-bottom
+#: silo's reference run with the same seed (the study's one assembly, §6.2.2, §6.4).
+OWN_ASSEMBLY, FLAT_SILO_ASSEMBLY = "own", "silo_flat"
+
+#: The keys a recirculating silo that starts from the flat-bottom silo's assembly shares with it: its geometry and
+#: everything its fill is made of. Its contacts, time step, dumps and run length stay its own.
+ASSEMBLY_KEYS = ("width", "depth", "fill_height", "outlet_width", "particle_model", "particle_material",
+                 "wall_materials", "fill", "settle", "seed")
+
+#: The stages a run that starts from another run's settled fill does not run.
+ASSEMBLY_STAGES = ("fill", "settle")
 
 
 @dataclass(frozen=True)
@@ -71,6 +84,9 @@ class RecirculationCase:
         Simulated time of the recirculation stage (s): from the opening to the end of the re-entry.
     final_discharge_time : float
         Simulated time of the discharge after the recirculations (s); 0 when the run ends recirculating.
+    assembly : SiloCase or None
+        The flat-bottom silo run whose settled fill this run starts from (``assembly: silo_flat``); None: the run
+        pours and settles its own.
     """
 
     pattern: str
@@ -83,6 +99,7 @@ class RecirculationCase:
     recirculation_time: float
     defining_parameters: dict = field(repr=False)
     final_discharge_time: float = 0.0
+    assembly: SiloCase | None = None
 
     @property
     def fill_height(self) -> float:
@@ -127,8 +144,10 @@ class RecirculationCase:
 
     def stages(self):
         """The batch silo's stages, its last one recirculating (:meth:`SiloCase.stages`), then the discharge after
-        the recirculations where there is one."""
+        the recirculations where there is one; without fill and settle when the run starts from an assembly."""
         stages = self.silo.stages(last="recirculate")
+        if self.assembly is not None:
+            stages = tuple(stage for stage in stages if stage.kind not in ASSEMBLY_STAGES)
         if not self.final_discharge_steps:
             return stages
         *before, recirculate = stages
@@ -155,6 +174,7 @@ class RecirculationCase:
                 "recirculation_time_s": self.recirculation_time,
                 "final_discharge_time_s": self.final_discharge_time,
                 "domain_z": list(self.domain_z),
+                "assembly_run_id": self.assembly.run_id if self.assembly is not None else None,
                 "parameters": self.defining_parameters,
             }
         )
@@ -250,6 +270,9 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         geometry["width"], geometry["fill_height"], section["outlet_width"], section["feeder_velocity"],
         section["channel_density_ratio"],
     )
+    # the study's one assembly (§6.2.2): the flat-bottom silo's reference run with this seed, whose geometry and fill
+    # check_recirculation_config has found equal to this section's
+    assembly = flat_silo_assembly(config) if role == "blending" and section["assembly"] == FLAT_SILO_ASSEMBLY else None
     changed = apply_flow_pattern(config, section["presets"][pattern], SECTION)
     silo = {key: copy.deepcopy(changed[SECTION][key]) for key in SILO_KEYS}
     silo.update(
@@ -274,6 +297,11 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         "channel_length": channel,
         "feeder_velocity": section["feeder_velocity"],
     }
+    if assembly is not None:
+        if assembly.fill.n_clumps != silo_case.fill.n_clumps:
+            raise ValueError(f"the flat-bottom silo's assembly holds {assembly.fill.n_clumps} clumps, the recirculating "
+                             f"silo's fill plan {silo_case.fill.n_clumps}: their fills differ")
+        defining["assembly"] = assembly.run_id
     timestep = silo_case.timestep
     final_steps = int(round(final_discharge * t_res / timestep))
     if final_steps:
@@ -290,7 +318,17 @@ def build_recirculation_case(config: dict, pattern: str, role: str = "blending")
         recirculation_time=(silo_case.discharge_steps - final_steps) * timestep,
         defining_parameters=defining,
         final_discharge_time=final_steps * timestep,
+        assembly=assembly,
     )
+
+
+def flat_silo_assembly(config: dict) -> SiloCase:
+    """The flat-bottom silo run whose settled fill a blending run of ``config`` starts from: the flat-bottom silo's
+    reference configuration (its base run) with the recirculating silo's seed, so that each replicate of a flow
+    pattern starts from its own fill and every flow pattern of one seed from the same one."""
+    reseeded = copy.deepcopy(config)
+    reseeded["silo_flat"]["seed"] = config[SECTION]["seed"]
+    return build_silo_case(reseeded)
 
 
 def recirculation_cases(config: dict) -> dict[str, RecirculationCase]:
@@ -324,3 +362,43 @@ def check_recirculation_config(config: Mapping, contact_pairs: Mapping) -> None:
     if not low < high:
         raise ConfigError(f"config key 'silo_recirculation.bulk_density_slab': {[low, high]} must be an increasing "
                           "pair of fractions of fill_height")
+    if blending["assembly"] == FLAT_SILO_ASSEMBLY and blending["enabled"]:
+        check_shared_assembly(config)
+
+
+def _replicate_count(section: Mapping) -> int:
+    return max(section["replicates"], section["reference_replicates"])
+
+
+def check_shared_assembly(config: Mapping) -> None:
+    """With ``silo_recirculation.assembly: silo_flat``, the recirculating silo must be the flat-bottom silo whose
+    settled fills it starts from: equal :data:`ASSEMBLY_KEYS`, front and back walls, one engine, and its reference
+    flow pattern's seeds among the flat-bottom silo's reference seeds.
+
+    Raises
+    ------
+    ConfigError
+        Naming the first key that differs and both values.
+    """
+    blending, flat = config[SECTION], config["silo_flat"]
+    reason = ("with silo_recirculation.assembly: silo_flat every flow pattern starts from the flat-bottom silo's "
+              "settled fill, so the recirculating silo is that silo")
+    for key in ASSEMBLY_KEYS:
+        mine, theirs = blending[key], flat[key]
+        if key == "fill":
+            mine, theirs = without_fill_checks({"fill": mine})["fill"], without_fill_checks({"fill": theirs})["fill"]
+        if mine != theirs:
+            raise ConfigError(f"config key 'silo_recirculation.{key}': {blending[key]!r} differs from silo_flat.{key} "
+                              f"({flat[key]!r}); {reason}: set them equal, or silo_recirculation.assembly: own")
+    if not flat["front_back_walls"]:
+        raise ConfigError(f"config key 'silo_flat.front_back_walls': false; {reason}, which has front and back walls")
+    engines = engine_kind(config, SECTION), engine_kind(config, "silo_flat")
+    if engines[0] != engines[1]:
+        raise ConfigError(f"config key 'silo_recirculation.engine': {engines[0]} differs from the flat-bottom silo's "
+                          f"engine ({engines[1]}); {reason}, whose settled fill only its own engine can read")
+    if _replicate_count(blending) > _replicate_count(flat):
+        raise ConfigError(
+            f"config key 'silo_recirculation.reference_replicates': the reference flow pattern runs "
+            f"{_replicate_count(blending)} seeds, the flat-bottom silo's reference {_replicate_count(flat)} "
+            "(silo_flat.replicates, silo_flat.reference_replicates); each seed starts from the flat-bottom silo's fill "
+            "of that seed: run as many seeds of the flat-bottom silo")

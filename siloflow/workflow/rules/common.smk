@@ -146,6 +146,23 @@ def run_ids(kind):
     return list(cases(kind))
 
 
+def settled_runs(kind):
+    """Run ids of case ``kind`` that pour and settle their own fill (not those that start from another run's, whose
+    settled fill is that run's)."""
+    return [run for run, case in cases(kind).items() if getattr(case, "assembly", None) is None]
+
+
+def settled_fill_record(kind):
+    """The input function of a step that reads a run's settled fill: the record of the run that settled it, the run's
+    own or, for a run that starts from another run's settled fill (its ``assembly``), that run's."""
+    def record(wildcards):
+        assembly = getattr(cases(kind)[wildcards.run], "assembly", None)
+        if assembly is None:
+            return run_path(kind, RUN_RECORD, run=wildcards.run)
+        return run_path("silo_flat", RUN_RECORD, run=assembly.run_id)
+    return record
+
+
 def among(found, runs):
     """The run ids of ``found`` that are in ``runs`` (all of them when ``runs`` is None), in ``found``'s order."""
     return list(found) if runs is None else [run for run in found if run in runs]

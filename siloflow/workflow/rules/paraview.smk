@@ -76,7 +76,8 @@ for _kind in PARAVIEW_LINES:
         name:
             f"{_kind}_paraview_force_chains"
         input:
-            record=run_rule_output(_kind),
+            # the settled fill's run: a run that starts from another run's settled fill shows that one's chains
+            record=settled_fill_record(_kind),
         output:
             chains=paraview_path(_kind, "force_chains.vtp"),
         log:

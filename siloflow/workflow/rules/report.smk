@@ -12,7 +12,7 @@ rule report_summary:
         blender=lambda wildcards: [f"{case_root('blender')}/comparison/configurations.csv"] if blender_runs() else [],
         blender_differences=lambda wildcards: [f"{case_root('blender')}/comparison/significance.csv"] if blender_runs() else [],
         balances=lambda wildcards: [run_path(kind, "metrics/fill_balance.json", run)
-                                    for kind in FILL_BALANCE_CASES for run in run_ids(kind)],
+                                    for kind in FILL_BALANCE_CASES for run in settled_runs(kind)],
         validation=rules.validation_table.output.table,
     output:
         page=report(f"{SUMMARY_DIR}/summary.html", caption="../report/summary.rst", category="0 Summary",

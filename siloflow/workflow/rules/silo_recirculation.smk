@@ -20,11 +20,14 @@ def recirculation_targets(wildcards=None, runs=None):
     targets = [
         run_path(RECIRCULATION, name, run)
         for run in blending
-        for name in ("metrics/blending.json", "metrics/fill_balance.json",
+        for name in ("metrics/blending.json",
                      *(plot_file(f"plots/{plot}") for plot in ("concentration", "vrr", "rtd", "lti", "vrr_period",
                                                                "recirculation_model")),
                      "plots/snapshots")
     ]
+    # a run that starts from the flat-bottom silo's assembly has that run's settled fill and balance
+    targets += [run_path(RECIRCULATION, "metrics/fill_balance.json", run) for run in blending
+                if run in settled_runs(RECIRCULATION)]
     if shortcut_measured():
         targets += [run_path(RECIRCULATION, name, run) for run in blending
                     for name in ("metrics/shortcut.csv", plot_file("plots/shortcut"))]
@@ -43,7 +46,16 @@ def recirculation_targets(wildcards=None, runs=None):
 CASE_TARGETS[RECIRCULATION] = recirculation_targets
 
 
+def recirculation_assembly(wildcards):
+    """The record of the flat-bottom silo run whose settled fill a blending run starts from (its folder keeps the
+    fill); none for a run that pours its own."""
+    assembly = cases(RECIRCULATION)[wildcards.run].assembly
+    return run_path("silo_flat", RUN_RECORD, run=assembly.run_id) if assembly is not None else []
+
+
 rule silo_recirculation_deck:
+    input:
+        assembly=recirculation_assembly,
     output:
         case=deck_rule_output(RECIRCULATION),
     params:
