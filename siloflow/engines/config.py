@@ -463,9 +463,9 @@ def _check_references(config: dict) -> None:
 
 
 def _check_bayesian(config: Mapping) -> None:
-    """The Bayesian calibration's priors have a box with their mean inside, both or neither of mean and sd; its
-    walkers are at least twice its parameters; its budget holds the first design, its replicates and the predictive
-    draws; its engines are engines siloflow has."""
+    """The Bayesian calibration's priors have a box with their mean inside, both or neither of mean and sd; each of
+    its targets has a standard error; its walkers are at least twice its parameters; its budget holds the first
+    design, its replicates and the predictive draws; its engines are engines siloflow has."""
     settings = config["calibration"]["bayesian"]
     key = "calibration.bayesian"
     for name, prior in settings["priors"].items():
@@ -478,8 +478,13 @@ def _check_bayesian(config: Mapping) -> None:
         if prior["mean"] is not None and not prior["lower"] <= prior["mean"] <= prior["upper"]:
             raise ConfigError(f"config key '{key}.priors.{name}.mean': {prior['mean']} lies outside the bounds "
                               f"[{prior['lower']}, {prior['upper']}]")
-    walls = [test for test in config["calibration"]["targets_deg"]
-             if test != "internal" and test in config["jenike"]["sweep"]["tests"]]
+    used = [test for test in config["calibration"]["targets_deg"] if test in config["jenike"]["sweep"]["tests"]]
+    missing = [test for test in used if test not in config["calibration"]["target_sd_deg"]]
+    if missing:
+        raise ConfigError(f"config key 'calibration.target_sd_deg': no standard error for the target(s) "
+                          f"{', '.join(missing)}, which the Bayesian calibration fits (calibration.targets_deg); give "
+                          "each the standard error of its measured mean (deg)")
+    walls = [test for test in used if test != "internal"]
     held = settings["fixed"]
     parameters = ((held["sliding_friction"] is None) + (held["rolling_friction"] is None)
                   + (len(walls) if held["wall_sliding_friction"] is None else 0))

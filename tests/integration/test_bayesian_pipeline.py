@@ -26,6 +26,7 @@ TINY_BAYESIAN = {
         "targets_deg": {"internal": 24.0}, "tolerance_deg": 1.0, "shape": "sphere", "rolling_friction": 0.1,
         "bayesian": {"engines": ["liggghts", "yade"], "initial_sets": 3, "replicates": 2, "sets_per_iteration": 1,
                      "max_iterations": 1, "max_sets": 6, "predictive_draws": 1, "walkers": 8, "steps": 400,
+                     "max_steps": 400,
                      "stop_shift": 0.001, "compare_with_chart": False,
                      "twin": {"enabled": True, "truth": {"sliding_friction": 0.3, "rolling_friction": 0.1},
                               "replicates": 2},
@@ -73,15 +74,22 @@ def calibrated_on_both(tmp_path_factory):
 def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(request, engine):
     folder = request.getfixturevalue("calibrated" if engine == "liggghts" else "calibrated_on_both") / engine
     first = json.loads((folder / "iteration_0" / "design.json").read_text())
-    assert len(first["sets"]) == 4 and [s["replicate"] for s in first["sets"]] == [0, 0, 0, 1]
+    # every set on its own seed; the first set repeated
+    assert len(first["sets"]) == 4 and [s["replicate"] for s in first["sets"]] == [0, 1, 2, 3]
     assert first["sets"][3]["theta"] == first["sets"][0]["theta"]
     second = json.loads((folder / "iteration_1" / "design.json").read_text())
-    assert len(second["sets"]) == 1  # the budget: 6 sets less the predictive draw, 4 done
+    # the budget: 6 sets less the predictive draw, 4 done: one, at the posterior's mode
+    assert len(second["sets"]) == 1 and second["sets"][0]["replicate"] == 4
     stopped = json.loads((folder / "iteration_2" / "design.json").read_text())
     assert stopped["stopped"] and stopped["sets"] == []
     posterior = json.loads((folder / "posterior.json").read_text())
     assert posterior["iteration"] == 1 and posterior["sets"] == 5
-    assert posterior["seed_noise_degrees_of_freedom"] == 1 and posterior["seed_sd_deg"]["internal"] >= 0
+    # the first set's replicate and the twin's second run at the truth: two degrees of freedom
+    assert posterior["seed_noise_degrees_of_freedom"] == 2 and posterior["seed_sd_deg"]["internal"] >= 0
+    assert posterior["surrogates"]["internal"]["inputs"] == ["sliding_friction", "rolling_friction"]
+    assert posterior["surrogates"]["internal"]["leave_one_out"]["n"] == 5
+    # the chain was held at 400 steps (max_steps): too short for 50 autocorrelation times, and said so
+    assert any(warning.startswith("sampler: ") for warning in posterior["warnings"])
     assert set(posterior["parameters"]) == {"sliding_friction", "rolling_friction"}
     for name, bounds in (("sliding_friction", (0.1, 0.6)), ("rolling_friction", (0.0, 0.2))):
         value = posterior["parameters"][name]
@@ -93,8 +101,10 @@ def test_each_engine_iterates_to_a_posterior_with_its_seed_noise(request, engine
     target = twin["targets_deg"]["internal"]
     assert 5.0 < target < 60.0 and twin["standard_error_deg"]["internal"] >= 0
     assert posterior["targets_deg"] == {"internal": target}
-    assert set(posterior["twin"]["marginals"]) == {"sliding_friction", "rolling_friction"}
-    assert isinstance(posterior["twin"]["inside_credible_region"], bool)
+    assert set(posterior["twin"]["parameters"]) == {"sliding_friction", "rolling_friction"}
+    assert posterior["twin"]["inside_credible_region"] == (posterior["twin"]["hpd_level"] <= 0.9)
+    assert posterior["target_degrees_of_freedom"] == 2
+    assert posterior["predictive"]["degrees_of_freedom"] == 1
     with open(folder / "predictive.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == 1 and rows[0]["test"] == "internal" and float(rows[0]["target_deg"]) == pytest.approx(target)

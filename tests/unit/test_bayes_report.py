@@ -15,6 +15,8 @@ from siloflow.calibration.bayes.joint import Calibration, calibration_of
 from siloflow.engines.config import validate_config
 from siloflow.calibration.bayes.plots import CHART_COLOR, plot_corner, plot_predictive
 from siloflow.calibration.bayes.posterior import Prior
+from scipy import stats
+
 from siloflow.calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
                                       predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
 
@@ -26,8 +28,8 @@ def _calibration(walls=("aluminium",)) -> Calibration:
     names = ("sliding_friction", "rolling_friction", *(f"wall_sliding_friction.{wall}" for wall in walls))
     d = len(names)
     return Calibration(names=names, prior=Prior(np.full(d, 0.0), np.full(d, 1.0)), tests=("internal", *walls),
-                       targets_deg=np.array([30.0, 9.5, 11.0][:1 + len(walls)]), target_sd_deg=1.0, shape="sphere2",
-                       restitution=0.1, settings={})
+                       targets_deg=np.array([30.0, 9.5, 11.0][:1 + len(walls)]),
+                       target_sd_deg=np.full(1 + len(walls), 1.0), shape="sphere2", restitution=0.1, settings={})
 
 
 # --- intervals -------------------------------------------------------------------------------------------------------
@@ -63,48 +65,60 @@ def test_interval_rows_refuse_samples_or_a_summary_that_do_not_match_the_names()
 # --- predictive check ------------------------------------------------------------------------------------------------
 
 def _predictive_input():
-    sets = [{"theta": [0.3, 0.1, 0.4], "replicate": 0, "points": {}, "runs": {"internal": "r1", "aluminium": "r2"}},
-            {"theta": [0.35, 0.12, 0.45], "replicate": 0, "points": {}, "runs": {"internal": "r3", "aluminium": "r4"}}]
+    sets = [{"theta": [0.3, 0.1, 0.4], "replicate": 5000, "points": {}, "runs": {"internal": "r1", "aluminium": "r2"},
+             "predicted_deg": {"internal": [33.0, 1.5], "aluminium": [8.0, 0.5]}},
+            {"theta": [0.35, 0.12, 0.45], "replicate": 5001, "points": {}, "runs": {"internal": "r3", "aluminium": "r4"},
+             "predicted_deg": {"internal": [29.0, 1.5], "aluminium": [10.0, 1.0]}}]
     summaries = {
-        # internal: allowed sqrt(1^2 + 2^2 + 2^2) = 3 deg; 36 - 30 = 6 deg = 2 sd: within (the limit counts)
+        # internal, against the target: allowed sqrt(1^2 + 2^2) = sqrt 5 deg (the run's own window error is part of
+        # the seed noise, not added again); 36 - 30 = 6 deg = 2.683 sd: outside. Against its prediction: sqrt(1.5^2 +
+        # 2^2) = 2.5 deg; (36 - 33) / 2.5 = 1.2
         "r1": {"bulk_friction_angle_deg": 36.0, "bulk_friction_angle_deg_error": 2.0, "window_method": "steady"},
-        # aluminium: allowed sqrt(1^2 + 0^2 + 0^2) = 1 deg; 7 - 9.5 = -2.5 deg = -2.5 sd: outside
+        # aluminium: allowed sqrt(1^2 + 0^2) = 1 deg; 7 - 9.5 = -2.5 sd: outside; z = (7 - 8) / 0.5 = -2
         "r2": {"bulk_friction_angle_deg": 7.0, "bulk_friction_angle_deg_error": 0.0, "window_method": "second half"},
-        # internal: 27 - 30 = -3 deg = -1 sd: within
+        # internal: 27 - 30 = -3 deg = -1.342 sd: within; z = (27 - 29) / 2.5 = -0.8
         "r3": {"bulk_friction_angle_deg": 27.0, "bulk_friction_angle_deg_error": 2.0, "window_method": "steady"},
-        # aluminium: allowed sqrt(1 + 0 + 1) = sqrt 2 deg; 10.5 - 9.5 = 1 deg = 1 / sqrt 2 sd: within
+        # aluminium: 10.5 - 9.5 = 1 sd: within; z = (10.5 - 10) / 1 = 0.5
         "r4": {"bulk_friction_angle_deg": 10.5, "bulk_friction_angle_deg_error": 1.0, "window_method": "steady"},
     }
     return sets, summaries, {"internal": 2.0, "aluminium": 0.0}
 
 
-def test_predictive_rows_set_each_run_against_its_target_in_the_allowed_uncertainty():
+def test_predictive_rows_set_each_run_against_its_prediction_and_its_target():
     calibration = _calibration()
     sets, summaries, seed = _predictive_input()
     rows = predictive_rows(calibration, sets, summaries, seed)
     assert [(row["set"], row["test"], row["run_id"]) for row in rows] == [
         (0, "internal", "r1"), (0, "aluminium", "r2"), (1, "internal", "r3"), (1, "aluminium", "r4")]
     assert all(list(row) == predictive_columns(calibration) for row in rows)
-    assert rows[0] == {"set": 0, "replicate": 0, "sliding_friction": 0.3, "rolling_friction": 0.1,
+    assert rows[0] == {"set": 0, "replicate": 5000, "sliding_friction": 0.3, "rolling_friction": 0.1,
                        "wall_sliding_friction.aluminium": 0.4, "test": "internal", "run_id": "r1", "target_deg": 30.0,
-                       "target_sd_deg": 1.0, "seed_sd_deg": 2.0, "angle_deg": 36.0, "angle_error_deg": 2.0,
-                       "allowed_sd_deg": 3.0, "difference_deg": 6.0, "difference_in_sd": 2.0, "within": True,
-                       "window_method": "steady"}
-    assert [row["allowed_sd_deg"] for row in rows] == pytest.approx([3.0, 1.0, 3.0, math.sqrt(2.0)])
-    assert [row["difference_deg"] for row in rows] == pytest.approx([6.0, -2.5, -3.0, 1.0])
-    assert [row["difference_in_sd"] for row in rows] == pytest.approx([2.0, -2.5, -1.0, 1.0 / math.sqrt(2.0)])
-    assert [row["within"] for row in rows] == [True, False, True, True]
-    assert rows[3]["wall_sliding_friction.aluminium"] == 0.45 and rows[1]["window_method"] == "second half"
-    # the seed noise may also come in the calibration's test order
+                       "target_sd_deg": 1.0, "seed_sd_deg": 2.0, "discrepancy_sd_deg": 0.0, "angle_deg": 36.0,
+                       "angle_error_deg": 2.0, "predicted_deg": 33.0, "predicted_sd_deg": 1.5,
+                       "predictive_sd_deg": 2.5, "z": pytest.approx(1.2), "pit": pytest.approx(stats.norm.cdf(1.2)),
+                       "allowed_sd_deg": pytest.approx(math.sqrt(5.0)),
+                       "difference_deg": 6.0, "difference_in_sd": pytest.approx(6.0 / math.sqrt(5.0)),
+                       "within": False, "window_method": "steady"}
+    assert [row["z"] for row in rows] == pytest.approx([1.2, -2.0, -0.8, 0.5])
+    assert [row["allowed_sd_deg"] for row in rows] == pytest.approx([math.sqrt(5.0), 1.0, math.sqrt(5.0), 1.0])
+    assert [row["difference_in_sd"] for row in rows] == pytest.approx([6.0 / math.sqrt(5.0), -2.5,
+                                                                       -3.0 / math.sqrt(5.0), 1.0])
+    assert [row["within"] for row in rows] == [False, False, True, True]
+    # the seed noise may also come in the calibration's test order; a twin's target sd replaces the configured one
     assert predictive_rows(calibration, sets, summaries, [2.0, 0.0]) == rows
+    twin = predictive_rows(calibration, sets, summaries, seed, {"internal": 0.0, "aluminium": 0.5})
+    assert twin[0]["allowed_sd_deg"] == pytest.approx(2.0) and twin[1]["allowed_sd_deg"] == pytest.approx(0.5)
+    # a model discrepancy widens what a run may miss its target by
+    wide = predictive_rows(Calibration(**{**calibration.__dict__, "discrepancy_sd_deg": 2.0}), sets, summaries, seed)
+    assert wide[1]["allowed_sd_deg"] == pytest.approx(math.sqrt(5.0))
 
 
-def test_a_run_without_its_error_is_not_within_and_missing_runs_are_named():
+def test_a_run_without_a_prediction_has_no_z_and_missing_runs_are_named():
     calibration = _calibration()
     sets, summaries, seed = _predictive_input()
-    summaries["r4"] = {**summaries["r4"], "bulk_friction_angle_deg_error": None}
+    del sets[1]["predicted_deg"]
     row = predictive_rows(calibration, sets, summaries, seed)[3]
-    assert math.isnan(row["allowed_sd_deg"]) and math.isnan(row["angle_error_deg"]) and row["within"] is False
+    assert math.isnan(row["z"]) and math.isnan(row["pit"]) and math.isnan(row["predicted_deg"])
     del summaries["r3"]
     with pytest.raises(ValueError, match="run r3"):
         predictive_rows(calibration, sets, summaries, seed)
@@ -112,15 +126,22 @@ def test_a_run_without_its_error_is_not_within_and_missing_runs_are_named():
         predictive_rows(calibration, sets[:1], {"r1": {}, "r2": {}}, {"internal": 1.0})
 
 
-def test_predictive_verdict_counts_the_runs_within():
+def test_predictive_verdict_tests_the_chi_square_of_the_runs_in_both_tails():
     calibration = _calibration()
     sets, summaries, seed = _predictive_input()
-    assert predictive_verdict(predictive_rows(calibration, sets, summaries, seed)) == {
-        "rows": 4, "within": 3, "fraction": 0.75, "unknown": 0}
-    summaries["r4"] = {**summaries["r4"], "bulk_friction_angle_deg_error": None}
-    assert predictive_verdict(predictive_rows(calibration, sets, summaries, seed)) == {
-        "rows": 4, "within": 2, "fraction": 0.5, "unknown": 1}
-    assert predictive_verdict([]) == {"rows": 0, "within": 0, "fraction": None, "unknown": 0}
+    verdict = predictive_verdict(predictive_rows(calibration, sets, summaries, seed))
+    chi2 = 1.2 ** 2 + 2.0 ** 2 + 0.8 ** 2 + 0.5 ** 2   # 6.33 over 4 runs
+    assert verdict == {"rows": 4, "within": 2, "fraction": 0.5, "unknown": 0, "chi2": pytest.approx(chi2),
+                       "degrees_of_freedom": 4, "p_upper": pytest.approx(stats.chi2.sf(chi2, 4)),
+                       "p_lower": pytest.approx(stats.chi2.cdf(chi2, 4)), "verdict": "consistent",
+                       "mean_pit": pytest.approx(np.mean(stats.norm.cdf([1.2, -2.0, -0.8, 0.5])))}
+    # twelve runs each 3 predictive sd off: the runs scatter far more than the model says
+    wide = [{"within": False, "allowed_sd_deg": 1.0, "z": 3.0}] * 12
+    assert predictive_verdict(wide)["verdict"] == "runs scatter more than predicted"
+    # twelve runs on their predictions to 0.05 sd: far less than the model says (the noise overestimated)
+    narrow = [{"within": True, "allowed_sd_deg": 1.0, "z": 0.05}] * 12
+    assert predictive_verdict(narrow)["verdict"] == "runs scatter less than predicted"
+    assert predictive_verdict([])["verdict"] == "no runs with a prediction"
 
 
 # --- chart beside the posterior --------------------------------------------------------------------------------------
@@ -272,23 +293,47 @@ def test_plot_predictive_writes_a_png_with_a_panel_per_test(tmp_path):
     figure = plot_predictive(rows, path)
     assert path.read_bytes().startswith(PNG_SIGNATURE)
     _only_file(tmp_path, "predictive.png")
-    assert [axes.get_title() for axes in figure.axes] == ["internal: 2 of 2 within 2 sd",
+    assert [axes.get_title() for axes in figure.axes] == ["internal: 1 of 2 within 2 sd",
                                                           "aluminium: 1 of 2 within 2 sd"]
     empty = tmp_path / "empty" / "predictive.png"
     plot_predictive([], empty)
     assert empty.read_bytes().startswith(PNG_SIGNATURE)
 
 
-def test_the_twin_verdict_says_whether_the_truth_came_back():
+def test_the_twin_verdict_tests_the_truths_highest_density_level_and_says_what_was_learnt():
+    # a Gaussian posterior of two parameters with a uniform prior on [0, 1]^2 (prior sd 1 / sqrt 12): the HPD level of
+    # a point is the chi-square(2) probability of its squared Mahalanobis distance, 1 - exp(-r^2 / 2)
     rng = np.random.default_rng(3)
-    samples = rng.normal([0.3, 0.1], [0.02, 0.01], size=(20000, 2))
-    inside = twin_verdict(["sliding_friction", "rolling_friction"], samples, [0.31, 0.1])
-    assert inside["inside_credible_region"] and inside["truth"] == {"sliding_friction": 0.31, "rolling_friction": 0.1}
-    assert inside["marginals"]["sliding_friction"]["inside"]
-    assert inside["marginals"]["sliding_friction"]["lower"] == pytest.approx(0.3 - 1.645 * 0.02, abs=1e-3)
-    outside = twin_verdict(["sliding_friction", "rolling_friction"], samples, [0.4, 0.1])
-    assert not outside["inside_credible_region"] and not outside["marginals"]["sliding_friction"]["inside"]
-    assert outside["marginals"]["rolling_friction"]["inside"]
+    mean, sd = np.array([0.3, 0.1]), np.array([0.02, 0.01])
+    samples = rng.normal(mean, sd, size=(40000, 2))
+    log_p = -0.5 * np.sum(((samples - mean) / sd) ** 2, axis=1)
+    calibration = Calibration(names=("sliding_friction", "rolling_friction"), prior=Prior([0.0, 0.0], [1.0, 1.0]),
+                              tests=("internal",), targets_deg=np.array([30.0]), target_sd_deg=np.array([1.0]),
+                              shape="sphere2", restitution=0.1, settings={})
+
+    def verdict(truth):
+        return twin_verdict(calibration, samples, log_p, truth, -0.5 * np.sum(((np.array(truth) - mean) / sd) ** 2))
+
+    inside = verdict([0.32, 0.1])   # r = 1
+    assert inside["hpd_level"] == pytest.approx(1.0 - math.exp(-0.5), abs=0.01)
+    assert inside["inside_credible_region"] and inside["truth"] == {"sliding_friction": 0.32, "rolling_friction": 0.1}
+    sliding = inside["parameters"]["sliding_friction"]
+    assert sliding["z"] == pytest.approx(1.0, abs=0.02) and sliding["inside"]
+    assert sliding["prior_sd"] == pytest.approx(1.0 / math.sqrt(12.0))
+    assert sliding["sd_over_prior_sd"] == pytest.approx(0.02 * math.sqrt(12.0), rel=0.02)
+    # the principal axes in prior-sd units: the sliding friction's (the wider) first
+    first, second = inside["axes"]
+    assert abs(first["loadings"]["sliding_friction"]) == pytest.approx(1.0, abs=1e-2)
+    assert first["sd_over_prior_sd"] == pytest.approx(0.02 * math.sqrt(12.0), rel=0.02)
+    assert second["sd_over_prior_sd"] == pytest.approx(0.01 * math.sqrt(12.0), rel=0.02)
+    assert abs(first["truth_z"]) == pytest.approx(1.0, abs=0.02) and abs(second["truth_z"]) < 0.05
+    outside = verdict([0.3, 0.125])   # r = 2.5: level 1 - exp(-3.125) = 0.956
+    assert outside["hpd_level"] == pytest.approx(1.0 - math.exp(-3.125), abs=0.01)
+    assert not outside["inside_credible_region"]
+    # every marginal may hold the truth while the joint region does not: the ridge's test is the joint one
+    corner = verdict([0.3 + 1.5 * 0.02, 0.1 + 1.5 * 0.01])   # r^2 = 4.5: level 0.895, each marginal inside
+    assert corner["parameters"]["sliding_friction"]["inside"] and corner["parameters"]["rolling_friction"]["inside"]
+    assert corner["hpd_level"] == pytest.approx(1.0 - math.exp(-2.25), abs=0.01)
 
 
 def test_the_chart_comparison_of_a_calibration_with_its_rolling_friction_held_fixed():

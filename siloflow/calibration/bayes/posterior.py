@@ -116,6 +116,18 @@ class Prior:
         log_p = np.where(inside, log_p, -np.inf)
         return float(log_p[0]) if theta.ndim == 1 else log_p
 
+    @property
+    def standard_deviation(self) -> np.ndarray:
+        """Each parameter's prior standard deviation, shape (d,), in its units: ``(upper - lower) / sqrt(12)`` for a
+        uniform prior, the truncated Gaussian's for a Gaussian one (the yardstick a posterior's width is measured
+        against: its sd over this says how much the data taught)."""
+        sd = (self.upper - self.lower) / np.sqrt(12.0)
+        if self._gaussian.any():
+            a, b = self._standard_bounds()
+            g = self._gaussian
+            sd[g] = stats.truncnorm.std(a, b, loc=self.mean[g], scale=self.sd[g])
+        return sd
+
     def sample(self, n: int, seed: int) -> np.ndarray:
         """``n`` independent draws from the prior, shape ``(n, d)``, in the parameters' units (e.g. walker starts)."""
         rng = np.random.default_rng(seed)
@@ -130,23 +142,33 @@ class Prior:
 
 # --- Likelihood ------------------------------------------------------------------------------------------------------
 
-def log_likelihood(predicted_mean, predicted_std, targets, target_sd, seed_sd) -> float | np.ndarray:
-    """Log-likelihood of measured targets given predicted observables: independent Gaussians.
+def log_likelihood(predicted_mean, predicted_std, targets, target_sd, discrepancy_sd=0.0,
+                   dof=None) -> float | np.ndarray:
+    """Log-likelihood of measured targets given predicted observables, independent per observable.
 
-    Each observable ``j`` is Gaussian about its predicted mean with variance
-    ``target_sd_j^2 + seed_sd_j^2 + predicted_std_j^2``: the measurement's uncertainty, the DEM's seed noise (a run
-    at the true parameters still scatters about the mean) and the surrogate's own uncertainty. As the last depends on
-    ``theta``, the normalisation ``-log(2 pi var) / 2`` is kept: without it, parameters where the surrogate is
-    unsure would be favoured.
+    Each target ``j`` (a measured mean, or the mean of a twin experiment's runs) lies about the surrogate's mean of the
+    observable with variance ``target_sd_j^2 + discrepancy_sd_j^2 + predicted_std_j^2``: the standard error of the
+    target's mean, a model-discrepancy term (0: the intervals assume the DEM at the true parameters reproduces the
+    measurement up to the other two) and the surrogate's own uncertainty. The surrogate predicts the mean over seeds,
+    so the DEM's seed noise is not added again: it enters through the surrogate's fit (each run's noise) and, for a
+    twin experiment, through its targets' standard error. As the surrogate's variance depends on ``theta``, the
+    normalisation is kept: without it, parameters where the surrogate is unsure would be favoured.
+
+    With ``dof`` (a target standard error estimated from few runs, with that many degrees of freedom) the observable
+    follows Student's t with ``dof`` degrees of freedom and that scale instead of a Gaussian: the marginal of a
+    Gaussian whose variance is known only from ``dof`` squared deviations, whose heavier tails keep a noise
+    estimated from two or three runs from making the posterior overconfident.
 
     Parameters
     ----------
     predicted_mean, predicted_std : array_like, shape (..., k)
         The surrogates' mean and standard deviation of each of ``k`` observables (bulk friction angles [deg]).
     targets, target_sd : array_like, shape (k,)
-        The measured observables and their uncertainty (one standard deviation), in the same units.
-    seed_sd : array_like, shape (k,)
-        The seed-noise standard deviation of each observable, in the same units.
+        The measured observables and the standard errors of their means, in the same units.
+    discrepancy_sd : float or array_like, shape (k,)
+        The model-discrepancy standard deviation of each observable, in the same units (0: none).
+    dof : float or array_like, shape (k,), optional
+        Degrees of freedom of each target's standard error (None, or inf: known, a Gaussian likelihood).
 
     Returns
     -------
@@ -154,16 +176,27 @@ def log_likelihood(predicted_mean, predicted_std, targets, target_sd, seed_sd) -
         The log-likelihood, summed over the observables.
     """
     mean = np.asarray(predicted_mean, dtype=float)
-    variance = (np.asarray(target_sd, dtype=float) ** 2 + np.asarray(seed_sd, dtype=float) ** 2
+    variance = (np.asarray(target_sd, dtype=float) ** 2 + np.asarray(discrepancy_sd, dtype=float) ** 2
                 + np.asarray(predicted_std, dtype=float) ** 2)
     if np.any(variance <= 0):
-        raise ValueError("the likelihood's variance must be positive: give a target or seed-noise sd above zero")
+        raise ValueError("the likelihood's variance must be positive: give the targets a standard error above zero")
     residual = mean - np.asarray(targets, dtype=float)
-    log_l = -0.5 * np.sum(residual ** 2 / variance + np.log(variance) + _LOG_2PI, axis=-1)
+    if dof is None:
+        log_l = -0.5 * np.sum(residual ** 2 / variance + np.log(variance) + _LOG_2PI, axis=-1)
+    else:
+        nu = np.broadcast_to(np.asarray(dof, dtype=float), np.shape(targets))
+        if np.any(~(nu > 0)):
+            raise ValueError(f"degrees of freedom must be positive, got {dof}")
+        scale = np.sqrt(variance)
+        # an infinite dof is the Gaussian limit, which scipy's t does not take
+        gaussian = stats.norm.logpdf(residual, scale=scale)
+        student = stats.t.logpdf(residual, np.where(np.isfinite(nu), nu, 1.0), scale=scale)
+        log_l = np.sum(np.where(np.isfinite(nu), student, gaussian), axis=-1)
     return float(log_l) if np.ndim(log_l) == 0 else log_l
 
 
-def log_posterior(prior: Prior, surrogates: Sequence, targets, target_sd, seed_sd) -> Callable:
+def log_posterior(prior: Prior, surrogates: Sequence, targets, target_sd, discrepancy_sd=0.0,
+                  dof=None) -> Callable:
     """The unnormalised log posterior on surrogates, as a vectorised function for :func:`sample_posterior`.
 
     Parameters
@@ -171,8 +204,9 @@ def log_posterior(prior: Prior, surrogates: Sequence, targets, target_sd, seed_s
     prior : Prior
         The parameters' prior.
     surrogates : sequence of objects with ``predict(theta) -> (mean, std)``
-        One per observable, in the order of ``targets`` (e.g. :class:`siloflow.calibration.bayes.surrogate.Surrogate`).
-    targets, target_sd, seed_sd : array_like, shape (k,)
+        One per observable, in the order of ``targets`` (e.g. :class:`siloflow.calibration.bayes.surrogate.Surrogate`);
+        each takes the whole parameter vector.
+    targets, target_sd, discrepancy_sd, dof : array_like, shape (k,)
         As for :func:`log_likelihood`.
 
     Returns
@@ -194,7 +228,7 @@ def log_posterior(prior: Prior, surrogates: Sequence, targets, target_sd, seed_s
             predictions = [surrogate.predict(points[inside]) for surrogate in surrogates]
             mean = np.column_stack([p[0] for p in predictions])
             std = np.column_stack([p[1] for p in predictions])
-            log_p[inside] += log_likelihood(mean, std, targets, target_sd, seed_sd)
+            log_p[inside] += log_likelihood(mean, std, targets, target_sd, discrepancy_sd, dof)
         return float(log_p[0]) if theta.ndim == 1 else log_p
 
     return log_probability

@@ -15,14 +15,25 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from siloflow.calibration.bayes.joint import WALL_PARAMETER, Calibration
-from siloflow.calibration.bayes.posterior import credible_interval, in_credible_region
+from scipy import stats
 
-__all__ = ["CHART_COMPARISON_COLUMNS", "chart_comparison_rows", "engines_rows", "interval_rows", "twin_verdict",
-           "predictive_columns", "predictive_rows", "predictive_verdict"]
+from siloflow.calibration.bayes.joint import WALL_PARAMETER, Calibration
+from siloflow.calibration.bayes.posterior import credible_interval
+
+__all__ = ["CHART_COMPARISON_COLUMNS", "TWIN_LEVEL", "chart_comparison_rows", "engines_rows", "interval_rows",
+           "twin_verdict", "predictive_columns", "predictive_rows", "predictive_verdict"]
 
 #: How many combined standard deviations a predictive run may lie from its target and still be within (-).
 WITHIN_SD = 2.0
+
+#: The predictive check's chi-square is consistent when neither tail's probability is below this (-): a two-sided
+#: test at 5 %, which fails a spread of runs too wide (the posterior or the noise model wrong) and one too narrow
+#: (the noise overestimated, the intervals too wide).
+PREDICTIVE_TAIL = 0.025
+
+#: The credible level of the twin experiment's test (-): the truth must lie inside the 90 % highest-posterior-density
+#: region.
+TWIN_LEVEL = 0.9
 
 #: The columns of :func:`chart_comparison_rows`, in order (the header of an empty comparison table too).
 CHART_COMPARISON_COLUMNS = ("parameter", "chart_value", "chart_error", "chart_fixed", "posterior_mean",
@@ -103,45 +114,53 @@ def _seed_sd(calibration: Calibration, seed_sd_deg) -> dict[str, float]:
 def predictive_columns(calibration: Calibration) -> list[str]:
     """The columns of :func:`predictive_rows`, in order (the header of a check without runs too)."""
     return ["set", "replicate", *calibration.names, "test", "run_id", "target_deg", "target_sd_deg", "seed_sd_deg",
-            "angle_deg", "angle_error_deg", "allowed_sd_deg", "difference_deg", "difference_in_sd", "within",
+            "discrepancy_sd_deg", "angle_deg", "angle_error_deg", "predicted_deg", "predicted_sd_deg",
+            "predictive_sd_deg", "z", "pit", "allowed_sd_deg", "difference_deg", "difference_in_sd", "within",
             "window_method"]
 
 
 def predictive_rows(calibration: Calibration, sets: Sequence[Mapping], summaries: Mapping[str, Mapping],
-                    seed_sd_deg) -> list[dict]:
-    """The posterior predictive check: each run at a posterior draw against its test's target.
+                    seed_sd_deg, target_sd_deg=None) -> list[dict]:
+    """The posterior predictive check: each run at a posterior draw, on a fresh seed, against what the calibrated
+    model predicts for it and against its test's target.
 
-    A run at parameters drawn from the posterior should give an angle about its target within the uncertainty the
-    likelihood allows a run at the true parameters: the target's, the DEM's seed noise and the run's own window
-    error, in quadrature,
+    Against the prediction: a run at the drawn parameters ``theta`` scatters about the surrogate's mean ``m(theta)``
+    with the surrogate's sd ``s(theta)`` and the DEM's seed noise ``sigma``,
 
-        ``allowed = sqrt(target_sd^2 + seed_sd^2 + run_error^2)`` (deg).
+        ``z = (angle - m) / sqrt(s^2 + sigma^2)``, ``pit = Phi(z)``,
 
-    A run is ``within`` when ``|angle - target| <= 2 allowed`` (about 95 % of runs for a Gaussian spread; the
-    posterior's own width adds to the spread of runs at draws from it, so a somewhat lower fraction is no alarm, a
-    much lower one is).
+    standard normal and uniform if the model is right; :func:`predictive_verdict` tests the sum of ``z^2``. The
+    run's own window error is part of its scatter over seeds, which ``sigma`` measures: it is not added again.
+
+    Against the target: ``difference = angle - target`` over ``allowed = sqrt(target_sd^2 + discrepancy^2 +
+    sigma^2)`` (deg), the spread of a run at the true parameters about the measured mean; ``within`` when
+    ``|difference| <= 2 allowed``.
 
     Parameters
     ----------
     calibration : siloflow.calibration.bayes.joint.Calibration
-        The calibration: its parameter names, tests, targets (deg) and their uncertainty (deg).
+        The calibration: its parameter names, tests, targets (deg) and model discrepancy (deg).
     sets : sequence of Mapping
         The predictive parameter sets as :func:`siloflow.calibration.bayes.runs.with_runs` writes them:
-        ``{"theta": [...], "replicate": k, "points": {...}, "runs": {test: run id}}``.
+        ``{"theta": [...], "replicate": k, "points": {...}, "runs": {test: run id}}``, with ``predicted_deg``
+        (``{test: [mean, sd]}``, deg) where the surrogates' prediction at the draw was kept.
     summaries : Mapping of str to Mapping
         ``{run id: bulk friction summary}`` (``metrics/bulk_friction.json``): ``bulk_friction_angle_deg``,
         ``bulk_friction_angle_deg_error`` (deg; null where unknown) and ``window_method``.
     seed_sd_deg : Mapping of str to float, or sequence of float
         The seed noise of each test's angle (deg), by test (or in ``calibration.tests`` order).
+    target_sd_deg : Mapping of str to float, or sequence of float, optional
+        The standard error of each target the likelihood took (deg; a twin's from the seed noise); default the
+        calibration's.
 
     Returns
     -------
     list of dict
-        One row per set and test, sets in order and tests in ``calibration.tests`` order: ``set`` (index),
-        ``replicate``, the set's parameter values by name (-), ``test``, ``run_id``, ``target_deg``,
-        ``target_sd_deg``, ``seed_sd_deg``, ``angle_deg``, ``angle_error_deg``, ``allowed_sd_deg`` (deg),
-        ``difference_deg`` (``angle - target``, deg), ``difference_in_sd`` (``difference_deg / allowed_sd_deg``, -),
-        ``within`` (bool; False where the allowed uncertainty is unknown) and ``window_method``.
+        One row per set and test, sets in order and tests in ``calibration.tests`` order, with the columns of
+        :func:`predictive_columns`: the set's parameter values by name (-), ``predicted_deg`` and
+        ``predicted_sd_deg`` (the surrogate's, deg; NaN where not kept), ``predictive_sd_deg`` (``sqrt(s^2 +
+        sigma^2)``, deg), ``z`` and ``pit`` (-; NaN without a prediction), ``allowed_sd_deg``, ``difference_deg``
+        (deg), ``difference_in_sd`` (-), ``within`` (bool).
 
     Raises
     ------
@@ -149,8 +168,9 @@ def predictive_rows(calibration: Calibration, sets: Sequence[Mapping], summaries
         If a set's theta does not match the parameters, a test has no run or no seed noise, or a run has no summary.
     """
     seeds = _seed_sd(calibration, seed_sd_deg)
+    target_sds = _seed_sd(calibration, calibration.target_sd_deg if target_sd_deg is None else target_sd_deg)
     targets = dict(zip(calibration.tests, calibration.targets_deg.tolist()))
-    target_sd = float(calibration.target_sd_deg)
+    discrepancy = float(calibration.discrepancy_sd_deg)
     rows = []
     for index, chosen in enumerate(sets):
         theta = [float(value) for value in chosen["theta"]]
@@ -165,36 +185,59 @@ def predictive_rows(calibration: Calibration, sets: Sequence[Mapping], summaries
             summary = summaries[run]
             angle = _number(summary["bulk_friction_angle_deg"])
             error = _number(summary.get("bulk_friction_angle_deg_error"))
-            allowed = math.sqrt(target_sd ** 2 + seeds[test] ** 2 + error ** 2)
+            mean, sd = (_number(value) for value in (chosen.get("predicted_deg") or {}).get(test, (None, None)))
+            predictive = math.sqrt(sd ** 2 + seeds[test] ** 2)
+            z = (angle - mean) / predictive if predictive > 0 else math.nan
+            allowed = math.sqrt(target_sds[test] ** 2 + discrepancy ** 2 + seeds[test] ** 2)
             difference = angle - targets[test]
             in_sd = difference / allowed if allowed > 0 else math.nan
             rows.append({"set": index, "replicate": int(chosen.get("replicate", 0)),
                          **dict(zip(calibration.names, theta)), "test": test, "run_id": run,
-                         "target_deg": targets[test], "target_sd_deg": target_sd, "seed_sd_deg": seeds[test],
-                         "angle_deg": angle, "angle_error_deg": error, "allowed_sd_deg": allowed,
-                         "difference_deg": difference, "difference_in_sd": in_sd,
+                         "target_deg": targets[test], "target_sd_deg": target_sds[test], "seed_sd_deg": seeds[test],
+                         "discrepancy_sd_deg": discrepancy, "angle_deg": angle, "angle_error_deg": error,
+                         "predicted_deg": mean, "predicted_sd_deg": sd, "predictive_sd_deg": predictive, "z": z,
+                         "pit": float(stats.norm.cdf(z)) if math.isfinite(z) else math.nan,
+                         "allowed_sd_deg": allowed, "difference_deg": difference, "difference_in_sd": in_sd,
                          "within": bool(abs(in_sd) <= WITHIN_SD), "window_method": summary.get("window_method")})
     return rows
 
 
 def predictive_verdict(rows: Sequence[Mapping]) -> dict:
-    """How many predictive runs lie within two allowed standard deviations of their target.
+    """The posterior predictive check's statistic and verdict.
+
+    The runs' ``z`` (:func:`predictive_rows`) are standard normal if the calibrated model (the surrogates and the seed
+    noise) predicts runs at posterior draws right, so ``chi2 = sum z^2`` follows a chi-square with as many degrees of
+    freedom as runs. The check is ``consistent`` when neither tail probability is below :data:`PREDICTIVE_TAIL`.
 
     Parameters
     ----------
     rows : sequence of Mapping
-        Rows of :func:`predictive_rows` (their ``within``).
+        Rows of :func:`predictive_rows` (their ``z`` and ``within``).
 
     Returns
     -------
     dict
-        ``rows`` (count), ``within`` (count), ``fraction`` (``within / rows``, -; None without rows) and
-        ``unknown`` (count of the rows whose allowed uncertainty is unknown, a run without its error: not within).
+        ``rows`` (count), ``within`` (count within 2 allowed sd of the target), ``fraction`` (``within / rows``, -;
+        None without rows), ``unknown`` (rows without an allowed uncertainty), ``chi2`` (-), ``degrees_of_freedom``
+        (the rows with a finite ``z``), ``p_upper`` and ``p_lower`` (the chi-square's upper and lower tail
+        probabilities, -), ``verdict`` (``"consistent"``, ``"runs scatter more than predicted"``, ``"runs scatter
+        less than predicted"`` or ``"no runs with a prediction"``) and ``mean_pit`` (-).
     """
     count = len(rows)
     within = sum(1 for row in rows if row["within"])
     unknown = sum(1 for row in rows if row.get("allowed_sd_deg") is None or math.isnan(float(row["allowed_sd_deg"])))
-    return {"rows": count, "within": within, "fraction": within / count if count else None, "unknown": unknown}
+    z = np.array([float(row["z"]) for row in rows if row.get("z") is not None and math.isfinite(float(row["z"]))])
+    verdict = {"rows": count, "within": within, "fraction": within / count if count else None, "unknown": unknown,
+               "chi2": None, "degrees_of_freedom": int(z.size), "p_upper": None, "p_lower": None,
+               "verdict": "no runs with a prediction", "mean_pit": None}
+    if z.size:
+        chi2 = float(np.sum(z ** 2))
+        p_upper, p_lower = float(stats.chi2.sf(chi2, z.size)), float(stats.chi2.cdf(chi2, z.size))
+        verdict.update(chi2=chi2, p_upper=p_upper, p_lower=p_lower, mean_pit=float(np.mean(stats.norm.cdf(z))),
+                       verdict=("runs scatter more than predicted" if p_upper < PREDICTIVE_TAIL
+                                else "runs scatter less than predicted" if p_lower < PREDICTIVE_TAIL
+                                else "consistent"))
+    return verdict
 
 
 def _chart_values(calibration: Calibration, chart_parameters: Mapping) -> dict[str, tuple[float, float]]:
@@ -350,35 +393,64 @@ def engines_rows(posteriors: Mapping[str, Mapping]) -> list[dict]:
     return rows
 
 
-def twin_verdict(names: Sequence[str], samples, truth, level: float = 0.9) -> dict:
-    """Whether a twin experiment brought its known parameters back.
+def twin_verdict(calibration: Calibration, samples, log_probability, truth, truth_log_probability,
+                 level: float = TWIN_LEVEL) -> dict:
+    """Whether a twin experiment brought its known parameters back, and how much it learnt.
+
+    The test: the truth's highest-posterior-density level, the posterior probability of the parameters more probable
+    than the truth, estimated as the fraction of samples whose log posterior exceeds the truth's. The truth passes
+    when that level is at most ``level``: it lies inside the ``level`` HPD region, whatever the posterior's shape (a
+    ridge, a bound). Beside it, per parameter and along the posterior's principal axes (in units of the prior sd, where
+    the prior is isotropic): the posterior sd over the prior sd (1: nothing learnt) and the truth's z-score.
 
     Parameters
     ----------
-    names : sequence of str
-        The parameters, in the samples' order.
+    calibration : siloflow.calibration.bayes.joint.Calibration
+        Its parameter names and prior.
     samples : array_like, shape (n, d)
         The posterior samples (-).
+    log_probability : array_like, shape (n,)
+        Their log posterior.
     truth : array_like, shape (d,)
         The parameters the engine made the targets with (-).
+    truth_log_probability : float
+        The log posterior at the truth, on the samples' scale (-inf outside the prior).
     level : float
-        The credible level (0.9: the 90 % region).
+        The credible level of the test.
 
     Returns
     -------
     dict
-        ``truth`` by name; ``inside_credible_region``: whether the truth lies inside the joint region at ``level``
-        (:func:`siloflow.calibration.bayes.posterior.in_credible_region`, a Gaussian approximation of the posterior);
-        ``marginals``: per parameter the equal-tailed interval at ``level`` and whether it holds the truth.
+        ``level``, ``hpd_level`` (-), ``inside_credible_region`` (bool, the verdict), ``truth`` by name, ``parameters``
+        (per name: ``truth``, ``mean``, ``sd``, ``prior_sd``, ``sd_over_prior_sd``, ``z``, the equal-tailed interval
+        ``lower``, ``upper`` at ``level`` and ``inside``) and ``axes`` (per principal axis, widest first:
+        ``loadings`` by name, ``sd_over_prior_sd``, ``truth_z``).
     """
-    samples = np.asarray(samples, dtype=float)
-    truth = np.asarray(truth, dtype=float)
-    intervals = credible_interval(samples, level)
-    return {
-        "level": level,
-        "truth": dict(zip(names, truth.tolist())),
-        "inside_credible_region": bool(in_credible_region(samples, truth, level)),
-        "marginals": {name: {"truth": float(truth[i]), "lower": float(intervals[i][0]), "upper": float(intervals[i][1]),
-                             "inside": bool(intervals[i][0] <= truth[i] <= intervals[i][1])}
-                      for i, name in enumerate(names)},
-    }
+    names = list(calibration.names)
+    values = _samples_of(samples, names)
+    log_p = np.asarray(log_probability, dtype=float).reshape(-1)
+    if log_p.size != len(values):
+        raise ValueError(f"{log_p.size} log probabilities for {len(values)} samples")
+    truth = np.asarray(truth, dtype=float).reshape(-1)
+    hpd_level = float(np.mean(log_p > float(truth_log_probability)))
+    mean, sd = values.mean(axis=0), values.std(axis=0, ddof=1)
+    prior_sd = calibration.prior.standard_deviation
+    intervals = np.atleast_2d(credible_interval(values, level))
+    parameters = {name: {"truth": float(truth[i]), "mean": float(mean[i]), "sd": float(sd[i]),
+                         "prior_sd": float(prior_sd[i]), "sd_over_prior_sd": float(sd[i] / prior_sd[i]),
+                         "z": float((truth[i] - mean[i]) / sd[i]), "lower": float(intervals[i, 0]),
+                         "upper": float(intervals[i, 1]),
+                         "inside": bool(intervals[i, 0] <= truth[i] <= intervals[i, 1])}
+                  for i, name in enumerate(names)}
+    scaled = values / prior_sd
+    covariance = np.atleast_2d(np.cov(scaled, rowvar=False))
+    eigenvalues, eigenvectors = np.linalg.eigh(covariance)
+    offset = (truth - mean) / prior_sd
+    axes = []
+    for k in np.argsort(eigenvalues)[::-1]:
+        vector = eigenvectors[:, k] * (1.0 if eigenvectors[np.argmax(np.abs(eigenvectors[:, k])), k] > 0 else -1.0)
+        width = math.sqrt(max(float(eigenvalues[k]), 0.0))
+        axes.append({"loadings": dict(zip(names, vector.tolist())), "sd_over_prior_sd": width,
+                     "truth_z": float(vector @ offset / width) if width > 0 else math.nan})
+    return {"level": level, "hpd_level": hpd_level, "inside_credible_region": bool(hpd_level <= level),
+            "truth": dict(zip(names, truth.tolist())), "parameters": parameters, "axes": axes}

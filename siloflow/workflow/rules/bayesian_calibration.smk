@@ -169,7 +169,8 @@ rule bayes_posterior:
         summaries=lambda wildcards: bayes_summaries(bayes_sets_upto(wildcards.engine, wildcards.iteration),
                                                     wildcards.engine),
         previous=lambda wildcards: [] if int(wildcards.iteration) == 0 else [
-            bayes_iteration_file("posterior.npz", wildcards.engine, int(wildcards.iteration) - 1)],
+            bayes_iteration_file(name, wildcards.engine, int(wildcards.iteration) - 1)
+            for name in ("posterior.npz", "posterior.json")],
         targets=bayes_targets,
     output:
         samples=bayes_iteration_file("posterior.npz"),

@@ -1,5 +1,6 @@
 """Snakemake adapter: the parameter sets of one iteration of the Bayesian calibration on one engine (design.json): the
-first design, or the next sets where the previous posterior has mass, or none when it stopped moving, the iterations
+first design, or the next sets where the previous posterior has mass and at its mode, or none when the previous
+iteration decided to stop (two iterations in a row that did not move, their new runs as predicted), the iterations
 ran out or the budget is spent."""
 
 import json
@@ -22,15 +23,15 @@ with logged_to(snakemake.log[0]) as log:
         sets = first_design(calibration)
     else:
         previous = json.loads(Path(snakemake.input.previous[0]).read_text())
-        samples = np.load(snakemake.input.previous[1])["samples"]
+        posterior = np.load(snakemake.input.previous[1])
         done = [chosen for path in snakemake.input.previous[2:] for chosen in json.loads(Path(path).read_text())["sets"]]
         if iteration > settings["max_iterations"]:
             stopped, reason = True, f"calibration.bayesian.max_iterations ({settings['max_iterations']}) reached"
-        elif not previous["moved"]:
-            stopped, reason = True, (f"the posterior moved {previous['shift']:.3g} (< stop_shift "
-                                     f"{settings['stop_shift']:g}) from the iteration before")
+        elif previous["stop"]:
+            stopped, reason = True, previous["stop_reason"]
         else:
-            sets = next_sets(calibration, samples, [chosen["theta"] for chosen in done], len(done), iteration)
+            sets = next_sets(calibration, posterior["samples"], posterior["log_probability"],
+                             [chosen["theta"] for chosen in done], len(done), iteration)
             if not sets:
                 stopped, reason = True, f"the budget of calibration.bayesian.max_sets ({settings['max_sets']}) is spent"
     write_json(snakemake.output.design, {"engine": engine, "iteration": iteration, "stopped": stopped,

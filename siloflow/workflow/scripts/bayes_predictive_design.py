@@ -1,5 +1,5 @@
 """Snakemake adapter: the parameter sets of the posterior predictive check on one engine (draws from the final
-posterior), with their runs."""
+posterior, on fresh seeds, with the surrogates' prediction at each), with their runs."""
 
 import numpy as np
 
@@ -10,7 +10,8 @@ from siloflow.engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     calibration = calibration_of(snakemake.config)
-    sets = predictive_sets(calibration, np.load(snakemake.input.samples)["samples"])
+    posterior = np.load(snakemake.input.samples)
+    sets = predictive_sets(calibration, posterior["samples"], posterior["predicted_mean"], posterior["predicted_std"])
     write_json(snakemake.output.design, {"engine": snakemake.wildcards.engine, "stopped": False, "reason": "",
                                          "parameters": list(calibration.names),
                                          "sets": with_runs(snakemake.config, calibration, sets,

@@ -29,10 +29,13 @@ with logged_to(snakemake.log[0]) as log:
     calibration = calibration_of(snakemake.config)
     twin = None
     if snakemake.input.targets:  # a twin experiment: the engine's own angles at the truth
-        calibration = with_targets(calibration, json.loads(Path(snakemake.input.targets[0]).read_text())["targets_deg"])
+        targets = json.loads(Path(snakemake.input.targets[0]).read_text())
+        calibration = with_targets(calibration, targets["targets_deg"],
+                                   np.column_stack([targets["angles_deg"][test] for test in calibration.tests]))
     engine = snakemake.wildcards.engine
     summary = json.loads(Path(snakemake.input.summary).read_text())
-    samples = np.load(snakemake.input.samples)["samples"]
+    posterior = np.load(snakemake.input.samples)
+    samples = posterior["samples"]
     sets = sets_of(snakemake.input.designs)
     predictive_sets = sets_of([snakemake.input.predictive_design])
 
@@ -49,7 +52,7 @@ with logged_to(snakemake.log[0]) as log:
     for run in predictive_failed:
         log.warning("predictive draw %s: its %s run %s failed", run["theta"], run["test"], run["run_id"])
     predictive = predictive_rows(calibration, completed_sets(predictive_sets, predictive_summaries),
-                                 predictive_summaries, summary["seed_sd_deg"])
+                                 predictive_summaries, summary["seed_sd_deg"], summary["target_sd_deg"])
     verdict = {**predictive_verdict(predictive), "failed_runs": predictive_failed}
     if predictive:
         write_flow_table(snakemake.output.predictive, predictive)
@@ -57,8 +60,9 @@ with logged_to(snakemake.log[0]) as log:
         write_text(snakemake.output.predictive, ",".join(predictive_columns(calibration)) + "\n")
         log.info("no predictive runs (calibration.bayesian.predictive_draws is 0): header only")
     plot_predictive(predictive, snakemake.output.predictive_plot)
-    log.info("predictive check on %s: %d of %d runs within 2 sd of their target", engine, verdict["within"],
-             verdict["rows"])
+    log.info("predictive check on %s: chi2 %s over %d runs (p upper %s, lower %s): %s; %d of %d runs within 2 sd of "
+             "their target", engine, verdict["chi2"], verdict["degrees_of_freedom"], verdict["p_upper"],
+             verdict["p_lower"], verdict["verdict"], verdict["within"], verdict["rows"])
 
     chart = None
     if snakemake.input.chart:
@@ -75,10 +79,13 @@ with logged_to(snakemake.log[0]) as log:
         log.info("the chart comparison was not asked for (calibration.bayesian.compare_with_chart): header only")
     truths = None
     if snakemake.input.targets:
-        twin = twin_verdict(calibration.names, samples, twin_truth(calibration))
+        twin = twin_verdict(calibration, samples, posterior["log_probability"], twin_truth(calibration),
+                            summary["truth_log_probability"])
         truths = twin["truth"]
-        log.info("twin experiment on %s: the truth %s is %s the 90 %% credible region", engine, twin["truth"],
-                 "inside" if twin["inside_credible_region"] else "outside")
+        log.info("twin experiment on %s: the truth %s lies at the %.3f highest-posterior-density level: %s the 90 %% "
+                 "region; per parameter sd/prior sd and z %s", engine, twin["truth"], twin["hpd_level"],
+                 "inside" if twin["inside_credible_region"] else "outside",
+                 {name: (round(p["sd_over_prior_sd"], 3), round(p["z"], 2)) for name, p in twin["parameters"].items()})
     plot_corner(samples, calibration.names, snakemake.output.corner, truths=truths, chart=chart)
 
     final_iteration = len(snakemake.input.designs) - 1
