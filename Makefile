@@ -126,7 +126,7 @@ validate: install
 	$(if $(GROUP),$(SILOFLOW) record restore --group '$(GROUP)' --config $(VALIDATION_CONFIG) \
 		--record $(VALIDATION_RECORD) --directory $(VALIDATION_DIR))
 	$(SILOFLOW) estimate --config $(VALIDATION_CONFIG) --directory $(VALIDATION_DIR) --cores $(CORES)
-	$(VALIDATION_RUN) $(if $(GROUP),--target 'validate_$(GROUP)') --keep-going --no-report
+	$(VALIDATION_RUN) $(if $(GROUP),--target 'validate_$(GROUP)' --part-deadline) --keep-going --no-report
 	@groups="$$($(SILOFLOW) record finished --config $(VALIDATION_CONFIG) --directory $(VALIDATION_DIR) \
 		$(if $(GROUP),--group '$(GROUP)'))" || exit 1; \
 	for group in $$groups; do \

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import time
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Sequence
@@ -19,12 +20,14 @@ from typing import Sequence
 from siloflow.cli import record
 from siloflow.engines.config import PACKAGE_ROOT, ConfigError, layered_config, validate_config
 from siloflow.engines.config_yaml import ConfigFileError
+from siloflow.engines.deadline import DEADLINE_VARIABLE
 from siloflow.engines.estimates import format_bytes, total_dump_bytes
 from siloflow.engines.layout import RESULTS
 from siloflow.engines.planning import estimate_report
 from siloflow.engines.preflight import Preflight, PreflightError, preflight
 from siloflow.engines.results_status import results_status, scan_results, status_lines
 from siloflow.engines.runs import render_run
+from siloflow.engines.validation_groups import GROUP_BUDGET_S, PART_FILL
 from siloflow.engines.workflow_lock import LiveRunError, launch
 from siloflow.model.cases.kinds import configured_kinds
 
@@ -196,6 +199,9 @@ def run(args: argparse.Namespace) -> int:
     _checked(files, directory)
     directory.mkdir(parents=True, exist_ok=True)
     extra = [*(["--keep-going"] if args.keep_going else []), *(["--dry-run"] if args.dry_run else [])]
+    if args.part_deadline:
+        # the run steps Snakemake starts inherit it (siloflow.engines.deadline)
+        os.environ[DEADLINE_VARIABLE] = repr(time.time() + PART_FILL * GROUP_BUDGET_S)
     code = launch(snakemake_arguments(files, directory, args.cores, args.target, extra))
     if code != 0 or args.no_report or args.dry_run:
         return code
@@ -226,6 +232,9 @@ def parser() -> argparse.ArgumentParser:
     sub.add_argument("--no-report", action="store_true", help="run only, write no report")
     sub.add_argument("--keep-going", action="store_true", help="go on with independent runs when one fails")
     sub.add_argument("--dry-run", action="store_true", help="print what would run, run nothing")
+    sub.add_argument("--part-deadline", action="store_true",
+                     help=f"stop the engine runs {PART_FILL * GROUP_BUDGET_S / 3600:g} h from now, a validation "
+                          "part's time; a stopped run carries on from its restart files the next time")
     sub.set_defaults(handler=run)
 
     sub = commands.add_parser("check", help="validate a configuration and plan it; nothing runs",

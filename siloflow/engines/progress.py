@@ -296,27 +296,48 @@ class ProgressMonitor:
         return report
 
 
+#: How long a stopped engine gets to exit after SIGTERM before it is killed (s).
+STOP_GRACE_S = 30.0
+
+
+def stop_process(process: subprocess.Popen, grace: float = STOP_GRACE_S) -> int:
+    """Stop a child process: SIGTERM (mpirun passes it on to its ranks), then SIGKILL after ``grace`` seconds;
+    returns its exit code."""
+    process.terminate()
+    try:
+        return process.wait(timeout=grace)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        return process.wait()
+
+
 def run_with_progress(command: list[str], run_dir: str | os.PathLike, output_path: str | os.PathLike,
                       environment: dict, parser: ScreenParser, target_time: float | None, report_every: float,
                       poll_every: float = 1.0) -> int:
     """Run ``command`` in ``run_dir`` with its output (stdout and stderr) written to ``output_path``, and return its
     exit code. With ``target_time`` [s of simulated time] a :class:`ProgressMonitor` reads the output with
     ``parser`` every ``poll_every`` s and reports every ``report_every`` s, in the log and, when the job's stderr is
-    a terminal, as one line naming the run there. No shell is involved and stdin is closed."""
+    a terminal, as one line naming the run there. No shell is involved and stdin is closed. An exception while it
+    runs (a part's deadline, :mod:`siloflow.engines.deadline`; an interrupt) stops the command first."""
     terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
     monitor = (ProgressMonitor(output_path, parser, target_time, os.path.basename(os.fspath(run_dir)), report_every,
                                logging.getLogger("siloflow"), terminal) if target_time else None)
     with open(output_path, "w", encoding="utf-8") as output:
         process = subprocess.Popen(command, cwd=run_dir, stdout=output, stderr=subprocess.STDOUT, env=environment,
                                    stdin=subprocess.DEVNULL)
-        while True:
-            try:
-                returncode = process.wait(timeout=poll_every)
-                break
-            except subprocess.TimeoutExpired:
-                if monitor is not None:
-                    output.flush()
-                    monitor.poll()
+        try:
+            while True:
+                try:
+                    returncode = process.wait(timeout=poll_every)
+                    break
+                except subprocess.TimeoutExpired:
+                    if monitor is not None:
+                        output.flush()
+                        monitor.poll()
+        except BaseException:
+            # interrupted (a part's deadline, Ctrl-C): the engine must not run on without its job
+            stop_process(process)
+            raise
     if monitor is not None:
         monitor.finish()
     return returncode

@@ -155,7 +155,8 @@ def runs_wall_time(runs: Iterable[tuple[float, int]], cores: int) -> float:
 
 @dataclass(frozen=True)
 class Part:
-    """A part of a validation group: the runs one `make validate GROUP=<name>` makes.
+    """A part of a validation group: the runs one `make validate GROUP=<name>` makes, or carries on (a run longer
+    than a part runs over several, :attr:`time_slice`).
 
     Attributes
     ----------
@@ -171,6 +172,9 @@ class Part:
     name: str
     group: str
     positions: tuple[int, ...]
+    #: ``(j, k)`` for runs longer than a part on their own: this part is the j-th of the k consecutive parts that run
+    #: them, each stopping them at its deadline and the next resuming them from their restart files; None otherwise
+    time_slice: tuple[int, int] | None = None
 
     def runs(self, members: Sequence):
         """The part's runs among ``members``, the group's runs in :func:`assign`'s order (estimates or run ids)."""
@@ -184,8 +188,9 @@ def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
 
     First-fit decreasing: the runs, the longest first, each go into the first part whose wall time
     (:func:`runs_wall_time`) stays within the budget with it, else into a new part. The parts depend only on the
-    estimates, so the same configuration always gives the same parts. A run longer than the budget on its own is a
-    part by itself (over budget: :func:`part_costs` flags it).
+    estimates, so the same configuration always gives the same parts. Runs longer than the budget on their own run
+    side by side, as many as the cores hold, over as many consecutive parts as the longest of them needs (time slices:
+    each part stops them at its deadline, the next resumes them from their restart files); these parts come first.
 
     Parameters
     ----------
@@ -205,8 +210,21 @@ def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
     """
     order = sorted(range(len(members)), key=lambda i: (-members[i].wall_time_s * members[i].mpi_ranks,
                                                        members[i].run_id))
+    long = [i for i in order if members[i].wall_time_s > budget_s]
+    sliced: list[tuple[list[int], int]] = []
+    while long:
+        # side by side while the cores hold their ranks
+        chosen, used = [], 0
+        for i in list(long):
+            ranks = min(members[i].mpi_ranks, cores)
+            if not chosen or used + ranks <= cores:
+                chosen.append(i)
+                used += ranks
+                long.remove(i)
+        slices = math.ceil(max(members[i].wall_time_s for i in chosen) / budget_s)
+        sliced.append((chosen, slices))
     bins: list[list[int]] = []
-    for i in order:
+    for i in (i for i in order if members[i].wall_time_s <= budget_s):
         fits = (b for b in bins
                 if runs_wall_time(((members[j].wall_time_s, members[j].mpi_ranks) for j in (*b, i)), cores) <= budget_s)
         target = next(fits, None)
@@ -214,9 +232,12 @@ def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
             bins.append([i])
         else:
             target.append(i)
-    if len(bins) == 1:
-        return [Part(group, group, tuple(sorted(bins[0])))]
-    return [Part(f"{group}_{k}", group, tuple(sorted(b))) for k, b in enumerate(bins, start=1)]
+    parts = [(tuple(sorted(chosen)), (j, slices)) for chosen, slices in sliced for j in range(1, slices + 1)]
+    parts += [(tuple(sorted(b)), None) for b in bins]
+    if len(parts) == 1:
+        return [Part(group, group, parts[0][0])]
+    return [Part(f"{group}_{k}", group, positions, time_slice)
+            for k, (positions, time_slice) in enumerate(parts, start=1)]
 
 
 def split_groups(made: Mapping[str, Sequence[RunEstimate]], cores: int = PART_CORES) -> dict[str, list[Part]]:
@@ -299,11 +320,25 @@ def group_costs(made: Mapping[str, Sequence[RunEstimate]], cores: int) -> list[G
     return [_cost(name, members, cores) for name, members in made.items()]
 
 
+def _slice_cost(part: Part, members: Sequence[RunEstimate], cores: int, budget_s: float) -> GroupCost:
+    """The cost of one time slice of runs longer than a part: the part's budget of wall time, or what the runs have
+    left in the last slice, and the core time their cores spend in it."""
+    j, _ = part.time_slice
+    runs = part.runs(members)
+    left = [max(0.0, e.wall_time_s - (j - 1) * budget_s) for e in runs]
+    spent = [min(budget_s, wall) for wall in left]
+    wall = max(spent)
+    core_seconds = math.fsum(s * e.mpi_ranks for s, e in zip(spent, runs))
+    return GroupCost(part.name, len(runs), core_seconds, wall, wall > GROUP_BUDGET_S)
+
+
 def part_costs(parts: Mapping[str, Sequence[Part]], made: Mapping[str, Sequence[RunEstimate]],
-               cores: int) -> dict[str, list[GroupCost]]:
+               cores: int, budget_s: float = PART_FILL * GROUP_BUDGET_S) -> dict[str, list[GroupCost]]:
     """``{group: [cost of each part]}`` on ``cores`` cores of the groups split into several parts (``parts`` from
-    :func:`split_groups`, ``made`` the groups' runs in the same order, possibly estimated with another cost model)."""
-    return {name: [_cost(part.name, part.runs(made[name]), cores) for part in group_parts]
+    :func:`split_groups`, ``made`` the groups' runs in the same order, possibly estimated with another cost model); a
+    time slice of runs longer than a part costs its share of them (``budget_s`` of wall time at most)."""
+    return {name: [_slice_cost(part, made[name], cores, budget_s) if part.time_slice
+                   else _cost(part.name, part.runs(made[name]), cores) for part in group_parts]
             for name, group_parts in parts.items() if len(group_parts) > 1}
 
 
@@ -381,7 +416,7 @@ def cost_lines(costs: Sequence[GroupCost], cores: int, parts: Mapping[str, Seque
         lines.append(f"  {cost.name:22s} {cost.runs:3d} runs  {cost.core_seconds / 3600:6.2f} core-h  "
                      f"{cost.wall_time_s / 3600:5.2f} h wall{flag}")
         for part in split_into:
-            over = "  OVER BUDGET: a run alone is longer; give it more MPI ranks" if part.over_budget else ""
+            over = "  OVER BUDGET" if part.over_budget else ""
             lines.append(f"    {part.name:20s} {part.runs:3d} runs  {part.core_seconds / 3600:6.2f} core-h  "
                          f"{part.wall_time_s / 3600:5.2f} h wall{over}")
     return lines

@@ -203,8 +203,9 @@ def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("runs in 4 parts: make validate GROUP=blending_1 then make validate GROUP=blending_2 then make validate "
-            "GROUP=blending_3 then make validate GROUP=blending_4" in capsys.readouterr().err)
+    # internal flow's two seeds side by side over five time slices, semi-mass flow over five, the thin silo
+    assert ("runs in 11 parts: " + " then ".join(f"make validate GROUP=blending_{k}" for k in range(1, 12))
+            in capsys.readouterr().err)
     # the blending study starts from the flat-bottom silo's settled fills: it waits for that silo's record
     assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 2
     assert "compares against the runs of silo, whose record is missing: run make validate GROUP=silo first" in (
@@ -225,15 +226,17 @@ def test_a_group_longer_than_a_session_is_split_first_fit_decreasing():
              _estimate("e", "blender", 2.4 * hour)]
     assert split("blender", mixed, budget_s=GROUP_BUDGET_S) == [Part("blender_1", "blender", (0, 1, 4)),
                                                                Part("blender_2", "blender", (2, 3))]
-    # by default a part is filled to 90 % of the budget, 2.25 h: e 2.4 h is a part alone; b 2.0 h and c 1.5 h side
-    # by side; d 1.0 h after c would end at 2.5 h, so it opens a third part; a 0.5 h after c ends at 2.0 h
+    # by default a part is filled to 90 % of the budget, 2.25 h: e 2.4 h is longer, so it runs over two time slices
+    # first; b 2.0 h and c 1.5 h side by side; d 1.0 h after c would end at 2.5 h, so it opens another part; a 0.5 h
+    # after c ends at 2.0 h
     assert PART_FILL == 0.9
-    assert split("blender", mixed) == [Part("blender_1", "blender", (4,)), Part("blender_2", "blender", (0, 1, 2)),
-                                      Part("blender_3", "blender", (3,))]
-    # a group that fits keeps its name; a run longer than the budget alone is a part by itself
+    assert split("blender", mixed) == [Part("blender_1", "blender", (4,), (1, 2)), Part("blender_2", "blender", (4,), (2, 2)),
+                                      Part("blender_3", "blender", (0, 1, 2)), Part("blender_4", "blender", (3,))]
+    # a group that fits keeps its name; a run longer than the budget runs over time slices of its own
     assert split("blending", mixed[:2]) == [Part("blending", "blending", (0, 1))]
     long = [_estimate("x", "blender", 3.0 * hour), _estimate("y", "blender", 0.1 * hour)]
-    assert split("blender", long) == [Part("blender_1", "blender", (0,)), Part("blender_2", "blender", (1,))]
+    assert split("blender", long) == [Part("blender_1", "blender", (0,), (1, 2)), Part("blender_2", "blender", (0,), (2, 2)),
+                                      Part("blender_3", "blender", (1,))]
     # on one core, two 1.5 h runs take 3 h: two parts
     pair = [_estimate("p", "blender", 1.5 * hour), _estimate("q", "blender", 1.5 * hour)]
     assert split("blender", pair) == [Part("blender", "blender", (0, 1))]
@@ -325,3 +328,27 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
     assert record_main(["check", "--group", "silo_series", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo first" in
             capsys.readouterr().err)
+
+
+def test_runs_longer_than_a_part_run_side_by_side_over_consecutive_time_slices():
+    hour = 3600.0
+    budget = PART_FILL * GROUP_BUDGET_S   # 2.25 h
+    # two runs of 9.2 h and one of 4 h (each longer than a part) and two short ones
+    members = [_estimate("a", "silo_recirculation", 9.2 * hour), _estimate("b", "silo_recirculation", 4.0 * hour),
+               _estimate("c", "silo_recirculation", 9.2 * hour), _estimate("s1", "silo_recirculation", 0.2 * hour),
+               _estimate("s2", "silo_recirculation", 0.3 * hour)]
+    parts = split("blending", members)
+    # a and c side by side for ceil(9.2 / 2.25) = 5 slices; then b alone for 2; then the short ones together
+    assert [(p.name, p.positions, p.time_slice) for p in parts] == [
+        *((f"blending_{j}", (0, 2), (j, 5)) for j in range(1, 6)),
+        ("blending_6", (1,), (1, 2)), ("blending_7", (1,), (2, 2)), ("blending_8", (3, 4), None)]
+    costs = part_costs({"blending": parts}, {"blending": members}, cores=2)["blending"]
+    # each full slice: its budget of wall time on both runs' cores; the last: what is left
+    assert costs[0].wall_time_s == pytest.approx(budget) and costs[0].core_seconds == pytest.approx(2 * budget)
+    assert costs[4].wall_time_s == pytest.approx(9.2 * hour - 4 * budget)
+    assert costs[6].wall_time_s == pytest.approx(4.0 * hour - budget)
+    assert not any(cost.over_budget for cost in costs)
+    # a two-rank run holds both cores: it runs its slices alone
+    wide = split("blender", [_estimate("w", "blender", 3.0 * hour, mpi_ranks=2), _estimate("v", "blender", 3.0 * hour)])
+    assert [(p.positions, p.time_slice) for p in wide] == [((0,), (1, 2)), ((0,), (2, 2)), ((1,), (1, 2)),
+                                                          ((1,), (2, 2))]
