@@ -364,6 +364,10 @@ def insert_clumps(rng, wanted):
     return placed
 
 
+#: how far above the domain's top a clump may be before it counts as lost (m); a case's outflow block may widen it
+TOP_MARGIN = 0.0
+
+
 def outflow():
     """Continuous discharge at constant head: a clump below the domain re-enters at its top, whole, with its x, y and
     velocity (the LIGGGHTS deck's periodic z)."""

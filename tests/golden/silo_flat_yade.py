@@ -366,7 +366,7 @@ def insert_clumps(rng, wanted):
     return placed
 
 
-#: how far above the domain's top a clump may be before it counts as lost (m)
+#: how far above the domain's top a clump may be before it counts as lost (m); a case's outflow block may widen it
 TOP_MARGIN = 0.0
 
 

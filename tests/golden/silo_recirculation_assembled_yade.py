@@ -366,6 +366,10 @@ def insert_clumps(rng, wanted):
     return placed
 
 
+#: how far above the domain's top a clump may be before it counts as lost (m); a case's outflow block may widen it
+TOP_MARGIN = 0.0
+
+
 #: a clump re-enters just below the domain's top, where the next one to re-enter nearby may push it up before it falls
 #: (LIGGGHTS' periodic box would carry it on through the bottom): above by a clump's size it counts as lost
 TOP_MARGIN = 2.0 * BOUNDING_RADIUS
