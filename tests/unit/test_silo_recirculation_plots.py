@@ -6,12 +6,14 @@ from __future__ import annotations
 import matplotlib.patches
 import numpy as np
 import pytest
-from matplotlib.collections import PathCollection
+from matplotlib.collections import PathCollection, PolyCollection
 from matplotlib.colors import to_hex
 from matplotlib.path import Path as MplPath
 
 import siloflow.analysis.studies.silo_recirculation.plots as plots
+from siloflow.analysis.io.plot_style import PALETTE
 import siloflow.analysis.studies.silo_recirculation.rtd_plots as rtd_plots
+import siloflow.analysis.studies.silo_recirculation.vrr_summary_plot as vrr_summary_plot
 from tests.plot_data import saved_figures
 from siloflow.analysis.studies.silo_recirculation.plots import (
     plot_coloured_snapshots,
@@ -19,6 +21,7 @@ from siloflow.analysis.studies.silo_recirculation.plots import (
     plot_paths_comparison,
     plot_vrr_versus_recirculations,
 )
+from siloflow.analysis.studies.silo_recirculation.vrr_summary_plot import plot_vrr_summary, vrr_replicate_curves
 from siloflow.analysis.studies.silo_recirculation.rtd_plots import (
     plot_lti_comparison,
     plot_recirculation_model,
@@ -42,7 +45,7 @@ def _assert_png(target, returned):
 @pytest.fixture
 def figures(monkeypatch):
     """The figures the writers save, kept (after they are written) so that their plotted data can be checked."""
-    return saved_figures(monkeypatch, plots, rtd_plots)
+    return saved_figures(monkeypatch, plots, rtd_plots, vrr_summary_plot)
 
 
 def _only_axes(figures):
@@ -266,6 +269,168 @@ def test_plot_vrr_versus_recirculations_rejects_bad_input(tmp_path):
     with pytest.raises(ValueError, match="factor must be a finite number >= 1"):
         plot_vrr_versus_recirculations([("a", nr, nr)], tmp_path / "a.png", "t", factor=0.5)
     assert not (tmp_path / "a.png").exists()
+
+
+# ---------------------------------------------------------------------------------------- VRR summary
+
+SUMMARY_NR = np.array([0.5, 1.5, 2.5, 3.5])
+#: internal flow blue13: three seeds, mean [3, 5, 9, 18] and sample standard deviation [1, 1, 1, 2]
+INTERNAL_BLUE13 = np.array([[2.0, 4.0, 8.0, 16.0], [3.0, 5.0, 9.0, 18.0], [4.0, 6.0, 10.0, 20.0]])
+STUDY_B4 = [{"id": "B4", "flow_pattern": "internal_flow", "at": 4.0, "low": 8.0, "high": 13.0},
+            {"id": "B4", "flow_pattern": "semi_mass_flow", "at": 4.0, "low": 4.0, "high": 6.0}]
+
+
+def _summary_curves():
+    """2 flow patterns x 2 layouts: internal flow with 3 seeds, semi-mass flow with 1; four ceilings, one None."""
+    return [
+        {"flow_pattern": "internal_flow", "layout": "blue13", "recirculations": SUMMARY_NR, "vrr": INTERNAL_BLUE13,
+         "ceiling": 500.0},
+        {"flow_pattern": "internal_flow", "layout": "blue4", "recirculations": SUMMARY_NR,
+         "vrr": 2.0 * INTERNAL_BLUE13, "ceiling": 300.0},
+        {"flow_pattern": "semi_mass_flow", "layout": "blue13", "recirculations": SUMMARY_NR,
+         "vrr": [[1.5, 2.5, 3.5, 4.5]], "ceiling": None},
+        {"flow_pattern": "semi_mass_flow", "layout": "blue4", "recirculations": SUMMARY_NR,
+         "vrr": [[1.2, 2.2, 3.2, 4.2]], "ceiling": 800.0},
+    ]
+
+
+def _bands(axes) -> list:
+    return [collection for collection in axes.collections if collection.get_gid() == "vrr_band"]
+
+
+def test_plot_vrr_summary_draws_one_mean_per_pattern_and_layout_with_a_band_for_replicates(tmp_path, figures):
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_summary(_summary_curves(), target, "VRR summary", findings=STUDY_B4))
+    axes = _only_axes(figures)
+    assert axes.get_yscale() == "log"
+    means = _lines_with_gid(axes, "vrr_mean")
+    assert len(means) == 2 * 2  # n_patterns x n_layouts, not x seeds
+    internal, semi = to_hex(PALETTE[0]), to_hex(PALETTE[1])
+    assert [to_hex(line.get_color()) for line in means] == [internal, internal, semi, semi]
+    assert [line.get_linestyle() for line in means] == ["-", "--", "-", "--"]  # one style per layout, in each pattern
+    assert [line.get_marker() for line in means] == ["o", "s", "o", "s"]
+    np.testing.assert_allclose(means[0].get_ydata(), [3.0, 5.0, 9.0, 18.0], rtol=1e-12)
+    np.testing.assert_array_equal(means[0].get_xdata(), SUMMARY_NR)
+    np.testing.assert_array_equal(means[2].get_ydata(), [1.5, 2.5, 3.5, 4.5])  # one seed: the seed itself
+    # a band for each replicated curve (internal flow) only, mean +- the standard error of the mean
+    bands = _bands(axes)
+    assert len(bands) == 2 and all(isinstance(band, PolyCollection) for band in bands)
+    assert [to_hex(band.get_facecolor()[0][:3]) for band in bands] == [internal, internal]
+    assert bands[0].get_alpha() == pytest.approx(0.2)
+    vertices = bands[0].get_paths()[0].vertices
+    at_three_and_a_half = sorted(vertices[np.isclose(vertices[:, 0], 3.5), 1])
+    sem = 2.0 / np.sqrt(3.0)
+    np.testing.assert_allclose([at_three_and_a_half[0], at_three_and_a_half[-1]], [18.0 - sem, 18.0 + sem],
+                               rtol=1e-12)
+
+
+def test_plot_vrr_summary_draws_the_lowest_ceiling_once_with_a_direct_label(tmp_path, figures):
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_summary(_summary_curves(), target, "VRR summary"))
+    axes = _only_axes(figures)
+    (ceiling,) = _lines_with_gid(axes, "ceiling")
+    assert list(ceiling.get_ydata()) == [300.0, 300.0]
+    assert ceiling.get_linestyle() == "--"
+    assert _horizontal_lines(axes) == [300.0]
+    (label,) = [text for text in axes.texts if text.get_gid() == "ceiling_label"]
+    assert label.get_text() == "counting-noise ceiling"
+    assert label.get_position() == (0.99, 300.0) and label.get_horizontalalignment() == "right"
+    legend = [text.get_text() for text in axes.get_legend().get_texts()]
+    assert not any("ceiling" in text for text in legend)
+
+
+def test_plot_vrr_summary_legend_has_each_pattern_layout_and_finding_once_outside_the_data(tmp_path, figures):
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_summary(_summary_curves(), target, "VRR summary", findings=STUDY_B4))
+    (figure,) = figures
+    axes = _only_axes(figures)
+    legend = axes.get_legend()
+    assert [text.get_text() for text in legend.get_texts()] == [
+        "internal flow", "semi mass flow", "layout blue13", "layout blue4", "study B4: internal flow 8-13",
+        "study B4: semi mass flow 4-6"]  # n_patterns + n_layouts + n_findings
+    figure.canvas.draw()
+    box, data_area = legend.get_window_extent(), axes.get_window_extent()
+    assert not box.overlaps(data_area)
+    assert box.x0 > data_area.x1
+    assert axes.get_xlabel() == "number of recirculations Nr [-]"
+    assert axes.get_ylabel() == "variance reduction ratio VRR [-]"
+    assert axes.get_title() == "VRR summary"
+
+
+def test_plot_vrr_summary_draws_each_finding_as_a_bar_at_its_nr_in_its_patterns_colour(tmp_path, figures):
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_summary(_summary_curves(), target, "VRR summary", findings=STUDY_B4))
+    axes = _only_axes(figures)
+    bars = [collection for collection in axes.collections if collection.get_gid() == "finding B4"]
+    segments = [[tuple(map(float, point)) for point in bar.get_segments()[0]] for bar in bars]
+    np.testing.assert_allclose(segments, [[(4.0, 8.0), (4.0, 13.0)], [(4.0, 4.0), (4.0, 6.0)]], rtol=1e-12)
+    assert [to_hex(bar.get_colors()[0]) for bar in bars] == [to_hex(PALETTE[0]), to_hex(PALETTE[1])]
+
+
+def test_plot_vrr_summary_skips_what_a_log_axis_cannot_show_and_colours_a_finding_without_curve(tmp_path, figures):
+    curves = [{"flow_pattern": "internal_flow", "layout": "blue13", "recirculations": [1.0, 2.0, 3.0],
+               "vrr": [[2.0, np.nan, np.inf], [4.0, 6.0, -1.0]]}]
+    findings = [{"id": "B4", "flow_pattern": "semi_mass_flow", "at": 4.0, "low": 4.0, "high": 6.0}]
+    target = tmp_path / "vrr.png"
+    _assert_png(target, plot_vrr_summary(curves, target, "gaps", findings=findings))
+    axes = _only_axes(figures)
+    (mean,) = _lines_with_gid(axes, "vrr_mean")
+    # Nr 1: both seeds; Nr 2: the one finite seed; Nr 3: none left (inf and -1 have no place on a log axis): a gap
+    np.testing.assert_array_equal(mean.get_ydata(), [3.0, 6.0, np.nan])
+    assert _lines_with_gid(axes, "ceiling") == []
+    (bar,) = [collection for collection in axes.collections if collection.get_gid() == "finding B4"]
+    assert to_hex(bar.get_colors()[0]) == to_hex(PALETTE[1])  # the next colour after the curves' flow pattern
+    assert [text.get_text() for text in axes.get_legend().get_texts()] == [
+        "internal flow", "layout blue13", "study B4: semi mass flow 4-6"]
+
+
+def test_plot_vrr_summary_rejects_bad_input(tmp_path):
+    target = tmp_path / "a.png"
+    good = _summary_curves()[0]
+    with pytest.raises(ValueError, match="curves must not be empty"):
+        plot_vrr_summary([], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] vrr must be a 2-D array"):
+        plot_vrr_summary([{**good, "vrr": [1.0, 2.0, 3.0, 4.0]}], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] vrr must have as many columns as curves\[0\] recirculations"):
+        plot_vrr_summary([{**good, "vrr": INTERNAL_BLUE13[:, :3]}], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] recirculations must contain only finite numbers"):
+        plot_vrr_summary([{**good, "recirculations": [0.5, np.nan, 2.5, 3.5]}], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[1\] ceiling must be a finite number > 0"):
+        plot_vrr_summary([good, {**good, "layout": "blue4", "ceiling": 0.0}], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[1\]: flow pattern 'internal_flow' with layout 'blue13' appears"):
+        plot_vrr_summary([good, good], target, "t")
+    with pytest.raises(ValueError, match=r"curves\[0\] lacks vrr"):
+        plot_vrr_summary([{key: value for key, value in good.items() if key != "vrr"}], target, "t")
+    with pytest.raises(ValueError, match=r"findings\[0\] high must be >= low"):
+        plot_vrr_summary([good], target, "t", findings=[{**STUDY_B4[0], "low": 13.0, "high": 8.0}])
+    with pytest.raises(ValueError, match=r"findings\[1\] low must be a finite number > 0"):
+        plot_vrr_summary([good], target, "t", findings=[STUDY_B4[0], {**STUDY_B4[1], "low": 0.0}])
+    assert not target.exists()
+
+
+def test_vrr_replicate_curves_groups_seeds_by_pattern_and_layout():
+    rows = [{"flow_pattern": "internal_flow", "layout": "blue13"}, {"flow_pattern": "internal_flow", "layout": "blue4"},
+            {"flow_pattern": "internal_flow", "layout": "blue13"},
+            {"flow_pattern": "semi_mass_flow", "layout": "blue13"}]
+    nr = [0.5, 1.5, 2.5, 3.5]
+    errors = [np.nan] * 4
+    curves = [("internal_flow blue13", nr, [2.0, 4.0, 8.0, 16.0], 500.0, errors),
+              ("internal_flow blue4", nr, [1.0, 2.0, 3.0, 4.0], 500.0, errors),
+              # another seed run for fewer windows, on another grid: its log VRR is interpolated onto the first's
+              ("internal_flow blue13", [1.0, 2.0, 3.0], [2.0, 8.0, 32.0], 300.0, [np.nan] * 3),
+              ("semi_mass_flow blue13", nr, [1.5, np.nan, 3.5, 4.5], None, errors)]
+    grouped = vrr_replicate_curves(rows, curves)
+    assert [(curve["flow_pattern"], curve["layout"], curve["ceiling"]) for curve in grouped] == [
+        ("internal_flow", "blue13", 300.0), ("internal_flow", "blue4", 500.0), ("semi_mass_flow", "blue13", None)]
+    blue13 = grouped[0]
+    np.testing.assert_array_equal(blue13["recirculations"], nr)
+    assert blue13["vrr"].shape == (2, 4)
+    np.testing.assert_array_equal(blue13["vrr"][0], [2.0, 4.0, 8.0, 16.0])
+    # halfway between 2 and 8 in log space is 4, between 8 and 32 is 16; no value outside the seed's own Nr range
+    np.testing.assert_allclose(blue13["vrr"][1], [np.nan, 4.0, 16.0, np.nan], rtol=1e-12)
+    np.testing.assert_array_equal(grouped[2]["vrr"], [[1.5, np.nan, 3.5, 4.5]])
+    with pytest.raises(ValueError, match="rows and curves must be of the same length"):
+        vrr_replicate_curves(rows, curves[:3])
 
 
 # ---------------------------------------------------------------------------------------- snapshots

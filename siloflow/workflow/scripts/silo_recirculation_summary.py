@@ -6,16 +6,21 @@ from pathlib import Path
 from siloflow.analysis.io.tables import write_flow_table
 from siloflow.analysis.numerics.reference_spread import floor_table
 from siloflow.analysis.numerics.replicates import combine_replicates
-from siloflow.analysis.studies.silo_recirculation.plots import plot_vrr_versus_recirculations
+from siloflow.analysis.studies.silo_recirculation.vrr_summary_plot import plot_vrr_summary, vrr_replicate_curves
 from siloflow.analysis.studies.silo_recirculation.tables import summary_rows
 from siloflow.engines.logs import logged_to
 
 with logged_to(snakemake.log[0]) as log:
     rows, curves = summary_rows([json.loads(Path(path).read_text()) for path in snakemake.input.summaries])
+    # the plot draws the seeds of one flow pattern and layout as their mean and band: group them before the table
+    # combines them
+    replicate_curves = vrr_replicate_curves(rows, curves)
     # replicates (the same flow pattern with other seeds) become one row per layout: their mean and its error
     rows = combine_replicates(rows, ["flow_pattern", "layout"])
     # a flow pattern run once takes the relative spread of the one run with several seeds (reference_replicates)
     rows = floor_table(rows)[0]
     write_flow_table(snakemake.output.table, rows)
-    plot_vrr_versus_recirculations(curves, snakemake.output.vrr_plot, "VRR per recirculation: flow patterns and layouts")
+    # no study band here: the study's VRR at the end of Nr recirculations (B4) is the discharge's after them, which
+    # this plot of the passes at constant head does not show
+    plot_vrr_summary(replicate_curves, snakemake.output.vrr_plot, "VRR per recirculation: flow patterns and layouts")
     log.info("%d flow pattern x layout rows", len(rows))

@@ -3,7 +3,8 @@
 Each writer takes arrays (or lists of labelled arrays), a path and a title, draws one figure and saves
 it atomically with :func:`siloflow.analysis.io.plots.save_figure` (PNG, PDF or SVG, as the path's suffix says); nothing is
 read from files.
-The RTD and LTI model curves are drawn by :mod:`siloflow.analysis.studies.silo_recirculation.rtd_plots`.
+The RTD and LTI model curves are drawn by :mod:`siloflow.analysis.studies.silo_recirculation.rtd_plots`, the VRR of every
+flow pattern and layout with its seeds by :mod:`siloflow.analysis.studies.silo_recirculation.vrr_summary_plot`.
 
 Geometry (as in :mod:`siloflow.analysis.studies.silo_flat.plots`): width W along x with walls at x = +-W/2, floor and outlet
 plane at z = 0, a slot outlet of width B0 centred on x = 0, and below it a channel of the same width
