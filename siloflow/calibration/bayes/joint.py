@@ -263,6 +263,8 @@ class IterationResult:
     predicted_mean, predicted_std : ndarray, shape (n, k)
         The surrogates' mean and sd of each test's angle at every sample (deg): the posterior predictive check's
         expectation for a run at a drawn sample.
+    leave_one_out : list of dict
+        Each test surrogate's leave-one-out check (:meth:`siloflow.calibration.bayes.surrogate.Surrogate.loo_check`).
     """
 
     sample: PosteriorSample
@@ -281,6 +283,7 @@ class IterationResult:
     truth_log_probability: float | None
     predicted_mean: np.ndarray
     predicted_std: np.ndarray
+    leave_one_out: list
 
     def summary(self, calibration: Calibration) -> dict:
         """Plain data: the posterior summary, the seed noise and the targets' standard errors, the surrogates' fitted
@@ -294,8 +297,8 @@ class IterationResult:
             "target_degrees_of_freedom": self.target_dof,
             "model_discrepancy_deg": calibration.discrepancy_sd_deg,
             "surrogates": {test: {**surrogate.surrogate.kernel_summary(), "inputs": list(surrogate.names),
-                                  "leave_one_out": surrogate.surrogate.loo_check()}
-                           for test, surrogate in zip(calibration.tests, self.surrogates)},
+                                  "leave_one_out": check}
+                           for test, surrogate, check in zip(calibration.tests, self.surrogates, self.leave_one_out)},
             "acceptance_fraction": self.sample.acceptance_fraction,
             "autocorrelation_time": self.sample.autocorrelation_time.tolist(),
             "effective_sample_size": self.sample.effective_sample_size.tolist(),
@@ -470,10 +473,9 @@ def iterate(calibration: Calibration, theta, angles_deg, angle_errors_deg, previ
     surrogates = fit_surrogates(calibration, theta, angles, _run_noise(errors, seed_variance))
     warnings = [f"{test} surrogate: {message}" for test, surrogate in zip(calibration.tests, surrogates)
                 for message in surrogate.surrogate.warnings]
-    for test, surrogate in zip(calibration.tests, surrogates):
-        check = surrogate.surrogate.loo_check()
-        if check["message"]:
-            warnings.append(f"{test} surrogate: {check['message']}")
+    leave_one_out = [surrogate.surrogate.loo_check() for surrogate in surrogates]
+    warnings += [f"{test} surrogate: {check['message']}" for test, check in zip(calibration.tests, leave_one_out)
+                 if check["message"]]
     log_probability = log_posterior(calibration.prior, surrogates, calibration.targets_deg, target_sd,
                                     calibration.discrepancy_sd_deg, target_dof)
     initial = calibration.prior.sample(settings["walkers"], settings["seed"])
@@ -505,7 +507,7 @@ def iterate(calibration: Calibration, theta, angles_deg, angle_errors_deg, previ
     stop, reason = should_stop(history, bool(agreement and agreement["within"]))
     return IterationResult(sample, seed_sd, int(dof), shift, moved, surrogates, np.asarray(target_sd, dtype=float),
                            target_dof, warnings, agreement, history, stop, reason, truth, predicted_mean,
-                           predicted_std)
+                           predicted_std, leave_one_out)
 
 
 def next_sets(calibration: Calibration, samples, log_probability, done_theta, sets_done: int,

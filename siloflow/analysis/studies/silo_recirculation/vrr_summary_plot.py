@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -147,11 +148,11 @@ def _replicate_mean(vrr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     values = _positive_finite_or_nan(vrr)
     counts = np.sum(np.isfinite(values), axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        total = np.nansum(values, axis=0)
-        mean = np.where(counts > 0, total / np.maximum(counts, 1), np.nan)
-        squares = np.nansum((values - mean) ** 2, axis=0)
-        error = np.where(counts >= 2, np.sqrt(squares / np.maximum(counts - 1, 1) / np.maximum(counts, 1)), np.nan)
+    with warnings.catch_warnings():
+        # a point no seed has a value at is NaN, by design: numpy's all-NaN warnings say nothing more
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean = np.nanmean(values, axis=0)
+        error = np.where(counts >= 2, np.nanstd(values, axis=0, ddof=1) / np.sqrt(np.maximum(counts, 1)), np.nan)
     return mean, error
 
 
