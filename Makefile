@@ -7,6 +7,8 @@ VENV          ?= .venv
 PYTHON        ?= $(VENV)/bin/python
 SILOFLOW       = $(PYTHON) -m siloflow
 CONFIG        ?= config/config.yaml
+# One --config per file, so that CONFIG="config/config.yaml config/bayesian_twin.yaml" layers the second over the first.
+CONFIG_ARGS    = $(addprefix --config ,$(CONFIG))
 CORES         ?= 2
 SUDO          := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 APT_PACKAGES  := liggghts openmpi-bin
@@ -76,7 +78,7 @@ install-docs: $(VENV)/.installed-docs
 RUN_DIR ?= .
 
 run: install
-	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES)
+	$(SILOFLOW) run $(CONFIG_ARGS) --directory $(RUN_DIR) --cores $(CORES)
 
 # A first result in minutes: the tiny configuration (numbers without physical meaning), into results/tiny/; the
 # example notebooks open its runs by default.
@@ -87,20 +89,20 @@ run-tiny: install
 
 # Validate CONFIG and plan it; nothing runs.
 check: install-python
-	$(SILOFLOW) check --config $(CONFIG) --cores $(CORES)
+	$(SILOFLOW) check $(CONFIG_ARGS) --cores $(CORES)
 
 # The checks the demo tier leaves out of `make run` (config/checks.yaml over CONFIG): the DEM verification suite,
 # the one-particle-thick recirculating silo and the lid comparison, then the report with their pages.
 CHECKS_CONFIG := config/checks.yaml
 
 verify: install
-	$(SILOFLOW) run --config $(CONFIG) --config $(CHECKS_CONFIG) --directory $(RUN_DIR) --cores $(CORES)
+	$(SILOFLOW) run $(CONFIG_ARGS) --config $(CHECKS_CONFIG) --directory $(RUN_DIR) --cores $(CORES)
 
 # The joint Bayesian calibration (calibration.bayesian, its own target): per engine, Jenike runs placed by the
 # posterior until it stops moving or the run budget is spent, the predictive check and the chart's answer beside it;
 # its report is RUN_DIR/results/report-bayesian.html.
 bayesian: install
-	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES) --target bayesian_calibration \
+	$(SILOFLOW) run $(CONFIG_ARGS) --directory $(RUN_DIR) --cores $(CORES) --target bayesian_calibration \
 		--report $(RUN_DIR)/results/report-bayesian.html
 
 # The validation scale (config/validation.yaml): the study's physics at the smallest scale that shows it
@@ -164,10 +166,10 @@ test-integration: install-test install-docs
 # Particle counts, steps, wall time and disk of every run of a config, before running it:
 # make estimate CONFIG=config/thesis.yaml
 estimate: install-python
-	$(SILOFLOW) estimate --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES)
+	$(SILOFLOW) estimate $(CONFIG_ARGS) --directory $(RUN_DIR) --cores $(CORES)
 
 dry-run: install
-	$(SILOFLOW) run --config $(CONFIG) --directory $(RUN_DIR) --cores $(CORES) --dry-run
+	$(SILOFLOW) run $(CONFIG_ARGS) --directory $(RUN_DIR) --cores $(CORES) --dry-run
 
 # Speed figures are ratios against a baseline measured in the same run (results/bench/).
 bench: install-test

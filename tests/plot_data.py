@@ -16,3 +16,24 @@ def saved_figures(monkeypatch, *modules) -> list:
     for module in modules:
         monkeypatch.setattr(module, "save_figure", keep)
     return saved
+
+
+def legend_texts(axes) -> list[str]:
+    """The texts of the legend of ``axes``, in order."""
+    return [text.get_text() for text in axes.get_legend().get_texts()]
+
+
+def lines_with_gid(axes, gid: str) -> list:
+    """The lines of ``axes`` whose gid is ``gid``: the series a writer tags by what it is."""
+    return [line for line in axes.get_lines() if line.get_gid() == gid]
+
+
+def assert_legend_outside(figure, axes, *clear_of) -> None:
+    """The legend of ``axes`` lies wholly right of its data area and of ``clear_of`` (artists right of it, e.g. a
+    secondary axis)."""
+    figure.canvas.draw()
+    box, data_area = axes.get_legend().get_window_extent(), axes.get_window_extent()
+    assert not box.overlaps(data_area)
+    assert box.x0 > data_area.x1
+    for artist in clear_of:
+        assert box.x0 > artist.get_tightbbox().x1

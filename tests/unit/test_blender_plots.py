@@ -7,8 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from matplotlib.colors import to_hex
 
 import siloflow.analysis.studies.blender.plots as blender_plots
+from siloflow.analysis.io.plot_style import PALETTE, StudyNote, StudyValue
+from siloflow.analysis.studies.validation.findings import PARTS
 import siloflow.analysis.studies.silo_recirculation.rtd_plots as rtd_plots
 from siloflow.analysis.studies.blender.comparison import comparison_table
 from siloflow.analysis.studies.blender.modes import continuous_mode, discontinuous_mode
@@ -26,7 +29,7 @@ from siloflow.analysis.studies.blender.plots import (
     plot_rtd_theta,
     plot_tracer_pathlines,
 )
-from tests.plot_data import saved_figures
+from tests.plot_data import assert_legend_outside, legend_texts, lines_with_gid, saved_figures
 from test_blender_analysis import PASSAGES, X_FULL, Z_ROWS, channel_field, metrics, shear_field, uniform_field
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -84,6 +87,80 @@ def test_plot_passage_distributions(tmp_path, figures):
             segment = next(line for line in axes.get_lines() if line.get_label().startswith(f"{name}:"))
             np.testing.assert_allclose(segment.get_xdata(), [1e3 * lo, 1e3 * hi])
             np.testing.assert_array_equal(segment.get_ydata(), [result.mean_v_z[name]] * 2)
+
+
+
+
+
+
+#: M1 at the diverging insert's outlet: each passage over the cross-section mean (exterior with a +- 10 % band).
+M1 = [StudyValue.of(PARTS["M1.exterior"], band=(0.144, 0.176), series="exterior"),
+      StudyValue.of(PARTS["M1.interior"], series="interior"), StudyValue.of(PARTS["M1.tube"], series="tube")]
+M2 = StudyNote.of(PARTS["M2.outlet_order"])
+
+
+def test_plot_passage_distributions_one_colour_per_passage_one_legend_outside_no_finding_unless_asked(
+        tmp_path, figures):
+    inlet = passage_velocities(shear_field(), 0.6, PASSAGES)
+    outlet = passage_velocities(uniform_field(), 0.2, {"interior": (0.0, 0.05), "exterior": (0.06, 0.1)})
+    target = tmp_path / "passages.png"
+    assert_png(target, plot_passage_distributions(inlet, outlet, target, "passages"))
+    (figure,) = figures
+    left, right = figure.axes
+    # per panel: the profile and each passage's mean on both sides of the axis
+    assert [len(lines_with_gid(axes, "profile")) for axes in (left, right)] == [1, 1]
+    assert [len(lines_with_gid(axes, "passage_mean")) for axes in (left, right)] == [2 * 3, 2 * 2]
+    tube, interior, exterior = (to_hex(colour) for colour in PALETTE[:3])  # the same in every configuration
+    assert [to_hex(line.get_color()) for line in lines_with_gid(left, "passage_mean")[::2]] == [tube, interior, exterior]
+    assert [to_hex(line.get_color()) for line in lines_with_gid(right, "passage_mean")[::2]] == [interior, exterior]
+    assert left.get_legend() is None  # one legend for both panels
+    assert legend_texts(right) == [
+        "v_z profile", f"tube: inlet {inlet.mean_v_z['tube']:.3g}, outlet n/a m/s",
+        f"interior: inlet {inlet.mean_v_z['interior']:.3g}, outlet {outlet.mean_v_z['interior']:.3g} m/s",
+        f"exterior: inlet {inlet.mean_v_z['exterior']:.3g}, outlet {outlet.mean_v_z['exterior']:.3g} m/s"]
+    assert not any("study" in text for text in legend_texts(right))
+    assert (left.get_ylabel(), left.get_xlabel(), right.get_xlabel()) == ("v_z [m/s]", "x [mm]", "x [mm]")
+    assert_legend_outside(figure, right)
+
+
+def test_plot_passage_distributions_draws_m1_over_each_outlet_passage_and_m2_as_a_note(tmp_path, figures):
+    inlet = passage_velocities(shear_field(), 0.6, PASSAGES)
+    outlet = passage_velocities(shear_field(0.1, 5.0), 0.2, PASSAGES)
+    target = tmp_path / "passages.png"
+    assert_png(target, plot_passage_distributions(inlet, outlet, target, "passages", findings=M1 + [M2]))
+    (figure,) = figures
+    left, right = figure.axes
+    assert [len(lines_with_gid(axes, "passage_mean")) for axes in (left, right)] == [2 * 3, 2 * 3]  # data unchanged
+    assert lines_with_gid(left, "finding M1") == []  # the findings are the outlet's
+    # one dotted segment at the finding's fraction of the outlet's cross-section mean on each side of each passage
+    lines = lines_with_gid(right, "finding M1")
+    assert len(lines) == 2 * 3 and {line.get_linestyle() for line in lines} == {":"}
+    mean = outlet.profile.cross_section_mean
+    for line, (name, ratio) in zip(lines[::2], (("exterior", 0.16), ("interior", 1.49), ("tube", 1.79))):
+        np.testing.assert_allclose(line.get_ydata(), [ratio * mean] * 2, rtol=1e-12)
+        lo, hi = PASSAGES[name]
+        np.testing.assert_allclose(sorted(np.abs(line.get_xdata())), [1e3 * lo, 1e3 * hi], rtol=1e-12)
+        assert to_hex(line.get_color()) == to_hex(PALETTE[("tube", "interior", "exterior").index(name)])
+    bands = [collection for collection in right.collections if collection.get_gid() == "finding M1"]
+    assert len(bands) == 2  # the exterior's band, on both sides
+    texts = legend_texts(right)
+    assert texts[4:] == ["study (M1): exterior ~0.16 of mean", "study (M1): interior ~1.49 of mean",
+                         "study (M1): tube ~1.79 of mean",
+                         "study (M2): tube > interior annulus > exterior annulus"]
+    assert_legend_outside(figure, right)
+
+
+def test_plot_passage_distributions_refuses_a_finding_it_cannot_draw(tmp_path):
+    inlet = passage_velocities(shear_field(), 0.6, PASSAGES)
+    target = tmp_path / "passages.png"
+    with pytest.raises(ValueError, match=r"findings\[0\] \(M1\) must be a velocity over the cross-section mean"):
+        plot_passage_distributions(inlet, inlet, target, "t", findings=[StudyValue("M1", 0.16, series="annulus")])
+    with pytest.raises(ValueError, match=r"findings\[0\] \(M1\) must be"):
+        plot_passage_distributions(inlet, inlet, target, "t",
+                                   findings=[StudyValue("M1", 0.16, unit="m/s", series="exterior")])
+    with pytest.raises(ValueError, match=r"findings\[0\] must be a StudyValue or StudyNote"):
+        plot_passage_distributions(inlet, inlet, target, "t", findings=[0.16])
+    assert not target.exists()
 
 
 def test_plot_channel_boundary(tmp_path, figures):
@@ -177,6 +254,51 @@ def test_plot_gravity_scaling_collapses_runs(tmp_path, figures):
     for line in (one, four):
         np.testing.assert_array_equal(line.get_xdata(), t1)
         np.testing.assert_array_equal(line.get_ydata(), v1)
+
+
+def _gravity_runs():
+    """The converging insert at 4, 1 and 9 g (the 9 g run off the square-root scaling), the straight one at 1 g."""
+    t1 = np.linspace(0.0, 3.0, 31)
+    v1 = -0.2 * (1.0 - np.exp(-t1))
+    return t1, v1, [("converging", 4.0, t1 / 2.0, 2.0 * v1), ("converging", 1.0, t1, v1),
+                    ("converging", 9.0, t1 / 3.0, 2.7 * v1), ("straight", 1.0, t1, 0.8 * v1)]
+
+
+def test_plot_gravity_scaling_one_colour_per_configuration_one_style_per_factor_no_finding_unless_asked(
+        tmp_path, figures):
+    _, _, runs = _gravity_runs()
+    target = tmp_path / "gravity.png"
+    assert_png(target, plot_gravity_scaling(runs, target, "gravity", quantity="mean v_z"))
+    axes = figures[0].axes[0]
+    lines = lines_with_gid(axes, "run")
+    assert len(lines) == 4 and len(axes.get_lines()) == 4  # one series per run, nothing else
+    converging, straight = to_hex(PALETTE[0]), to_hex(PALETTE[1])
+    assert [to_hex(line.get_color()) for line in lines] == [converging, converging, converging, straight]
+    assert [line.get_linestyle() for line in lines] == ["--", "-", "-.", "-"]  # 1, 4, 9 g: the factor's style
+    assert legend_texts(axes) == ["converging (4 g)", "converging (1 g)", "converging (9 g)", "straight (1 g)"]
+    assert lines_with_gid(axes, "finding M4") == []
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("t sqrt(g_run / g) [s]", "mean v_z / sqrt(g_run / g) [m/s]")
+    assert_legend_outside(figures[0], axes)
+
+
+def test_plot_gravity_scaling_draws_the_square_root_scaling_once_labelled_m4(tmp_path, figures):
+    t1, v1, runs = _gravity_runs()
+    target = tmp_path / "gravity.png"
+    m4 = StudyNote("M4", "v scales with sqrt(g)")
+    assert_png(target, plot_gravity_scaling(runs, target, "gravity", findings=[m4]))
+    axes = figures[0].axes[0]
+    assert len(lines_with_gid(axes, "run")) == 4
+    # the curve each configuration's runs lie on under the scaling (its 1 g run's), under the runs, one legend entry
+    scalings = lines_with_gid(axes, "finding M4")
+    assert len(scalings) == 2 and axes.get_lines()[:2] == scalings
+    for scaling, factor in zip(scalings, (1.0, 0.8)):
+        np.testing.assert_allclose(scaling.get_xdata(), t1, rtol=1e-12)
+        np.testing.assert_allclose(scaling.get_ydata(), factor * v1, rtol=1e-12)
+    assert legend_texts(axes) == ["study (M4): v scales with sqrt(g)", "converging (4 g)", "converging (1 g)",
+                                   "converging (9 g)", "straight (1 g)"]
+    assert_legend_outside(figures[0], axes)
+    with pytest.raises(ValueError, match=r"findings\[0\] must be a StudyNote, got StudyValue"):
+        plot_gravity_scaling(runs, tmp_path / "bad.png", "gravity", findings=[StudyValue("M4", 0.5)])
 
 
 def test_plot_configuration_comparison(tmp_path, figures):

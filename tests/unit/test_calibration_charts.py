@@ -8,12 +8,16 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.colors import to_hex
 
+from siloflow.analysis.io.plot_style import PALETTE, REFERENCE_COLOUR, StudyNote, StudyValue
+from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.calibration.charts import plot_calibration_chart, plot_force_history, plot_lid_comparison, plot_polar_histogram
 from siloflow.calibration.contact_diagnostics import angular_histogram
 from siloflow.calibration.friction import BulkFriction, SteadyWindow
 from siloflow.calibration.inversion import CalibrationCurve, curves_from_table
 from siloflow.calibration.shear import ShearSignals
+from tests.plot_data import assert_legend_outside, legend_texts
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -77,11 +81,12 @@ def test_plot_calibration_chart_draws_each_curve_in_degrees_with_its_error_and_t
                 [particle, np.degrees(np.arctan(bulk)) - error, np.degrees(np.arctan(bulk)) + error]), rtol=1e-14)
 
     bands = [patch for patch in axes.patches if patch.get_label().startswith("target")]
-    target_lines = [line for line in axes.get_lines() if line.get_linestyle() == "--"]
+    target_lines = [line for line in axes.get_lines() if line.get_gid() == "target"]
     if target is None:
         assert bands == [] and target_lines == []
     else:
-        (line,) = target_lines
+        (line,) = target_lines  # drawn once, dashed
+        assert line.get_linestyle() == "--"
         np.testing.assert_array_equal(line.get_ydata(), [30.0, 30.0])
         if tolerance is None:
             assert bands == [] and line.get_label() == "target 30 deg"
@@ -143,6 +148,71 @@ def test_plot_calibration_chart_rejects_empty_and_keeps_old_file(tmp_path):
         plot_calibration_chart(_curves(), path, "bad", 30.0, -1.0)
     assert path.read_bytes() == b"old"
     _only_file(tmp_path, "chart.png")
+
+
+def _finding_artists(axes, finding_id):
+    """The lines and bands drawn for a finding (``gid="finding <id>"``)."""
+    gid = f"finding {finding_id}"
+    return ([line for line in axes.get_lines() if line.get_gid() == gid],
+            [patch for patch in axes.patches if patch.get_gid() == gid])
+
+
+
+
+
+#: C2's plateau of the two-sphere clump with its band (+- 10 %), C7's measured internal friction angle.
+C2_SPHERE2 = StudyValue.of(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
+C7_INTERNAL = StudyValue.of(PARTS["C7.internal"])
+
+
+def test_plot_calibration_chart_in_the_journal_style_one_colour_per_shape_one_style_per_rolling_friction(tmp_path):
+    figure = plot_calibration_chart(_curves(), tmp_path / "chart.png", "sphere2, internal friction", 30.0, 1.0)
+    axes = figure.axes[0]
+    curves = [container for container in axes.containers if not container.get_label().startswith("_")]
+    assert len(curves) == 3  # one series per curve, nothing else drawn as data
+    data_lines = [container.lines[0] for container in curves]
+    assert {to_hex(line.get_color()) for line in data_lines} == {to_hex(PALETTE[1])}  # sphere2's colour
+    assert [line.get_linestyle() for line in data_lines] == ["-", "--", "-."]
+    assert [line.get_marker() for line in data_lines] == ["o", "s", "^"]
+    assert axes.xaxis.label.get_fontsize() == 9 and axes.title.get_fontsize() == 9
+    # the curves first, then the target; no finding unless asked for
+    assert legend_texts(axes) == ["mu_r = 0", "mu_r = 0.05", "mu_r = 0.1", "target 30 ± 1 deg"]
+    assert not any("study" in text for text in legend_texts(axes))
+    assert [line for line in axes.get_lines() if (line.get_gid() or "").startswith("finding")] == []
+    assert "[deg]" in axes.get_ylabel() and "[-]" in axes.get_xlabel()
+    assert_legend_outside(figure, axes, *axes.child_axes)
+
+
+def test_plot_calibration_chart_draws_each_finding_once_at_its_angle_labelled_with_its_id(tmp_path):
+    figure = plot_calibration_chart(_curves(), tmp_path / "chart.png", "sphere2, internal friction", 30.0, 1.0,
+                                    findings=[C2_SPHERE2, C7_INTERNAL, StudyNote("C1", "finite at zero friction")])
+    axes = figure.axes[0]
+    assert len([container for container in axes.containers if not container.get_label().startswith("_")]) == 3
+    assert legend_texts(axes) == ["mu_r = 0", "mu_r = 0.05", "mu_r = 0.1", "target 30 ± 1 deg",
+                                   "study (C2): sphere2 ~0.54", "study (C7): ~30 deg",
+                                   "study (C1): finite at zero friction"]
+    # C2: a coefficient, drawn at its angle atan(0.54) [deg] with its band, in the colour of its shape
+    (line,), (band,) = _finding_artists(axes, "C2")
+    np.testing.assert_allclose(line.get_ydata(), [math.degrees(math.atan(0.54))] * 2, rtol=1e-12)
+    assert line.get_linestyle() == ":" and to_hex(line.get_color()) == to_hex(PALETTE[1])
+    np.testing.assert_allclose([band.get_y(), band.get_y() + band.get_height()],
+                               np.degrees(np.arctan([0.486, 0.594])), rtol=1e-12)
+    # C7: an angle, drawn as it is, in the reference grey (no series), with no band
+    (line,), bands = _finding_artists(axes, "C7")
+    np.testing.assert_array_equal(line.get_ydata(), [30.0, 30.0])
+    assert bands == [] and to_hex(line.get_color()) == to_hex(REFERENCE_COLOUR)
+    (note,), _ = _finding_artists(axes, "C1")
+    assert np.size(note.get_xdata()) == 0  # a legend entry only: no data
+    assert_legend_outside(figure, axes, *axes.child_axes)
+
+
+def test_plot_calibration_chart_refuses_a_finding_it_cannot_draw(tmp_path):
+    path = tmp_path / "chart.png"
+    with pytest.raises(ValueError, match=r"findings\[0\] \(S2\) must be a bulk friction coefficient"):
+        plot_calibration_chart(_curves(), path, "t", findings=[StudyValue.of(PARTS["S2"])])
+    with pytest.raises(ValueError, match=r"findings\[1\] must be a StudyValue or StudyNote, got tuple"):
+        plot_calibration_chart(_curves(), path, "t", findings=[C2_SPHERE2, ("C2", 0.54)])
+    assert not path.exists()
 
 
 def _sectors(figure):

@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import matplotlib
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
+from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.io.plot_style import (
+    BAND_ALPHA,
     LABEL_SIZE,
     LEGEND_SIZE,
     LINE_STYLES,
@@ -16,11 +19,20 @@ from siloflow.analysis.io.plot_style import (
     MARKER_SIZE,
     MARKERS,
     PALETTE,
+    REFERENCE_COLOUR,
     STYLE,
     TICK_SIZE,
+    StudyNote,
+    StudyValue,
     colour_of,
+    draw_reference_band,
+    draw_reference_value,
+    draw_study_value,
     journal_style,
     legend_outside,
+    note_study,
+    study_findings,
+    study_label,
 )
 
 OKABE_ITO = ["#000000", "#e69f00", "#56b4e9", "#009e73", "#f0e442", "#0072b2", "#d55e00", "#cc79a7"]
@@ -90,5 +102,117 @@ def test_legend_outside_puts_the_legend_right_of_the_data_area():
             box, data_area = legend.get_window_extent(), axes.get_window_extent()
             assert box.x0 > data_area.x1  # wholly right of the axes
             assert box.y1 == pytest.approx(data_area.y1, abs=1.0)  # aligned with the axes' top
+        finally:
+            plt.close(figure)
+
+
+def test_legend_outside_clear_of_stands_right_of_a_secondary_axis():
+    with journal_style():
+        figure, axes = plt.subplots(figsize=(6.5, 3.5))
+        try:
+            figure.subplots_adjust(right=0.55)
+            axes.plot([0, 1], [10, 40], label="a line")
+            secondary = axes.secondary_yaxis("right", functions=(lambda d: d / 100.0, lambda c: 100.0 * c))
+            secondary.set_ylabel("coefficient [-]")
+            legend = legend_outside(axes, clear_of=[secondary])
+            figure.canvas.draw()
+            box = legend.get_window_extent()
+            assert box.x0 > secondary.get_tightbbox().x1 > axes.get_window_extent().x1
+            assert not box.overlaps(axes.get_window_extent())
+        finally:
+            plt.close(figure)
+
+
+# ---------------------------------------------------------------------------------------- the study's findings
+
+
+def test_study_values_and_notes_are_labelled_with_the_finding_id():
+    assert study_label("C2", "~0.54") == "study (C2): ~0.54"
+    assert StudyValue("C2", 0.54).label == "study (C2): ~0.54"
+    assert StudyValue("C7", 30, unit="deg").label == "study (C7): ~30 deg"
+    assert StudyValue("M1", 0.16, series="exterior", approximate=False).label == "study (M1): exterior 0.16"
+    assert StudyNote("S5", "B decreases with height").label == "study (S5): B decreases with height"
+
+
+def test_study_values_and_notes_of_the_findings_parts():
+    plateau = StudyValue.of(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
+    assert (plateau.id, plateau.value, plateau.unit, plateau.band, plateau.approximate) == (
+        "C2", 0.54, "-", (0.486, 0.594), True)
+    assert StudyValue.of(PARTS["C7.internal"]).label == "study (C7): ~30 deg"
+    assert not StudyValue.of(PARTS["B8.internal"]).approximate  # a number stated with no "about"
+    assert not StudyValue.of(PARTS["S2"]).approximate  # a number stated with its band
+    assert StudyNote.of(PARTS["M2.outlet_order"]).label == "study (M2): tube > interior annulus > exterior annulus"
+    assert StudyNote.of(PARTS["S5.dem"], "B decreases with height").label == "study (S5): B decreases with height"
+    with pytest.raises(ValueError, match="S5.dem states no number"):
+        StudyValue.of(PARTS["S5.dem"])
+
+
+def test_study_values_and_notes_refuse_what_cannot_be_drawn():
+    with pytest.raises(ValueError, match="id must be a non-empty finding id"):
+        StudyValue("", 0.5)
+    with pytest.raises(ValueError, match="C2: value must be a finite number"):
+        StudyValue("C2", float("nan"))
+    with pytest.raises(ValueError, match=r"C2: band must be \(low, high\) with low <= high"):
+        StudyValue("C2", 0.5, band=(0.6, 0.4))
+    with pytest.raises(ValueError, match=r"C2: band must be \(low, high\)"):
+        StudyValue("C2", 0.5, band=(0.4,))
+    with pytest.raises(ValueError, match="S5: text must be a non-empty string"):
+        StudyNote("S5", "")
+    assert study_findings(None, StudyNote) == []
+    with pytest.raises(ValueError, match=r"findings\[1\] must be a StudyNote, got StudyValue"):
+        study_findings([StudyNote("S5", "x"), StudyValue("S5", 1.0)], StudyNote)
+
+
+def test_reference_values_and_bands_are_drawn_once_across_the_axes():
+    with journal_style():
+        figure, axes = plt.subplots()
+        try:
+            axes.plot([0.0, 1.0], [0.0, 1.0])
+            line = draw_reference_value(axes, 0.4, "target", gid="target")
+            band = draw_reference_band(axes, 0.3, 0.5, gid="target")
+            vertical = draw_reference_value(axes, 0.7, vertical=True)
+            assert list(line.get_ydata()) == [0.4, 0.4] and line.get_label() == "target"
+            assert (line.get_linestyle(), to_hex(line.get_color()), line.get_gid()) == (
+                ":", to_hex(REFERENCE_COLOUR), "target")
+            assert (band.get_y(), band.get_y() + band.get_height()) == pytest.approx((0.3, 0.5))
+            assert band.get_alpha() == BAND_ALPHA and band.get_label() == "_nolegend_"
+            assert list(vertical.get_xdata()) == [0.7, 0.7]
+            assert [text.get_text() for text in axes.legend().get_texts()] == ["target"]
+        finally:
+            plt.close(figure)
+
+
+def test_draw_study_value_converts_to_the_axis_unit_across_the_axes_or_over_spans():
+    study = StudyValue("C2", 0.5, band=(0.4, 0.6), series="sphere2")
+    with journal_style():
+        figure, axes = plt.subplots()
+        try:
+            band, line = draw_study_value(axes, study, colour=PALETTE[1], convert=lambda mu: 100.0 * mu)
+            assert list(line.get_ydata()) == [50.0, 50.0] and line.get_label() == "study (C2): sphere2 ~0.5"
+            assert (band.get_y(), band.get_y() + band.get_height()) == pytest.approx((40.0, 60.0))
+            assert {band.get_gid(), line.get_gid()} == {"finding C2"}
+            assert to_hex(line.get_color()) == to_hex(PALETTE[1])
+            artists = draw_study_value(axes, StudyValue("M1", 2.0), spans=[(1.0, 2.0), (-2.0, -1.0)],
+                                       label="study (M1): ~2 of mean")
+            assert len(artists) == 2  # no band: one segment per span
+            assert artists[-1].get_label() == "study (M1): ~2 of mean" and list(artists[-1].get_xdata()) == [1.0, 2.0]
+            assert artists[0].get_label() == "_nolegend_" and list(artists[0].get_xdata()) == [-2.0, -1.0]
+            assert [text.get_text() for text in axes.legend().get_texts()] == [
+                "study (C2): sphere2 ~0.5", "study (M1): ~2 of mean"]
+        finally:
+            plt.close(figure)
+
+
+def test_note_study_is_a_legend_entry_without_data():
+    with journal_style():
+        figure, axes = plt.subplots()
+        try:
+            axes.plot([0.0, 1.0], [2.0, 3.0], label="data")
+            limits = axes.dataLim.frozen()
+            handle = note_study(axes, StudyNote("S5", "B decreases with height"))
+            assert handle.get_gid() == "finding S5" and np.size(handle.get_xdata()) == 0
+            assert np.allclose(axes.dataLim.get_points(), limits.get_points())  # moves no axis limit
+            assert [text.get_text() for text in axes.legend().get_texts()] == [
+                "data", "study (S5): B decreases with height"]
         finally:
             plt.close(figure)

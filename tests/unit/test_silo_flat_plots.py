@@ -9,7 +9,9 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.colors import to_hex
 
+from siloflow.analysis.io.plot_style import PALETTE, StudyNote, StudyValue
 from siloflow.analysis.numerics.force_chains import ForceChainSegments
 from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
 from siloflow.analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis, ProfileUncertainty
@@ -27,6 +29,7 @@ from siloflow.analysis.studies.silo_flat.plots import (
     plot_profiles_over_silo,
     plot_velocity_contour,
 )
+from tests.plot_data import assert_legend_outside, legend_texts, lines_with_gid
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 X = np.array([-0.02, -0.01, 0.0, 0.01, 0.02])
@@ -152,25 +155,107 @@ def test_plot_kinematic_constant_draws_the_standard_error_of_b_as_horizontal_bar
     assert second.size == 0  # unknown error: no bar
 
 
+def _janssen():
+    return JanssenComparison(depth_below_surface=np.array([0.005, 0.015]), simulated=np.array([40.0, 95.0]),
+                             janssen=np.array([38.0, 100.0]), surface_height=0.05, height=np.array([0.045, 0.035]),
+                             simulated_error=np.array([4.0, 6.0]), hydrostatic=np.array([45.0, 135.0]),
+                             hydrostatic_error=np.array([0.5, 1.5]), bin_pairs=2)
+
+
 def test_plot_janssen_draws_the_dem_stress_with_its_error_janssen_and_hydrostatic_against_depth(tmp_path, written):
-    comparison = JanssenComparison(depth_below_surface=np.array([0.005, 0.015]), simulated=np.array([40.0, 95.0]),
-                                   janssen=np.array([38.0, 100.0]), surface_height=0.05,
-                                   height=np.array([0.045, 0.035]), simulated_error=np.array([4.0, 6.0]),
-                                   hydrostatic=np.array([45.0, 135.0]), hydrostatic_error=np.array([0.5, 1.5]),
-                                   bin_pairs=2)
     path = tmp_path / "janssen.png"
-    figure = written(plot_janssen(comparison, path, "stress"), path)
+    figure = written(plot_janssen(_janssen(), path, "stress"), path)
     (axes,) = figure.axes
     lines = {line.get_label(): line.get_xydata() for line in axes.get_lines()}
-    np.testing.assert_allclose(lines["DEM (contact stress)"], [[40.0, 5.0], [95.0, 15.0]])
     np.testing.assert_allclose(lines["Janssen"], [[38.0, 5.0], [100.0, 15.0]])
     np.testing.assert_allclose(lines["hydrostatic rho_b g h"], [[45.0, 5.0], [135.0, 15.0]])
-    (container,) = axes.containers
-    assert container.get_label() == "DEM ± standard error" and container.has_xerr and not container.has_yerr
+    (container,) = axes.containers  # the DEM points and their bars: one series
+    assert container.get_label() == "DEM (contact stress) ± standard error"
+    assert container.has_xerr and not container.has_yerr
+    np.testing.assert_allclose(container.lines[0].get_xydata(), [[40.0, 5.0], [95.0, 15.0]])
     np.testing.assert_allclose(_bars(container), [[[36.0, 5.0], [44.0, 5.0]], [[89.0, 15.0], [101.0, 15.0]]],
                                rtol=1e-14)
     assert axes.yaxis_inverted()  # depth grows downwards
     assert (axes.get_xlabel(), axes.get_ylabel()) == ("vertical stress [Pa]", "depth below surface [mm]")
+
+
+# --------------------------------------------------------------------------- the record's figures in the journal style
+
+S1 = StudyNote("S1", "DEM in good agreement")
+S5 = StudyNote("S5", "B decreases with height")
+
+
+
+
+
+
+def test_plot_profiles_over_silo_one_colour_for_the_profiles_one_for_the_boundary_legend_outside(tmp_path, written):
+    path = tmp_path / "profiles.png"
+    figure = written(plot_profiles_over_silo(_profiles(), 0.05, 0.01, 0.04, path, "profiles",
+                                             uncertainty=_uncertainty()), path)
+    (axes,) = figure.axes
+    profiles, boundaries = lines_with_gid(axes, "profile"), lines_with_gid(axes, "fcb")
+    assert len(profiles) == len(boundaries) == len(HEIGHTS)  # one profile and one boundary pair per height
+    assert {to_hex(line.get_color()) for line in profiles} == {to_hex(PALETTE[5])}
+    assert {to_hex(line.get_color()) for line in boundaries} == {to_hex(PALETTE[6])}
+    assert legend_texts(axes) == ["FCB at 10 % of centreline v_z", "v_z (1 mm = 0.00625 m/s)"]
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("x [mm]", "z [mm]")
+    assert_legend_outside(figure, axes)
+
+
+def test_plot_kinematic_constant_draws_the_expected_trend_of_the_study_only_when_asked(tmp_path, written):
+    path = tmp_path / "plain" / "B.png"
+    figure = written(plot_kinematic_constant(HEIGHTS, [0.002, 0.0031], path, "B", B_error=[0.0002, np.nan]), path)
+    (axes,) = figure.axes
+    assert len(lines_with_gid(axes, "kinematic_B")) == 1 and len(axes.containers) == 1  # B, its error bars
+    assert legend_texts(axes) == ["DEM kinematic constant B", "± standard error"]
+    assert lines_with_gid(axes, "finding S5") == []
+    assert_legend_outside(figure, axes)
+
+    path = tmp_path / "study" / "B.png"
+    figure = written(plot_kinematic_constant(HEIGHTS, [0.002, 0.0031], path, "B", B_error=[0.0002, np.nan],
+                                             findings=[S5]), path)
+    (axes,) = figure.axes
+    (line,) = lines_with_gid(axes, "kinematic_B")
+    np.testing.assert_allclose(line.get_xydata(), [[2.0, 10.0], [3.1, 30.0]])
+    assert len(axes.containers) == 1
+    assert legend_texts(axes) == ["DEM kinematic constant B", "± standard error",
+                                   "study (S5): B decreases with height"]
+    (note,) = lines_with_gid(axes, "finding S5")
+    assert np.size(note.get_xdata()) == 0  # an annotation: no data, no mark
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("B [mm]", "z [mm]")
+    assert_legend_outside(figure, axes)
+
+
+def test_plot_janssen_names_the_janssen_curve_with_the_study_finding_only_when_asked(tmp_path, written):
+    path = tmp_path / "plain" / "janssen.png"
+    figure = written(plot_janssen(_janssen(), path, "stress"), path)
+    (axes,) = figure.axes
+    assert legend_texts(axes) == ["DEM (contact stress) ± standard error", "Janssen", "hydrostatic rho_b g h"]
+    assert not any("S1" in text for text in legend_texts(axes))
+    assert_legend_outside(figure, axes)
+
+    path = tmp_path / "study" / "janssen.png"
+    figure = written(plot_janssen(_janssen(), path, "stress", findings=[S1]), path)
+    (axes,) = figure.axes
+    # the DEM, Janssen and hydrostatic: three series, Janssen's drawn once
+    assert [len(lines_with_gid(axes, gid)) for gid in ("dem_stress", "janssen", "hydrostatic")] == [1, 1, 1]
+    assert len(axes.containers) == 1
+    assert legend_texts(axes) == ["DEM (contact stress) ± standard error",
+                                   "Janssen, study (S1): DEM in good agreement", "hydrostatic rho_b g h"]
+    (janssen,) = lines_with_gid(axes, "janssen")
+    np.testing.assert_allclose(janssen.get_xydata(), [[38.0, 5.0], [100.0, 15.0]])
+    assert (axes.get_xlabel(), axes.get_ylabel()) == ("vertical stress [Pa]", "depth below surface [mm]")
+    assert_legend_outside(figure, axes)
+
+
+def test_silo_figures_refuse_a_finding_they_cannot_draw(tmp_path):
+    path = tmp_path / "x.png"
+    with pytest.raises(ValueError, match=r"findings\[0\] must be a StudyNote, got StudyValue"):
+        plot_kinematic_constant(HEIGHTS, [0.002, 0.0031], path, "B", findings=[StudyValue("S5", 1.0)])
+    with pytest.raises(ValueError, match=r"findings\[0\] must be a StudyNote, got str"):
+        plot_janssen(_janssen(), path, "stress", findings=["S1"])
+    assert not path.exists()
 
 
 def test_plot_centreline_velocity_draws_one_history_per_height(tmp_path, written):

@@ -222,11 +222,22 @@ def test_the_page_renders_status_runs_rows_and_both_verdicts():
     # a run that did not note its own commit: the page says whose commit the record holds
     assert "2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, unknown (the record was written by c0ffee)" in text
     study = _rows()[0]["study"]
+    # one short line per row, its evidence folded below the rows
     assert (f"| Flat-bottom silo | Filling bulk density | sphere2-abc | 548 ± 1.7 kg/m3 | S2 | {study} | not reproduced "
-            "| at scale | S2: 547.6 lies outside 618 to 627.4; at the study's scale for S2; settled fill |") in lines
-    assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | - | - | - |" in text
+            "| at scale |") in lines
+    assert "| Flat-bottom silo | Wall share \\| of weight | sphere2-abc | not measured | - | - | - | - |" in lines
+    silo = lines[lines.index("## silo"):lines.index("## silo_series")]
+    assert silo.index('<details markdown="1">') > silo.index("| table | figure | case | value | finding | study | "
+                                                              "agreement | scale |")
+    assert "<summary>Why each row is judged so: its evidence (2 rows)</summary>" in silo
+    assert ("| Filling bulk density | sphere2-abc | S2 | S2: 547.6 lies outside 618 to 627.4; at the study's scale for "
+            "S2; settled fill |") in silo
+    assert silo.index("</details>") > silo.index('<details markdown="1">')
     assert "runs this group in about" not in text  # no row of these groups is off the study's scale
-    assert "![profiles.png](silo/profiles.png)" in lines
+    # the group's figure beside its rows, before them: one figure takes the page's width
+    assert '<img src="silo/profiles.png" alt="profiles.png" width="100%">' in silo
+    assert silo.index('<img src="silo/profiles.png" alt="profiles.png" width="100%">') < silo.index(
+        "| table | figure | case | value | finding | study | agreement | scale |")
     # a configuration that plans none of a group's recorded runs: the estimate of those it plans, said to be others
     others = record_page(groups, status, {}, wall, 2, "config/validation.yaml", "config/thesis.yaml",
                          planned_core_s={"silo": 7200.0})

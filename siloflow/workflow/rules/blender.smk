@@ -114,6 +114,7 @@ rule blender_analysis:
         case=typed_case("blender"),
         blender=lambda wildcards: {key: config["blender"][key] for key in (
             "bin_size", "fill_height", "profile_heights_above", "pathlines", "rtd", "discontinuous", "continuous")},
+        validation=config["validation"],
     log:
         f"{run_dir('blender')}/logs/analysis.log",
     script:

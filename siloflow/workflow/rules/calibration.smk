@@ -169,6 +169,7 @@ rule calibration_chart:
         base_restitution=config["jenike"]["sweep"]["restitution"],
         shear_velocity=config["jenike"]["shear"]["velocity"],
         lid=config["jenike"]["lid"],
+        validation=config["validation"],
     log:
         f"{CALIBRATION_DIR}/logs/chart_{{chart}}.log",
     script:

@@ -36,6 +36,8 @@ from siloflow.analysis.studies.blender.study import (
     study_metrics,
     top_internal,
 )
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances
+from siloflow.analysis.studies.validation.figure_findings import insert_findings
 from siloflow.analysis.studies.blender.tables import (
     blender_summary,
     profile_rows,
@@ -90,7 +92,9 @@ with logged_to(snakemake.log[0]) as log:
     plot_profiles_over_time(study.profiles, snakemake.output.profiles_plot, f"Normalised v_z profiles: {name}")
     inlet = study.inlet if study.inlet is not None else study.outlet
     plot_passage_distributions(inlet, study.outlet, snakemake.output.distribution_plot,
-                               f"Velocity across the insert inlet and outlet: {name}")
+                               f"Velocity across the insert inlet and outlet: {name}",
+                               findings=insert_findings(case.configuration,
+                                                        AgreementTolerances.from_config(snakemake.params.validation)))
     plot_channel_boundary(BlenderField.from_planar(steady), study.boundary, snakemake.output.fcb_plot,
                           f"Flow channel boundary (10 % of centreline, wall velocity subtracted): {name}")
     plot_tracer_pathlines(study.pathlines, snakemake.output.pathlines_plot, f"Pathlines and residence times: {name}")

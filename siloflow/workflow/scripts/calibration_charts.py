@@ -3,6 +3,8 @@
 import json
 from pathlib import Path
 
+from siloflow.analysis.studies.validation.agreement import AgreementTolerances
+from siloflow.analysis.studies.validation.figure_findings import calibration_chart_findings
 from siloflow.calibration.charts import plot_calibration_chart
 from siloflow.calibration.inversion import curves_from_table
 from siloflow.calibration.sweep import chart_rows
@@ -18,5 +20,7 @@ with logged_to(snakemake.log[0]) as log:
     target = calibration["targets_deg"].get(test)
     plot_calibration_chart(curves, snakemake.output.chart,
                            title=f"{shape}, {'internal friction' if test == 'internal' else test + ' wall friction'}",
-                           target_angle_deg=target, tolerance_deg=calibration["tolerance_deg"] if target else None)
+                           target_angle_deg=target, tolerance_deg=calibration["tolerance_deg"] if target else None,
+                           findings=calibration_chart_findings(
+                               shape, test, AgreementTolerances.from_config(params.validation)))
     log.info("chart %s: %d curves", snakemake.output.chart, len(curves))

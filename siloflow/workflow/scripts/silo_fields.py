@@ -13,6 +13,7 @@ from siloflow.analysis.io.silo_field_study import write_silo_field_study
 from siloflow.analysis.io.tables import write_flow_table
 from siloflow.analysis.studies.silo_flat.field_study import SiloDimensions, SiloFieldOptions, analyse_silo_fields, janssen_rows
 from siloflow.analysis.studies.silo_flat.plots import plot_force_chains, plot_janssen
+from siloflow.analysis.studies.validation.figure_findings import janssen_findings
 from siloflow.engines.interface import engine_named
 from siloflow.engines.logs import logged_to
 
@@ -41,7 +42,8 @@ with logged_to(snakemake.log[0]) as log:
     write_fields_vti(fields_dir / "settled_stress.vti", study.grid, study.fields[0], time=0.0,
                      extra_arrays={"contact_stress": study.stress})
     write_flow_table(snakemake.output.janssen, janssen_rows(study.janssen))
-    plot_janssen(study.janssen, snakemake.output.janssen_plot, "Vertical stress at the end of filling")
+    plot_janssen(study.janssen, snakemake.output.janssen_plot, "Vertical stress at the end of filling",
+                 findings=janssen_findings())
     plot_force_chains(study.segments, silo.width, silo.outlet_width, study.top, snakemake.output.force_chain_plot,
                       f"Force chains in a {1e3 * options.force_chain_slice:g} mm slice")
     log.info("profile flow rate %.4g kg/s vs outflow %.4g kg/s (ratio %.3f)", study.profile_rate,

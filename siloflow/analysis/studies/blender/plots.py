@@ -16,8 +16,23 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.lines import Line2D
 
 from siloflow.model.checks import finite_array, number_or_nan, positive_number
+from siloflow.analysis.io.plot_style import (
+    BAND_ALPHA,
+    LINE_STYLES,
+    PAGE_WIDTH,
+    REFERENCE_COLOUR,
+    StudyNote,
+    StudyValue,
+    colour_of,
+    draw_study_value,
+    journal_style,
+    legend_outside,
+    note_study,
+    study_findings,
+)
 from siloflow.analysis.io.plots import non_empty_list, positive_finite_points, save_figure, tuple_entry
 from siloflow.analysis.numerics.rtd import RTD
 from siloflow.analysis.studies.blender.gravity import gravity_normalised_time, gravity_normalised_velocity
@@ -41,6 +56,8 @@ __all__ = [
 
 MM = 1.0e3
 """Metres to millimetres."""
+_PASSAGES = ("tube", "interior", "exterior")
+"""The blender's passages, in the order that gives each its colour of the palette in every figure."""
 
 
 def _instance(name: str, value, kind):
@@ -106,12 +123,35 @@ def plot_profiles_over_time(profiles: ProfilesOverTime, path: str | os.PathLike,
         plt.close(figure)
 
 
-def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelocities, path: str | os.PathLike,
-                               title: str) -> Path:
-    """Vertical velocity across the width at the insert inlet (left) and outlet (right), passage means marked.
+def _passage_findings(findings, outlet: PassageVelocities) -> list:
+    """Checked findings of :func:`plot_passage_distributions`: notes, or dimensionless values of outlet passages."""
+    checked = study_findings(findings, StudyValue, StudyNote)
+    for i, item in enumerate(checked):
+        if isinstance(item, StudyValue) and (item.unit not in ("", "-") or item.series not in outlet.passages):
+            raise ValueError(f"findings[{i}] ({item.id}) must be a velocity over the cross-section mean (unit '-') "
+                             f"of an outlet passage ({', '.join(outlet.passages)}) as its series, got unit "
+                             f"{item.unit!r} and series {item.series!r}")
+    return checked
 
-    Each passage is shaded on both sides of the axis and its mean velocity drawn as a horizontal
-    segment over it (a passage without bins has no segment).
+
+def _passage_entry(name: str, panels) -> str:
+    """The legend entry of a passage: its mean at the inlet and outlet (n/a where it has none or no bin) [m/s]."""
+    means = [result.mean_v_z.get(name, math.nan) for _, result in panels]
+    shown = ", ".join(f"{where.split()[-1]} {mean:.3g}" if math.isfinite(mean) else f"{where.split()[-1]} n/a"
+                      for (where, _), mean in zip(panels, means))
+    return f"{name}: {shown} m/s"
+
+
+def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelocities, path: str | os.PathLike,
+                               title: str, findings: Sequence[StudyValue | StudyNote] | None = None) -> Path:
+    """Vertical velocity across the width at the insert inlet (left) and outlet (right), passage means marked, in
+    the project's style (:func:`siloflow.analysis.io.plot_style.journal_style`).
+
+    The profile is drawn in grey (``gid="profile"``); each passage has one colour of
+    :data:`~siloflow.analysis.io.plot_style.PALETTE` in both panels (tube, interior, exterior annulus always the
+    same), is shaded on both sides of the axis and its mean velocity drawn as a horizontal segment over it
+    (``gid="passage_mean"``; a passage without bins has no segment). One legend for both panels stands right of
+    the outlet panel: the profile, each passage with its inlet and outlet means, then the findings.
 
     Parameters
     ----------
@@ -121,38 +161,79 @@ def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelociti
         Destination plot file, written atomically in the format of its suffix (:func:`siloflow.analysis.io.plots.save_figure`).
     title : str
         Figure title.
+    findings : sequence of StudyValue or StudyNote, optional
+        The study's findings at the insert outlet, drawn on the outlet panel. A
+        :class:`~siloflow.analysis.io.plot_style.StudyValue` is a passage's velocity over the outlet's
+        cross-section mean (unit ``"-"``, its ``series`` the passage, e.g. M1's ``StudyValue("M1", 0.16,
+        series="exterior")``): a dotted segment at that fraction of the mean [m/s] over the passage (its band
+        shaded, if given), in the passage's colour, ``gid="finding <id>"``, legend ``study (M1): exterior ~0.16 of
+        mean`` (none where the mean is not finite). A :class:`~siloflow.analysis.io.plot_style.StudyNote` is a
+        legend entry, e.g. M2's expected order ``StudyNote.of(PARTS["M2.outlet_order"])``. None (the default):
+        none.
 
     Returns
     -------
     pathlib.Path
         The written path.
+
+    Raises
+    ------
+    ValueError
+        For an inlet or outlet that is no PassageVelocities, a finding that is neither a study value nor a note,
+        or a study value not dimensionless or of no outlet passage.
     """
     panels = [("insert inlet", _instance("inlet", inlet, PassageVelocities)),
               ("insert outlet", _instance("outlet", outlet, PassageVelocities))]
-    figure, axes_pair = plt.subplots(1, 2, figsize=(10.0, 4.0), sharey=True)
-    try:
-        for axes, (where, result) in zip(axes_pair, panels):
-            profile = result.profile
-            axes.plot(MM * profile.x, profile.v_z, "o-", color="0.2", markersize=3, linewidth=1.0, label="v_z")
-            for index, (name, (lo, hi)) in enumerate(result.passages.items()):
-                colour = f"C{index}"
-                for sign in (-1.0, 1.0):
-                    axes.axvspan(sign * MM * lo, sign * MM * hi, color=colour, alpha=0.12)
-                mean = result.mean_v_z[name]
-                if math.isfinite(mean):
-                    for sign, label in ((1.0, f"{name}: {mean:.3g} m/s"), (-1.0, None)):
-                        axes.plot([sign * MM * lo, sign * MM * hi], [mean, mean], "-", color=colour, linewidth=2.5,
-                                  label=label)
-            axes.axhline(0.0, color="black", linewidth=0.6)
-            axes.set_title(f"{where}, z = {MM * profile.z:.0f} mm", fontsize=9)
-            axes.set_xlabel("x [mm]")
-            axes.grid(alpha=0.3)
-            axes.legend(fontsize=7)
-        axes_pair[0].set_ylabel("v_z [m/s]")
-        figure.suptitle(title)
-        return save_figure(figure, path, tight=True)
-    finally:
-        plt.close(figure)
+    checked = _passage_findings(findings, outlet)
+    names = list(dict.fromkeys([*inlet.passages, *outlet.passages]))
+    # the study's passages first, so that each keeps its colour whichever a configuration has
+    colours = colour_of([*_PASSAGES, *names])
+    with journal_style():
+        figure, axes_pair = plt.subplots(1, 2, figsize=(PAGE_WIDTH, 3.0), sharey=True)
+        try:
+            # room on the right for the one legend of both panels, so that the figure keeps the page's width
+            figure.subplots_adjust(left=0.09, right=0.62, bottom=0.15, top=0.84, wspace=0.08)
+            for axes, (where, result) in zip(axes_pair, panels):
+                profile = result.profile
+                axes.plot(MM * profile.x, profile.v_z, "o-", color=REFERENCE_COLOUR, markersize=2.5, linewidth=1.0,
+                          label="v_z", gid="profile")
+                for name, (lo, hi) in result.passages.items():
+                    for sign in (-1.0, 1.0):
+                        axes.axvspan(sign * MM * lo, sign * MM * hi, color=colours[name], alpha=BAND_ALPHA,
+                                     linewidth=0.0)
+                    mean = result.mean_v_z[name]
+                    if math.isfinite(mean):
+                        for sign, label in ((1.0, f"{name}: {mean:.3g} m/s"), (-1.0, "_nolegend_")):
+                            axes.plot([sign * MM * lo, sign * MM * hi], [mean, mean], "-", color=colours[name],
+                                      linewidth=2.5, label=label, gid="passage_mean")
+                axes.axhline(0.0, color="black", linewidth=0.6)
+                axes.set_title(f"{where}, z = {MM * profile.z:.0f} mm")
+                axes.set_xlabel("x [mm]")
+                axes.grid(alpha=0.3)
+            axes_pair[0].set_ylabel("v_z [m/s]")
+            handles = [Line2D([], [], marker="o", markersize=2.5, linewidth=1.0, color=REFERENCE_COLOUR,
+                              label="v_z profile")]
+            handles += [Line2D([], [], linewidth=2.5, color=colours[name], label=_passage_entry(name, panels))
+                        for name in names]
+            handles += [_draw_passage_finding(axes_pair[1], item, outlet, colours) for item in checked]
+            legend_outside(axes_pair[1], handles=[handle for handle in handles if handle is not None])
+            figure.suptitle(title)
+            return save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
+
+
+def _draw_passage_finding(axes, item, outlet: PassageVelocities, colours: Mapping):
+    """Draw one finding of :func:`plot_passage_distributions` on the outlet panel; its legend handle (None: not
+    drawn, the outlet's cross-section mean being unknown)."""
+    if isinstance(item, StudyNote):
+        return note_study(axes, item)
+    mean = outlet.profile.cross_section_mean
+    if not math.isfinite(mean):
+        return None
+    lo, hi = outlet.passages[item.series]
+    return draw_study_value(axes, item, colour=colours[item.series], convert=lambda ratio: ratio * mean,
+                            spans=[(MM * lo, MM * hi), (-MM * hi, -MM * lo)], label=f"{item.label} of mean")[-1]
 
 
 def plot_channel_boundary(field: BlenderField, boundary: ChannelBoundary, path: str | os.PathLike, title: str) -> Path:
@@ -355,8 +436,13 @@ def plot_continuous_mode(results: Mapping, path: str | os.PathLike, title: str) 
 
 
 def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
-                         quantity: str = "mean velocity") -> Path:
-    """Runs at several gravity factors on the 1 g scale: ``v / sqrt(f)`` against ``t sqrt(f)``.
+                         quantity: str = "mean velocity", findings: Sequence[StudyNote] | None = None) -> Path:
+    """Runs at several gravity factors on the 1 g scale: ``v / sqrt(f)`` against ``t sqrt(f)``, in the project's
+    style (:func:`siloflow.analysis.io.plot_style.journal_style`).
+
+    One colour per configuration (the run's label) and one line style per gravity factor (``gid="run"``); the
+    legend stands right of the axes. Where the velocity scales with the square root of gravity, the runs of a
+    configuration lie on one curve.
 
     Parameters
     ----------
@@ -369,11 +455,23 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
         Figure title.
     quantity : str, optional
         What the velocity is, for the axis label.
+    findings : sequence of StudyNote, optional
+        The study's finding on the scaling, e.g. M4's ``StudyNote("M4", "v scales with sqrt(g)")``: the curve the
+        runs of a configuration lie on under that scaling, that of its run of the lowest gravity factor (the first
+        of them), is drawn once under the runs as a wide light grey line (``gid="finding <id>"``), one legend entry
+        for all configurations, the notes' labels (``study (M4): v scales with sqrt(g)``). None (the default):
+        none.
 
     Returns
     -------
     pathlib.Path
         The written path.
+
+    Raises
+    ------
+    ValueError
+        Naming the run: no run, a gravity factor not > 0, non-finite times or a velocity not of their shape; a
+        finding that is not a StudyNote; more configurations than the palette's 8 colours.
     """
     checked = []
     for i, item in enumerate(non_empty_list("runs", runs)):
@@ -385,18 +483,35 @@ def plot_gravity_scaling(runs: Sequence, path: str | os.PathLike, title: str,
             raise ValueError(f"runs[{i}] velocity must have the shape of time {time.shape}, got {velocity.shape}")
         checked.append((str(label), factor, gravity_normalised_time(time, factor),
                         gravity_normalised_velocity(velocity, factor)))
-    figure, axes = plt.subplots(figsize=(6.4, 4.2))
-    try:
-        for label, factor, time, velocity in checked:
-            axes.plot(time, velocity, "-", linewidth=1.3, label=f"{label} ({factor:g} g)")
-        axes.set_xlabel("t sqrt(g_run / g) [s]")
-        axes.set_ylabel(f"{quantity} / sqrt(g_run / g) [m/s]")
-        axes.set_title(title)
-        axes.grid(alpha=0.3)
-        axes.legend(fontsize=8)
-        return save_figure(figure, path, tight=True)
-    finally:
-        plt.close(figure)
+    notes = study_findings(findings, StudyNote)
+    configurations = list(dict.fromkeys(label for label, _, _, _ in checked))
+    colours = colour_of(configurations)
+    factors = sorted({factor for _, factor, _, _ in checked})
+    styles = {factor: LINE_STYLES[k % len(LINE_STYLES)] for k, factor in enumerate(factors)}
+    with journal_style():
+        figure, axes = plt.subplots(figsize=(PAGE_WIDTH, 3.4))
+        try:
+            figure.subplots_adjust(left=0.1, right=0.62, bottom=0.14, top=0.9)
+            if notes:
+                # drawn first, under the runs, which are read against it: each configuration's lowest factor, the
+                # legend entry once
+                for k, configuration in enumerate(configurations):
+                    _, _, time, velocity = min((run for run in checked if run[0] == configuration),
+                                               key=lambda run: run[1])
+                    axes.plot(time, velocity, "-", color="0.75", linewidth=5.0, solid_capstyle="round",
+                              label="; ".join(note.label for note in notes) if k == 0 else "_nolegend_",
+                              gid=f"finding {notes[0].id}")
+            for label, factor, time, velocity in checked:
+                axes.plot(time, velocity, styles[factor], color=colours[label], label=f"{label} ({factor:g} g)",
+                          gid="run")
+            axes.set_xlabel("t sqrt(g_run / g) [s]")
+            axes.set_ylabel(f"{quantity} / sqrt(g_run / g) [m/s]")
+            axes.set_title(title)
+            axes.grid(alpha=0.3)
+            legend_outside(axes)
+            return save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
 
 
 def plot_configuration_comparison(rows: Sequence, columns: Sequence, path: str | os.PathLike, title: str,

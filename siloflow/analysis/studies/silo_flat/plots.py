@@ -8,14 +8,30 @@ tests check."""
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 
+from siloflow.analysis.io.plot_style import (
+    PAGE_WIDTH,
+    PALETTE,
+    REFERENCE_COLOUR,
+    StudyNote,
+    journal_style,
+    legend_outside,
+    note_study,
+    study_findings,
+)
 from siloflow.analysis.io.plots import save_figure, silo_outline
 from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
+
+#: Colour of a velocity profile or fitted kinematic constant: the palette's blue.
+_PROFILE_COLOUR = PALETTE[5]
+#: Colour of the flow channel boundary: the palette's vermillion, apart from the profiles' blue in any colour vision.
+_BOUNDARY_COLOUR = PALETTE[6]
 
 
 def plot_discharge(
@@ -97,44 +113,51 @@ def plot_discharge(
 
 def plot_profiles_over_silo(profiles, width: float, outlet_width: float, top: float, path, title: str,
                             fcb_fraction_index: int = -1, uncertainty=None) -> Figure:
-    """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary in red.
+    """Vertical velocity profiles drawn as lines over the silo outline, flow channel boundary marked, in the
+    project's style (:func:`siloflow.analysis.io.plot_style.journal_style`).
 
-    Each profile is drawn at its height z as z + s v_z(x), with the scale s chosen so that the fastest
-    profile spans 80 % of the spacing between heights; the red dots mark the flow channel boundary at the
-    chosen fraction of the centreline velocity. With ``uncertainty`` (a
-    :class:`~siloflow.analysis.studies.silo_flat.fields.ProfileUncertainty`) each dot gets a horizontal error bar of one
-    standard error (mm), one errorbar container per height (NaN errors draw nothing).
+    Each profile is drawn at its height z as z + s v_z(x) (``gid="profile"``, blue), with the scale s chosen so
+    that the fastest profile spans 80 % of the spacing between heights, over a light grey guide at z; the
+    vermillion dots mark the flow channel boundary at the chosen fraction of the centreline velocity
+    (``gid="fcb"``). With ``uncertainty`` (a :class:`~siloflow.analysis.studies.silo_flat.fields.ProfileUncertainty`)
+    each dot gets a horizontal error bar of one standard error (mm), one errorbar container per height (NaN errors
+    draw nothing). The legend (the boundary, and the profile with its velocity scale) stands right of the silo.
+    Lengths in mm.
     """
     heights = profiles.heights
     spacing = np.min(np.diff(heights)) if heights.size > 1 else 0.02
     peak = np.nanmax(np.abs(profiles.v_z)) or 1.0
     scale = 0.8 * spacing / peak
     x_mm = 1e3 * profiles.x
-    figure, axes = plt.subplots(figsize=(5.0, 6.0))
-    try:
-        silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
-        for i, z in enumerate(heights):
-            axes.axhline(1e3 * z, color="0.8", linewidth=0.6)
-            axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color="tab:blue")
-            boundary_mm = 1e3 * np.array([profiles.fcb_left[i, fcb_fraction_index],
-                                          profiles.fcb_right[i, fcb_fraction_index]])
-            axes.plot(boundary_mm, [1e3 * z, 1e3 * z], "o", color="red", markersize=4)
-            if uncertainty is not None:
-                errors = [uncertainty.fcb_left_error[i, fcb_fraction_index],
-                          uncertainty.fcb_right_error[i, fcb_fraction_index]]
-                axes.errorbar(boundary_mm, [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
-                              fmt="none", ecolor="red", elinewidth=1.0, capsize=3)
-        fraction = profiles.fcb_fractions[fcb_fraction_index]
-        axes.plot([], [], "o", color="red", label=f"FCB at {100 * fraction:g} % of centreline v_z")
-        axes.plot([], [], color="tab:blue", label=f"v_z (1 mm = {1e-3 / scale:.3g} m/s)")
-        axes.set_aspect("equal")
-        axes.set_xlabel("x [mm]")
-        axes.set_ylabel("z [mm]")
-        axes.set_title(title)
-        axes.legend(loc="upper center", fontsize=8)
-        save_figure(figure, path, tight=True)
-    finally:
-        plt.close(figure)
+    with journal_style():
+        figure, axes = plt.subplots(figsize=(PAGE_WIDTH, 4.4))
+        try:
+            # room on the right for the legend, so that the figure keeps the page's width
+            figure.subplots_adjust(left=0.1, right=0.62, bottom=0.11, top=0.93)
+            silo_outline(axes, 1e3 * width, 1e3 * outlet_width, 1e3 * top)
+            for i, z in enumerate(heights):
+                axes.axhline(1e3 * z, color="0.85", linewidth=0.6)
+                axes.plot(x_mm, 1e3 * (z + scale * profiles.v_z[i]), color=_PROFILE_COLOUR, gid="profile")
+                boundary_mm = 1e3 * np.array([profiles.fcb_left[i, fcb_fraction_index],
+                                              profiles.fcb_right[i, fcb_fraction_index]])
+                axes.plot(boundary_mm, [1e3 * z, 1e3 * z], "o", color=_BOUNDARY_COLOUR, gid="fcb")
+                if uncertainty is not None:
+                    errors = [uncertainty.fcb_left_error[i, fcb_fraction_index],
+                              uncertainty.fcb_right_error[i, fcb_fraction_index]]
+                    axes.errorbar(boundary_mm, [1e3 * z, 1e3 * z], xerr=1e3 * np.array(errors),
+                                  fmt="none", ecolor=_BOUNDARY_COLOUR, elinewidth=1.0, capsize=3)
+            fraction = profiles.fcb_fractions[fcb_fraction_index]
+            # proxies: each kind once in the legend, however many heights
+            axes.plot([], [], "o", color=_BOUNDARY_COLOUR, label=f"FCB at {100 * fraction:g} % of centreline v_z")
+            axes.plot([], [], color=_PROFILE_COLOUR, label=f"v_z (1 mm = {1e-3 / scale:.3g} m/s)")
+            axes.set_aspect("equal")
+            axes.set_xlabel("x [mm]")
+            axes.set_ylabel("z [mm]")
+            axes.set_title(title)
+            legend_outside(axes)
+            save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
     return figure
 
 
@@ -157,45 +180,120 @@ def plot_velocity_contour(x, z, v_z, width: float, outlet_width: float, path, ti
     return figure
 
 
-def plot_kinematic_constant(heights, B, path, title: str, B_error=None) -> Figure:
-    """Kinematic constant B (mm) against height above the outlet (mm), with horizontal error bars of one
-    standard error ``B_error`` (m, NaN draws none) when given."""
-    figure, axes = plt.subplots(figsize=(5.0, 4.0))
-    try:
-        axes.plot(1e3 * np.asarray(B), 1e3 * np.asarray(heights), "o-")
-        if B_error is not None:
-            axes.errorbar(1e3 * np.asarray(B), 1e3 * np.asarray(heights), xerr=1e3 * np.asarray(B_error),
-                          fmt="none", ecolor="tab:blue", capsize=3, label="± standard error")
-        axes.set_xlabel("B [mm]")
-        axes.set_ylabel("z [mm]")
-        axes.set_title(title)
-        axes.grid(alpha=0.3)
-        save_figure(figure, path, tight=True)
-    finally:
-        plt.close(figure)
+def plot_kinematic_constant(heights, B, path, title: str, B_error=None,
+                            findings: Sequence[StudyNote] | None = None) -> Figure:
+    """Kinematic constant B [mm] against height above the outlet z [mm], in the project's style
+    (:func:`siloflow.analysis.io.plot_style.journal_style`).
+
+    B is drawn as one line with markers (``gid="kinematic_B"``), with horizontal error bars of one standard error
+    ``B_error`` (NaN draws none) when given. Each finding is an entry of the legend, which stands right of the axes.
+
+    Parameters
+    ----------
+    heights : array_like
+        Heights above the outlet z [m].
+    B : array_like
+        Kinematic constant B at each height [m].
+    path : str or os.PathLike
+        Destination plot file, written atomically in the format of its suffix
+        (:func:`siloflow.analysis.io.plots.save_figure`).
+    title : str
+        Figure title.
+    B_error : array_like, optional
+        Standard error of B at each height [m]; None: no error bars.
+    findings : sequence of StudyNote, optional
+        The study's expected trend to show beside B (a legend entry labelled with its id), e.g. S5:
+        ``StudyNote("S5", "B decreases with height")``. None (the default): none.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        For a finding that is not a StudyNote.
+    """
+    notes = study_findings(findings, StudyNote)
+    with journal_style():
+        figure, axes = plt.subplots(figsize=(PAGE_WIDTH, 3.4))
+        try:
+            figure.subplots_adjust(left=0.1, right=0.6, bottom=0.14, top=0.9)
+            # the legend lists the data (B, its errors), then the findings they are read against
+            handles = axes.plot(1e3 * np.asarray(B), 1e3 * np.asarray(heights), "o-", color=_PROFILE_COLOUR,
+                                label="DEM kinematic constant B", gid="kinematic_B")
+            if B_error is not None:
+                handles.append(axes.errorbar(1e3 * np.asarray(B), 1e3 * np.asarray(heights),
+                                             xerr=1e3 * np.asarray(B_error), fmt="none", ecolor=_PROFILE_COLOUR,
+                                             capsize=3, label="± standard error"))
+            handles += [note_study(axes, note) for note in notes]
+            axes.set_xlabel("B [mm]")
+            axes.set_ylabel("z [mm]")
+            axes.set_title(title)
+            axes.grid(alpha=0.3)
+            legend_outside(axes, handles=handles)
+            save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
     return figure
 
 
-def plot_janssen(comparison, path, title: str) -> Figure:
-    """Mean vertical stress against depth below the surface: DEM contacts with horizontal error bars of one
-    standard error, Janssen's formula and the hydrostatic ``rho_b g h``."""
-    figure, axes = plt.subplots(figsize=(5.0, 4.0))
-    try:
-        depth_mm = 1e3 * comparison.depth_below_surface
-        axes.plot(comparison.simulated, depth_mm, "o", label="DEM (contact stress)")
-        axes.errorbar(comparison.simulated, depth_mm, xerr=comparison.simulated_error, fmt="none",
-                      ecolor="tab:blue", capsize=2, label="DEM ± standard error")
-        axes.plot(comparison.janssen, depth_mm, "-", label="Janssen")
-        axes.plot(comparison.hydrostatic, depth_mm, ":", color="0.3", label="hydrostatic rho_b g h")
-        axes.invert_yaxis()
-        axes.set_xlabel("vertical stress [Pa]")
-        axes.set_ylabel("depth below surface [mm]")
-        axes.set_title(title)
-        axes.legend(fontsize=8)
-        axes.grid(alpha=0.3)
-        save_figure(figure, path, tight=True)
-    finally:
-        plt.close(figure)
+def plot_janssen(comparison, path, title: str, findings: Sequence[StudyNote] | None = None) -> Figure:
+    """Mean vertical stress against depth below the surface, in the project's style
+    (:func:`siloflow.analysis.io.plot_style.journal_style`): the DEM contact stress with horizontal error bars of
+    one standard error (one errorbar container, its points ``gid="dem_stress"``), Janssen's formula (``gid="janssen"``) and the hydrostatic
+    ``rho_b g h`` (``gid="hydrostatic"``, dotted grey). Stresses in Pa, depth in mm (growing downwards); the legend
+    stands right of the axes.
+
+    Parameters
+    ----------
+    comparison : siloflow.analysis.studies.silo_flat.fields.JanssenComparison
+        The stresses to draw.
+    path : str or os.PathLike
+        Destination plot file, written atomically in the format of its suffix
+        (:func:`siloflow.analysis.io.plots.save_figure`).
+    title : str
+        Figure title.
+    findings : sequence of StudyNote, optional
+        The study's finding on Janssen's curve, which then names it in the legend: with S1,
+        ``StudyNote("S1", "DEM in good agreement")``, the Janssen entry reads ``Janssen, study (S1): DEM in good
+        agreement``. None (the default): ``Janssen``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        For a finding that is not a StudyNote.
+    """
+    notes = study_findings(findings, StudyNote)
+    janssen_label = ", ".join(["Janssen"] + [note.label for note in notes])
+    with journal_style():
+        figure, axes = plt.subplots(figsize=(PAGE_WIDTH, 3.4))
+        try:
+            figure.subplots_adjust(left=0.1, right=0.6, bottom=0.14, top=0.9)
+            depth_mm = 1e3 * comparison.depth_below_surface
+            # the points and their error bars are one series: one artist, one legend entry
+            dem = axes.errorbar(comparison.simulated, depth_mm, xerr=comparison.simulated_error, fmt="o",
+                                color=PALETTE[0], capsize=2, label="DEM (contact stress) ± standard error")
+            dem.lines[0].set_gid("dem_stress")
+            (janssen,) = axes.plot(comparison.janssen, depth_mm, "-", color=_PROFILE_COLOUR, label=janssen_label,
+                                   gid="janssen")
+            (hydrostatic,) = axes.plot(comparison.hydrostatic, depth_mm, ":", color=REFERENCE_COLOUR,
+                                       label="hydrostatic rho_b g h", gid="hydrostatic")
+            axes.invert_yaxis()
+            axes.set_xlabel("vertical stress [Pa]")
+            axes.set_ylabel("depth below surface [mm]")
+            axes.set_title(title)
+            axes.grid(alpha=0.3)
+            legend_outside(axes, handles=[dem, janssen, hydrostatic])
+            save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
     return figure
 
 

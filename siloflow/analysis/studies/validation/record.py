@@ -273,6 +273,12 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
     return lines
 
 
+def _figure_width(count: int) -> str:
+    """The width of each of a group's ``count`` figures on its line of the page: two side by side, one alone at the
+    page's width."""
+    return "100%" if count == 1 else "49%"
+
+
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None,
@@ -376,20 +382,28 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
         attempts = _attempts_sentence(record.runs)
         if attempts:
             lines[-1] += " " + attempts
-        lines += ["", "| table | figure | case | value | finding | study | agreement | scale | why, and evidence |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        for row in record.rows:
-            why = "; ".join(_cell(text) for text in (row["agreement_reason"], row["scale_reason"], row["evidence"])
-                            if text)
-            lines.append(f"| {_cell(row['group'])} | {_cell(row['figure'])} | {_cell(row['case'])} | "
-                         f"{_cell(_value(row))} | {row['finding']} | {_cell(row['study'] or '-')} | "
-                         f"{row['agreement']} | {row['scale']} | {why} |")
+        # the figures first, beside the rows they support; then one short line per row; its evidence folded below
+        if record.plots:
+            lines += ["", " ".join(f'<img src="{name}/{plot}" alt="{plot}" width="{_figure_width(len(record.plots))}">'
+                                   for plot in record.plots)]
+        lines += ["", "| table | figure | case | value | finding | study | agreement | scale |",
+                  "|---|---|---|---|---|---|---|---|"]
+        lines += [f"| {_cell(row['group'])} | {_cell(row['figure'])} | {_cell(row['case'])} | "
+                  f"{_cell(_value(row))} | {row['finding']} | {_cell(row['study'] or '-')} | "
+                  f"{row['agreement']} | {row['scale']} |" for row in record.rows]
         elsewhere = [row for row in record.rows if row["scale"] not in (AT_SCALE, NO_FINDING)]
         if elsewhere:
             cost = full_scale_core_s.get(name, math.nan)
             lines += ["", f"Rows not at the study's scale ({len(elsewhere)}): each names what differs; the study's "
                       f"full scale (`{full_scale_config}`) runs this group in about {cost / 86400.0:.3g} core-days "
                       f"(`make estimate CONFIG={full_scale_config}`)."]
-        if record.plots:
-            lines += [""] + [f"![{plot}]({name}/{plot})" for plot in record.plots]
+        if record.rows:
+            lines += ["", '<details markdown="1">', f"<summary>Why each row is judged so: its evidence "
+                      f"({len(record.rows)} rows)</summary>", "", "| figure | case | finding | why, and evidence |",
+                      "|---|---|---|---|"]
+            for row in record.rows:
+                why = "; ".join(_cell(text) for text in (row["agreement_reason"], row["scale_reason"], row["evidence"])
+                                if text)
+                lines.append(f"| {_cell(row['figure'])} | {_cell(row['case'])} | {row['finding']} | {why} |")
+            lines += ["", "</details>"]
     return "\n".join(lines) + "\n"
