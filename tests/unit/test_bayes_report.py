@@ -18,7 +18,8 @@ from siloflow.calibration.bayes.posterior import Prior
 from scipy import stats
 
 from siloflow.calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, engines_rows, interval_rows,
-                                      predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
+                                      predictive_columns, predictive_rows, predictive_verdict, TWIN_COLUMNS,
+                                      twin_rows, twin_verdict)
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 NAMES = ("sliding_friction", "rolling_friction", "wall_sliding_friction.aluminium")
@@ -347,3 +348,21 @@ def test_the_chart_comparison_of_a_calibration_with_its_rolling_friction_held_fi
     (row,) = chart_comparison_rows(calibration, samples, chart)
     assert row["parameter"] == "sliding_friction" and row["chart_inside"]
     assert row["conditional_samples"] == 101 and row["conditional_mean"] == pytest.approx(0.3)
+
+
+def test_the_twin_table_has_a_row_per_parameter_per_axis_and_the_verdict_last():
+    verdict = {"level": 0.9, "hpd_level": 0.64, "inside_credible_region": True,
+               "parameters": {"a": {"truth": 0.3, "mean": 0.31, "sd": 0.07, "sd_over_prior_sd": 0.45, "z": -0.12,
+                                    "inside": True},
+                              "b": {"truth": 0.1, "mean": 0.09, "sd": 0.06, "sd_over_prior_sd": 1.02, "z": 0.12,
+                                    "inside": False}},
+               "axes": [{"loadings": {"a": 0.96, "b": -0.28}, "sd_over_prior_sd": 1.05, "truth_z": 0.124}]}
+    rows = twin_rows(verdict)
+    assert all(tuple(row) == TWIN_COLUMNS for row in rows)
+    assert rows[0] == {"quantity": "a", "truth": 0.3, "posterior_mean": 0.31, "posterior_sd": 0.07,
+                       "sd_over_prior_sd": 0.45, "truth_z": -0.12, "hpd_level": "", "level": 0.9, "inside": True}
+    assert rows[1]["inside"] is False
+    assert rows[2] == {**dict.fromkeys(TWIN_COLUMNS, ""), "quantity": "axis 1: 0.960*a + -0.280*b",
+                       "sd_over_prior_sd": 1.05, "truth_z": 0.124}
+    assert rows[3] == {**dict.fromkeys(TWIN_COLUMNS, ""), "quantity": "truth (all parameters)", "hpd_level": 0.64,
+                       "level": 0.9, "inside": True}

@@ -21,7 +21,7 @@ from siloflow.calibration.bayes.joint import WALL_PARAMETER, Calibration
 from siloflow.calibration.bayes.posterior import credible_interval
 
 __all__ = ["CHART_COMPARISON_COLUMNS", "TWIN_LEVEL", "chart_comparison_rows", "engines_rows", "interval_rows",
-           "twin_verdict", "predictive_columns", "predictive_rows", "predictive_verdict"]
+           "twin_verdict", "TWIN_COLUMNS", "twin_rows", "predictive_columns", "predictive_rows", "predictive_verdict"]
 
 #: How many combined standard deviations a predictive run may lie from its target and still be within (-).
 WITHIN_SD = 2.0
@@ -454,3 +454,39 @@ def twin_verdict(calibration: Calibration, samples, log_probability, truth, trut
                      "truth_z": float(vector @ offset / width) if width > 0 else math.nan})
     return {"level": level, "hpd_level": hpd_level, "inside_credible_region": bool(hpd_level <= level),
             "truth": dict(zip(names, truth.tolist())), "parameters": parameters, "axes": axes}
+
+
+#: The columns of :func:`twin_rows` (a report without a twin experiment writes them as its header only).
+TWIN_COLUMNS = ("quantity", "truth", "posterior_mean", "posterior_sd", "sd_over_prior_sd", "truth_z", "hpd_level",
+                "level", "inside")
+
+
+def twin_rows(verdict: Mapping) -> list[dict]:
+    """The twin experiment's table: one row per parameter, then per principal axis of the posterior, then the verdict.
+
+    Parameters
+    ----------
+    verdict : mapping
+        :func:`twin_verdict`'s result.
+
+    Returns
+    -------
+    list of dict
+        With :data:`TWIN_COLUMNS`. A parameter's row: its ``truth``, ``posterior_mean``, ``posterior_sd`` (-),
+        ``sd_over_prior_sd`` (1: the runs taught nothing), the truth's ``truth_z`` and whether the truth lies in its
+        equal-tailed ``level`` interval (``inside``). An axis's row (``axis k: a*name + ...``, widest first, in prior
+        sd units): its ``sd_over_prior_sd`` and ``truth_z``. The last row, ``truth (all parameters)``: the truth's
+        ``hpd_level`` and whether it lies inside the ``level`` HPD region, the experiment's verdict. Cells a row does
+        not have are empty.
+    """
+    empty = dict.fromkeys(TWIN_COLUMNS, "")
+    rows = [{**empty, "quantity": name, "truth": p["truth"], "posterior_mean": p["mean"], "posterior_sd": p["sd"],
+             "sd_over_prior_sd": p["sd_over_prior_sd"], "truth_z": p["z"], "level": verdict["level"],
+             "inside": p["inside"]} for name, p in verdict["parameters"].items()]
+    for k, axis in enumerate(verdict["axes"], start=1):
+        combination = " + ".join(f"{weight:.3f}*{name}" for name, weight in axis["loadings"].items())
+        rows.append({**empty, "quantity": f"axis {k}: {combination}", "sd_over_prior_sd": axis["sd_over_prior_sd"],
+                     "truth_z": axis["truth_z"]})
+    rows.append({**empty, "quantity": "truth (all parameters)", "hpd_level": verdict["hpd_level"],
+                 "level": verdict["level"], "inside": verdict["inside_credible_region"]})
+    return rows

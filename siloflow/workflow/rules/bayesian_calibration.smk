@@ -226,6 +226,8 @@ rule bayes_report:
                      subcategory="Bayesian", labels={"figure": "ridge {engine}"}),
         comparison=report(f"{bayes_folder()}/chart_comparison.csv", caption="../report/bayes_chart.rst",
                           category="1 Calibration", subcategory="Bayesian", labels={"figure": "chart beside posterior {engine}"}),
+        twin=report(f"{bayes_folder()}/twin.csv", caption="../report/bayes_twin.rst", category="1 Calibration",
+                    subcategory="Bayesian", labels={"figure": "twin experiment {engine}"}),
         corner=report(plot_file(f"{bayes_folder()}/corner"), caption="../report/bayes_corner.rst", category="1 Calibration",
                       subcategory="Bayesian", labels={"figure": "posterior {engine}"}),
         predictive_plot=report(plot_file(f"{bayes_folder()}/predictive"), caption="../report/bayes_predictive.rst",

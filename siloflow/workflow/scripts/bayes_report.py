@@ -13,7 +13,8 @@ from siloflow.calibration.bayes.joint import calibration_of, twin_truth, with_ta
 from siloflow.calibration.bayes.plots import plot_corner, plot_predictive
 from siloflow.calibration.bayes.runs import completed_sets, failed_runs
 from siloflow.calibration.bayes.report import (CHART_COMPARISON_COLUMNS, chart_comparison_rows, interval_rows,
-                                      predictive_columns, predictive_rows, predictive_verdict, twin_verdict)
+                                      predictive_columns, predictive_rows, predictive_verdict, TWIN_COLUMNS,
+                                      twin_rows, twin_verdict)
 from siloflow.engines.logs import logged_to
 
 
@@ -82,10 +83,13 @@ with logged_to(snakemake.log[0]) as log:
         twin = twin_verdict(calibration, samples, posterior["log_probability"], twin_truth(calibration),
                             summary["truth_log_probability"])
         truths = twin["truth"]
+        write_flow_table(snakemake.output.twin, twin_rows(twin))
         log.info("twin experiment on %s: the truth %s lies at the %.3f highest-posterior-density level: %s the 90 %% "
                  "region; per parameter sd/prior sd and z %s", engine, twin["truth"], twin["hpd_level"],
                  "inside" if twin["inside_credible_region"] else "outside",
                  {name: (round(p["sd_over_prior_sd"], 3), round(p["z"], 2)) for name, p in twin["parameters"].items()})
+    else:
+        write_text(snakemake.output.twin, ",".join(TWIN_COLUMNS) + "\n")
     plot_corner(samples, calibration.names, snakemake.output.corner, truths=truths, chart=chart)
 
     final_iteration = len(snakemake.input.designs) - 1
