@@ -58,15 +58,22 @@ def rederive(config_path: str, record_dir: str | Path, groups: Sequence[str]) ->
     """Derive again the rows of each of ``groups`` from the products its record keeps, with today's row code and
     ``config_path``'s ``validation`` section and dimensions, and write them into its record (its runs, plots and
     products unchanged). A product is looked for in the group's own record, then in those of the groups it reads.
-    Returns ``{group: rows}``; refuses (ValueError) a group whose record keeps no derivation or lacks a product."""
+    Returns ``{group: rows}``; refuses (ValueError) a group whose record keeps no derivation or lacks a product, or
+    whose recorded runs are not those ``config_path`` plans (its dimensions are not theirs)."""
     config = load_config(config_path)
     record_dir = Path(record_dir)
+    planned = _planned(config_path)
     written = {}
     for name in groups:
         group = read_group_record(record_dir / name) if (record_dir / name / "runs.csv").is_file() else None
         if group is None or group.derivation is None:
             raise ValueError(f"{name}: its record keeps no derivation (written before records kept one): "
                              f"`make validate GROUP={name}` records it again")
+        # a row's scale verdict is judged on the configuration's dimensions: only those of the runs it comes from
+        recorded = {run["run_id"] for run in group.runs}
+        if recorded != planned.get(name, set()):
+            raise ValueError(f"{name}: its recorded runs are not those {config_path} plans, so their rows cannot be "
+                             f"judged on its dimensions: `make validate GROUP={name}` records it again")
         derivation = group.derivation
         places = [record_dir / other / PRODUCTS for other in (name, *GROUPS[name].reads)]
 

@@ -238,8 +238,15 @@ def test_the_validation_config_is_judged_finding_by_finding():
     verdicts = {finding: scale_verdict(finding, entry.kind, config, True) for finding, entry in FINDING_SCALES.items()}
     summary = "\n".join(f"{finding}: {'at scale' if v.at_study_scale else 'not at scale'}: {v.text}"
                         for finding, v in verdicts.items())
-    depth = {d.name: d for d in verdicts["M1"].differences}.get("depth")
-    assert depth is not None, summary
-    assert depth.run_m == 0.0125 and depth.ratio == pytest.approx(0.3125), summary
-    assert depth.run_diameters == pytest.approx(0.0125 / D), summary
-    assert "depth 12.5 mm = 0.31 of the study's 40 mm (3.8 particle diameters;" in verdicts["M1"].text, summary
+    # the silos are the study's 150 x 40 x 270 mm assembly: every finding of ch. 5 and 6 that depends on the geometry
+    # alone is at the study's scale; the contact stiffness (and for S2 the restitution) still differ
+    at_scale = {finding for finding, verdict in verdicts.items() if verdict.at_study_scale}
+    assert at_scale == {"S1", "S3", "S4", "S5", "S6", "B2", "B3", "B4", "B5", "B6", "B7", "B8"}, summary
+    assert {d.name for d in verdicts["B1"].differences} == {"youngs_modulus"}, summary
+    assert {d.name for d in verdicts["S2"].differences} == {"youngs_modulus", "restitution"}, summary
+    # the blender: the study's 40 mm depth at half its width, so its width, tube and bed are named, not its depth
+    differing = {d.name: d for d in verdicts["M1"].differences}
+    assert set(differing) == {"width", "bed_above_insert", "tube_width"}, summary
+    assert differing["width"].run_m == 0.225 and differing["width"].ratio == pytest.approx(0.5), summary
+    assert "depth" not in verdicts["M1"].text, summary
+    assert "width 225 mm = 0.5 of the study's 450 mm (67.6 particle diameters;" in verdicts["M1"].text, summary

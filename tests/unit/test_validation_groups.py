@@ -75,9 +75,11 @@ def test_the_validation_config_s_runs_fall_into_their_groups():
     made = group_runs(config, config_estimates(config))
     counts = {name: len(runs) for name, runs in made.items()}
     # 8 sphere2 internal + 8 aluminium + 2 more seeds of its reference point; 8 sphere + 8 sphere4 + 2 more seeds of
-    # each one's; 4 blocked + 4 servo + 1 restitution + 2 other speeds + 3 poured at their own friction (not 0.1)
-    assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 14, "silo": 3,
-                      "silo_series": 4, "blending": 4, "blender": 7}
+    # each one's; 4 blocked + 4 servo + 1 restitution + 2 other speeds + 3 poured at their own friction (not 0.1);
+    # two fills of the flat-bottom silo and its frictionless front walls; a run per flow pattern and the thin silo;
+    # three inserts, the converging one's second seed and two more gravities
+    assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 14, "silo": 2,
+                      "silo_series": 1, "blending": 3, "blender": 6}
 
 
 def test_an_unknown_group_is_refused_with_the_groups_named():
@@ -197,18 +199,19 @@ def test_validate_status_reads_the_record_and_names_each_group(tmp_path, capsys)
 
 def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert record_main(["check", "--group", "blender", "--config", config, "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "blender_1", "--config", config, "--record", str(tmp_path)]) == 0
     assert record_main(["check", "--group", "silos", "--config", config, "--record", str(tmp_path)]) == 2
-    assert "unknown validation group 'silos'; this configuration's groups and parts are calibration, " in (
+    assert "unknown validation group 'silos'; this configuration's groups and parts are calibration_1, " in (
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    # internal flow's two seeds side by side over five time slices, semi-mass flow over five, the thin silo
-    assert ("runs in 11 parts: " + " then ".join(f"make validate GROUP=blending_{k}" for k in range(1, 12))
+    # both flow patterns side by side over five time slices, the thin silo
+    assert ("runs in 6 parts: " + " then ".join(f"make validate GROUP=blending_{k}" for k in range(1, 7))
             in capsys.readouterr().err)
     # the blending study starts from the flat-bottom silo's settled fills: it waits for that silo's record
     assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 2
-    assert "compares against the runs of silo, whose record is missing: run make validate GROUP=silo first" in (
+    assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
+            "validate GROUP=silo_2 first") in (
         capsys.readouterr().err)
     assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
@@ -292,7 +295,7 @@ def test_validate_writes_a_record_only_once_the_group_s_runs_have_finished(tmp_p
     assert record_main(["finished", "--config", config, "--directory", str(tmp_path), "--group", "silo_2"]) == 0
     captured = capsys.readouterr()
     assert captured.out.strip() == ""
-    assert captured.err.strip() == ("siloflow: silo: 3 of 3 runs behind its rows still to make; its record is written "
+    assert captured.err.strip() == ("siloflow: silo: 2 of 2 runs behind its rows still to make; its record is written "
                                     "by the `make validate GROUP=` that makes the last")
     assert record_main(["finished", "--config", config, "--directory", str(tmp_path), "--group", "silos"]) == 2
 
@@ -312,21 +315,22 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
                     {"silo": [Part("silo_1", "silo", (0, 1)), Part("silo_2", "silo", (2,))]})
     # through the command line, before anything runs: the validation config plans the checks, the empty record has none
     config = str(REPO_ROOT / "config" / "validation.yaml")
-    assert record_main(["check", "--group", "calibration", "--config", config, "--record", str(tmp_path)]) == 0
-    assert record_main(["check", "--group", "calibration_checks", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("run make validate GROUP=calibration then make validate GROUP=calibration_shapes first" in
-            capsys.readouterr().err)
+    assert record_main(["check", "--group", "calibration_1", "--config", config, "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "calibration_checks_1", "--config", config, "--record", str(tmp_path)]) == 2
+    assert ("run make validate GROUP=calibration_1 then make validate GROUP=calibration_2 then make validate "
+            "GROUP=calibration_shapes_1 then make validate GROUP=calibration_shapes_2 first" in capsys.readouterr().err)
     # restoring the runs a group reads checks first: nothing is copied for a group that cannot run yet
     workdir = tmp_path / "work"
-    assert record_main(["restore", "--group", "calibration_checks", "--config", config, "--record", str(tmp_path),
+    assert record_main(["restore", "--group", "calibration_checks_1", "--config", config, "--record", str(tmp_path),
                         "--directory", str(workdir)]) == 2
-    assert ("run make validate GROUP=calibration then make validate GROUP=calibration_shapes first" in
+    assert ("run make validate GROUP=calibration_1 then make validate GROUP=calibration_2" in
             capsys.readouterr().err) and not workdir.exists()
-    assert record_main(["restore", "--group", "calibration", "--config", config, "--record", str(tmp_path),
+    assert record_main(["restore", "--group", "calibration_1", "--config", config, "--record", str(tmp_path),
                         "--directory", str(workdir)]) == 0
     assert capsys.readouterr().out == "" and not workdir.exists()
-    assert record_main(["check", "--group", "silo_series", "--config", config, "--record", str(tmp_path)]) == 2
-    assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo first" in
+    assert record_main(["check", "--group", "silo_series_1", "--config", config, "--record", str(tmp_path)]) == 2
+    assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
+            "validate GROUP=silo_2 first" in
             capsys.readouterr().err)
 
 

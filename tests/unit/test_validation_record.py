@@ -149,9 +149,9 @@ def test_the_record_keeps_png_plots_and_refuses_another_format_before_anything_r
     raw = load_config_file(REPO_ROOT / "config" / "validation.yaml")
     config = tmp_path / "validation_pdf.yaml"
     config.write_text(yaml.safe_dump({**raw, "plots": {"format": "pdf"}}, sort_keys=False))
-    assert record_main(["check", "--group", "blender", "--config", str(config), "--record", str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "blender_1", "--config", str(config), "--record", str(tmp_path)]) == 2
     assert re.search(message, capsys.readouterr().err)
-    assert record_main(["check", "--group", "blender", "--config", str(REPO_ROOT / "config" / "validation.yaml"), "--record", str(tmp_path)]) == 0
+    assert record_main(["check", "--group", "blender_1", "--config", str(REPO_ROOT / "config" / "validation.yaml"), "--record", str(tmp_path)]) == 0
 
 
 def test_a_table_without_the_validation_columns_is_refused(tmp_path):
@@ -366,10 +366,22 @@ def test_rederive_writes_a_group_s_rows_again_from_the_products_its_record_keeps
     (tmp_path / "silo" / DERIVATION).write_text(json.dumps({**derivation, "row_code": "older"}))
     (tmp_path / "silo" / TABLE).write_text("group,figure,case,value,value_error,unit,study_value,scale_shows,evidence\n"
                                            "Silo,Density,r,1.0,0.1,kg/m3,667,yes,old\n")
+    # runs the configuration no longer plans: their dimensions are not its own, so their rows are not judged on them
+    assert record_main(["rederive", "--record", str(tmp_path), "--config", config]) == 2
+    assert ("silo: its recorded runs are not those " + config + " plans, so their rows cannot be judged on its "
+            "dimensions: `make validate GROUP=silo` records it again") in capsys.readouterr().err
+    # the same record as if its runs were those the configuration plans: derived again with today's row code
+    planned = sorted(CLI._planned(config)["silo"])
+    runs = (tmp_path / "silo" / RUNS).read_text().splitlines()
+    (tmp_path / "silo" / RUNS).write_text("\n".join([runs[0], *(re.sub(r"^[^,]+", run_id, line)
+                                                               for run_id, line in zip(planned, runs[1:]))]) + "\n")
     assert record_main(["rederive", "--record", str(tmp_path), "--config", config]) == 0
     assert "rows of silo derived again from the products its record keeps" in capsys.readouterr().out
     again = read_group_record(tmp_path / "silo")
-    assert again.rows == read_group_record(REPO_ROOT / "docs" / "validation" / "silo").rows
+    committed = read_group_record(REPO_ROOT / "docs" / "validation" / "silo").rows
+    judged = ("scale", "scale_reason")  # on this configuration's dimensions, not those the committed rows were
+    assert [{k: v for k, v in row.items() if k not in judged} for row in again.rows] == [
+        {k: v for k, v in row.items() if k not in judged} for row in committed]
     assert again.derivation["row_code"] == row_code_digest() and again.runs and again.products
     # a record that keeps no derivation cannot be derived again: it is recorded again
     shutil.copytree(REPO_ROOT / "docs" / "validation" / "blender", tmp_path / "blender")
