@@ -87,6 +87,8 @@ def test_recirculation_time_covers_the_asked_recirculations(golden_config):
     t_res = 0.08 * 0.05 / (0.024 * 0.4 * 0.5)
     expected = 2.0 * t_res
     assert case.estimated_residence_time == pytest.approx(t_res, rel=1e-12)
+    # the study's nominal time: the channel as dense as the fill, whatever channel_density_ratio sized the run
+    assert case.nominal_residence_time == pytest.approx(0.08 * 0.05 / (0.024 * 0.4), rel=1e-12)
     assert expected <= case.recirculation_time < expected + case.silo.timestep
     assert case.feeder_zone == (-0.012, 0.012, -0.04, -0.02)
     assert case.silo.sink_depth == 0.04

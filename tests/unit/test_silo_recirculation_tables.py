@@ -105,7 +105,8 @@ RESULT = BlendingResult(
                         waveform="square", n_periods=4),
 )
 #: What of the run's case the blending summary holds.
-RUN = {"run_id": "recirculation_ab12", "flow_pattern": "mass flow", "estimated_residence_time": 2.5}
+RUN = {"run_id": "recirculation_ab12", "flow_pattern": "mass flow", "estimated_residence_time": 2.5,
+       "nominal_residence_time": 1.25}
 
 
 def assert_rows(rows, columns, expected):
@@ -228,7 +229,7 @@ def test_blending_summary_holds_timing_rtds_and_every_layout():
         assert summary["rtd_particle_ids"].pop(key) == pytest.approx(value, rel=1e-15)
     np.testing.assert_equal(summary, {
         "run_id": "recirculation_ab12", "flow_pattern": "mass flow", "residence_time_s": 2.0,
-        "estimated_residence_time_s": 2.5, "holdup_clumps": 20.0, "throughput_clumps_per_s": 10.0,
+        "estimated_residence_time_s": 2.5, "nominal_residence_time_s": 1.25, "holdup_clumps": 20.0, "throughput_clumps_per_s": 10.0,
         "recirculations": 1.5, "window_s": 1.0, "clumps_per_window": 10.0, "vrr_sampling_limit": 10.0,
         "vrr_ceiling_factor": 2.0,
         "residence_time_s_error": 0.125, "holdup_clumps_error": 0.5, "throughput_clumps_per_s_error": 0.25,

@@ -202,6 +202,18 @@ def test_theta_of_the_peak_in_t_rm_t_s_over_t_d_and_the_density_drop():
     assert "80%" in _one(other, "B8.internal")["differs"]
 
 
+def test_theta_of_the_peak_beside_it_in_the_study_s_nominal_residence_time():
+    """The study's t_rm is W H / (B0 V_out) (§6.2.3.3); the row takes the measured holdup over throughput and says
+    where the peak lies in the nominal time, without judging it."""
+    summary = _summary("internal_flow", _internal(), nominal_residence_time_s=1.25)
+    theta = _one(recirculation_rows([_run(summary)], TOLERANCES), "B7.internal")
+    assert theta["value"] == 0.75  # 1.5 s over the measured 2.0 s, as without the nominal time
+    assert ("in the study's nominal residence time W H / (B0 V_out) = 1.25 s (the channel as dense as the fill) its "
+            "theta = 1.2") in theta["evidence"]
+    plain = _one(recirculation_rows([_run(_summary("internal_flow", _internal()))], TOLERANCES), "B7.internal")
+    assert "nominal" not in plain["evidence"]
+
+
 def test_a_pattern_the_study_did_not_run_gives_rows_with_no_finding():
     rows = recirculation_rows([_run(_summary("custom_flow", {"blue13": _layout(0.13, 1, [2.0, 3.0, 4.0, 5.0, 6.0])}))],
                               TOLERANCES)

@@ -16,9 +16,9 @@ from tests.unit.test_validation_blending import TOLERANCES, _internal, _layout, 
 from tests.unit.test_validation_blending import _summary as _blending_summary
 
 
-def _summary(pattern, layouts, discharge=None, recirculations=6.1):
+def _summary(pattern, layouts, discharge=None, recirculations=6.1, **extra):
     """The blending rows' summary, with the discharge after the recirculations where given."""
-    extra = {} if discharge is None else {"final_discharge": discharge}
+    extra = extra if discharge is None else {**extra, "final_discharge": discharge}
     return _blending_summary(pattern, layouts, recirculations, **extra)
 
 
@@ -142,3 +142,13 @@ def test_the_seeds_of_a_discharge_combine_like_any_figure():
     assert entry["vrr"] == 9.0 and entry["vrr_error"] == pytest.approx(1.0)  # the seeds' standard error, sd / sqrt(2)
     assert spread[("final_discharge", "layouts", "blue13", "vrr")] == pytest.approx(math.sqrt(2.0) / 9.0)
     assert _one(recirculation_rows([_run(combined, dof=1.0)], TOLERANCES), "B4.internal")["value"] == 9.0
+
+
+def test_the_discharge_s_nr_is_also_given_in_the_study_s_nominal_residence_times():
+    # Nr = 4.02 measured residence times of 2.0 s: 8.04 s, or 6.432 nominal residence times of 1.25 s
+    summary = _summary("internal_flow", _internal(), _discharge(DISCHARGE), nominal_residence_time_s=1.25)
+    small = _one(recirculation_rows([_run(summary)], TOLERANCES), "B4.internal", "blue13:")
+    assert small["evidence"].startswith(
+        "discharge after Nr = 4.02 recirculations (in the study's nominal residence time W H / (B0 V_out) = 1.25 s "
+        "(the channel as dense as the fill) that Nr = 6.43) from t = 8.04 s: ")
+    assert small["value"] == 9.0 and small["differs"] == ""  # judged as before: the row's Nr is the measured one

@@ -112,6 +112,13 @@ class RecirculationCase:
         return self.silo.gravity
 
     @property
+    def nominal_residence_time(self) -> float:
+        """The study's nominal mean residence time ``W H / (B0 V_out)`` (s): the silo's contents over the feeder's
+        volumetric rate with the channel as dense as the fill (§6.2.3.3, 2.75 s for its silo), whatever
+        ``channel_density_ratio`` sized the run."""
+        return estimated_residence_time(self.silo.width, self.fill_height, self.silo.outlet_width, self.feeder_velocity)
+
+    @property
     def seeds(self) -> tuple[int, ...]:
         """The random seeds the engine is given: the silo's."""
         return self.silo.seeds

@@ -95,6 +95,7 @@ with logged_to(snakemake.log[0]) as log:
                  {name: round(layout.vrr, 2) for name, layout in discharge.layouts.items()})
     summary = blending_summary(result, eulerian_rtd, eulerian["bin_size"], run_id=case.run_id,
                                flow_pattern=case.pattern, estimated_residence_time=case.estimated_residence_time,
+                               nominal_residence_time=case.nominal_residence_time,
                                final_discharge=discharge)
     write_json(out.summary, {**summary, **density.summary()})
 

@@ -252,7 +252,8 @@ def clumps_per_window(result: BlendingResult) -> float:
 
 
 def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_size: float, *, run_id: str,
-                     flow_pattern: str, estimated_residence_time: float, factor: float = CEILING_FACTOR,
+                     flow_pattern: str, estimated_residence_time: float, nominal_residence_time: float,
+                     factor: float = CEILING_FACTOR,
                      k: float = 2.0, final_discharge: FinalDischarge | None = None) -> dict:
     """The summary of one recirculation run (``blending.json``).
 
@@ -270,6 +271,9 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
         Its flow-pattern preset.
     estimated_residence_time : float
         The a-priori residence time the run was sized with [s].
+    nominal_residence_time : float
+        The study's nominal mean residence time ``W H / (B0 V_out)`` [s]
+        (:attr:`siloflow.model.cases.silo_recirculation.RecirculationCase.nominal_residence_time`).
     factor : float, optional
         A measured VRR at or above ``vrr_sampling_limit / factor`` is flagged as at the ceiling, >= 1 [-].
     k : float, optional
@@ -284,6 +288,7 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
     -------
     dict
         ``run_id``, ``flow_pattern``, the timing (``residence_time_s`` [s], ``estimated_residence_time_s`` [s],
+        ``nominal_residence_time_s`` [s],
         ``holdup_clumps`` [-], ``throughput_clumps_per_s`` [1/s], ``recirculations`` [-], ``window_s`` [s],
         ``clumps_per_window`` [-], ``vrr_sampling_limit`` (the counting-noise ceiling of the VRR [-]),
         ``vrr_ceiling_factor`` (``factor`` [-])), the RTDs (``rtd_particle_ids``, ``rtd_eulerian``: moments [s,
@@ -326,7 +331,7 @@ def blending_summary(result: BlendingResult, eulerian_rtd: RTD, eulerian_bin_siz
     return {
         "run_id": run_id, "flow_pattern": flow_pattern,
         "residence_time_s": timing.residence_time, "residence_time_s_error": timing.residence_time_error,
-        "estimated_residence_time_s": estimated_residence_time,
+        "estimated_residence_time_s": estimated_residence_time, "nominal_residence_time_s": nominal_residence_time,
         "holdup_clumps": timing.holdup, "holdup_clumps_error": timing.holdup_error,
         "throughput_clumps_per_s": timing.throughput, "throughput_clumps_per_s_error": timing.throughput_error,
         "frame_interval_s": timing.frame_interval, "recirculations": timing.recirculations, "window_s": result.window,

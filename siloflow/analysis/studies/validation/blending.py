@@ -145,6 +145,16 @@ class _Run:
         self.windows = (f"outlet windows of {float(self.summary['clumps_per_window']):.0f} clumps: counting-noise "
                         f"ceiling {limit:.0f}, a VRR above {limit / factor:.0f} is a lower bound")
 
+    def nominal(self, t: float, what: str) -> str:
+        """The evidence clause of a time ``t`` (s) read in the study's nominal residence time (§6.2.3.3: W H / (B0
+        V_out), the channel as dense as the fill) beside the measured one the row takes: ``what`` is its name; "" when
+        the summary has no nominal time."""
+        nominal = number_or_nan(self.summary.get("nominal_residence_time_s"))
+        if not math.isfinite(nominal) or nominal <= 0:
+            return ""
+        return (f"in the study's nominal residence time W H / (B0 V_out) = {nominal:.3g} s (the channel as dense as "
+                f"the fill) {what} = {t / nominal:.3g}")
+
     def part(self, finding: str) -> str | None:
         """The pattern's part of a finding (``"B4"`` -> ``"B4.internal"``), None for a pattern the study did not run."""
         return f"{finding}.{self.suffix}" if self.suffix else None
@@ -187,8 +197,9 @@ class _Run:
             "longer silo_recirculation.final_discharge sees it all)")
         bound = (f"the VRR of the discharge is at the counting-noise ceiling of its windows ({ceiling:.0f})"
                  if discharge.get("at_ceiling") else "")
+        nominal = self.nominal(nr * number_or_nan(self.summary.get("residence_time_s")), "that Nr")
         evidence = (
-            f"discharge after Nr = {nr:.2f} recirculations from t = {start:.4g} s: "
+            f"discharge after Nr = {nr:.2f} recirculations{f' ({nominal})' if nominal else ''} from t = {start:.4g} s: "
             f"{number_or_nan(discharge.get('windows')):.0f} windows of {number_or_nan(common.get('window_s')):.3g} s "
             f"to t = {end:.4g} s, {number_or_nan(discharge.get('clumps')):.0f} clumps, "
             f"{number_or_nan(discharge.get('left_out_fraction')):.1%} of its outflow left out (windows from the stop "
@@ -351,7 +362,8 @@ def _rtd_rows(run: _Run, tolerances: AgreementTolerances) -> list[dict]:
         rows.append(_judged(
             "Theta of the RTD's peak, t_peak / t_rm", run.pattern, theta, theta_error, "-",
             f"peak at {theta * t_rm:.3g} s of {len(chosen)} bins of {times[1] - times[0]:.3g} s (error: a bin over "
-            f"sqrt(12)); {scale}; {tracer}{tail}", dof, run.part("B7"),
+            f"sqrt(12)); {scale}; {joined((run.nominal(theta * t_rm, 'its theta'), tracer))}{tail}", dof,
+            run.part("B7"),
             lambda p: rules.value_in_band(theta, theta_error, dof, p, tolerances), differs=differs))
     first, first_error = float(ids["t_s_over_t_d"]), number_or_nan(ids.get("t_s_over_t_d_error"))
     differs = "" if not exited < 1.0 else (
