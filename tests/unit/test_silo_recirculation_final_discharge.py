@@ -268,7 +268,8 @@ def test_the_conveyor_s_discharge_after_its_recirculations(discharge, result):
 
 
 def test_the_discharge_goes_into_the_blending_summary_and_the_summary_table(tmp_path, result, discharge):
-    run = {"run_id": "r1", "flow_pattern": "internal_flow", "estimated_residence_time": 7.5}
+    run = {"run_id": "r1", "flow_pattern": "internal_flow", "estimated_residence_time": 7.5,
+           "nominal_residence_time": 3.75}
     without = blending_summary(result, result.rtd.silo, 0.01, **run)
     assert "final_discharge" not in without
     written = json.loads(write_json(tmp_path / "blending.json", blending_summary(
