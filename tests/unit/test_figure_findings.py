@@ -10,6 +10,7 @@ from siloflow.analysis.studies.validation.figure_findings import (
     insert_findings,
     janssen_findings,
     kinematic_findings,
+    vrr_findings,
 )
 
 TOLERANCES = AgreementTolerances(**{key: 0.1 for key in AgreementTolerances.__dataclass_fields__})
@@ -48,3 +49,9 @@ def test_the_silo_and_gravity_figures_carry_their_trends():
     assert [n.label for n in kinematic_findings()] == ["study (S5): B decreases with height"]
     (m4,) = gravity_findings()
     assert isinstance(m4, StudyNote) and m4.id == "M4"
+
+
+def test_the_vrr_figure_draws_b4_per_flow_pattern_at_nr_4():
+    assert vrr_findings(TOLERANCES) == [
+        {"id": "B4", "flow_pattern": "internal_flow", "at": 4.0, "low": 8.0, "high": 13.0},
+        {"id": "B4", "flow_pattern": "semi_mass_flow", "at": 4.0, "low": 4.0, "high": 6.0}]

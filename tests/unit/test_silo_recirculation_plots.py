@@ -431,6 +431,46 @@ def test_vrr_replicate_curves_groups_seeds_by_pattern_and_layout():
     np.testing.assert_array_equal(grouped[2]["vrr"], [[1.5, np.nan, 3.5, 4.5]])
     with pytest.raises(ValueError, match="rows and curves must be of the same length"):
         vrr_replicate_curves(rows, curves[:3])
+    assert [curve["discharge"] for curve in grouped] == [None, None, None]  # no run discharged after recirculating
+
+
+def test_vrr_replicate_curves_keeps_each_seeds_discharge_after_the_recirculations():
+    rows = [{"flow_pattern": "internal_flow", "layout": "blue13", "final_discharge_recirculations": 4.1,
+             "final_discharge_vrr": 9.0},
+            {"flow_pattern": "internal_flow", "layout": "blue13", "final_discharge_recirculations": 3.9,
+             "final_discharge_vrr": 11.0},
+            {"flow_pattern": "semi_mass_flow", "layout": "blue13", "final_discharge_recirculations": np.nan,
+             "final_discharge_vrr": np.nan}]
+    nr = [0.5, 1.5]
+    curves = [(f"{row['flow_pattern']} blue13", nr, [2.0, 4.0], 500.0, [np.nan] * 2) for row in rows]
+    internal, semi = vrr_replicate_curves(rows, curves)
+    np.testing.assert_array_equal(internal["discharge"]["recirculations"], [4.1, 3.9])
+    np.testing.assert_array_equal(internal["discharge"]["vrr"], [9.0, 11.0])
+    assert semi["discharge"] is None
+
+
+def test_plot_vrr_summary_draws_the_discharge_after_the_recirculations_beside_b4(tmp_path, figures):
+    curves = [{"flow_pattern": "internal_flow", "layout": "blue13", "recirculations": [0.5, 1.5],
+               "vrr": [[2.0, 4.0], [2.0, 6.0]], "ceiling": 400.0,
+               "discharge": {"recirculations": [4.1, 3.9], "vrr": [9.0, 11.0]}},
+              {"flow_pattern": "semi_mass_flow", "layout": "blue13", "recirculations": [0.5, 1.5],
+               "vrr": [[1.5, 2.0]], "ceiling": 400.0, "discharge": {"recirculations": [4.2], "vrr": [5.0]}}]
+    findings = [{"id": "B4", "flow_pattern": "internal_flow", "at": 4.0, "low": 8.0, "high": 13.0},
+                {"id": "B4", "flow_pattern": "semi_mass_flow", "at": 4.0, "low": 4.0, "high": 6.0}]
+    plot_vrr_summary(curves, tmp_path / "vrr.png", "VRR", findings=findings)
+    (figure,) = figures
+    axes = figure.axes[0]
+    points = [line for line in axes.get_lines() if line.get_gid() == "vrr_discharge"]
+    # one open marker per curve at the seeds' mean Nr and VRR, in its pattern's colour
+    assert [(list(line.get_xdata()), list(line.get_ydata())) for line in points] == [([4.0], [10.0]), ([4.2], [5.0])]
+    assert [line.get_markerfacecolor() for line in points] == ["white", "white"]
+    assert to_hex(points[0].get_color()) == to_hex(PALETTE[0]) and to_hex(points[1].get_color()) == to_hex(PALETTE[1])
+    # the standard error of the mean of two seeds, 9 and 11: sqrt(2) / sqrt(2) = 1; none for one seed
+    (bar,) = [c for c in axes.collections if c.get_gid() == "vrr_discharge_error"]
+    np.testing.assert_allclose(bar.get_segments()[0][:, 1], [9.0, 11.0], rtol=1e-12)
+    texts = [text.get_text() for text in axes.get_legend().get_texts()]
+    assert "discharge after the recirculations" in texts
+    assert "study B4: internal flow 8-13" in texts and "study B4: semi mass flow 4-6" in texts
 
 
 # ---------------------------------------------------------------------------------------- snapshots

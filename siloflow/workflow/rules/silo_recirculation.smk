@@ -185,6 +185,7 @@ rule silo_recirculation_summary:
         vrr_plot=report(plot_file(f"{case_root(RECIRCULATION)}/summary/vrr"), caption="../report/silo_recirculation_summary.rst", category="3 Recirculating silo", subcategory="Summary", labels={"figure": "VRR all"}),
     params:
         runs=lambda wildcards: recirculation_runs(),
+        validation=config["validation"],
     log:
         f"{case_root(RECIRCULATION)}/summary/summary.log",
     script:

@@ -38,7 +38,8 @@ def vrr_replicate_curves(rows: Sequence[Mapping], curves: Sequence) -> list[dict
     ----------
     rows : sequence of mapping
         The rows of ``summary_rows``, one per run and layout, before replicates are combined: each has
-        ``flow_pattern`` and ``layout``.
+        ``flow_pattern`` and ``layout``, and where the run discharged after its recirculations
+        ``final_discharge_recirculations`` (its Nr [-]) and ``final_discharge_vrr`` [-] (NaN or absent: none).
     curves : sequence of tuple
         The curves of ``summary_rows``, in the same order as ``rows``: ``(label, Nr, VRR, ceiling, VRR error)``
         with Nr the number of recirculations at mid-window [-], the VRR [-] and the run's counting-noise ceiling
@@ -48,9 +49,10 @@ def vrr_replicate_curves(rows: Sequence[Mapping], curves: Sequence) -> list[dict
     -------
     list of dict
         One per (flow pattern, layout), in the order of first appearance: ``{"flow_pattern", "layout",
-        "recirculations", "vrr", "ceiling"}`` with ``vrr`` of shape (n_seeds, n_points), one row per run (seed) in
-        the order of ``rows``, on the Nr grid of the first run, and ``ceiling`` the lowest ceiling of the runs
-        (None if none has one).
+        "recirculations", "vrr", "ceiling", "discharge"}`` with ``vrr`` of shape (n_seeds, n_points), one row per run
+        (seed) in the order of ``rows``, on the Nr grid of the first run, ``ceiling`` the lowest ceiling of the runs
+        (None if none has one) and ``discharge`` the discharge after the recirculations of the seeds that have one,
+        ``{"recirculations": array (n,), "vrr": array (n,)}`` (None when no seed has one).
 
     Raises
     ------
@@ -70,7 +72,12 @@ def vrr_replicate_curves(rows: Sequence[Mapping], curves: Sequence) -> list[dict
         vrr = np.asarray(vrr, dtype=float)
         key = (str(row["flow_pattern"]), str(row["layout"]))
         group = groups.setdefault(key, {"flow_pattern": key[0], "layout": key[1], "recirculations": recirculations,
-                                        "vrr": [], "ceiling": None})
+                                        "vrr": [], "ceiling": None, "discharge_nr": [], "discharge_vrr": []})
+        discharge_nr = float(row.get("final_discharge_recirculations", math.nan))
+        discharge_vrr = float(row.get("final_discharge_vrr", math.nan))
+        if math.isfinite(discharge_nr) and math.isfinite(discharge_vrr):
+            group["discharge_nr"].append(discharge_nr)
+            group["discharge_vrr"].append(discharge_vrr)
         grid = group["recirculations"]
         if recirculations.shape != grid.shape or not np.array_equal(recirculations, grid):
             # Seeds run for different lengths (or with other windows) have other Nr grids: put this seed's VRR on
@@ -85,7 +92,11 @@ def vrr_replicate_curves(rows: Sequence[Mapping], curves: Sequence) -> list[dict
         group["vrr"].append(vrr)
         if ceiling is not None and math.isfinite(float(ceiling)):
             group["ceiling"] = float(ceiling) if group["ceiling"] is None else min(group["ceiling"], float(ceiling))
-    return [{**group, "vrr": np.vstack(group["vrr"])} for group in groups.values()]
+    return [{**{key: value for key, value in group.items() if not key.startswith("discharge_")},
+             "vrr": np.vstack(group["vrr"]),
+             "discharge": {"recirculations": np.array(group["discharge_nr"]), "vrr": np.array(group["discharge_vrr"])}
+             if group["discharge_nr"] else None}
+            for group in groups.values()]
 
 
 def _replicate_curves(curves) -> list[dict]:
@@ -114,8 +125,16 @@ def _replicate_curves(curves) -> list[dict]:
         ceiling = item.get("ceiling")
         if ceiling is not None:
             ceiling = positive_number(f"curves[{i}] ceiling", ceiling)
+        discharge = item.get("discharge")
+        if discharge is not None:
+            nr = finite_abscissa(f"curves[{i}] discharge recirculations", discharge["recirculations"])
+            values = np.asarray(discharge["vrr"], dtype=float).reshape(-1)
+            if values.shape != nr.shape:
+                raise ValueError(f"curves[{i}] discharge vrr must have one value per discharge Nr ({nr.size}), got "
+                                 f"{values.size}")
+            discharge = {"recirculations": nr, "vrr": values}
         checked.append({"flow_pattern": key[0], "layout": key[1], "recirculations": recirculations, "vrr": vrr,
-                        "ceiling": ceiling})
+                        "ceiling": ceiling, "discharge": discharge})
     return checked
 
 
@@ -156,6 +175,24 @@ def _replicate_mean(vrr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mean, error
 
 
+def _draw_discharge(axes, discharge: Mapping, colour: str, marker: str) -> None:
+    """One curve's discharge after the recirculations: the seeds' mean Nr and mean VRR as an open marker, with a bar
+    of one standard error of the mean when 2 or more seeds have a VRR a log axis can take."""
+    values = _positive_finite_or_nan(discharge["vrr"])
+    usable = np.isfinite(values)
+    if not usable.any():
+        return
+    nr, vrr = float(np.mean(discharge["recirculations"][usable])), float(np.mean(values[usable]))
+    axes.plot([nr], [vrr], linestyle="none", marker=marker, markersize=7, markerfacecolor="white", color=colour,
+              markeredgewidth=1.5, gid="vrr_discharge", label="_nolegend_", zorder=3)
+    if usable.sum() >= 2:
+        error = float(np.std(values[usable], ddof=1) / math.sqrt(usable.sum()))
+        bar = axes.errorbar([nr], [vrr], yerr=[[min(error, 0.999 * vrr)], [error]], fmt="none", color=colour,
+                            elinewidth=1.0, capsize=2.5, label="_nolegend_")
+        for artist in bar.lines[2]:
+            artist.set_gid("vrr_discharge_error")
+
+
 def _display_name(name: str) -> str:
     """A flow pattern's name as a reader reads it: ``internal_flow`` -> ``internal flow``."""
     return name.replace("_", " ")
@@ -175,6 +212,9 @@ def plot_vrr_summary(curves, path: str | os.PathLike, title: str, findings=None)
     The counting-noise ceiling is drawn once (``gid="ceiling"``), dashed grey with a label at its right end: the
     lowest ceiling of the curves, the VRR above which the runs with that ceiling can no longer be told from a
     perfectly mixed outflow (:func:`siloflow.analysis.numerics.vrr_noise.vrr_ceiling`).
+    A curve's discharge after the recirculations (the study's VRR "at the end of Nr recirculations", §6.4.2) is one
+    open marker of its layout at the seeds' mean Nr and mean VRR (``gid="vrr_discharge"``), with a bar of one
+    standard error of the mean across the seeds when 2 or more have one (``gid="vrr_discharge_error"``).
     Each finding is a vertical bar from ``low`` to ``high`` at Nr = ``at`` in its flow pattern's colour
     (``gid="finding <id>"``).
     The legend stands to the right of the axes (:func:`siloflow.analysis.io.plot_style.legend_outside`): the flow
@@ -186,8 +226,10 @@ def plot_vrr_summary(curves, path: str | os.PathLike, title: str, findings=None)
         ``{"flow_pattern": str, "layout": str, "recirculations": array_like, "vrr": array_like, "ceiling": float or
         None}``: the number of recirculations Nr = t / t_res at which the VRR is taken [-] (finite, n_points), the
         variance reduction ratio sigma_in^2 / sigma_out^2 of each seed [-] (shape (n_seeds, n_points), one row per
-        seed) and the counting-noise ceiling of that curve's VRR [-] (> 0; None or absent: none). One curve per
-        (flow pattern, layout); :func:`vrr_replicate_curves` builds them from the summary table's curves.
+        seed) and the counting-noise ceiling of that curve's VRR [-] (> 0; None or absent: none); optionally
+        ``"discharge": {"recirculations": array_like, "vrr": array_like}``, the Nr [-] and VRR [-] of the discharge
+        after the recirculations of each seed that has one (None or absent: none). One curve per (flow pattern,
+        layout); :func:`vrr_replicate_curves` builds them from the summary table's rows and curves.
     path : str or os.PathLike
         Destination plot file, written atomically in the format of its suffix (:func:`siloflow.analysis.io.plots.save_figure`).
     title : str
@@ -235,6 +277,8 @@ def plot_vrr_summary(curves, path: str | os.PathLike, title: str, findings=None)
                 if curve["vrr"].shape[0] >= 2:
                     axes.fill_between(curve["recirculations"], mean - error, mean + error, color=colour, alpha=0.2,
                                       linewidth=0.0, gid="vrr_band", label="_nolegend_")
+                if curve["discharge"] is not None:
+                    _draw_discharge(axes, curve["discharge"], colour, marker)
             if ceilings:
                 ceiling = min(ceilings)
                 axes.axhline(ceiling, color="0.5", linestyle="--", linewidth=1.0, gid="ceiling", label="_nolegend_")
@@ -253,6 +297,9 @@ def plot_vrr_summary(curves, path: str | os.PathLike, title: str, findings=None)
                        for pattern in patterns]
             handles += [Line2D([], [], color="0.3", linestyle=styles[layout][0], marker=styles[layout][1],
                                label=f"layout {layout}") for layout in layouts]
+            if any(curve["discharge"] is not None for curve in checked):
+                handles.append(Line2D([], [], color="0.3", linestyle="none", marker="o", markerfacecolor="white",
+                                      markersize=7, label="discharge after the recirculations"))
             handles += [Line2D([], [], color=colours[finding["flow_pattern"]], linestyle="none", marker="|",
                                markersize=9, markeredgewidth=2.5,
                                label=f"study {finding['id']}: {_display_name(finding['flow_pattern'])} "

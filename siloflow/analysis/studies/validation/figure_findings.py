@@ -10,10 +10,11 @@ from __future__ import annotations
 
 from siloflow.analysis.io.plot_style import StudyNote, StudyValue
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, study_band
+from siloflow.analysis.studies.validation.blending import NR_STUDY, PATTERNS
 from siloflow.analysis.studies.validation.findings import PARTS
 
 __all__ = ["CHART_FINDINGS", "calibration_chart_findings", "janssen_findings", "kinematic_findings",
-           "insert_findings", "gravity_findings"]
+           "insert_findings", "gravity_findings", "vrr_findings"]
 
 #: The finding a calibration chart of each test carries: its plateau of bulk friction (coefficient, -) per shape.
 CHART_FINDINGS = {"internal": "C2", "aluminium": "C3"}
@@ -82,3 +83,23 @@ def insert_findings(configuration: str, tolerances: AgreementTolerances) -> list
 def gravity_findings() -> list[StudyNote]:
     """M4: the mass flow rate and the cross-section mean velocity scale with the square root of gravity."""
     return [StudyNote("M4", "mean v scales with sqrt(g)")]
+
+
+def vrr_findings(tolerances: AgreementTolerances) -> list[dict]:
+    """B4: the VRR at the end of the study's 4 recirculations, per flow pattern, as
+    :func:`siloflow.analysis.studies.silo_recirculation.vrr_summary_plot.plot_vrr_summary` draws it beside the
+    discharge after the recirculations.
+
+    Parameters
+    ----------
+    tolerances : AgreementTolerances
+        The record's tolerances, for the band (B4 states its own: 8-13 internal, 4-6 semi-mass flow).
+
+    Returns
+    -------
+    list of dict
+        ``{"id", "flow_pattern", "at", "low", "high"}`` per flow pattern, at Nr = 4 [-], the band in VRR [-].
+    """
+    return [{"id": "B4", "flow_pattern": pattern, "at": float(NR_STUDY),
+             **dict(zip(("low", "high"), study_band(PARTS[f"B4.{suffix}"], tolerances)))}
+            for pattern, suffix in PATTERNS.items()]
