@@ -93,8 +93,11 @@ def test_missing_dumps_are_reported(tiny_config, tmp_path):
 
 
 def test_engine_command_serial_and_mpi():
-    assert engine_command("deck/in.liggghts", executable="true") == ["true", "-in", "deck/in.liggghts", "-log", "log.liggghts"]
-    assert engine_command("d", executable="true", mpi_ranks=2, mpirun="true")[:4] == ["true", "-np", "2", "--oversubscribe"]
+    # the screen line-buffered (stdbuf, coreutils: on every Debian), so that the progress line sees each thermo row
+    assert engine_command("deck/in.liggghts", executable="true") == ["stdbuf", "-oL", "true", "-in", "deck/in.liggghts",
+                                                                     "-log", "log.liggghts"]
+    assert engine_command("d", executable="true", mpi_ranks=2, mpirun="true") == [
+        "true", "-np", "2", "--oversubscribe", "stdbuf", "-oL", "true", "-in", "d", "-log", "log.liggghts"]
 
 
 def test_missing_executable_is_a_clear_error_naming_its_key():

@@ -94,11 +94,21 @@ def check_programs(executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str
                              "not an executable on PATH or at that path; install openmpi-bin or give its path")
 
 
+#: GNU coreutils' line-buffering wrapper of a program's standard output. LIGGGHTS 3.8's ``thermo_modify flush yes``
+#: flushes its log file only (``src/thermo.cpp``), not the screen: through a pipe its thermo rows arrive in 4 KB
+#: blocks, half an hour apart in a large run, and the progress line (which reads the screen) stalls between them.
+LINE_BUFFERED = ("stdbuf", "-oL")
+
+
 def engine_command(deck: str, executable: str = "liggghts", mpi_ranks: int = 1, mpirun: str = "mpirun",
                    log_name: str = LOG_NAME) -> list[str]:
-    """Command line of one engine run, serial or under MPI (no shell involved)."""
+    """Command line of one engine run, serial or under MPI (no shell involved); its screen line-buffered
+    (:data:`LINE_BUFFERED`) where ``stdbuf`` is installed. ``stdbuf`` execs the engine in its own process, so the
+    engine receives the signals that stop or interrupt the run."""
     check_programs(executable, mpi_ranks, mpirun)
     command = [executable, "-in", deck, "-log", log_name]
+    if shutil.which(LINE_BUFFERED[0]) is not None:
+        command = [*LINE_BUFFERED, *command]
     if mpi_ranks > 1:
         command = [mpirun, "-np", str(mpi_ranks), "--oversubscribe", *command]
     return command
