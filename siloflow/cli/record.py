@@ -62,7 +62,7 @@ def rederive(config_path: str, record_dir: str | Path, groups: Sequence[str]) ->
     whose recorded runs are not those ``config_path`` plans (its dimensions are not theirs)."""
     config = load_config(config_path)
     record_dir = Path(record_dir)
-    planned = _planned(config_path)
+    planned = planned_runs(group_runs(config, config_estimates(config)))
     written = {}
     for name in groups:
         group = read_group_record(record_dir / name) if (record_dir / name / "runs.csv").is_file() else None

@@ -11,6 +11,7 @@ from matplotlib.colors import to_hex
 
 import siloflow.analysis.studies.blender.plots as blender_plots
 from siloflow.analysis.io.plot_style import PALETTE, StudyNote, StudyValue
+from siloflow.analysis.studies.validation.figure_findings import study_note, study_value
 from siloflow.analysis.studies.validation.findings import PARTS
 import siloflow.analysis.studies.silo_recirculation.rtd_plots as rtd_plots
 from siloflow.analysis.studies.blender.comparison import comparison_table
@@ -94,9 +95,9 @@ def test_plot_passage_distributions(tmp_path, figures):
 
 
 #: M1 at the diverging insert's outlet: each passage over the cross-section mean (exterior with a +- 10 % band).
-M1 = [StudyValue.of(PARTS["M1.exterior"], band=(0.144, 0.176), series="exterior"),
-      StudyValue.of(PARTS["M1.interior"], series="interior"), StudyValue.of(PARTS["M1.tube"], series="tube")]
-M2 = StudyNote.of(PARTS["M2.outlet_order"])
+M1 = [study_value(PARTS["M1.exterior"], band=(0.144, 0.176), series="exterior"),
+      study_value(PARTS["M1.interior"], series="interior"), study_value(PARTS["M1.tube"], series="tube")]
+M2 = study_note(PARTS["M2.outlet_order"])
 
 
 def test_plot_passage_distributions_one_colour_per_passage_one_legend_outside_no_finding_unless_asked(

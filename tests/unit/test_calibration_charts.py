@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from siloflow.analysis.io.plot_style import PALETTE, REFERENCE_COLOUR, StudyNote, StudyValue
+from siloflow.analysis.io.plot_style import PALETTE, REFERENCE_COLOUR, StudyNote
+from siloflow.analysis.studies.validation.figure_findings import study_value
 from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.calibration.charts import plot_calibration_chart, plot_force_history, plot_lid_comparison, plot_polar_histogram
 from siloflow.calibration.contact_diagnostics import angular_histogram
@@ -161,8 +162,8 @@ def _finding_artists(axes, finding_id):
 
 
 #: C2's plateau of the two-sphere clump with its band (+- 10 %), C7's measured internal friction angle.
-C2_SPHERE2 = StudyValue.of(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
-C7_INTERNAL = StudyValue.of(PARTS["C7.internal"])
+C2_SPHERE2 = study_value(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
+C7_INTERNAL = study_value(PARTS["C7.internal"])
 
 
 def test_plot_calibration_chart_in_the_journal_style_one_colour_per_shape_one_style_per_rolling_friction(tmp_path):
@@ -209,7 +210,7 @@ def test_plot_calibration_chart_draws_each_finding_once_at_its_angle_labelled_wi
 def test_plot_calibration_chart_refuses_a_finding_it_cannot_draw(tmp_path):
     path = tmp_path / "chart.png"
     with pytest.raises(ValueError, match=r"findings\[0\] \(S2\) must be a bulk friction coefficient"):
-        plot_calibration_chart(_curves(), path, "t", findings=[StudyValue.of(PARTS["S2"])])
+        plot_calibration_chart(_curves(), path, "t", findings=[study_value(PARTS["S2"])])
     with pytest.raises(ValueError, match=r"findings\[1\] must be a StudyValue or StudyNote, got tuple"):
         plot_calibration_chart(_curves(), path, "t", findings=[C2_SPHERE2, ("C2", 0.54)])
     assert not path.exists()

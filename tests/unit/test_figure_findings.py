@@ -4,12 +4,15 @@ import pytest
 
 from siloflow.analysis.io.plot_style import StudyNote, StudyValue
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances
+from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.studies.validation.figure_findings import (
     calibration_chart_findings,
     gravity_findings,
     insert_findings,
     janssen_findings,
     kinematic_findings,
+    study_note,
+    study_value,
     vrr_findings,
 )
 
@@ -55,3 +58,16 @@ def test_the_vrr_figure_draws_b4_per_flow_pattern_at_nr_4():
     assert vrr_findings(TOLERANCES) == [
         {"id": "B4", "flow_pattern": "internal_flow", "at": 4.0, "low": 8.0, "high": 13.0},
         {"id": "B4", "flow_pattern": "semi_mass_flow", "at": 4.0, "low": 4.0, "high": 6.0}]
+
+
+def test_study_values_and_notes_of_the_findings_parts():
+    plateau = study_value(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
+    assert (plateau.id, plateau.value, plateau.unit, plateau.band, plateau.approximate) == (
+        "C2", 0.54, "-", (0.486, 0.594), True)
+    assert study_value(PARTS["C7.internal"]).label == "study (C7): ~30 deg"
+    assert not study_value(PARTS["B8.internal"]).approximate  # a number stated with no "about"
+    assert not study_value(PARTS["S2"]).approximate  # a number stated with its band
+    assert study_note(PARTS["M2.outlet_order"]).label == "study (M2): tube > interior annulus > exterior annulus"
+    assert study_note(PARTS["S5.dem"], "B decreases with height").label == "study (S5): B decreases with height"
+    with pytest.raises(ValueError, match="S5.dem states no number"):
+        study_value(PARTS["S5.dem"])

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.io.plot_style import (
     BAND_ALPHA,
     LABEL_SIZE,
@@ -132,19 +131,6 @@ def test_study_values_and_notes_are_labelled_with_the_finding_id():
     assert StudyValue("C7", 30, unit="deg").label == "study (C7): ~30 deg"
     assert StudyValue("M1", 0.16, series="exterior", approximate=False).label == "study (M1): exterior 0.16"
     assert StudyNote("S5", "B decreases with height").label == "study (S5): B decreases with height"
-
-
-def test_study_values_and_notes_of_the_findings_parts():
-    plateau = StudyValue.of(PARTS["C2.sphere2"], band=(0.486, 0.594), series="sphere2")
-    assert (plateau.id, plateau.value, plateau.unit, plateau.band, plateau.approximate) == (
-        "C2", 0.54, "-", (0.486, 0.594), True)
-    assert StudyValue.of(PARTS["C7.internal"]).label == "study (C7): ~30 deg"
-    assert not StudyValue.of(PARTS["B8.internal"]).approximate  # a number stated with no "about"
-    assert not StudyValue.of(PARTS["S2"]).approximate  # a number stated with its band
-    assert StudyNote.of(PARTS["M2.outlet_order"]).label == "study (M2): tube > interior annulus > exterior annulus"
-    assert StudyNote.of(PARTS["S5.dem"], "B decreases with height").label == "study (S5): B decreases with height"
-    with pytest.raises(ValueError, match="S5.dem states no number"):
-        StudyValue.of(PARTS["S5.dem"])
 
 
 def test_study_values_and_notes_refuse_what_cannot_be_drawn():

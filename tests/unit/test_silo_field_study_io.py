@@ -13,8 +13,11 @@ from scipy.optimize import OptimizeWarning
 
 from siloflow.model.frames import ClumpFrame
 from siloflow.analysis.io.fields import load_fields_npz, read_fields_vti
+import siloflow.analysis.studies.silo_flat.plots as silo_plots
+from siloflow.analysis.io.plot_style import StudyNote
 from siloflow.analysis.io.silo_field_study import SILO_FIELD_STUDY_FILES, write_silo_field_study
 from siloflow.analysis.io.tables import read_table
+from tests.plot_data import legend_texts, saved_figures
 from siloflow.analysis.studies.silo_flat.field_study import (
     SiloDimensions,
     SiloFieldOptions,
@@ -89,3 +92,11 @@ def test_a_missing_destination_is_named_and_nothing_is_written(tmp_path, study):
     with pytest.raises(ValueError, match=r"lacks \['kinematic', 'centreline_plot'\]"):
         write_silo_field_study(outputs, study, 1, OUTFLOW, WIDTH, OUTLET, "lattice")
     assert not any(tmp_path.iterdir())
+
+
+def test_the_kinematic_plot_draws_the_findings_it_is_given(tmp_path, study, monkeypatch):
+    figures = saved_figures(monkeypatch, silo_plots)
+    write_silo_field_study(_outputs(tmp_path), study, OPTIONS.vtk_every, OUTFLOW, WIDTH, OUTLET, "lattice",
+                           kinematic_findings=[StudyNote("S5", "B decreases with height")])
+    labels = [text for figure in figures for axes in figure.axes if axes.get_legend() for text in legend_texts(axes)]
+    assert labels.count("study (S5): B decreases with height") == 1

@@ -19,7 +19,6 @@ width (typically 8-9 pt, never below 6-7 pt), so a figure drawn at that width ne
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -27,6 +26,8 @@ from dataclasses import dataclass
 import matplotlib
 from matplotlib import cycler
 from matplotlib.lines import Line2D
+
+from siloflow.model.checks import finite_number
 
 
 __all__ = [
@@ -211,13 +212,6 @@ def _finding_id(name: str, value) -> str:
     return value
 
 
-def _finite(name: str, value) -> float:
-    number = float(value)
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return number
-
-
 @dataclass(frozen=True)
 class StudyValue:
     """A number the study states, to draw beside the result it is compared with (:func:`draw_study_value`).
@@ -255,12 +249,12 @@ class StudyValue:
 
     def __post_init__(self):
         _finding_id("id", self.id)
-        object.__setattr__(self, "value", _finite(f"{self.id}: value", self.value))
+        object.__setattr__(self, "value", finite_number(f"{self.id}: value", self.value))
         if self.band is not None:
             band = tuple(self.band)
             if len(band) != 2:
                 raise ValueError(f"{self.id}: band must be (low, high), got {self.band!r}")
-            low, high = (_finite(f"{self.id}: band", end) for end in band)
+            low, high = (finite_number(f"{self.id}: band", end) for end in band)
             if high < low:
                 raise ValueError(f"{self.id}: band must be (low, high) with low <= high, got {self.band!r}")
             object.__setattr__(self, "band", (low, high))
@@ -271,36 +265,6 @@ class StudyValue:
         series = f"{self.series} " if self.series else ""
         unit = "" if self.unit in ("", "-") else f" {self.unit}"
         return study_label(self.id, f"{series}{'~' if self.approximate else ''}{self.value:g}{unit}")
-
-    @classmethod
-    def of(cls, part, band: tuple[float, float] | None = None, series: str | None = None) -> "StudyValue":
-        """The number a part of a finding states (:data:`siloflow.analysis.studies.validation.findings.PARTS`).
-
-        Parameters
-        ----------
-        part : siloflow.analysis.studies.validation.findings.Part
-            Read by its attributes only: the plotting layer sits below the studies and imports none of them.
-            A part that states a number (``part.value``), e.g. ``PARTS["C2.sphere2"]``.
-        band : tuple of float, optional
-            ``(low, high)`` in the part's unit, e.g. ``study_band(part, tolerances)``.
-        series : str, optional
-            As :attr:`series`.
-
-        Returns
-        -------
-        StudyValue
-            With the finding's id (the part's id up to its first dot), value and unit; approximate unless the study
-            states the number with a band or as exact.
-
-        Raises
-        ------
-        ValueError
-            When the part states no number (a trend, an order, a configured value).
-        """
-        if part.value is None:
-            raise ValueError(f"{part.id} states no number ({part.kind}); draw it as a StudyNote")
-        approximate = part.band is None and part.tolerance not in (None, "no_band_relative")
-        return cls(part.id.split(".")[0], part.value, part.unit, band, series, approximate)
 
 
 @dataclass(frozen=True)
@@ -332,25 +296,6 @@ class StudyNote:
     def label(self) -> str:
         """``study (<id>): <text>``, e.g. ``study (S5): B decreases with height``."""
         return study_label(self.id, self.text)
-
-    @classmethod
-    def of(cls, part, text: str | None = None) -> "StudyNote":
-        """What a part of a finding states, e.g. ``PARTS["M2.outlet_order"]``: ``tube > interior annulus >
-        exterior annulus``.
-
-        Parameters
-        ----------
-        part : siloflow.analysis.studies.validation.findings.Part
-            The part.
-        text : str, optional
-            The text to show; None: :meth:`~siloflow.analysis.studies.validation.findings.Part.stated`.
-
-        Returns
-        -------
-        StudyNote
-            With the finding's id (the part's id up to its first dot).
-        """
-        return cls(part.id.split(".")[0], part.stated() if text is None else text)
 
 
 def study_findings(findings, *kinds: type) -> list:

@@ -40,7 +40,8 @@ SILO_FIELD_STUDY_FILES = ("pvd", "arrays", "profiles", "boundaries", "kinematic"
 
 
 def write_silo_field_study(outputs: Mapping[str, str | os.PathLike], study: SiloFieldStudy, vtk_every: int,
-                           outflow_rate: float, width: float, outlet_width: float, run_name: str) -> Path:
+                           outflow_rate: float, width: float, outlet_width: float, run_name: str,
+                           kinematic_findings=None) -> Path:
     """Write a silo field study's fields, tables, summary and flow plots.
 
     Parameters
@@ -68,6 +69,9 @@ def write_silo_field_study(outputs: Mapping[str, str | os.PathLike], study: Silo
         Silo width and outlet width [m], for the silo's outline in the plots.
     run_name : str
         The run's name, in the plots' titles.
+    kinematic_findings : sequence of StudyNote, optional
+        The study's trend of B(z) drawn beside it (``findings`` of
+        :func:`~siloflow.analysis.studies.silo_flat.plots.plot_kinematic_constant`); None: none.
 
     Returns
     -------
@@ -105,7 +109,8 @@ def write_silo_field_study(outputs: Mapping[str, str | os.PathLike], study: Silo
     plot_velocity_contour(plane.grid.x, plane.grid.z, plane.velocity[:, 0, :, 2], width, outlet_width,
                           outputs["contour_plot"], f"Depth-averaged v_z, {run_name}")
     plot_kinematic_constant(study.profiles.heights, study.profiles.kinematic_B, outputs["kinematic_plot"],
-                            "Kinematic constant B(z)", B_error=study.uncertainty.kinematic_B_error)
+                            "Kinematic constant B(z)", B_error=study.uncertainty.kinematic_B_error,
+                            findings=kinematic_findings)
     plot_kinematic_horizontal_velocity(study.profiles, outputs["kinematic_u_plot"],
                                        "Horizontal velocity: DEM against the kinematic model")
     plot_centreline_velocity(study.times, study.heights, study.centreline, outputs["centreline_plot"],

@@ -12,6 +12,7 @@ from siloflow.analysis.io.silo_field_study import write_silo_field_study
 from siloflow.analysis.io.tables import write_json
 from siloflow.analysis.studies.silo_flat.existing_run import analyses_summary, existing_field_study
 from siloflow.analysis.studies.silo_flat.field_study import SiloFieldOptions
+from siloflow.analysis.studies.validation.figure_findings import kinematic_findings
 from siloflow.engines.existing_runs import read_existing_frames
 from siloflow.engines.logs import logged_to
 
@@ -28,7 +29,7 @@ with logged_to(snakemake.log[0]) as log:
     log.info("grid %s cells of %s m, %d frames", study.grid.shape, study.grid.spacing, len(study.fields))
 
     write_silo_field_study(snakemake.output, study, options.vtk_every, flow["mass_flow_rate_kg_s"], run.width,
-                           run.outlet_width, run.name)
+                           run.outlet_width, run.name, kinematic_findings=kinematic_findings())
     summary = analyses_summary(run, study.steps, flow["settled_step"], snakemake.params.made)
     write_json(snakemake.output.analyses, summary)
     for skipped in summary["skipped"]:

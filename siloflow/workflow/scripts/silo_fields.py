@@ -13,7 +13,7 @@ from siloflow.analysis.io.silo_field_study import write_silo_field_study
 from siloflow.analysis.io.tables import write_flow_table
 from siloflow.analysis.studies.silo_flat.field_study import SiloDimensions, SiloFieldOptions, analyse_silo_fields, janssen_rows
 from siloflow.analysis.studies.silo_flat.plots import plot_force_chains, plot_janssen
-from siloflow.analysis.studies.validation.figure_findings import janssen_findings
+from siloflow.analysis.studies.validation.figure_findings import janssen_findings, kinematic_findings
 from siloflow.engines.interface import engine_named
 from siloflow.engines.logs import logged_to
 
@@ -37,7 +37,8 @@ with logged_to(snakemake.log[0]) as log:
     log.info("grid %s cells of %s m, %d frames", study.grid.shape, study.grid.spacing, len(study.fields))
 
     fields_dir = write_silo_field_study(snakemake.output, study, options.vtk_every, flow["mass_flow_rate_kg_s"],
-                                        silo.width, silo.outlet_width, case.run_id)
+                                        silo.width, silo.outlet_width, case.run_id,
+                                        kinematic_findings=kinematic_findings())
     # What needs the settled fill's contacts: its contact stress (ParaView, beside the time series), Janssen, chains.
     write_fields_vti(fields_dir / "settled_stress.vti", study.grid, study.fields[0], time=0.0,
                      extra_arrays={"contact_stress": study.stress})

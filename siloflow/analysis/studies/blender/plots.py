@@ -168,7 +168,7 @@ def plot_passage_distributions(inlet: PassageVelocities, outlet: PassageVelociti
         series="exterior")``): a dotted segment at that fraction of the mean [m/s] over the passage (its band
         shaded, if given), in the passage's colour, ``gid="finding <id>"``, legend ``study (M1): exterior ~0.16 of
         mean`` (none where the mean is not finite). A :class:`~siloflow.analysis.io.plot_style.StudyNote` is a
-        legend entry, e.g. M2's expected order ``StudyNote.of(PARTS["M2.outlet_order"])``. None (the default):
+        legend entry, e.g. M2's expected order ``study_note(PARTS["M2.outlet_order"])`` (:mod:`siloflow.analysis.studies.validation.figure_findings`). None (the default):
         none.
 
     Returns

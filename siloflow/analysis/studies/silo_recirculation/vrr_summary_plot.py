@@ -178,15 +178,15 @@ def _replicate_mean(vrr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _draw_discharge(axes, discharge: Mapping, colour: str, marker: str) -> None:
     """One curve's discharge after the recirculations: the seeds' mean Nr and mean VRR as an open marker, with a bar
     of one standard error of the mean when 2 or more seeds have a VRR a log axis can take."""
-    values = _positive_finite_or_nan(discharge["vrr"])
-    usable = np.isfinite(values)
-    if not usable.any():
+    # the seeds are the rows of one point: their mean and its standard error as the curves' (_replicate_mean)
+    mean, error = (float(value[0]) for value in _replicate_mean(discharge["vrr"].reshape(-1, 1)))
+    if not math.isfinite(mean):
         return
-    nr, vrr = float(np.mean(discharge["recirculations"][usable])), float(np.mean(values[usable]))
+    usable = np.isfinite(_positive_finite_or_nan(discharge["vrr"]))
+    nr, vrr = float(np.mean(discharge["recirculations"][usable])), mean
     axes.plot([nr], [vrr], linestyle="none", marker=marker, markersize=7, markerfacecolor="white", color=colour,
               markeredgewidth=1.5, gid="vrr_discharge", label="_nolegend_", zorder=3)
-    if usable.sum() >= 2:
-        error = float(np.std(values[usable], ddof=1) / math.sqrt(usable.sum()))
+    if math.isfinite(error):
         bar = axes.errorbar([nr], [vrr], yerr=[[min(error, 0.999 * vrr)], [error]], fmt="none", color=colour,
                             elinewidth=1.0, capsize=2.5, label="_nolegend_")
         for artist in bar.lines[2]:

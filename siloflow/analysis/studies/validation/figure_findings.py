@@ -11,10 +11,45 @@ from __future__ import annotations
 from siloflow.analysis.io.plot_style import StudyNote, StudyValue
 from siloflow.analysis.studies.validation.agreement import AgreementTolerances, study_band
 from siloflow.analysis.studies.validation.blending import NR_STUDY, PATTERNS
-from siloflow.analysis.studies.validation.findings import PARTS
+from siloflow.analysis.studies.validation.findings import PARTS, Part
 
-__all__ = ["CHART_FINDINGS", "calibration_chart_findings", "janssen_findings", "kinematic_findings",
+__all__ = ["study_value", "study_note", "CHART_FINDINGS", "calibration_chart_findings", "janssen_findings", "kinematic_findings",
            "insert_findings", "gravity_findings", "vrr_findings"]
+
+def study_value(part: Part, band: tuple[float, float] | None = None, series: str | None = None) -> StudyValue:
+    """The number a part of a finding states, to draw beside the result (e.g. ``PARTS["C2.sphere2"]``).
+
+    Parameters
+    ----------
+    part : Part
+        A part that states a number (``part.value``).
+    band : tuple of float, optional
+        ``(low, high)`` in the part's unit, e.g. ``study_band(part, tolerances)``.
+    series : str, optional
+        The series it belongs to (:attr:`~siloflow.analysis.io.plot_style.StudyValue.series`).
+
+    Returns
+    -------
+    StudyValue
+        With the finding's id (the part's id up to its first dot), value and unit; approximate unless the study
+        states the number with a band or as exact.
+
+    Raises
+    ------
+    ValueError
+        When the part states no number (a trend, an order, a configured value).
+    """
+    if part.value is None:
+        raise ValueError(f"{part.id} states no number ({part.kind}); draw it as a StudyNote")
+    approximate = part.band is None and part.tolerance not in (None, "no_band_relative")
+    return StudyValue(part.id.split(".")[0], part.value, part.unit, band, series, approximate)
+
+
+def study_note(part: Part, text: str | None = None) -> StudyNote:
+    """What a part of a finding states in words, e.g. ``PARTS["M2.outlet_order"]``: ``tube > interior annulus >
+    exterior annulus``; ``text`` (None: :meth:`Part.stated`) replaces it, with the finding's id kept."""
+    return StudyNote(part.id.split(".")[0], part.stated() if text is None else text)
+
 
 #: The finding a calibration chart of each test carries: its plateau of bulk friction (coefficient, -) per shape.
 CHART_FINDINGS = {"internal": "C2", "aluminium": "C3"}
@@ -44,7 +79,7 @@ def calibration_chart_findings(shape: str, test: str, tolerances: AgreementToler
     part = PARTS.get(f"{finding}.{shape}") if finding else None
     if part is None:
         return []
-    return [StudyValue.of(part, band=study_band(part, tolerances), series=shape)]
+    return [study_value(part, band=study_band(part, tolerances), series=shape)]
 
 
 def janssen_findings() -> list[StudyNote]:
@@ -54,7 +89,7 @@ def janssen_findings() -> list[StudyNote]:
 
 def kinematic_findings() -> list[StudyNote]:
     """S5: the kinematic constant B decreases with the height above the outlet (DEM and experiment)."""
-    return [StudyNote.of(PARTS["S5.dem"], "B decreases with height")]
+    return [study_note(PARTS["S5.dem"], "B decreases with height")]
 
 
 def insert_findings(configuration: str, tolerances: AgreementTolerances) -> list[StudyValue | StudyNote]:
@@ -73,10 +108,10 @@ def insert_findings(configuration: str, tolerances: AgreementTolerances) -> list
     list of StudyValue or StudyNote
     """
     if configuration == "diverging":
-        return [StudyValue.of(PARTS[f"M1.{passage}"], band=study_band(PARTS[f"M1.{passage}"], tolerances),
+        return [study_value(PARTS[f"M1.{passage}"], band=study_band(PARTS[f"M1.{passage}"], tolerances),
                               series=passage) for passage in M1_PASSAGES]
     if configuration == "converging":
-        return [StudyNote.of(PARTS["M2.outlet_order"])]
+        return [study_note(PARTS["M2.outlet_order"])]
     return []
 
 
