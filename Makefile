@@ -15,7 +15,7 @@ APT_PACKAGES  := liggghts openmpi-bin
 YADE_MODULES  := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 PIP            = $(PYTHON) -m pip install --quiet --disable-pip-version-check
 
-.PHONY: install install-system install-python install-test install-docs run run-tiny check verify bayesian validate \
+.PHONY: install install-system install-python install-test install-docs run run-tiny check verify bayesian validate hypothesis \
 	validate-status test test-physics test-unit test-integration dry-run bench estimate docs
 
 # What running needs; the test and documentation extras come with `make test` and `make docs` only.
@@ -136,6 +136,16 @@ validate: install
 		$(SILOFLOW) record publish --directory $(VALIDATION_DIR) --record $(VALIDATION_RECORD) --group $$group \
 		|| exit 1; \
 	done
+	$(SILOFLOW) record page --config $(VALIDATION_CONFIG) --full-scale $(FULL_SCALE_CONFIG) --record $(VALIDATION_RECORD)
+
+# A measured hypothesis of the validation record (siloflow.engines.hypotheses; `siloflow hypothesis --help` lists them):
+# a reduced case and the same with one change, run to the rows of the findings it is for, in
+# $(VALIDATION_DIR)/results/hypotheses/NAME/; each call stops its engine runs at a part's deadline and the next carries
+# them on; once both are made, docs/validation/hypotheses/NAME.csv and the record's page say where the change moves
+# each row.
+NAME ?=
+hypothesis: install
+	$(SILOFLOW) hypothesis '$(NAME)' --cores $(CORES) --directory $(VALIDATION_DIR) --record $(VALIDATION_RECORD)
 	$(SILOFLOW) record page --config $(VALIDATION_CONFIG) --full-scale $(FULL_SCALE_CONFIG) --record $(VALIDATION_RECORD)
 
 validate-status: install-python

@@ -18,10 +18,12 @@ from pathlib import Path
 from typing import Sequence
 
 from siloflow.cli import record
+from siloflow.cli.hypothesis import PAIR, record_hypothesis
 from siloflow.engines.config import PACKAGE_ROOT, ConfigError, layered_config, validate_config
 from siloflow.engines.config_yaml import ConfigFileError
 from siloflow.engines.deadline import DEADLINE_VARIABLE
 from siloflow.engines.estimates import format_bytes, total_dump_bytes
+from siloflow.engines.hypotheses import HYPOTHESES, hypothesis_directory, hypothesis_named
 from siloflow.engines.layout import RESULTS
 from siloflow.engines.planning import estimate_report
 from siloflow.engines.preflight import Preflight, PreflightError, preflight
@@ -210,6 +212,38 @@ def run(args: argparse.Namespace) -> int:
                                       ["--report", str(report.resolve())]))
 
 
+def hypothesis(args: argparse.Namespace) -> int:
+    """Run a measured hypothesis's pair (its base, then its variant) to their validation rows, each stopping its
+    engine runs at a validation part's deadline, and record the comparison once both are made."""
+    try:
+        chosen = hypothesis_named(args.name)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    directory = hypothesis_directory(chosen.name, _directory(args))
+    members = dict(zip(PAIR, (chosen.base_files(), chosen.variant_files())))
+    for member, files in members.items():  # both checked before anything runs
+        for path in files:
+            if not path.is_file():
+                raise UsageError(f"hypothesis {chosen.name!r}: its {member}'s configuration {str(path)!r} is missing; "
+                                 "run it from the clone's top folder")
+        _checked(files, Path("."))
+    os.environ[DEADLINE_VARIABLE] = repr(time.time() + PART_FILL * GROUP_BUDGET_S)
+    for member, files in members.items():
+        (directory / member).mkdir(parents=True, exist_ok=True)
+        code = launch(snakemake_arguments(files, directory / member, args.cores, [f"validation_rows_{chosen.group}"],
+                                          ["--keep-going"]))
+        if code != 0:
+            print(f"siloflow hypothesis: the {member} of {chosen.name} stopped (exit {code}); "
+                  f"`make hypothesis NAME={chosen.name}` carries it on from its restart files", file=sys.stderr)
+            return code
+    try:
+        path = record_hypothesis(chosen, directory, Path(args.record))
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    print(f"siloflow result: {path.resolve()}")
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------------------ parser
 
 
@@ -264,6 +298,22 @@ def parser() -> argparse.ArgumentParser:
                                           "longer plans, and whether the report is older than its runs.")
     _common(sub, in_folder)
     sub.set_defaults(handler=status)
+
+    sub = commands.add_parser("hypothesis", help="run a measured hypothesis's pair and record where it moves the "
+                                                 "findings",
+                              description="Run a measured hypothesis of the validation record (a reduced case and the "
+                                          "same with one change) to its validation rows, then record, per row, whether "
+                                          "the change moves the figure towards the study: "
+                                          "docs/validation/hypotheses/NAME.csv. Each call stops its engine runs "
+                                          f"{PART_FILL * GROUP_BUDGET_S / 3600:g} h after it starts; the next carries "
+                                          "them on. The hypotheses: " + ", ".join(HYPOTHESES) + ".")
+    sub.add_argument("name", metavar="NAME", help="the hypothesis: " + ", ".join(HYPOTHESES))
+    sub.add_argument("--cores", type=_cores, default=2, metavar="N", help="cores to use (default: 2)")
+    sub.add_argument("--directory", default=".", metavar="DIR",
+                     help="working folder: the pair runs in DIR/results/hypotheses/NAME/ (default: the current folder)")
+    sub.add_argument("--record", default=record.RECORD_DIR, metavar="DIR",
+                     help=f"the validation record's folder (default: {record.RECORD_DIR})")
+    sub.set_defaults(handler=hypothesis)
 
     record.add_parser(commands, _common)
     return top

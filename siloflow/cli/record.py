@@ -23,14 +23,15 @@ from typing import Sequence
 
 from siloflow.analysis.io.tables import write_text
 from siloflow.analysis.io.validation_products import read_group_products, row_code_digest
-from siloflow.analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_record, restore_products,
-                                           write_group_record)
+from siloflow.analysis.io.validation_record import (PRODUCTS, check_plot_format, read_group_record, read_hypothesis_records,
+                                           read_record, restore_products, write_group_record)
 from siloflow.analysis.studies.validation.group_rows import UNMADE, judged_rows
 from siloflow.analysis.studies.validation.findings import FINDINGS
 from siloflow.analysis.studies.validation.record import record_page, run_wall_time
 from siloflow.analysis.studies.validation.scale import FINDING_SCALES, scale_verdict
 from siloflow.calibration.table import point_table
 from siloflow.engines.config import load_config
+from siloflow.engines.hypotheses import HYPOTHESES
 from siloflow.engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
 from siloflow.engines.planning import config_estimates, group_runs, run_directory
 from siloflow.engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, find_part, finished_groups,
@@ -229,7 +230,8 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
-                       verdicts, UNMADE, {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)})
+                       verdicts, UNMADE, {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)},
+                       read_hypothesis_records(record_dir), {name: h.findings for name, h in HYPOTHESES.items()})
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.

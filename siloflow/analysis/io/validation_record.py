@@ -24,11 +24,13 @@ from PIL import Image
 
 from siloflow.model.checks import number_or_nan
 from siloflow.analysis.io.tables import write_flow_table, write_json
+from siloflow.analysis.studies.validation.hypothesis import HYPOTHESIS_COLUMNS, HYPOTHESIS_NUMBERS
 from siloflow.analysis.studies.validation.record import RUN_COLUMNS, GroupRecord
 from siloflow.analysis.studies.validation.rows import COLUMNS, NO_FINDING
 
 __all__ = ["TABLE", "RUNS", "DERIVATION", "PRODUCTS", "RECORD_PLOT_FORMAT", "RECORD_PLOT_COLOURS", "check_plot_format", "benchmark_wall_time",
-           "read_validation_rows", "write_record_plot", "write_group_record", "read_group_record", "read_record", "restore_products"]
+           "read_validation_rows", "write_record_plot", "write_group_record", "read_group_record", "read_record", "restore_products",
+           "HYPOTHESES_DIR", "write_hypothesis_record", "read_hypothesis_records"]
 
 #: A group's table rows and its runs' provenance, in its folder.
 TABLE, RUNS = "table.csv", "runs.csv"
@@ -38,6 +40,9 @@ DERIVATION = "derivation.json"
 #: The folder of a group's record that keeps the products of its runs another group reads, each under its path in the
 #: workflow's working directory (``products/results/...``).
 PRODUCTS = "products"
+#: The folder of the record that keeps the measured hypotheses, one ``<name>.csv`` each
+#: (:mod:`siloflow.analysis.studies.validation.hypothesis`).
+HYPOTHESES_DIR = "hypotheses"
 #: The format of a record's plots, their file name suffix (see the module's notes).
 RECORD_PLOT_FORMAT = "png"
 
@@ -202,3 +207,27 @@ def restore_products(directory: str | os.PathLike, workdir: str | os.PathLike) -
     for target in copied:
         os.utime(target, (stamp, stamp))
     return copied
+
+
+def write_hypothesis_record(path: str | os.PathLike, rows: Sequence[Mapping]) -> Path:
+    """Write a measured hypothesis's record (:data:`HYPOTHESIS_COLUMNS`, one row per compared row), atomically."""
+    missing = [column for column in HYPOTHESIS_COLUMNS if rows and column not in rows[0]]
+    if not rows or missing:
+        raise ValueError(f"{path}: a hypothesis's record needs at least one row with the columns "
+                         f"{', '.join(missing or HYPOTHESIS_COLUMNS)}")
+    return write_flow_table(path, [{column: row[column] for column in HYPOTHESIS_COLUMNS} for row in rows])
+
+
+def read_hypothesis_records(record_dir: str | os.PathLike) -> list[dict]:
+    """Every measured hypothesis's rows under ``record_dir`` (:data:`HYPOTHESES_DIR`), the hypotheses in name order;
+    numbers as float (NaN where empty), the other columns as text. None recorded: an empty list."""
+    rows = []
+    for path in sorted((Path(record_dir) / HYPOTHESES_DIR).glob("*.csv")):
+        with open(path, newline="", encoding="utf-8") as handle:
+            read = list(csv.DictReader(handle))
+        missing = [column for column in HYPOTHESIS_COLUMNS if read and column not in read[0]]
+        if missing:
+            raise ValueError(f"{path}: a hypothesis's record needs the columns {', '.join(missing)}")
+        rows += [{column: number_or_nan(row[column] or None) if column in HYPOTHESIS_NUMBERS else row[column]
+                  for column in HYPOTHESIS_COLUMNS} for row in read]
+    return rows

@@ -26,7 +26,7 @@ from siloflow.analysis.studies.validation.scale import ScaleVerdict
 YES, NO = "yes", "no"
 
 __all__ = ["STUDY_PARAGRAPH", "RUN_COLUMNS", "GroupRecord", "provenance_row", "run_wall_time", "simulated_time",
-           "record_page", "findings_section"]
+           "record_page", "findings_section", "hypotheses_section"]
 
 #: The page's opening paragraph: the study the record compares with, by the thesis's own chapters and sections.
 STUDY_PARAGRAPH = (
@@ -197,8 +197,58 @@ def _measured(row: Mapping) -> str:
             f"{_cell(row['agreement_reason'])}")
 
 
+def _hypothesis_row(row: Mapping) -> str:
+    """One compared row of a measured hypothesis, for the summary's list."""
+    unit = f" {row['unit']}" if row["unit"] and row["unit"] != "-" else ""
+    return (f"{row['finding']}: {_cell(row['figure'])} ({_cell(row['case'])}): "
+            f"{plus_minus(row['base'], row['base_error'])} -> {plus_minus(row['variant'], row['variant_error'])}{unit}; "
+            f"{_cell(row['reason'])}: **{row['moves']}**")
+
+
+def hypotheses_section(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequence[str]]) -> list[str]:
+    """The measured hypotheses (:mod:`siloflow.analysis.studies.validation.hypothesis`): per hypothesis recorded, what
+    it supposes, the one change, the pair's cost and every compared row with where the change moves it; the planned
+    hypotheses not recorded yet, with the command that records each.
+
+    Parameters
+    ----------
+    hypotheses : sequence of mapping
+        The recorded hypotheses' rows (:data:`~siloflow.analysis.studies.validation.hypothesis.HYPOTHESIS_COLUMNS`).
+    planned : mapping
+        ``{name: finding ids}`` of every hypothesis siloflow defines (:data:`siloflow.engines.hypotheses.HYPOTHESES`).
+
+    Returns
+    -------
+    list of str
+        Markdown lines.
+    """
+    lines = ["### Measured hypotheses", "",
+             "For a finding not reproduced, or not at the study's scale: one change that could move it, run as a pair "
+             "on a reduced case (the base, and the variant with the change) and compared row by row. A change moves "
+             "a figure towards the study or away from it when its 95 % interval excludes zero; the pair's figures are "
+             "the reduced case's, not the tier's.", ""]
+    by_name: dict[str, list[Mapping]] = {}
+    for row in hypotheses:
+        by_name.setdefault(row["hypothesis"], []).append(row)
+    for name, rows in by_name.items():
+        first = rows[0]
+        findings = sorted({row["finding"].split(".")[0] for row in rows})
+        lines.append(f"- **{name}** ({', '.join(findings)}; the pair {first['core_hours']:.2f} core-h, code "
+                     f"{first['commit']}, {first['date']}): {_cell(first['statement'])} The change: "
+                     f"{_cell(first['change'])}.")
+        lines += [f"  - {_hypothesis_row(row)}" for row in rows]
+    waiting = [name for name in planned if name not in by_name]
+    if waiting:
+        lines += [f"- {name} ({', '.join(planned[name])}): not recorded yet: `make hypothesis NAME={name}`"
+                  for name in waiting]
+    if not by_name and not waiting:
+        lines.append("None.")
+    return lines
+
+
 def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, ScaleVerdict],
-                     unmade: Mapping[str, str], config_name: str) -> list[str]:
+                     unmade: Mapping[str, str], config_name: str, hypotheses: Sequence[Mapping] = (),
+                     planned_hypotheses: Mapping[str, Sequence[str]] | None = None) -> list[str]:
     """The summary that opens the page: per chapter, how many findings are reproduced, not reproduced, not resolved,
     not at the study's scale or not measured (:mod:`siloflow.analysis.studies.validation.findings_summary`); the
     findings not reproduced, each row's figure beside the study's; the disagreements at another scale; every finding
@@ -215,6 +265,10 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
         ``{part id: why no row of this tier measures it, and what would}``.
     config_name : str
         The configuration, as the page names it.
+    hypotheses : sequence of mapping
+        The measured hypotheses' rows (:func:`hypotheses_section`).
+    planned_hypotheses : mapping, optional
+        ``{name: finding ids}`` of the hypotheses siloflow defines.
 
     Returns
     -------
@@ -255,15 +309,22 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
               "Rows not at the study's scale whose figure lies outside the study's band or has the other sign: "
               "results at this scale, not verdicts on the study.", ""]
     lines += [f"- {row['finding']}: {_measured(row)}" for row in elsewhere] or ["None."]
+    lines += ["", *hypotheses_section(hypotheses, planned_hypotheses or {})]
+    tested: dict[str, list[str]] = {}
+    for row in hypotheses:
+        names = tested.setdefault(row["finding"].split(".")[0], [])
+        if row["hypothesis"] not in names:
+            names.append(row["hypothesis"])
     lines += ["", "### Every finding", "",
-              "| finding | thesis | status | rows | at the study's scale (dimensions) | what differs (ratio to the study's) |",
-              "|---|---|---|---|---|---|"]
+              "| finding | thesis | status | rows | at the study's scale (dimensions) | what differs (ratio to the study's) "
+              "| measured hypotheses |",
+              "|---|---|---|---|---|---|---|"]
     for entry in statuses:
         verdict = verdicts.get(entry.finding.id)
         differs = "; ".join(_difference_brief(d) for d in verdict.differences) if verdict else ""
         at_scale = "-" if verdict is None else YES if verdict.at_study_scale else NO
         lines.append(f"| {entry.finding.id} | {entry.finding.section} | {entry.status} | {len(entry.rows)} | "
-                     f"{at_scale} | {_cell(differs or '-')} |")
+                     f"{at_scale} | {_cell(differs or '-')} | {', '.join(tested.get(entry.finding.id, [])) or '-'} |")
     measured = {row["finding"] for entry in statuses for row in entry.rows}
     missing = [(part.id, unmade.get(part.id, "its group's rows in this record predate it: re-derive or record the "
                                              "group again")) for entry in statuses for part in entry.finding.parts
@@ -284,7 +345,8 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
                 parts: Mapping[str, Sequence[str]] | None = None,
                 estimated_core_s: Mapping[str, float] | None = None,
                 verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None,
-                planned_core_s: Mapping[str, float] | None = None) -> str:
+                planned_core_s: Mapping[str, float] | None = None, hypotheses: Sequence[Mapping] = (),
+                planned_hypotheses: Mapping[str, Sequence[str]] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows with their two verdicts, and for the rows not at the study's scale, what the study's scale
     costs.
@@ -320,6 +382,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     planned_core_s : mapping, optional
         ``{group: CPU s}`` of the runs ``config_name`` plans for each group, shown where it plans none of the recorded
         runs.
+    hypotheses, planned_hypotheses
+        The measured hypotheses' rows and ``{name: finding ids}`` of those siloflow defines, for the summary
+        (:func:`hypotheses_section`).
 
     Returns
     -------
@@ -338,7 +403,8 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     ]
     if verdicts is not None:
         rows = [row for record in groups.values() for row in record.rows]
-        section = findings_section(finding_statuses(rows), verdicts, unmade or {}, config_name)
+        section = findings_section(finding_statuses(rows), verdicts, unmade or {}, config_name, hypotheses,
+                                   planned_hypotheses)
         stale = [name for name, state in status.items() if state != "complete"]
         if stale:
             # the summary counts what the record holds: say which of it the configuration no longer plans as recorded

@@ -1,0 +1,218 @@
+"""Measured hypotheses: the direction a change moves a row, the comparison of a pair's rows, their record, the page's
+section and the registry of hypotheses with their configuration layers."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from siloflow.analysis.io.validation_record import (HYPOTHESES_DIR, read_hypothesis_records, write_flow_table,
+                                                    write_hypothesis_record)
+from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, REPRODUCED, Agreement
+from siloflow.analysis.studies.validation.findings import BY_ID, PARTS
+from siloflow.analysis.studies.validation.hypothesis import (AWAY, COMPARED_COLUMNS, HYPOTHESIS_COLUMNS, NO_DIRECTION,
+                                                             NOT_MOVED, TOWARDS, compare_rows, moved, study_direction)
+from siloflow.analysis.studies.validation.record import findings_section, hypotheses_section
+from siloflow.analysis.studies.validation.findings_summary import finding_statuses
+from siloflow.analysis.studies.validation.rows import COLUMNS, row
+from siloflow.cli.hypothesis import configured_numbers, pair_core_seconds, record_hypothesis, rows_file
+from siloflow.cli.main import main
+from siloflow.engines.config import layered_config, validate_config
+from siloflow.engines.hypotheses import HYPOTHESES, Hypothesis, hypothesis_directory, hypothesis_named
+from siloflow.engines.layout import RESULTS
+from tests.repo import REPO_ROOT
+
+
+# ------------------------------------------------------------------------------------------------------- direction
+
+
+@pytest.mark.parametrize("part, base, direction", [
+    ("S2", 560.0, 1),              # band 618.03-627.37, centre 622.70: up
+    ("S2", 630.0, -1),
+    ("S2", 622.6978, 0),           # on the point: every move leads away
+    ("C2.sphere2", 0.6, -1),       # point 0.54
+    ("B4.internal", 4.0, 1),       # band 8-13, centre 10.5
+    ("C6.friction_0_5", 1.1, 1),   # ratio 1.2
+    ("S5.dem", 0.5, -1),           # the study's sign, whatever the base
+    ("C1.above_particle_friction", -2.0, 1),
+    ("C2.levels_off", 0.03, -1),   # negligible: towards zero
+    ("C2.levels_off", -0.03, 1),
+    ("M4.mass_flow", 0.4, 1),      # towards the exponent 0.5
+    ("M4.exterior_deviates", 0.4, -1),  # the study states a deviation: away from 0.5
+    ("B6", 1.0, None),             # an order has no one figure
+])
+def test_the_study_s_direction_from_the_base_figure_follows_the_part_s_kind(part, base, direction):
+    assert study_direction(PARTS[part], base) == direction
+
+
+def test_a_configured_part_heads_for_the_configured_number_and_needs_it():
+    assert study_direction(PARTS["C7.aluminium"], 15.0, (16.0, 18.0)) == 1
+    assert study_direction(PARTS["C7.aluminium"], 19.0, (16.0, 18.0)) == -1
+    with pytest.raises(ValueError, match="calibration.targets_deg.aluminium"):
+        study_direction(PARTS["C7.aluminium"], 15.0)
+
+
+@pytest.mark.parametrize("difference, error, dof, direction, verdict", [
+    (1.0, 0.4, None, 1, TOWARDS),       # 1.0 > 1.96 * 0.4 = 0.784
+    (1.0, 0.4, None, -1, AWAY),
+    (1.0, 0.6, None, 1, NOT_MOVED),     # 1.0 < 1.176
+    (1.0, 0.4, 2.0, 1, NOT_MOVED),      # 1.0 < 4.303 * 0.4 = 1.72
+    (1.0, math.nan, None, 1, NOT_MOVED),
+    (1.0, 0.1, None, 0, AWAY),          # from the study's point
+    (1.0, 0.1, None, None, NO_DIRECTION),
+])
+def test_a_change_moves_a_figure_only_beyond_its_95_percent_reach(difference, error, dof, direction, verdict):
+    assert moved(difference, error, dof, direction) == verdict
+
+
+# ------------------------------------------------------------------------------------------------------ comparison
+
+
+def _density(value, error, dof=None, case="sphere2-aaaa"):
+    entry = row("Flat-bottom silo", "Filling bulk density", case, value, error, "kg/m3", "settled fill", dof=dof,
+                finding="S2", agreement=Agreement(NOT_REPRODUCED, "S2: outside"))
+    return entry
+
+
+def _b(value, error, figure="Change of B, z = 60 - 20 mm", case="sphere2-aaaa", dof=None):
+    return row("Flat-bottom silo", figure, case, value, error, "m", "profiles", dof=dof, finding="S5.dem",
+               agreement=Agreement(REPRODUCED, "S5.dem: decreases"))
+
+
+def _rate(value, case="sphere2-aaaa"):
+    return row("Flat-bottom silo", "Steady mass flow rate", case, value, 0.001, "kg/s", "no finding")
+
+
+def test_the_pair_s_rows_are_compared_by_figure_and_occurrence_with_their_combined_error():
+    base = [_density(564.0, 3.0, 2.0), _b(0.0014, 0.0001), _b(-0.0010, 0.0001), _rate(0.43)]
+    variant = [_density(600.0, 4.0, 3.0, case="sphere2-bbbb"), _b(0.0014, 0.0001, case="sphere2-bbbb"),
+               _b(-0.0020, 0.0001, case="sphere2-bbbb"), _rate(0.40, case="sphere2-bbbb")]
+    rows = compare_rows("stiffness", "It supposes.", "E 5e6 -> 2.8e8 Pa", ("S2", "S5"), base, variant)
+    assert [tuple(r) for r in rows] == [COMPARED_COLUMNS] * 3
+    density, same, steeper = rows
+    assert density["difference"] == 36.0 and density["difference_error"] == 5.0   # sqrt(3^2 + 4^2)
+    assert density["dof"] == 2.0 and density["moves"] == TOWARDS                     # 36 > 4.303 * 5 = 21.5
+    assert density["case"] == "sphere2-aaaa" and density["base"] == 564.0 and density["variant"] == 600.0
+    assert density["reason"].startswith("change 36 ± 5 (95 %: 14.49 to 57.51); the study: 622.7, 618 to 627.4")
+    assert same["difference"] == 0.0 and same["moves"] == NOT_MOVED
+    assert steeper["difference"] == pytest.approx(-0.001) and steeper["dof"] == ""
+    assert steeper["moves"] == TOWARDS                                               # S5.dem: B decreases
+
+
+def test_a_pair_that_does_not_judge_the_same_rows_or_judges_none_is_refused():
+    with pytest.raises(ValueError, match=r"in one only: Change of B, z = 60 - 20 mm \(S5.dem\)"):
+        compare_rows("h", "s", "c", ("S2", "S5"), [_density(564.0, 3.0), _b(0.001, 0.0001), _b(0.001, 0.0001)],
+                     [_density(600.0, 4.0), _b(0.001, 0.0001)])
+    with pytest.raises(ValueError, match="no row of either run judges B1"):
+        compare_rows("h", "s", "c", ("B1",), [_density(564.0, 3.0)], [_density(600.0, 4.0)])
+
+
+def test_a_configured_part_without_its_number_and_an_unknown_base_have_no_direction():
+    angle = row("Calibration", "Bulk wall friction angle", "sphere2, aluminium", 15.0, 0.1, "deg", "e", finding="C7.aluminium",
+                agreement=Agreement(NOT_REPRODUCED, "C7"))
+    moved_angle = dict(angle, value=17.0)
+    assert compare_rows("h", "s", "c", ("C7",), [angle], [moved_angle])[0]["moves"] == NO_DIRECTION
+    assert compare_rows("h", "s", "c", ("C7",), [angle], [moved_angle], {"C7.aluminium": (16.8, 16.8)})[0]["moves"] == TOWARDS
+    unknown = _density(math.nan, math.nan)
+    assert compare_rows("h", "s", "c", ("S2",), [unknown], [_density(600.0, 4.0)])[0]["moves"] == NO_DIRECTION
+
+
+# ---------------------------------------------------------------------------------------------------- record, page
+
+
+def _recorded(name="stiffness_silo", moves=TOWARDS):
+    compared = compare_rows(name, "It supposes.", "E 5e6 -> 2.8e8 Pa", ("S2",), [_density(564.0, 3.0, 2.0)],
+                            [_density(600.0, 4.0, 3.0)])
+    return [{**entry, "moves": moves, "core_hours": 2.5, "commit": "abc123", "date": "2026-12-07"} for entry in compared]
+
+
+def test_a_hypothesis_record_round_trips_and_refuses_missing_columns(tmp_path):
+    path = write_hypothesis_record(tmp_path / HYPOTHESES_DIR / "stiffness_silo.csv", _recorded())
+    back = read_hypothesis_records(tmp_path)
+    assert [tuple(entry) for entry in back] == [HYPOTHESIS_COLUMNS]
+    assert back[0]["difference"] == 36.0 and back[0]["core_hours"] == 2.5 and back[0]["dof"] == "2.0"
+    assert read_hypothesis_records(tmp_path / "none") == []
+    with pytest.raises(ValueError, match="columns core_hours"):
+        write_hypothesis_record(path, [{column: 1 for column in COMPARED_COLUMNS}])
+    write_flow_table(path, [{"hypothesis": "x"}])
+    with pytest.raises(ValueError, match="needs the columns statement"):
+        read_hypothesis_records(tmp_path)
+
+
+def test_the_page_lists_each_recorded_hypothesis_its_rows_and_those_still_to_run():
+    lines = hypotheses_section(_recorded(), {"stiffness_silo": ("S2",), "stiffness_calibration": ("C2", "C3")})
+    assert lines[0] == "### Measured hypotheses"
+    assert ("- **stiffness_silo** (S2; the pair 2.50 core-h, code abc123, 2026-12-07): It supposes. The change: "
+            "E 5e6 -> 2.8e8 Pa.") in lines
+    assert ("  - S2: Filling bulk density (sphere2-aaaa): 564 ± 3 -> 600 ± 4 kg/m3; change 36 ± 5 (95 %: 14.49 to "
+            "57.51); the study: 622.7, 618 to 627.4: **towards the study**") in lines
+    assert ("- stiffness_calibration (C2, C3): not recorded yet: `make hypothesis NAME=stiffness_calibration`"
+            in lines)
+    assert hypotheses_section([], {})[-1] == "None."
+
+
+def test_every_finding_s_line_names_the_hypotheses_recorded_for_it():
+    statuses = finding_statuses([])
+    lines = findings_section(statuses, {}, {}, "config/validation.yaml", _recorded(), {"stiffness_silo": ("S2",)})
+    assert "| S2 | §5.4.2, §3.10 | not measured | 0 | - | - | stiffness_silo |" in lines
+    assert "| S1 | §5.4.1 | not measured | 0 | - | - | - |" in lines
+    assert "### Measured hypotheses" in lines
+
+
+# ------------------------------------------------------------------------------------------------- registry, files
+
+
+def test_every_hypothesis_names_findings_of_the_study_and_its_configuration_layers_exist_and_validate():
+    for hypothesis in HYPOTHESES.values():
+        assert set(hypothesis.findings) <= set(BY_ID), hypothesis.name
+        for files in (hypothesis.base_files(REPO_ROOT), hypothesis.variant_files(REPO_ROOT)):
+            assert all(path.is_file() for path in files), files
+            validate_config(layered_config(files))
+
+
+def test_the_stiffness_variants_change_the_moduli_only():
+    for name in ("stiffness_calibration", "stiffness_silo"):
+        chosen = HYPOTHESES[name]
+        base = validate_config(layered_config(chosen.base_files(REPO_ROOT)))
+        variant = validate_config(layered_config(chosen.variant_files(REPO_ROOT)))
+        changed = {material for material in base["materials"]
+                   if base["materials"][material] != variant["materials"][material]}
+        assert changed == {"hdpe", "aluminium", "perspex", "lid"}
+        assert {m["youngs_modulus"] for m in variant["materials"].values()} == {2.8e8}
+        assert {key for key in base if base[key] != variant[key]} == {"materials"}
+
+
+def test_an_unknown_hypothesis_or_group_is_refused_naming_what_there_is(capsys):
+    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo"):
+        hypothesis_named("nonsense")
+    with pytest.raises(ValueError, match="no validation group 'silos'"):
+        Hypothesis("h", "silos", ("S2",), "s", "c", "base.yaml", "variant.yaml")
+    with pytest.raises(ValueError, match="names no finding"):
+        Hypothesis("h", "silo", (), "s", "c", "base.yaml", "variant.yaml")
+    assert main(["hypothesis", "nonsense"]) == 2
+    assert "no measured hypothesis 'nonsense'" in capsys.readouterr().err
+
+
+def test_the_record_is_written_from_the_pair_s_rows_files_with_the_pair_s_cost(tmp_path):
+    chosen = HYPOTHESES["stiffness_silo"]
+    directory = hypothesis_directory(chosen.name, tmp_path)
+    assert directory == tmp_path / "results" / "hypotheses" / "stiffness_silo"
+    with pytest.raises(FileNotFoundError, match="the base's rows .* are not made yet"):
+        record_hypothesis(chosen, directory, tmp_path / "record", REPO_ROOT)
+    for member, density in (("base", _density(564.0, 3.0, 2.0)), ("variant", _density(600.0, 4.0, 3.0))):
+        write_flow_table(rows_file(chosen, directory, member), [{column: density[column] for column in COLUMNS}])
+        benchmark = directory / member / RESULTS / "silo_flat" / "sphere2-x" / "logs" / "run_benchmark.tsv"
+        benchmark.parent.mkdir(parents=True)
+        benchmark.write_text("s\th:m:s\n1800.0\t0:30:00\n")
+    assert pair_core_seconds(directory) == 3600.0
+    path = record_hypothesis(chosen, directory, tmp_path / "record", REPO_ROOT)
+    assert path == tmp_path / "record" / HYPOTHESES_DIR / "stiffness_silo.csv"
+    (recorded,) = read_hypothesis_records(tmp_path / "record")
+    assert recorded["core_hours"] == 1.0 and recorded["moves"] == TOWARDS and recorded["difference"] == 36.0
+    assert recorded["statement"] == chosen.statement and recorded["change"] == chosen.change
+
+
+def test_the_configured_numbers_are_read_by_the_parts_dotted_keys():
+    config = {"calibration": {"targets_deg": {"aluminium": 16.79, "internal": 33.7}}}
+    assert configured_numbers(config) == {"C7.aluminium": (16.79, 16.79)}
