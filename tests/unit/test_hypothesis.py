@@ -183,8 +183,18 @@ def test_the_stiffness_variants_change_the_moduli_only():
         assert {key for key in base if base[key] != variant[key]} == {"materials"}
 
 
+def test_the_bed_variant_raises_the_blender_s_fill_and_walls_only():
+    chosen = HYPOTHESES["bed_blender"]
+    base = validate_config(layered_config(chosen.base_files(REPO_ROOT)))
+    variant = validate_config(layered_config(chosen.variant_files(REPO_ROOT)))
+    assert {key for key in base if base[key] != variant[key]} == {"blender"}
+    assert {key for key in base["blender"] if base["blender"][key] != variant["blender"][key]} == {"fill_height",
+                                                                                                  "vertical_height"}
+    assert (base["blender"]["fill_height"], variant["blender"]["fill_height"]) == (0.225, 0.325)
+
+
 def test_an_unknown_hypothesis_or_group_is_refused_naming_what_there_is(capsys):
-    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo"):
+    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo, bed_blender"):
         hypothesis_named("nonsense")
     with pytest.raises(ValueError, match="no validation group 'silos'"):
         Hypothesis("h", "silos", ("S2",), "s", "c", "base.yaml", "variant.yaml")
