@@ -285,6 +285,10 @@ def test_m1_is_each_passage_of_the_diverging_insert_over_the_mean_of_the_bins_at
     assert fallback["value"] == pytest.approx(-1.8 / mean) and "narrowest clear widths" in fallback["differs"]
     batch = _one(blender_rows([_brun(_blender("diverging", -1.8, -1.5, -0.1, mode="batch"))], TOLERANCES), "M1.tube")
     assert "continuous" in batch["differs"]
+    # each row says its discharge mode and averaging window beside the study's
+    assert ("continuous discharge averaged over its steady window 0.4-0.8 s after opening (the study's PIV: continuous "
+            "discharge, 2 s averages, §7.5; its DEM: batch discharge, 3-4 s, §7.7)") in tube["evidence"]
+    assert "batch discharge averaged over its steady window 0.4-0.8 s" in batch["evidence"]
 
 
 def test_m1_judges_the_wall_layer_the_piv_sees_and_quotes_the_depth_average():

@@ -157,8 +157,12 @@ def _wall_layer_label(summary: Mapping) -> str:
 
 
 def _steady(summary: Mapping) -> str:
+    """The evidence's discharge mode and averaging window of a run, beside the study's: its PIV findings (M1, M2) are
+    of the continuous discharge averaged over 2 s (§7.5), its DEM discharged in batch and averaged over 3-4 s (§7.7)."""
     low, high = summary.get("steady_window_s") or (math.nan, math.nan)
-    return f"steady window {float(low):g}-{float(high):g} s after opening"
+    return (f"{summary.get('mode', 'continuous')} discharge averaged over its steady window {float(low):g}-{float(high):g} "
+            "s after opening (the study's PIV: continuous discharge, 2 s averages, §7.5; its DEM: batch discharge, "
+            "3-4 s, §7.7)")
 
 
 def _passage_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerances) -> list[dict]:
