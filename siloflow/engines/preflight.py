@@ -14,7 +14,6 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from siloflow.model.cases import cases_of
 from siloflow.model.cases.kinds import configured_kinds

@@ -57,7 +57,8 @@ from pathlib import Path
 from typing import Any
 
 from siloflow.model.cases.blender import BlenderCase, build_blender_case
-from siloflow.model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike import JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike_contacts import LID_TYPE
 from siloflow.model.cases.jenike_sweep import sweep_points
 from siloflow.model.cases.silo_flat import SiloCase
 from siloflow.engines.interface import Engine, EngineOptions, engine_for

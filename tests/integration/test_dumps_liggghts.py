@@ -27,7 +27,8 @@ import pyvista
 
 from siloflow.model.frames import ParticleFrame, clumps_from_frame
 from siloflow.model.record import RunRecord
-from siloflow.model.cases.jenike import LID_TYPE, PARTICLE_TYPE, JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike import JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike_contacts import LID_TYPE, PARTICLE_TYPE
 from siloflow.model.cases.silo_flat import SiloCase, build_silo_case
 from siloflow.engines.config import load_config_file, validate_config
 from siloflow.engines.interface import EngineOptions

@@ -23,7 +23,8 @@ from siloflow.analysis.numerics.force_balance import BalanceTolerances, balance_
 from siloflow.calibration.friction import BulkFriction, bulk_friction
 from siloflow.calibration.shear import ShearSignals, shear_signals
 from siloflow.engines.config import validate_config
-from siloflow.model.cases.jenike import LID_TYPE, JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike import JenikeCase, build_jenike_case
+from siloflow.model.cases.jenike_contacts import LID_TYPE
 from siloflow.engines.liggghts.run import DUMP_PREFIX
 from siloflow.engines.liggghts.jenike import (
     FORCES_NAME,

@@ -15,15 +15,8 @@ from siloflow.engines.interface import CaseNotSupported, engine_named
 
 from siloflow.engines.config import ConfigError, load_config, validate_config
 from siloflow.model.cases.geometry import read_stl
-from siloflow.model.cases.jenike import (
-    FILL_SOLID_FRACTION,
-    LID_TYPE,
-    PARTICLE_TYPE,
-    PLATE_TYPE,
-    RING_TYPE,
-    build_jenike_case,
-    force_sample_every,
-)
+from siloflow.model.cases.jenike import FILL_SOLID_FRACTION, build_jenike_case, force_sample_every
+from siloflow.model.cases.jenike_contacts import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE
 from siloflow.model.cases.jenike_cell import circle_intersection_area
 from siloflow.engines.interface import EngineRunError
 from siloflow.engines.markers import Marker

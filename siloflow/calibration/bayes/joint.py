@@ -25,7 +25,7 @@ from siloflow.calibration.bayes.posterior import (PosteriorSample, Prior, log_po
                                          sample_posterior)
 from siloflow.calibration.bayes.stopping import posterior_moved, predictive_agreement, should_stop
 from siloflow.calibration.bayes.surrogate import Surrogate
-from siloflow.model.cases.jenike import PARTICLE_FRICTION_KEY
+from siloflow.model.cases.jenike_contacts import PARTICLE_FRICTION_KEY
 
 __all__ = ["Calibration", "IterationResult", "PREDICTIVE_SEED_OFFSET", "TWIN_SEED_OFFSET", "TestSurrogate",
            "calibration_of", "draw_estimates", "first_design", "fit_surrogates", "iterate", "next_sets",

@@ -31,7 +31,8 @@ import numpy as np
 
 from siloflow.model.contacts import ContactFrame, WallContactFrame
 from siloflow.model.cases.geometry import write_stl
-from siloflow.model.cases.jenike import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet, JenikeCase
+from siloflow.model.cases.jenike import JenikeCase
+from siloflow.model.cases.jenike_contacts import LID_TYPE, PARTICLE_TYPE, PLATE_TYPE, RING_TYPE, ContactSet
 from siloflow.model.record import RunRecord
 from siloflow.engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from siloflow.engines.layout import RUN_RECORD

@@ -34,7 +34,8 @@ import numpy as np
 
 from siloflow.model.contacts import ContactFrame, WallContactFrame
 from siloflow.model.record import RunRecord
-from siloflow.model.cases.jenike import LID_TYPE, PLATE_TYPE, RING_TYPE, JenikeCase
+from siloflow.model.cases.jenike import JenikeCase
+from siloflow.model.cases.jenike_contacts import LID_TYPE, PLATE_TYPE, RING_TYPE
 from siloflow.engines.jenike_checks import SETTLED_WALLS, check_jenike_run, jenike_run_record
 from siloflow.engines.templating import render_deck
 from siloflow.engines.yade.inputs import (

@@ -33,19 +33,17 @@ import numpy as np
 
 from siloflow.model.constants import GRAVITY
 from siloflow.model.cases.jenike_cell import CellGeometry, circle_intersection_area, segments_for_chord
+from siloflow.model.cases.jenike_contacts import PARTICLE_FRICTION_KEY, ContactSet, contact_sets, material_table
 from siloflow.model.cases.jenike_lids import RigidLid, ServoLid, lid_sphere_layout
 from siloflow.model.cases.particles import ParticleTemplate, model_parameters, particle_template
 from siloflow.model.cases.physics import (
     ChosenTimestep, TimestepChoice, engine_seeds, free_fall_velocity, stable_timestep, steps_for,
 )
-from siloflow.model.cases.common import NEUTRAL_CONTACT, MaterialTable, engine_kind, run_id, without_fill_checks
+from siloflow.model.cases.common import MaterialTable, engine_kind, run_id, without_fill_checks
 from siloflow.model.cases.jenike_sweep import CONFIGURED_POUR, POURS, sweep_points
 from siloflow.model.cases.stages import Stage
 
 CASE_NAME = "jenike"
-
-#: Engine atom types by role. The plate type exists only in wall tests; the rings share one material.
-PARTICLE_TYPE, RING_TYPE, LID_TYPE, PLATE_TYPE = 1, 2, 3, 4
 
 #: Estimated solid fraction of the settled low-friction fill (-); only sizes the pour, the overfill
 #: above the shear ring absorbs the error (a denser packing than this leaves less to remove).
@@ -70,15 +68,6 @@ SHEAR_DUMPS = 10
 
 
 # ---------------------------------------------------------------------------------------------- the case
-
-
-@dataclass(frozen=True)
-class ContactSet:
-    """Per-pair contact matrices (row-major over the atom types) of one stage (-)."""
-
-    sliding_friction: tuple[tuple[float, ...], ...]
-    rolling_friction: tuple[tuple[float, ...], ...]
-    restitution: tuple[tuple[float, ...], ...]
 
 
 @dataclass(frozen=True)
@@ -256,9 +245,6 @@ class JenikeCase(ChosenTimestep):
 
 LID_KINDS = ("rigid", "servo")
 POINT_KEYS = ("shape", "test", "sliding_friction", "rolling_friction", "restitution", "rotation_blocked")
-#: A wall test's particle-particle sliding friction, where a point sets it (a joint calibration varies it with the
-#: wall friction); without it, ``jenike.sweep.wall_test_particle_friction``.
-PARTICLE_FRICTION_KEY = "particle_sliding_friction"
 
 
 def _check_point(point: dict) -> dict:
@@ -286,22 +272,6 @@ def _check_point(point: dict) -> dict:
     }
 
 
-def _contact(config: dict, a: str, b: str) -> dict:
-    for contact in config["contacts"]:
-        if sorted(contact["materials"]) == sorted((a, b)):
-            return contact
-    raise ValueError(f"config key 'contacts': no contact parameters for the pair [{a}, {b}] used by jenike")
-
-
-def _matrix(n_types: int, particle_row: dict[int, float], neutral: float) -> tuple[tuple[float, ...], ...]:
-    """Symmetric matrix: particle (type 1) pairs from ``particle_row`` (type -> value), others neutral."""
-    rows = [[neutral] * n_types for _ in range(n_types)]
-    for other, value in particle_row.items():
-        rows[PARTICLE_TYPE - 1][other - 1] = value
-        rows[other - 1][PARTICLE_TYPE - 1] = value
-    return tuple(tuple(float(v) for v in row) for row in rows)
-
-
 #: Keys of ``jenike.fill`` whose whole effect is in the fill's contact set (``fill_contacts``, itself a defining
 #: parameter): left out of the section in the run id, so that spelling out a value that changes no contact does not
 #: rename the runs that already exist.
@@ -314,71 +284,6 @@ def _defining_section(jenike: dict) -> dict:
     section = without_fill_checks({key: value for key, value in jenike.items() if key != "sweep"})
     section["fill"] = {key: value for key, value in section["fill"].items() if key not in FILL_CONTACT_KEYS}
     return section
-
-
-def contact_sets(config: dict, point: dict, n_types: int) -> tuple[ContactSet, ContactSet]:
-    """Contact matrices while filling and while testing.
-
-    Testing: internal test, particle-particle sliding = point value; wall test, particle-plate sliding =
-    point value and particle-particle sliding = the point's :data:`PARTICLE_FRICTION_KEY` or else
-    ``jenike.sweep.wall_test_particle_friction``;
-    particle-ring and particle-lid sliding from ``contacts``; rolling friction = point value for every
-    particle contact (particles, rings, plate, lid); restitution = point value for every particle contact.
-    Filling: every particle sliding friction = ``jenike.fill.sliding_friction`` (null: the test's particle-particle
-    sliding friction; a rotation-blocked point's ``jenike.fill.rotation_blocked_sliding_friction`` where set),
-    rolling = ``jenike.fill.rolling_friction``, restitution = ``jenike.fill.restitution`` (null: the test's). Pairs
-    without a particle are neutral.
-    """
-    jenike = config["jenike"]
-    particle = jenike["particle_material"]
-    ring = _contact(config, particle, jenike["ring_material"])
-    lid = _contact(config, particle, jenike["lid_material"])
-    types = list(range(1, n_types + 1))
-    wall_test = point["test"] != "internal"
-    particle_particle = (point.get(PARTICLE_FRICTION_KEY, jenike["sweep"]["wall_test_particle_friction"]) if wall_test
-                         else point["sliding_friction"])
-    sliding = {PARTICLE_TYPE: particle_particle, RING_TYPE: ring["sliding_friction"], LID_TYPE: lid["sliding_friction"]}
-    if wall_test:
-        sliding[PLATE_TYPE] = point["sliding_friction"]
-    rolling = {t: point["rolling_friction"] for t in types}
-    restitution = {t: point["restitution"] for t in types}
-    pour_friction = particle_particle if jenike["fill"]["sliding_friction"] is None else jenike["fill"]["sliding_friction"]
-    if point["rotation_blocked"] and jenike["fill"]["rotation_blocked_sliding_friction"] is not None:
-        pour_friction = jenike["fill"]["rotation_blocked_sliding_friction"]
-    pour_restitution = jenike["fill"]["restitution"]
-    test = ContactSet(
-        sliding_friction=_matrix(n_types, sliding, NEUTRAL_CONTACT["sliding_friction"]),
-        rolling_friction=_matrix(n_types, rolling, NEUTRAL_CONTACT["rolling_friction"]),
-        restitution=_matrix(n_types, restitution, NEUTRAL_CONTACT["restitution"]),
-    )
-    fill = ContactSet(
-        sliding_friction=_matrix(n_types, {t: pour_friction for t in types}, 0.0),
-        rolling_friction=_matrix(n_types, {t: jenike["fill"]["rolling_friction"] for t in types}, 0.0),
-        restitution=test.restitution if pour_restitution is None else _matrix(
-            n_types, {t: pour_restitution for t in types}, NEUTRAL_CONTACT["restitution"]),
-    )
-    return fill, test
-
-
-def _material_table(config: dict, point: dict, test: ContactSet) -> MaterialTable:
-    jenike = config["jenike"]
-    names = [jenike["particle_material"], jenike["ring_material"], jenike["lid_material"]]
-    if point["test"] != "internal":
-        names.append(point["test"])
-    materials = config["materials"]
-    for name in names:
-        if name not in materials:
-            raise ValueError(f"jenike: material '{name}' is not defined under materials")
-    if "density" not in materials[names[0]]:
-        raise ValueError(f"config key 'materials.{names[0]}.density': the particle material needs a density")
-    return MaterialTable(
-        names=tuple(names),
-        youngs_modulus=tuple(float(materials[n]["youngs_modulus"]) for n in names),
-        poisson_ratio=tuple(float(materials[n]["poisson_ratio"]) for n in names),
-        sliding_friction=test.sliding_friction,
-        rolling_friction=test.rolling_friction,
-        restitution=test.restitution,
-    )
 
 
 def check_cell_fits(inner_radius: float, particle: ParticleTemplate) -> None:
@@ -503,7 +408,7 @@ def build_jenike_case(config: dict, point: dict) -> JenikeCase:
     wall_test = point["test"] != "internal"
     n_types = 4 if wall_test else 3
     fill_contacts, test_contacts = contact_sets(config, point, n_types)
-    table = _material_table(config, point, test_contacts)
+    table = material_table(config, point, test_contacts)
 
     radius = 0.5 * cell["inner_diameter"]
     check_cell_fits(radius, particle)  # before the rings' polygons, which need a cell wider than the chord error
