@@ -1,6 +1,6 @@
 """The calibration table: one row per sweep point from the bulk friction summaries of its runs.
 
-Each run's ``metrics/bulk_friction.json`` is a flat record (:func:`siloflow.calibration.friction.bulk_friction_summary` plus
+Each run's ``metrics/bulk_friction.json`` is a flat record (:func:`siloflow.calibration.shear_record.bulk_friction_summary` plus
 its point). A point run with several seeds (the sweep's reference point) becomes one row: the mean of each figure,
 its error (the larger of the seeds' standard error and the within-run errors), the seeds' standard deviation and
 ``replicates`` (:func:`siloflow.analysis.numerics.replicates.combine_replicates`); it reached a steady shear window only when
@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from siloflow.analysis.numerics.replicates import combine_replicates
-from siloflow.calibration.friction import combined_window_method
+from siloflow.calibration.shear_record import combined_window_method
 
 __all__ = ["POINT_COLUMNS", "point_table"]
 

@@ -14,12 +14,12 @@ from siloflow.calibration.friction import (
     SteadyWindow,
     bulk_friction,
     bulk_friction_of_shear,
-    bulk_friction_summary,
     detect_steady_window,
     friction_angle,
     friction_coefficient,
     mean_and_standard_error,
 )
+from siloflow.calibration.shear_record import bulk_friction_summary
 
 N_SAMPLES = 101
 

@@ -8,7 +8,8 @@ import pytest
 
 from siloflow.analysis.numerics.reference_spread import (SeedSpread, combine_seeds, floor_errors, floor_table, relative_spread, seed_note, table_spread,
                                                with_reference_spread)
-from siloflow.calibration.friction import SECOND_HALF, STEADY, combined_window_method
+from siloflow.calibration.friction import SECOND_HALF, STEADY
+from siloflow.calibration.shear_record import combined_window_method
 from siloflow.model.cases import cases_of, reference_runs
 from siloflow.model.cases.jenike import jenike_cases
 from siloflow.model.cases.jenike_sweep import reference_point, sweep_points

@@ -4,7 +4,8 @@ import json
 from pathlib import Path
 
 from siloflow.analysis.io.tables import write_json
-from siloflow.calibration.friction import bulk_friction_of_shear, shear_test_summary
+from siloflow.calibration.friction import bulk_friction_of_shear
+from siloflow.calibration.shear_record import shear_test_summary
 from siloflow.calibration.shear import shear_signals
 from siloflow.engines.interface import engine_named
 from siloflow.engines.logs import logged_to
