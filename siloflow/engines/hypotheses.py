@@ -89,6 +89,11 @@ HYPOTHESES: dict[str, Hypothesis] = {hypothesis.name: hypothesis for hypothesis 
         "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
         "silo_reduced.yaml", "stiffness_study.yaml"),
     Hypothesis(
+        "stiffness_blending", "blending", ("B1",),
+        f"The recirculating silo's flowing bulk density moves with {_STIFFNESS}.",
+        "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
+        "blending_reduced.yaml", "stiffness_study.yaml"),
+    Hypothesis(
         "bed_blender", "blender", ("M1", "M2"),
         "The flow through the insert's passages moves with the bed above them: the tier's bed stands 14 mm above the "
         "insert (the study's about 700 mm), so the head that feeds the passages and the tube inlet is a small share of "

@@ -172,7 +172,7 @@ def test_every_hypothesis_names_findings_of_the_study_and_its_configuration_laye
 
 
 def test_the_stiffness_variants_change_the_moduli_only():
-    for name in ("stiffness_calibration", "stiffness_silo"):
+    for name in ("stiffness_calibration", "stiffness_silo", "stiffness_blending"):
         chosen = HYPOTHESES[name]
         base = validate_config(layered_config(chosen.base_files(REPO_ROOT)))
         variant = validate_config(layered_config(chosen.variant_files(REPO_ROOT)))
@@ -194,7 +194,7 @@ def test_the_bed_variant_raises_the_blender_s_fill_and_walls_only():
 
 
 def test_an_unknown_hypothesis_or_group_is_refused_naming_what_there_is(capsys):
-    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo, bed_blender"):
+    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo, stiffness_blending, bed_blender"):
         hypothesis_named("nonsense")
     with pytest.raises(ValueError, match="no validation group 'silos'"):
         Hypothesis("h", "silos", ("S2",), "s", "c", "base.yaml", "variant.yaml")
