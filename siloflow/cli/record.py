@@ -260,7 +260,19 @@ def _status(args: argparse.Namespace) -> int:
     other = other_row_code(read_record(args.record, GROUPS))
     print(f"The validation record in {args.record} against the runs {config} plans and today's row code:")
     print("\n".join(status_lines(planned, recorded, other)))
+    print("\n".join(hypothesis_lines(read_hypothesis_records(args.record))))
     return 1 if {STALE, MISSING} & set(group_status(planned, recorded, other).values()) else 0
+
+
+def hypothesis_lines(recorded: Sequence[dict]) -> list[str]:
+    """`make validate-status`'s lines on the measured hypotheses (:data:`siloflow.engines.hypotheses.HYPOTHESES`):
+    each recorded one with its date and its rows, each other one with the command that records it."""
+    lines = ["Measured hypotheses (make hypothesis NAME=<name>):"]
+    for name, hypothesis in HYPOTHESES.items():
+        rows = [row for row in recorded if row["hypothesis"] == name]
+        lines.append(f"{name:22s} recorded {rows[0]['date']}: {len(rows)} rows of {', '.join(hypothesis.findings)}"
+                     if rows else f"{name:22s} not recorded: make hypothesis NAME={name}")
+    return lines
 
 
 def _rederive(args: argparse.Namespace) -> int:

@@ -18,6 +18,7 @@ from siloflow.analysis.studies.validation.findings_summary import finding_status
 from siloflow.analysis.studies.validation.rows import COLUMNS, row
 from siloflow.cli.hypothesis import configured_numbers, pair_core_seconds, record_hypothesis, rows_file
 from siloflow.cli.main import main
+from siloflow.cli.record import hypothesis_lines
 from siloflow.engines.config import layered_config, validate_config
 from siloflow.engines.hypotheses import HYPOTHESES, Hypothesis, hypothesis_directory, hypothesis_named
 from siloflow.engines.layout import RESULTS
@@ -226,3 +227,11 @@ def test_the_record_is_written_from_the_pair_s_rows_files_with_the_pair_s_cost(t
 def test_the_configured_numbers_are_read_by_the_parts_dotted_keys():
     config = {"calibration": {"targets_deg": {"aluminium": 16.79, "internal": 33.7}}}
     assert configured_numbers(config) == {"C7.aluminium": (16.79, 16.79)}
+
+
+def test_the_status_lists_each_hypothesis_recorded_or_the_command_that_records_it():
+    lines = hypothesis_lines(_recorded())
+    assert lines[0] == "Measured hypotheses (make hypothesis NAME=<name>):"
+    assert "stiffness_silo         recorded 2026-12-07: 1 rows of S1, S2, S3, S5" in lines
+    assert "bed_blender            not recorded: make hypothesis NAME=bed_blender" in lines
+    assert len(lines) == 1 + len(HYPOTHESES)
