@@ -18,6 +18,7 @@ from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.studies.validation.hypothesis import compare_rows
 from siloflow.engines.config import layered_config, validate_config
 from siloflow.engines.hypotheses import Hypothesis
+from siloflow.engines.interface import engine_named
 from siloflow.engines.layout import RESULTS, RUN_BENCHMARK, RUN_RECORD, SUMMARY_DIR
 from siloflow.engines.provenance import code_commit
 from siloflow.model.record import read_run_record
@@ -34,14 +35,19 @@ def rows_file(hypothesis: Hypothesis, directory: Path, member: str) -> Path:
 
 
 def pair_core_seconds(directory: Path) -> float:
-    """Core time of the pair's engine runs (CPU s): each run step's wall time (its Snakemake benchmark, the last
-    attempt) times its MPI ranks, over every run under ``directory``."""
+    """Core time of the pair's engine runs (CPU s): each finished run's time over all its attempts (its run step's
+    Snakemake benchmark, the last attempt, plus the attempts before it from the engine's own log, as the groups'
+    records count them) times its MPI ranks, over every run under ``directory``."""
     total = []
     for member in PAIR:
         for benchmark in sorted((directory / member / RESULTS).rglob(RUN_BENCHMARK)):
-            record = benchmark.parent.parent / RUN_RECORD
-            ranks = read_run_record(record).mpi_ranks if record.is_file() else 1
-            total.append(benchmark_wall_time(benchmark) * ranks)
+            run_dir = benchmark.parent.parent
+            if not (run_dir / RUN_RECORD).is_file():
+                total.append(benchmark_wall_time(benchmark))  # a step that made no run record: one core
+                continue
+            record = read_run_record(run_dir / RUN_RECORD)
+            earlier = engine_named(record.engine).earlier_attempts_seconds(run_dir)
+            total.append((benchmark_wall_time(benchmark) + earlier) * record.mpi_ranks)
     return math.fsum(total)
 
 

@@ -22,6 +22,7 @@ from siloflow.cli.record import hypothesis_lines
 from siloflow.engines.config import layered_config, validate_config
 from siloflow.engines.hypotheses import HYPOTHESES, Hypothesis, hypothesis_directory, hypothesis_named
 from siloflow.engines.layout import RESULTS
+from siloflow.model.record import RunRecord
 from tests.repo import REPO_ROOT
 
 
@@ -217,10 +218,15 @@ def test_the_record_is_written_from_the_pair_s_rows_files_with_the_pair_s_cost(t
         benchmark.parent.mkdir(parents=True)
         benchmark.write_text("s\th:m:s\n1800.0\t0:30:00\n")
     assert pair_core_seconds(directory) == 3600.0
+    # a finished run on 2 ranks, made in one go (no earlier attempt in its folder): its wall time twice
+    record = RunRecord(engine="liggghts", case="silo_flat", run_id="sphere2-x", timestep_s=1e-5, n_clumps=10,
+                       n_frames=1, mpi_ranks=2, stages={})
+    (directory / "variant" / RESULTS / "silo_flat" / "sphere2-x" / "run.json").write_text(record.to_json())
+    assert pair_core_seconds(directory) == 1800.0 + 2 * 1800.0
     path = record_hypothesis(chosen, directory, tmp_path / "record", REPO_ROOT)
     assert path == tmp_path / "record" / HYPOTHESES_DIR / "stiffness_silo.csv"
     (recorded,) = read_hypothesis_records(tmp_path / "record")
-    assert recorded["core_hours"] == 1.0 and recorded["moves"] == TOWARDS and recorded["difference"] == 36.0
+    assert recorded["core_hours"] == 1.5 and recorded["moves"] == TOWARDS and recorded["difference"] == 36.0
     assert recorded["statement"] == chosen.statement and recorded["change"] == chosen.change
 
 
