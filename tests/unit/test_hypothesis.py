@@ -156,9 +156,12 @@ def test_the_page_lists_each_recorded_hypothesis_its_rows_and_those_still_to_run
 
 def test_every_finding_s_line_names_the_hypotheses_recorded_for_it():
     statuses = finding_statuses([])
-    lines = findings_section(statuses, {}, {}, "config/validation.yaml", _recorded(), {"stiffness_silo": ("S2",)})
+    lines = findings_section(statuses, {}, {}, "config/validation.yaml", _recorded(),
+                             {"stiffness_silo": ("S1", "S2"), "bed_blender": ("M1",)})
     assert "| S2 | §5.4.2, §3.10 | not measured | 0 | - | - | stiffness_silo |" in lines
-    assert "| S1 | §5.4.1 | not measured | 0 | - | - | - |" in lines
+    assert "| S1 | §5.4.1 | not measured | 0 | - | - | - |" in lines        # recorded, but no row of S1 in it
+    assert "| M1 | §7.5.1.1 | not measured | 0 | - | - | bed_blender (not recorded) |" in lines
+    assert "| S3 | §5.4.2 | not measured | 0 | - | - | - |" in lines
     assert "### Measured hypotheses" in lines
 
 

@@ -315,6 +315,10 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
         names = tested.setdefault(row["finding"].split(".")[0], [])
         if row["hypothesis"] not in names:
             names.append(row["hypothesis"])
+    recorded = {row["hypothesis"] for row in hypotheses}
+    for name, findings in (planned_hypotheses or {}).items():
+        for finding_id in findings if name not in recorded else ():
+            tested.setdefault(finding_id, []).append(f"{name} (not recorded)")
     lines += ["", "### Every finding", "",
               "| finding | thesis | status | rows | at the study's scale (dimensions) | what differs (ratio to the study's) "
               "| measured hypotheses |",
