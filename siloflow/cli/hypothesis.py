@@ -3,7 +3,7 @@ of runs.
 
 The command (in :mod:`siloflow.cli.main`) runs the base and the variant to their validation rows; this module reads
 the two rows files, compares them (:func:`siloflow.analysis.studies.validation.hypothesis.compare_rows`) and writes
-the hypothesis's record, ``docs/validation/hypotheses/<name>.csv``, with the pair's cost and the code that ran it.
+the hypothesis's record, ``docs/validation/hypotheses/<name>.csv``, with the pair's cost and the code that ran its runs.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ from siloflow.engines.config import layered_config, validate_config
 from siloflow.engines.hypotheses import Hypothesis
 from siloflow.engines.interface import engine_named
 from siloflow.engines.layout import RESULTS, RUN_BENCHMARK, RUN_RECORD, SUMMARY_DIR
-from siloflow.engines.provenance import code_commit
+from siloflow.engines.provenance import read_attempts
 from siloflow.model.record import read_run_record
 
-__all__ = ["PAIR", "rows_file", "pair_core_seconds", "configured_numbers", "record_hypothesis"]
+__all__ = ["PAIR", "rows_file", "pair_core_seconds", "pair_commits", "configured_numbers", "record_hypothesis"]
 
 #: The pair's runs, each in its own working folder under the hypothesis's.
 PAIR = ("base", "variant")
@@ -49,6 +49,17 @@ def pair_core_seconds(directory: Path) -> float:
             earlier = engine_named(record.engine).earlier_attempts_seconds(run_dir)
             total.append((benchmark_wall_time(benchmark) + earlier) * record.mpi_ranks)
     return math.fsum(total)
+
+
+def pair_commits(directory: Path) -> str:
+    """The commits of siloflow's code that ran the pair's runs (each run's last attempt, as its provenance notes it:
+    :mod:`siloflow.engines.provenance`), each once, in order; ``unknown`` for a run that noted none."""
+    commits = []
+    for member in PAIR:
+        for benchmark in sorted((directory / member / RESULTS).rglob(RUN_BENCHMARK)):
+            attempts = read_attempts(benchmark.parent.parent)
+            commits.append(attempts[-1]["commit"] if attempts else "unknown")
+    return " ".join(dict.fromkeys(commits)) or "unknown"
 
 
 def configured_numbers(config: dict) -> dict[str, tuple[float, float]]:
@@ -87,7 +98,7 @@ def record_hypothesis(hypothesis: Hypothesis, directory: Path, record_dir: Path,
     rows = compare_rows(hypothesis.name, hypothesis.statement, hypothesis.change, hypothesis.findings,
                         read_validation_rows(files["base"]), read_validation_rows(files["variant"]),
                         configured_numbers(base_config))
-    provenance = {"core_hours": pair_core_seconds(directory) / 3600.0, "commit": code_commit(directory),
+    provenance = {"core_hours": pair_core_seconds(directory) / 3600.0, "commit": pair_commits(directory),
                   "date": date.today().isoformat()}
     return write_hypothesis_record(Path(record_dir) / HYPOTHESES_DIR / f"{hypothesis.name}.csv",
                                    [{**row, **provenance} for row in rows])

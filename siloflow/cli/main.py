@@ -213,8 +213,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def hypothesis(args: argparse.Namespace) -> int:
-    """Run a measured hypothesis's pair (its base, then its variant) to their validation rows, each stopping its
-    engine runs at a validation part's deadline, and record the comparison once both are made."""
+    """Run a measured hypothesis's pair (its base, then its variant) to their validation rows, the engine runs of both
+    stopped at one validation part's deadline from the call's start (the next call carries them on), and record the
+    comparison once both are made."""
     try:
         chosen = hypothesis_named(args.name)
     except ValueError as error:
@@ -226,7 +227,8 @@ def hypothesis(args: argparse.Namespace) -> int:
             if not path.is_file():
                 raise UsageError(f"hypothesis {chosen.name!r}: its {member}'s configuration {str(path)!r} is missing; "
                                  "run it from the clone's top folder")
-        _checked(files, Path("."))
+        # relative paths of the configuration from the member's folder, as its workflow takes them
+        _checked(files, directory / member)
     os.environ[DEADLINE_VARIABLE] = repr(time.time() + PART_FILL * GROUP_BUDGET_S)
     for member, files in members.items():
         (directory / member).mkdir(parents=True, exist_ok=True)

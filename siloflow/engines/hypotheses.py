@@ -84,7 +84,7 @@ HYPOTHESES: dict[str, Hypothesis] = {hypothesis.name: hypothesis for hypothesis 
         "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
         "calibration_reduced.yaml", "stiffness_study.yaml"),
     Hypothesis(
-        "stiffness_silo", "silo", ("S1", "S2", "S3", "S5"),
+        "stiffness_silo", "silo", ("S1", "S2", "S5"),
         f"The flat-bottom silo's fill and flow move with {_STIFFNESS}.",
         "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
         "silo_reduced.yaml", "stiffness_study.yaml"),
@@ -94,7 +94,7 @@ HYPOTHESES: dict[str, Hypothesis] = {hypothesis.name: hypothesis for hypothesis 
         "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
         "blending_reduced.yaml", "stiffness_study.yaml"),
     Hypothesis(
-        "bed_blender", "blender", ("M1", "M2"),
+        "bed_blender", "blender", ("M1",),
         "The flow through the insert's passages moves with the bed above them: the tier's bed stands 14 mm above the "
         "insert (the study's about 700 mm), so the head that feeds the passages and the tube inlet is a small share of "
         "the study's.",

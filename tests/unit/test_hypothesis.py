@@ -12,16 +12,18 @@ from siloflow.analysis.io.validation_record import (HYPOTHESES_DIR, read_hypothe
 from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, REPRODUCED, Agreement
 from siloflow.analysis.studies.validation.findings import BY_ID, PARTS
 from siloflow.analysis.studies.validation.hypothesis import (AWAY, COMPARED_COLUMNS, HYPOTHESIS_COLUMNS, NO_DIRECTION,
-                                                             NOT_MOVED, TOWARDS, compare_rows, moved, study_direction)
+                                                             NOT_KNOWN, NOT_MOVED, TOWARDS, compare_rows, moved,
+                                                             study_target)
 from siloflow.analysis.studies.validation.record import findings_section, hypotheses_section
 from siloflow.analysis.studies.validation.findings_summary import finding_statuses
 from siloflow.analysis.studies.validation.rows import COLUMNS, row
-from siloflow.cli.hypothesis import configured_numbers, pair_core_seconds, record_hypothesis, rows_file
+from siloflow.cli.hypothesis import configured_numbers, pair_commits, pair_core_seconds, record_hypothesis, rows_file
 from siloflow.cli.main import main
 from siloflow.cli.record import hypothesis_lines
 from siloflow.engines.config import layered_config, validate_config
 from siloflow.engines.hypotheses import HYPOTHESES, Hypothesis, hypothesis_directory, hypothesis_named
 from siloflow.engines.layout import RESULTS
+from siloflow.engines.provenance import note_attempt
 from siloflow.model.record import RunRecord
 from tests.repo import REPO_ROOT
 
@@ -29,95 +31,124 @@ from tests.repo import REPO_ROOT
 # ------------------------------------------------------------------------------------------------------- direction
 
 
-@pytest.mark.parametrize("part, base, direction", [
-    ("S2", 560.0, 1),              # band 618.03-627.37, centre 622.70: up
-    ("S2", 630.0, -1),
-    ("S2", 622.6978, 0),           # on the point: every move leads away
-    ("C2.sphere2", 0.6, -1),       # point 0.54
-    ("B4.internal", 4.0, 1),       # band 8-13, centre 10.5
-    ("C6.friction_0_5", 1.1, 1),   # ratio 1.2
-    ("S5.dem", 0.5, -1),           # the study's sign, whatever the base
-    ("C1.above_particle_friction", -2.0, 1),
-    ("C2.levels_off", 0.03, -1),   # negligible: towards zero
-    ("C2.levels_off", -0.03, 1),
-    ("M4.mass_flow", 0.4, 1),      # towards the exponent 0.5
-    ("M4.exterior_deviates", 0.4, -1),  # the study states a deviation: away from 0.5
-    ("B6", 1.0, None),             # an order has no one figure
+@pytest.mark.parametrize("part, target", [
+    ("S2", 622.6978),             # the study's point inside its band 618.03-627.37
+    ("B4.internal", 10.5),        # a band without a point: its middle
+    ("C6.friction_0_5", 1.2),     # a ratio
+    ("C2.levels_off", 0.0),       # negligible
+    ("M4.mass_flow", 0.5),        # a power law's exponent
+    ("S5.dem", None),             # a sign states no number
+    ("B6", None),                 # nor does an order
 ])
-def test_the_study_s_direction_from_the_base_figure_follows_the_part_s_kind(part, base, direction):
-    assert study_direction(PARTS[part], base) == direction
+def test_the_study_s_target_follows_the_part_s_kind(part, target):
+    assert study_target(PARTS[part]) == target
 
 
 def test_a_configured_part_heads_for_the_configured_number_and_needs_it():
-    assert study_direction(PARTS["C7.aluminium"], 15.0, (16.0, 18.0)) == 1
-    assert study_direction(PARTS["C7.aluminium"], 19.0, (16.0, 18.0)) == -1
+    assert study_target(PARTS["C7.aluminium"], (16.0, 18.0)) == 17.0
     with pytest.raises(ValueError, match="calibration.targets_deg.aluminium"):
-        study_direction(PARTS["C7.aluminium"], 15.0)
+        study_target(PARTS["C7.aluminium"])
 
 
-@pytest.mark.parametrize("difference, error, dof, direction, verdict", [
-    (1.0, 0.4, None, 1, TOWARDS),       # 1.0 > 1.96 * 0.4 = 0.784
-    (1.0, 0.4, None, -1, AWAY),
-    (1.0, 0.6, None, 1, NOT_MOVED),     # 1.0 < 1.176
-    (1.0, 0.4, 2.0, 1, NOT_MOVED),      # 1.0 < 4.303 * 0.4 = 1.72
-    (1.0, math.nan, None, 1, NOT_MOVED),
-    (1.0, 0.1, None, 0, AWAY),          # from the study's point
-    (1.0, 0.1, None, None, NO_DIRECTION),
+@pytest.mark.parametrize("part, base, variant, error, dof, verdict, note", [
+    ("S2", 560.0, 600.0, 10.0, None, TOWARDS, ""),          # 40 > 1.96 * 10; closer to 622.7
+    ("S2", 600.0, 560.0, 10.0, None, AWAY, ""),
+    ("S2", 600.0, 700.0, 10.0, None, AWAY, "past the study's 622.7"),     # overshoots: 77.3 from it, not 22.7
+    ("S2", 600.0, 630.0, 10.0, None, TOWARDS, "past the study's 622.7"),  # past it, but closer: 7.3
+    ("S2", 560.0, 570.0, 10.0, None, NOT_MOVED, ""),         # 10 < 19.6
+    ("S2", 560.0, 600.0, 10.0, 2.0, NOT_MOVED, ""),          # 40 < 4.303 * 10
+    ("S2", 560.0, 600.0, math.nan, None, NOT_KNOWN, ""),
+    ("S2", 560.0, math.nan, 10.0, None, NOT_KNOWN, ""),
+    ("C6.friction_0_5", 1.0, 1.1, 0.01, None, TOWARDS, ""),   # ratio 1.2
+    ("C2.levels_off", 0.01, -0.5, 0.01, None, AWAY, "past the study's 0"),  # negligible: farther from zero
+    ("C2.levels_off", 0.2, 0.05, 0.01, None, TOWARDS, ""),
+    ("M4.mass_flow", 0.4, 0.45, 0.01, None, TOWARDS, ""),     # towards the exponent 0.5
+    ("M4.exterior_deviates", 0.4, 0.45, 0.01, None, AWAY, ""),    # the study states a deviation from 0.5
+    ("M4.exterior_deviates", 0.5, 0.45, 0.01, None, TOWARDS, ""),  # from the exponent itself, any move deviates
+    ("S5.dem", 0.5, 0.3, 0.05, None, TOWARDS, ""),            # the study's sign: decreases
+    ("S5.dem", -0.5, -0.3, 0.05, None, AWAY, ""),
+    ("B6", 1.0, 2.0, 0.1, None, NO_DIRECTION, ""),            # an order has no one figure
+    ("C7.aluminium", 15.0, 17.0, 0.1, None, NO_DIRECTION, ""),  # its number not given
 ])
-def test_a_change_moves_a_figure_only_beyond_its_95_percent_reach(difference, error, dof, direction, verdict):
-    assert moved(difference, error, dof, direction) == verdict
+def test_a_change_moves_a_figure_only_beyond_its_95_percent_reach_and_closer_to_the_study(
+        part, base, variant, error, dof, verdict, note):
+    assert moved(PARTS[part], base, variant, error, dof) == (verdict, note)
+
+
+def test_a_configured_part_is_judged_by_the_configured_number():
+    assert moved(PARTS["C7.aluminium"], 15.0, 17.0, 0.1, None, (16.8, 16.8)) == (TOWARDS, "past the study's 16.8")
 
 
 # ------------------------------------------------------------------------------------------------------ comparison
 
 
-def _density(value, error, dof=None, case="sphere2-aaaa"):
+def _density(value, error, dof=None, case="sphere2-aaaaaaaaaa"):
     entry = row("Flat-bottom silo", "Filling bulk density", case, value, error, "kg/m3", "settled fill", dof=dof,
                 finding="S2", agreement=Agreement(NOT_REPRODUCED, "S2: outside"))
     return entry
 
 
-def _b(value, error, figure="Change of B, z = 60 - 20 mm", case="sphere2-aaaa", dof=None):
+def _b(value, error, figure="Change of B, z = 60 - 20 mm", case="sphere2-aaaaaaaaaa", dof=None):
     return row("Flat-bottom silo", figure, case, value, error, "m", "profiles", dof=dof, finding="S5.dem",
                agreement=Agreement(REPRODUCED, "S5.dem: decreases"))
 
 
-def _rate(value, case="sphere2-aaaa"):
+def _rate(value, case="sphere2-aaaaaaaaaa"):
     return row("Flat-bottom silo", "Steady mass flow rate", case, value, 0.001, "kg/s", "no finding")
 
 
 def test_the_pair_s_rows_are_compared_by_figure_and_occurrence_with_their_combined_error():
     base = [_density(564.0, 3.0, 2.0), _b(0.0014, 0.0001), _b(-0.0010, 0.0001), _rate(0.43)]
-    variant = [_density(600.0, 4.0, 3.0, case="sphere2-bbbb"), _b(0.0014, 0.0001, case="sphere2-bbbb"),
-               _b(-0.0020, 0.0001, case="sphere2-bbbb"), _rate(0.40, case="sphere2-bbbb")]
+    variant = [_density(600.0, 4.0, 3.0, case="sphere2-bbbbbbbbbb"), _b(0.0014, 0.0001, case="sphere2-bbbbbbbbbb"),
+               _b(-0.0020, 0.0001, case="sphere2-bbbbbbbbbb"), _rate(0.40, case="sphere2-bbbbbbbbbb")]
     rows = compare_rows("stiffness", "It supposes.", "E 5e6 -> 2.8e8 Pa", ("S2", "S5"), base, variant)
     assert [tuple(r) for r in rows] == [COMPARED_COLUMNS] * 3
     density, same, steeper = rows
     assert density["difference"] == 36.0 and density["difference_error"] == 5.0   # sqrt(3^2 + 4^2)
     assert density["dof"] == 2.0 and density["moves"] == TOWARDS                     # 36 > 4.303 * 5 = 21.5
-    assert density["case"] == "sphere2-aaaa" and density["base"] == 564.0 and density["variant"] == 600.0
+    assert density["case"] == "sphere2-aaaaaaaaaa" and density["base"] == 564.0 and density["variant"] == 600.0
     assert density["reason"].startswith("change 36 ± 5 (95 %: 14.49 to 57.51); the study: 622.7, 618 to 627.4")
     assert same["difference"] == 0.0 and same["moves"] == NOT_MOVED
     assert steeper["difference"] == pytest.approx(-0.001) and steeper["dof"] == ""
     assert steeper["moves"] == TOWARDS                                               # S5.dem: B decreases
 
 
+def test_rows_pair_by_finding_and_case_not_by_a_figure_that_quotes_a_measured_number():
+    def janssen(value, depth, case):
+        return row("Flat-bottom silo", f"Janssen at {depth} mm below the surface", case, value, 0.01, "-", "e",
+                   finding="S1.janssen", agreement=Agreement(REPRODUCED, "S1"))
+
+    def chart(value, case):
+        return row("Calibration", "Bulk friction", case, value, 0.01, "-", "e", finding="C2.rises",
+                   agreement=Agreement(REPRODUCED, "C2"))
+
+    base = [janssen(1.02, 93, "sphere2-0123456789"), chart(0.40, "sphere2, internal, rolling 0"),
+            chart(0.45, "sphere2, internal, rolling 0.1")]
+    variant = [janssen(1.00, 95, "sphere2-9876543210"), chart(0.50, "sphere2, internal, rolling 0"),
+               chart(0.55, "sphere2, internal, rolling 0.1")]
+    rows = compare_rows("h", "s", "c", ("S1", "C2"), base, variant)
+    assert [r["figure"] for r in rows] == ["Janssen at 93 mm below the surface", "Bulk friction", "Bulk friction"]
+    assert [r["difference"] for r in rows] == pytest.approx([-0.02, 0.1, 0.1])
+    with pytest.raises(ValueError, match=r"C2.rises \(Calibration, sphere2, internal, rolling 0.2\)"):
+        compare_rows("h", "s", "c", ("C2",), base, [*variant[:2], chart(0.55, "sphere2, internal, rolling 0.2")])
+
+
 def test_a_pair_that_does_not_judge_the_same_rows_or_judges_none_is_refused():
-    with pytest.raises(ValueError, match=r"in one only: Change of B, z = 60 - 20 mm \(S5.dem\)"):
+    with pytest.raises(ValueError, match=r"in one only: S5.dem \(Flat-bottom silo, sphere2\)"):
         compare_rows("h", "s", "c", ("S2", "S5"), [_density(564.0, 3.0), _b(0.001, 0.0001), _b(0.001, 0.0001)],
                      [_density(600.0, 4.0), _b(0.001, 0.0001)])
     with pytest.raises(ValueError, match="no row of either run judges B1"):
         compare_rows("h", "s", "c", ("B1",), [_density(564.0, 3.0)], [_density(600.0, 4.0)])
 
 
-def test_a_configured_part_without_its_number_and_an_unknown_base_have_no_direction():
+def test_a_configured_part_without_its_number_has_no_direction_and_an_unknown_base_is_not_known():
     angle = row("Calibration", "Bulk wall friction angle", "sphere2, aluminium", 15.0, 0.1, "deg", "e", finding="C7.aluminium",
                 agreement=Agreement(NOT_REPRODUCED, "C7"))
     moved_angle = dict(angle, value=17.0)
     assert compare_rows("h", "s", "c", ("C7",), [angle], [moved_angle])[0]["moves"] == NO_DIRECTION
     assert compare_rows("h", "s", "c", ("C7",), [angle], [moved_angle], {"C7.aluminium": (16.8, 16.8)})[0]["moves"] == TOWARDS
     unknown = _density(math.nan, math.nan)
-    assert compare_rows("h", "s", "c", ("S2",), [unknown], [_density(600.0, 4.0)])[0]["moves"] == NO_DIRECTION
+    assert compare_rows("h", "s", "c", ("S2",), [unknown], [_density(600.0, 4.0)])[0]["moves"] == NOT_KNOWN
 
 
 # ---------------------------------------------------------------------------------------------------- record, page
@@ -143,14 +174,15 @@ def test_a_hypothesis_record_round_trips_and_refuses_missing_columns(tmp_path):
 
 
 def test_the_page_lists_each_recorded_hypothesis_its_rows_and_those_still_to_run():
-    lines = hypotheses_section(_recorded(), {"stiffness_silo": ("S2",), "stiffness_calibration": ("C2", "C3")})
+    lines = hypotheses_section(_recorded(), {"stiffness_silo": ("S1", "S2"), "stiffness_calibration": ("C2", "C3")})
     assert lines[0] == "### Measured hypotheses"
     assert ("- **stiffness_silo** (S2; the pair 2.50 core-h, code abc123, 2026-12-07): It supposes. The change: "
             "E 5e6 -> 2.8e8 Pa.") in lines
-    assert ("  - S2: Filling bulk density (sphere2-aaaa): 564 ± 3 -> 600 ± 4 kg/m3; change 36 ± 5 (95 %: 14.49 to "
+    assert ("  - S2: Filling bulk density (sphere2-aaaaaaaaaa): 564 ± 3 -> 600 ± 4 kg/m3; change 36 ± 5 (95 %: 14.49 to "
             "57.51); the study: 622.7, 618 to 627.4: **towards the study**") in lines
     assert ("- stiffness_calibration (C2, C3): not recorded yet: `make hypothesis NAME=stiffness_calibration`"
             in lines)
+    assert "  - no row of the pair judges S1" in lines
     assert hypotheses_section([], {})[-1] == "None."
 
 
@@ -226,10 +258,14 @@ def test_the_record_is_written_from_the_pair_s_rows_files_with_the_pair_s_cost(t
                        n_frames=1, mpi_ranks=2, stages={})
     (directory / "variant" / RESULTS / "silo_flat" / "sphere2-x" / "run.json").write_text(record.to_json())
     assert pair_core_seconds(directory) == 1800.0 + 2 * 1800.0
+    # the code that ran the runs, as each run's provenance notes it (none noted: unknown)
+    assert pair_commits(directory) == "unknown"
+    note_attempt(directory / "variant" / RESULTS / "silo_flat" / "sphere2-x", "liggghts", "3.8", "abc123")
+    assert pair_commits(directory) == "unknown abc123"
     path = record_hypothesis(chosen, directory, tmp_path / "record", REPO_ROOT)
     assert path == tmp_path / "record" / HYPOTHESES_DIR / "stiffness_silo.csv"
     (recorded,) = read_hypothesis_records(tmp_path / "record")
-    assert recorded["core_hours"] == 1.5 and recorded["moves"] == TOWARDS and recorded["difference"] == 36.0
+    assert recorded["core_hours"] == 1.5 and recorded["moves"] == TOWARDS and recorded["commit"] == "unknown abc123" and recorded["difference"] == 36.0
     assert recorded["statement"] == chosen.statement and recorded["change"] == chosen.change
 
 
@@ -241,6 +277,6 @@ def test_the_configured_numbers_are_read_by_the_parts_dotted_keys():
 def test_the_status_lists_each_hypothesis_recorded_or_the_command_that_records_it():
     lines = hypothesis_lines(_recorded())
     assert lines[0] == "Measured hypotheses (make hypothesis NAME=<name>):"
-    assert "stiffness_silo         recorded 2026-12-07: 1 rows of S1, S2, S3, S5" in lines
+    assert "stiffness_silo         recorded 2026-12-07: 1 rows of S1, S2, S5" in lines
     assert "bed_blender            not recorded: make hypothesis NAME=bed_blender" in lines
     assert len(lines) == 1 + len(HYPOTHESES)

@@ -225,8 +225,9 @@ def hypotheses_section(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequ
     lines = ["### Measured hypotheses", "",
              "For a finding not reproduced, or not at the study's scale: one change that could move it, run as a pair "
              "on a reduced case (the base, and the variant with the change) and compared row by row. A change moves "
-             "a figure towards the study or away from it when its 95 % interval excludes zero; the pair's figures are "
-             "the reduced case's, not the tier's.", ""]
+             "a figure towards the study (closer to its number, or in its sign) or away from it when its 95 % interval "
+             "excludes zero; its error is the two rows' errors combined, within-run ones where a member ran one seed. "
+             "The pair's figures are the reduced case's, not the tier's.", ""]
     by_name: dict[str, list[Mapping]] = {}
     for row in hypotheses:
         by_name.setdefault(row["hypothesis"], []).append(row)
@@ -237,6 +238,9 @@ def hypotheses_section(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequ
                      f"{first['commit']}, {first['date']}): {_cell(first['statement'])} The change: "
                      f"{_cell(first['change'])}.")
         lines += [f"  - {_hypothesis_row(row)}" for row in rows]
+        unjudged = [finding for finding in planned.get(name, ()) if finding not in findings]
+        if unjudged:
+            lines.append(f"  - no row of the pair judges {', '.join(unjudged)}")
     waiting = [name for name in planned if name not in by_name]
     if waiting:
         lines += [f"- {name} ({', '.join(planned[name])}): not recorded yet: `make hypothesis NAME={name}`"
