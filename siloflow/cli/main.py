@@ -233,11 +233,13 @@ def hypothesis(args: argparse.Namespace) -> int:
     for member, files in members.items():
         (directory / member).mkdir(parents=True, exist_ok=True)
         code = launch(snakemake_arguments(files, directory / member, args.cores, [f"validation_rows_{chosen.group}"],
-                                          ["--keep-going"]))
+                                          ["--keep-going", *(["--dry-run"] if args.dry_run else [])]))
         if code != 0:
             print(f"siloflow hypothesis: the {member} of {chosen.name} stopped (exit {code}); "
                   f"`make hypothesis NAME={chosen.name}` carries it on from its restart files", file=sys.stderr)
             return code
+    if args.dry_run:
+        return 0
     try:
         path = record_hypothesis(chosen, directory, Path(args.record))
     except ValueError as error:
@@ -315,6 +317,7 @@ def parser() -> argparse.ArgumentParser:
                      help="working folder: the pair runs in DIR/results/hypotheses/NAME/ (default: the current folder)")
     sub.add_argument("--record", default=record.RECORD_DIR, metavar="DIR",
                      help=f"the validation record's folder (default: {record.RECORD_DIR})")
+    sub.add_argument("--dry-run", action="store_true", help="print what the pair would run, run and record nothing")
     sub.set_defaults(handler=hypothesis)
 
     record.add_parser(commands, _common)
