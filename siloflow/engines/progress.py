@@ -20,11 +20,14 @@ import dataclasses
 import logging
 import math
 import os
+import signal
 import subprocess
 import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable, Protocol, TextIO
+from typing import Callable, Iterator, Protocol, TextIO
 
 from siloflow.engines.estimates import format_duration
 
@@ -311,6 +314,31 @@ def stop_process(process: subprocess.Popen, grace: float = STOP_GRACE_S) -> int:
         return process.wait()
 
 
+class Terminated(Exception):
+    """The run step was told to stop (SIGTERM or SIGHUP: a killed job, a cancelled batch job) while its engine ran."""
+
+
+@contextmanager
+def _stop_signals_raise() -> Iterator[None]:
+    """While the body runs, SIGTERM and SIGHUP raise :class:`Terminated` instead of ending the process at once, so
+    that :func:`run_with_progress` stops its engine first rather than leaving it running without its job (as a
+    process ended by the signal's default action would). Signal handlers belong to the main thread: elsewhere the
+    body runs as is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated(f"stopped by {signal.Signals(signum).name}")
+
+    previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
 def run_with_progress(command: list[str], run_dir: str | os.PathLike, output_path: str | os.PathLike,
                       environment: dict, parser: ScreenParser, target_time: float | None, report_every: float,
                       poll_every: float = 1.0) -> int:
@@ -318,7 +346,8 @@ def run_with_progress(command: list[str], run_dir: str | os.PathLike, output_pat
     exit code. With ``target_time`` [s of simulated time] a :class:`ProgressMonitor` reads the output with
     ``parser`` every ``poll_every`` s and reports every ``report_every`` s, in the log and, when the job's stderr is
     a terminal, as one line naming the run there. No shell is involved and stdin is closed. An exception while it
-    runs (a part's deadline, :mod:`siloflow.engines.deadline`; an interrupt) stops the command first."""
+    runs (a part's deadline, :mod:`siloflow.engines.deadline`; an interrupt; SIGTERM or SIGHUP to the step, which
+    raise :class:`Terminated`) stops the command first."""
     terminal = sys.__stderr__ if sys.__stderr__ is not None and sys.__stderr__.isatty() else None
     monitor = (ProgressMonitor(output_path, parser, target_time, os.path.basename(os.fspath(run_dir)), report_every,
                                logging.getLogger("siloflow"), terminal) if target_time else None)
@@ -326,16 +355,17 @@ def run_with_progress(command: list[str], run_dir: str | os.PathLike, output_pat
         process = subprocess.Popen(command, cwd=run_dir, stdout=output, stderr=subprocess.STDOUT, env=environment,
                                    stdin=subprocess.DEVNULL)
         try:
-            while True:
-                try:
-                    returncode = process.wait(timeout=poll_every)
-                    break
-                except subprocess.TimeoutExpired:
-                    if monitor is not None:
-                        output.flush()
-                        monitor.poll()
+            with _stop_signals_raise():
+                while True:
+                    try:
+                        returncode = process.wait(timeout=poll_every)
+                        break
+                    except subprocess.TimeoutExpired:
+                        if monitor is not None:
+                            output.flush()
+                            monitor.poll()
         except BaseException:
-            # interrupted (a part's deadline, Ctrl-C): the engine must not run on without its job
+            # interrupted (a part's deadline, Ctrl-C, SIGTERM): the engine must not run on without its job
             stop_process(process)
             raise
     if monitor is not None:

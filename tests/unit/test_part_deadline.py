@@ -3,6 +3,7 @@ too) or refuses to start one once the part's time is up."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import time
@@ -62,3 +63,31 @@ def test_the_deadline_stops_an_engine_in_progress_and_its_process(tmp_path):
     # the engine is gone with its job, and the alarm is cleared
     assert captured["process"].poll() is not None
     time.sleep(1.2)
+
+
+def test_a_stop_signal_to_the_run_step_stops_its_engine_too(tmp_path):
+    # the run step in a process of its own, as Snakemake runs a script: SIGTERM to it must not leave the engine running
+    step = (
+        "import subprocess, sys\n"
+        "from siloflow.engines.progress import run_with_progress\n"
+        "class P:\n"
+        "    def feed(self, text): return []\n"
+        "original = subprocess.Popen\n"
+        "def spawn(*args, **kwargs):\n"
+        "    process = original(*args, **kwargs)\n"
+        "    print(process.pid, flush=True)\n"
+        "    return process\n"
+        "subprocess.Popen = spawn\n"
+        f"run_with_progress([sys.executable, '-c', 'import time; time.sleep(60)'], {str(tmp_path)!r}, "
+        f"{str(tmp_path / 'out.txt')!r}, {{}}, P(), None, 30.0, 0.1)\n"
+    )
+    runner = subprocess.Popen([sys.executable, "-c", step], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    engine_pid = int(runner.stdout.readline())
+    time.sleep(0.5)
+    runner.terminate()
+    _, error = runner.communicate(timeout=40)
+    assert runner.returncode != 0 and "Terminated: stopped by SIGTERM" in error
+    # the engine is gone: signal 0 to its pid finds no process (it was the runner's child, reaped with it)
+    time.sleep(0.2)
+    with pytest.raises(ProcessLookupError):
+        os.kill(engine_pid, 0)
