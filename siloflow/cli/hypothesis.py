@@ -34,31 +34,32 @@ def rows_file(hypothesis: Hypothesis, directory: Path, member: str) -> Path:
     return directory / member / SUMMARY_DIR / "rows" / f"{hypothesis.group}.csv"
 
 
+def _pair_runs(directory: Path) -> list[Path]:
+    """The folders of the pair's engine runs (those whose run step Snakemake timed), base first."""
+    return [benchmark.parent.parent for member in PAIR
+            for benchmark in sorted((directory / member / RESULTS).rglob(RUN_BENCHMARK))]
+
+
 def pair_core_seconds(directory: Path) -> float:
     """Core time of the pair's engine runs (CPU s): each finished run's time over all its attempts (its run step's
     Snakemake benchmark, the last attempt, plus the attempts before it from the engine's own log, as the groups'
     records count them) times its MPI ranks, over every run under ``directory``."""
     total = []
-    for member in PAIR:
-        for benchmark in sorted((directory / member / RESULTS).rglob(RUN_BENCHMARK)):
-            run_dir = benchmark.parent.parent
-            if not (run_dir / RUN_RECORD).is_file():
-                total.append(benchmark_wall_time(benchmark))  # a step that made no run record: one core
-                continue
-            record = read_run_record(run_dir / RUN_RECORD)
-            earlier = engine_named(record.engine).earlier_attempts_seconds(run_dir)
-            total.append((benchmark_wall_time(benchmark) + earlier) * record.mpi_ranks)
+    for run_dir in _pair_runs(directory):
+        wall = benchmark_wall_time(run_dir / RUN_BENCHMARK)
+        if not (run_dir / RUN_RECORD).is_file():
+            total.append(wall)  # a step that made no run record: one core
+            continue
+        record = read_run_record(run_dir / RUN_RECORD)
+        total.append((wall + engine_named(record.engine).earlier_attempts_seconds(run_dir)) * record.mpi_ranks)
     return math.fsum(total)
 
 
 def pair_commits(directory: Path) -> str:
     """The commits of siloflow's code that ran the pair's runs (each run's last attempt, as its provenance notes it:
     :mod:`siloflow.engines.provenance`), each once, in order; ``unknown`` for a run that noted none."""
-    commits = []
-    for member in PAIR:
-        for benchmark in sorted((directory / member / RESULTS).rglob(RUN_BENCHMARK)):
-            attempts = read_attempts(benchmark.parent.parent)
-            commits.append(attempts[-1]["commit"] if attempts else "unknown")
+    commits = [attempts[-1]["commit"] if (attempts := read_attempts(run_dir)) else "unknown"
+               for run_dir in _pair_runs(directory)]
     return " ".join(dict.fromkeys(commits)) or "unknown"
 
 

@@ -227,7 +227,7 @@ def hypothesis(args: argparse.Namespace) -> int:
             if not path.is_file():
                 raise UsageError(f"hypothesis {chosen.name!r}: its {member}'s configuration {str(path)!r} is missing; "
                                  "run it from the clone's top folder")
-        # relative paths of the configuration from the member's folder, as its workflow takes them
+        # as `siloflow run` checks its --directory: relative paths from the member's folder once it exists
         _checked(files, directory / member)
     os.environ[DEADLINE_VARIABLE] = repr(time.time() + PART_FILL * GROUP_BUDGET_S)
     for member, files in members.items():

@@ -13,8 +13,9 @@ from siloflow.analysis.studies.validation.agreement import AgreementTolerances, 
 from siloflow.analysis.studies.validation.blending import NR_STUDY, PATTERNS
 from siloflow.analysis.studies.validation.findings import PARTS, Part
 
-__all__ = ["study_value", "study_note", "CHART_FINDINGS", "calibration_chart_findings", "janssen_findings", "kinematic_findings",
-           "insert_findings", "gravity_findings", "vrr_findings"]
+__all__ = ["study_value", "study_note", "CHART_FINDINGS", "calibration_chart_findings", "janssen_findings",
+           "kinematic_findings", "insert_findings", "gravity_findings", "vrr_findings"]
+
 
 def study_value(part: Part, band: tuple[float, float] | None = None, series: str | None = None) -> StudyValue:
     """The number a part of a finding states, to draw beside the result (e.g. ``PARTS["C2.sphere2"]``).

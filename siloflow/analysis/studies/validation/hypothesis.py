@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections import Counter
 from collections.abc import Mapping, Sequence
 
 from siloflow.analysis.numerics.uncertainty import combine_independent
@@ -152,12 +153,13 @@ def _keyed(rows: Sequence[Mapping], findings: Sequence[str]) -> dict[tuple, Mapp
     """The rows that judge a part of ``findings``, keyed by :func:`_key` and their occurrence under it: a reduced
     case's rows come in the same order in both runs."""
     keyed: dict[tuple, Mapping] = {}
+    seen: Counter = Counter()
     for row in rows:
         if row["finding"] == NO_FINDING or row["finding"].split(".")[0] not in findings:
             continue
         stem = _key(row)
-        occurrence = sum(key[:3] == stem for key in keyed)
-        keyed[(*stem, occurrence)] = row
+        keyed[(*stem, seen[stem])] = row
+        seen[stem] += 1
     return keyed
 
 

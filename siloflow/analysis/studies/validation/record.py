@@ -205,6 +205,28 @@ def _hypothesis_row(row: Mapping) -> str:
             f"{_cell(row['reason'])}: **{row['moves']}**")
 
 
+def _by_hypothesis(hypotheses: Sequence[Mapping]) -> dict[str, list[Mapping]]:
+    """The recorded hypotheses' rows by hypothesis, in the order they come."""
+    by_name: dict[str, list[Mapping]] = {}
+    for row in hypotheses:
+        by_name.setdefault(row["hypothesis"], []).append(row)
+    return by_name
+
+
+def _hypotheses_by_finding(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequence[str]]) -> dict[str, list[str]]:
+    """``{finding id: hypotheses}`` for the finding table: each recorded hypothesis beside the findings its rows judge,
+    each planned one not recorded yet beside the findings it is for, marked so."""
+    by_finding: dict[str, list[str]] = {}
+    recorded = _by_hypothesis(hypotheses)
+    for name, rows in recorded.items():
+        for finding_id in dict.fromkeys(row["finding"].split(".")[0] for row in rows):
+            by_finding.setdefault(finding_id, []).append(name)
+    for name, findings in planned.items():
+        for finding_id in findings if name not in recorded else ():
+            by_finding.setdefault(finding_id, []).append(f"{name} (not recorded)")
+    return by_finding
+
+
 def hypotheses_section(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequence[str]]) -> list[str]:
     """The measured hypotheses (:mod:`siloflow.analysis.studies.validation.hypothesis`): per hypothesis recorded, what
     it supposes, the one change, the pair's cost and every compared row with where the change moves it; the planned
@@ -228,9 +250,7 @@ def hypotheses_section(hypotheses: Sequence[Mapping], planned: Mapping[str, Sequ
              "a figure towards the study (closer to its number, or in its sign) or away from it when its 95 % interval "
              "excludes zero; its error is the two rows' errors combined, within-run ones where a member ran one seed. "
              "The pair's figures are the reduced case's, not the tier's.", ""]
-    by_name: dict[str, list[Mapping]] = {}
-    for row in hypotheses:
-        by_name.setdefault(row["hypothesis"], []).append(row)
+    by_name = _by_hypothesis(hypotheses)
     for name, rows in by_name.items():
         first = rows[0]
         findings = sorted({row["finding"].split(".")[0] for row in rows})
@@ -314,15 +334,7 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
               "results at this scale, not verdicts on the study.", ""]
     lines += [f"- {row['finding']}: {_measured(row)}" for row in elsewhere] or ["None."]
     lines += ["", *hypotheses_section(hypotheses, planned_hypotheses or {})]
-    tested: dict[str, list[str]] = {}
-    for row in hypotheses:
-        names = tested.setdefault(row["finding"].split(".")[0], [])
-        if row["hypothesis"] not in names:
-            names.append(row["hypothesis"])
-    recorded = {row["hypothesis"] for row in hypotheses}
-    for name, findings in (planned_hypotheses or {}).items():
-        for finding_id in findings if name not in recorded else ():
-            tested.setdefault(finding_id, []).append(f"{name} (not recorded)")
+    tested = _hypotheses_by_finding(hypotheses, planned_hypotheses or {})
     lines += ["", "### Every finding", "",
               "| finding | thesis | status | rows | at the study's scale (dimensions) | what differs (ratio to the study's) "
               "| measured hypotheses |",
