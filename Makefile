@@ -16,7 +16,7 @@ YADE_MODULES  := /usr/lib/x86_64-linux-gnu/yade-double/py/yade
 PIP            = $(PYTHON) -m pip install --quiet --disable-pip-version-check
 
 .PHONY: install install-system install-python install-test install-docs run run-tiny check verify bayesian validate hypothesis \
-	validate-status test test-physics test-unit test-integration dry-run bench estimate docs
+	validate-status test test-physics test-unit test-integration dry-run bench bench-assembly estimate docs
 
 # What running needs; the test and documentation extras come with `make test` and `make docs` only.
 install: install-system install-python
@@ -190,6 +190,13 @@ bench: install-test
 	$(PYTHON) -m tests.bench.bench_decks results/bench/decks.csv
 	$(PYTHON) -m tests.bench.bench_engines results/bench/engines.csv
 	$(PYTHON) -m tests.bench.bench_piv results/bench/piv.csv
+
+# 1 against 2 MPI ranks on the validation tier's 270 mm assembly (a flat-bottom silo run of the tier that has settled
+# its fill): make bench-assembly ASSEMBLY=results/validation/results/silo_flat/<run>
+ASSEMBLY ?=
+bench-assembly: install-test
+	$(if $(ASSEMBLY),,$(error name the flat-bottom silo run whose fill the benchmark starts from: ASSEMBLY=<run folder>))
+	$(PYTHON) -m tests.bench.bench_mpi_assembly '$(ASSEMBLY)' results/bench/mpi_assembly.csv
 
 # The documentation site (mkdocs.yml, docs/): --strict fails on a broken link, a missing page or a docstring the API
 # reference cannot render. The example notebooks are shown executed on the tiny run (made first where missing;
