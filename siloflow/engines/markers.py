@@ -36,3 +36,22 @@ def parse_markers(log_text: str) -> list[Marker]:
                 values[key] = raw
         markers.append(Marker(match.group(1), values))
     return markers
+
+
+def without_redone(markers: list[Marker]) -> list[Marker]:
+    """The markers of a run's attempts joined, in order, without those a later attempt made again.
+
+    An attempt resumed from a restart file at step R prints a ``resumed`` marker at R: the markers that the attempts
+    before it printed after step R belong to steps it runs again, and its own replace them. Markers without a step
+    are kept.
+    """
+    def step(marker: Marker) -> float | None:
+        value = marker.values.get("step")
+        return value if isinstance(value, float) else None
+
+    kept: list[Marker] = []
+    for marker in markers:
+        if marker.event == "resumed" and step(marker) is not None:
+            kept = [m for m in kept if step(m) is None or step(m) <= step(marker)]
+        kept.append(marker)
+    return kept

@@ -3,6 +3,7 @@
 # Run headless with the system Python 3 (`/usr/bin/python3 deck/run.py` inside the run directory): importing YADE
 # from Python opens no port, unlike its launcher (`yade`, `yade-batch`), which serves a console and XMLRPC.
 # Every number below was rendered after a finite check; no configuration string reaches this file.
+import json
 import math
 import os
 import sys

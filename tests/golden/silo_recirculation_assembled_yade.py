@@ -3,6 +3,7 @@
 # Run headless with the system Python 3 (`/usr/bin/python3 deck/run.py` inside the run directory): importing YADE
 # from Python opens no port, unlike its launcher (`yade`, `yade-batch`), which serves a console and XMLRPC.
 # Every number below was rendered after a finite check; no configuration string reaches this file.
+import json
 import math
 import os
 import sys
@@ -317,6 +318,8 @@ SNAPSHOT_STEPS = 200
 DISCHARGE_STEPS = 216631
 SAMPLE_EVERY = 867
 RESTART_EVERY = 10832
+#: steps between snapshots in the pour and the settling (about 20 in the pour)
+FILL_RESTART_EVERY = 10218
 BOUNDING_RADIUS = float(np.max(np.linalg.norm(CLUMP_CENTRES, axis=1) + CLUMP_RADII))
 
 MATERIAL_IDS = materials()
@@ -437,7 +440,21 @@ RESTART = sys.argv[1] if len(sys.argv) > 1 else None
 FINAL_STEP = int(sys.argv[2]) if len(sys.argv) > 2 else None
 os.makedirs("dumps", exist_ok=True)
 os.makedirs('restart', exist_ok=True)
-if RESTART is None:
+#: the stage a resumed attempt goes on in (the snapshot's tag; "discharge" for one without), None in the first attempt
+RESUMED_IN = None
+if RESTART is not None:
+    # --- resume from a snapshot of an attempt that was stopped ---
+    O.load(RESTART)
+    RESUMED_IN = O.tags["siloflow_stage"] if "siloflow_stage" in O.tags.keys() else "discharge"
+    # the walls added after an assembly was loaded (their ids follow its clumps')
+    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
+        name, ids = entry.split(":")
+        WALLS[name] = [int(i) for i in ids.split(",")]
+    forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
+    if RESUMED_IN == "discharge":
+        WALLS['outlet_gate'] = []
+    say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))
+if RESUMED_IN != "discharge":
     # --- the assembly: the settled fill of the run it starts from (the study's, §6.2.2), its clock restarted; the
     # scene built above holds that run's walls in its order, so their ids stay ---
     O.load('deck/assembly.yade')
@@ -461,23 +478,14 @@ if RESTART is None:
     WALLS['outlet_gate'] = []
     FINAL_STEP = O.iter + DISCHARGE_STEPS
     say_stage("opened", final_step=FINAL_STEP)
+    O.tags["siloflow_stage"] = "discharge"
     checkpoint()
-else:
-    # --- resume the discharge from a snapshot of an attempt that was killed ---
-    O.load(RESTART)
-    # the walls added after an assembly was loaded (their ids follow its clumps')
-    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
-        name, ids = entry.split(":")
-        WALLS[name] = [int(i) for i in ids.split(",")]
-    forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
-    WALLS['outlet_gate'] = []
-    say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))
 
 # --- recirculate: clumps leave through the outlet (outflow() says where they go) ---
 SCHEDULE[:] = DISCHARGE_ACTIONS + [
     (SAMPLE_EVERY, lambda: (check_sane(inside), frame(), forces.sample(), progress('recirculate'))),
     (RESTART_EVERY, checkpoint)]
-if RESTART is None:
+if RESUMED_IN != "discharge":
     frame()
 run_steps(FINAL_STEP - O.iter)
 say_stage('discharged')

@@ -3,6 +3,7 @@
 # Run headless with the system Python 3 (`/usr/bin/python3 deck/run.py` inside the run directory): importing YADE
 # from Python opens no port, unlike its launcher (`yade`, `yade-batch`), which serves a console and XMLRPC.
 # Every number below was rendered after a finite check; no configuration string reaches this file.
+import json
 import math
 import os
 import sys
@@ -317,6 +318,8 @@ SNAPSHOT_STEPS = 200
 DISCHARGE_STEPS = 144421
 SAMPLE_EVERY = 867
 RESTART_EVERY = 7222
+#: steps between snapshots in the pour and the settling (about 20 in the pour)
+FILL_RESTART_EVERY = 10218
 BOUNDING_RADIUS = float(np.max(np.linalg.norm(CLUMP_CENTRES, axis=1) + CLUMP_RADII))
 
 MATERIAL_IDS = materials()
@@ -437,33 +440,67 @@ RESTART = sys.argv[1] if len(sys.argv) > 1 else None
 FINAL_STEP = int(sys.argv[2]) if len(sys.argv) > 2 else None
 os.makedirs("dumps", exist_ok=True)
 os.makedirs('restart', exist_ok=True)
-if RESTART is None:
-    forces = WallForceFile('wall_force_history.txt', WALLS)
-    SCHEDULE[:] = [(SAMPLE_EVERY, lambda: (check_sane(inside), forces.sample(), progress("fill")))]
-    # --- fill: pour centrally from the insertion zone above the heap ---
+#: the stage a resumed attempt goes on in (the snapshot's tag; "discharge" for one without), None in the first attempt
+RESUMED_IN = None
+if RESTART is not None:
+    # --- resume from a snapshot of an attempt that was stopped ---
+    O.load(RESTART)
+    RESUMED_IN = O.tags["siloflow_stage"] if "siloflow_stage" in O.tags.keys() else "discharge"
+    # the walls added after an assembly was loaded (their ids follow its clumps')
+    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
+        name, ids = entry.split(":")
+        WALLS[name] = [int(i) for i in ids.split(",")]
+    forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
+    if RESUMED_IN == "discharge":
+        WALLS['outlet_gate'] = []
+    say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))
+if RESUMED_IN != "discharge":
+    if RESTART is None:
+        forces = WallForceFile('wall_force_history.txt', WALLS)
     rng = np.random.default_rng(FILL_SEED)
-    inserted = [insert_clumps(rng, min(PER_INSERTION, N_CLUMPS))]
+    #: settling checks made so far (by this attempt and those it resumes)
+    settle_done = [0]
+    if RESUMED_IN is not None:
+        # the pour's random state and the checks made, as the stopped attempt's snapshot kept them
+        rng.bit_generator.state = json.loads(O.tags["siloflow_rng"])
+        settle_done[0] = int(O.tags["siloflow_settle_checks"])
 
-    def insert_more():
-        if inserted[0] < N_CLUMPS:
-            inserted[0] += insert_clumps(rng, min(PER_INSERTION, N_CLUMPS - inserted[0]))
+    def fill_checkpoint(stage):
+        """A snapshot in the pour or the settling, with what a resumed attempt needs to go on from it."""
+        O.tags["siloflow_stage"] = stage
+        O.tags["siloflow_rng"] = json.dumps(rng.bit_generator.state)
+        O.tags["siloflow_settle_checks"] = str(settle_done[0])
+        checkpoint()
 
-    SCHEDULE.append((INSERT_EVERY, insert_more))
-    run_steps(FILL_STEPS)
-    for _ in range(MAX_EXTRA_INSERTIONS):
-        if inserted[0] >= N_CLUMPS:
-            break
-        run_steps(INSERT_EVERY)
-    SCHEDULE.pop()
-    say_stage("filled")
+    if RESUMED_IN in (None, "fill"):
+        # --- fill: pour centrally from the insertion zone above the heap ---
+        SCHEDULE[:] = [(SAMPLE_EVERY, lambda: (check_sane(inside), forces.sample(), progress("fill"))),
+                       (FILL_RESTART_EVERY, lambda: fill_checkpoint("fill"))]
+        # a resumed pour counts what it holds: no clump leaves the closed silo
+        inserted = [len(clumps()) if RESUMED_IN else insert_clumps(rng, min(PER_INSERTION, N_CLUMPS))]
+
+        def insert_more():
+            if inserted[0] < N_CLUMPS:
+                inserted[0] += insert_clumps(rng, min(PER_INSERTION, N_CLUMPS - inserted[0]))
+
+        SCHEDULE.insert(1, (INSERT_EVERY, insert_more))
+        run_steps(max(FILL_STEPS - O.iter, 0))
+        for _ in range(MAX_EXTRA_INSERTIONS):
+            if inserted[0] >= N_CLUMPS:
+                break
+            run_steps(INSERT_EVERY)
+        say_stage("filled")
 
     # --- settle ---
-    SCHEDULE[0] = (SAMPLE_EVERY, lambda: (check_sane(inside), forces.sample(), progress("settle")))
-    for _ in range(SETTLE_MAX_CHECKS):
+    SCHEDULE[:] = [(SAMPLE_EVERY, lambda: (check_sane(inside), forces.sample(), progress("settle"))),
+                   (FILL_RESTART_EVERY, lambda: fill_checkpoint("settle"))]
+    while settle_done[0] < SETTLE_MAX_CHECKS:
         run_steps(SETTLE_CHECK_STEPS)
+        settle_done[0] += 1
         say_stage("settle")
         if kinetic_energy_per_clump() < SETTLE_THRESHOLD:
             break
+    SCHEDULE[1:] = []
     say_stage("settled")
     # --- the settled fill at the last two steps of a short run, for the force balance ---
     run_steps(SNAPSHOT_STEPS - 2)
@@ -477,23 +514,14 @@ if RESTART is None:
     WALLS['outlet_gate'] = []
     FINAL_STEP = O.iter + DISCHARGE_STEPS
     say_stage("opened", final_step=FINAL_STEP)
+    O.tags["siloflow_stage"] = "discharge"
     checkpoint()
-else:
-    # --- resume the discharge from a snapshot of an attempt that was killed ---
-    O.load(RESTART)
-    # the walls added after an assembly was loaded (their ids follow its clumps')
-    for entry in O.tags["siloflow_added_walls"].split() if "siloflow_added_walls" in O.tags.keys() else []:
-        name, ids = entry.split(":")
-        WALLS[name] = [int(i) for i in ids.split(",")]
-    forces = WallForceFile(f"resume_{O.iter}_wall_force_history.txt", WALLS)
-    WALLS['outlet_gate'] = []
-    say("resumed", step=O.iter, time=O.time, clumps=len(clumps()))
 
 # --- recirculate: clumps leave through the outlet (outflow() says where they go) ---
 SCHEDULE[:] = DISCHARGE_ACTIONS + [
     (SAMPLE_EVERY, lambda: (check_sane(inside), frame(), forces.sample(), progress('recirculate'))),
     (RESTART_EVERY, checkpoint)]
-if RESTART is None:
+if RESUMED_IN != "discharge":
     frame()
 run_steps(FINAL_STEP - O.iter)
 say_stage('recirculated')

@@ -1,9 +1,10 @@
-"""A run killed with SIGKILL resumes from its newest restart file on the next workflow call.
+"""A run killed with SIGKILL resumes from its newest restart file on the next workflow call, in the stage it was
+killed in.
 
-The tiny silo (about 1,400 clumps) runs killed (the whole process group: Snakemake, the script and LIGGGHTS) after
-its discharge has written two restart files. The killed workflow is unlocked and called again; it resumes. In
-`make test-physics` the tiny silo also runs uninterrupted, and both runs end with the same clumps and flow rates
-within noise.
+The tiny silo (about 1,400 clumps) runs killed (the whole process group: Snakemake, the script and LIGGGHTS) once
+during its pour, after it has written two restart files, and once during its discharge, after two restart files past
+the opening of its outlet. The killed workflow is unlocked and called again; it resumes. In `make test-physics` the
+tiny silo also runs uninterrupted, and each resumed run ends with the same clumps and flow rate within noise.
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ from tests.repo import REPO_ROOT
 from siloflow.engines.layout import run_dir as layout_run_dir, run_path
 from siloflow.engines.liggghts.run import restart_files
 from siloflow.model.cases.silo_flat import build_silo_case
+from tests.stopped_runs import killable
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(100)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(160)]
 
 CONFIG = {"silo_flat": TINY_SILO, "silo_recirculation": NO_BLENDING, "blender": NO_BLENDER}
 
@@ -49,21 +51,24 @@ def _workdir(tmp_path_factory, name):
     return workdir
 
 
-@pytest.fixture(scope="module")
-def killed_and_resumed(tmp_path_factory):
-    """The tiny silo's workflow killed during its discharge, unlocked and called again; yields the run directory."""
+@pytest.fixture(scope="module", params=["fill", "discharge"])
+def killed_and_resumed(request, tmp_path_factory):
+    """The tiny silo's workflow killed during its pour or its discharge, unlocked and called again; yields the stage
+    and the run directory."""
     require_liggghts()
+    stage = request.param
     run_id = _run_id()
     target = run_path("silo_flat", "metrics/flow.csv", run_id)
-    workdir = _workdir(tmp_path_factory, "killed")
+    workdir = _workdir(tmp_path_factory, f"killed_in_{stage}")
     killed = subprocess.Popen(_snakemake_command(workdir, workdir / "tiny.yaml", target),
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     run_dir = workdir / layout_run_dir("silo_flat", run_id)
     deadline = time.monotonic() + 600
-    while len(restart_files(run_dir)) < 2 and killed.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.5)
-    assert killed.poll() is None, "the run finished before it could be killed; lengthen the discharge"
-    assert len(restart_files(run_dir)) >= 2, "no restart files within 10 minutes"
+    while (not killable(run_dir, stage, "log.liggghts", restart_files) and killed.poll() is None
+           and time.monotonic() < deadline):
+        time.sleep(0.2)
+    assert killed.poll() is None, f"the run went past its {stage} before it could be killed there"
+    assert killable(run_dir, stage, "log.liggghts", restart_files), f"no two restart files in its {stage} in 10 minutes"
     os.killpg(killed.pid, signal.SIGKILL)
     killed.wait()
     # let the orphaned engine die with its group before looking at the run directory
@@ -74,7 +79,7 @@ def killed_and_resumed(tmp_path_factory):
     resumed = run_snakemake(workdir, "--cores", "1", "--rerun-incomplete", "--configfile",
                             str(workdir / "tiny.yaml"), targets=[target])
     assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
-    yield run_dir
+    yield stage, run_dir
 
 
 @pytest.fixture(scope="module")
@@ -89,25 +94,33 @@ def uninterrupted(tmp_path_factory):
     yield workdir / layout_run_dir("silo_flat", run_id)
 
 
-def test_the_killed_run_resumes_from_its_restart_file(killed_and_resumed):
-    run_dir = killed_and_resumed
+def test_the_killed_run_resumes_from_its_restart_file_in_the_stage_it_was_killed_in(killed_and_resumed):
+    stage, run_dir = killed_and_resumed
     log = (run_dir / "logs" / "run.log").read_text()
-    assert "resuming" in log and "from restart file restart/state_" in log
+    assert "from restart file restart/state_" in log and f" in its {stage}" in log, log[-2000:]
     record = read_run_record(run_dir / "run.json")
     assert record.resumed_attempts == 1
-    assert "SILOFLOW resumed" in (run_dir / "resume1.log.liggghts").read_text()
+    resumed_log = (run_dir / "resume1.log.liggghts").read_text()
+    assert "SILOFLOW resumed" in resumed_log
+    # a pour resumed goes on inserting where it stopped: the fill holds the case's clumps, no more
+    assert record.stage("fill")["clumps"] == record.n_clumps
+    assert ("SILOFLOW filled" in resumed_log) == (stage == "fill")
+    # the markers' times are the steps' (LIGGGHTS starts its clock again at zero in a resumed attempt)
+    assert record.open_time_s == pytest.approx(record.open_step * record.timestep_s, rel=1e-12)
     # restart files only serve resumption; a finished run has none left
     assert not (run_dir / "restart").exists()
 
 
 @pytest.mark.physics  # a second run of the tiny silo, uninterrupted
 def test_resumed_and_uninterrupted_runs_agree(killed_and_resumed, uninterrupted):
-    resumed_dir, uninterrupted_dir = killed_and_resumed, uninterrupted
+    (_, resumed_dir), uninterrupted_dir = killed_and_resumed, uninterrupted
     resumed = read_run_record(resumed_dir / "run.json")
     uninterrupted = read_run_record(uninterrupted_dir / "run.json")
     assert resumed.stage("fill")["clumps"] == uninterrupted.stage("fill")["clumps"] == resumed.n_clumps
     assert resumed.n_frames == uninterrupted.n_frames
-    assert resumed.stage("discharge")["step"] == uninterrupted.stage("discharge")["step"]
+    # the same discharge, from wherever the outlet opened (a fill resumed settles in its own number of checks)
+    assert (resumed.stage("discharge")["step"] - resumed.open_step
+            == uninterrupted.stage("discharge")["step"] - uninterrupted.open_step)
     (a,) = csv.DictReader((resumed_dir / "metrics" / "flow.csv").open())
     (b,) = csv.DictReader((uninterrupted_dir / "metrics" / "flow.csv").open())
     rate_a, rate_b = float(a["mass_flow_rate_kg_s"]), float(b["mass_flow_rate_kg_s"])

@@ -1,7 +1,7 @@
 """YADE runs the micro silo (about 350 two-sphere clumps, 20 mm of fill) through the engine interface: fill, settle,
-open, discharge. The run is SIGKILLed after its discharge has written two snapshots and resumed by the next call; no
-socket listens while it runs; its frames, wall forces and settled fill read back into the neutral objects and the
-analysis works on them unchanged (flow rate, force balance).
+open, discharge. The run is SIGKILLed, once after its pour has written two snapshots and once after its discharge has,
+and resumed by the next call in that stage; no socket listens while it runs; its frames, wall forces and settled fill
+read back into the neutral objects and the analysis works on them unchanged (flow rate, force balance).
 """
 
 from __future__ import annotations
@@ -21,10 +21,11 @@ from siloflow.model.cases.silo_flat import build_silo_case
 from siloflow.engines.config import load_config_file, validate_config
 from siloflow.engines.interface import EngineOptions, EngineRunError, engine_for
 from siloflow.engines.yade.run import restart_files
+from tests.stopped_runs import killable
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
 from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 
-pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(45)]
+pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(90)]
 
 
 def listening_inodes() -> set[str]:
@@ -67,34 +68,38 @@ def script_processes(run_dir: Path) -> list[int]:
     return found
 
 
-@pytest.fixture(scope="module")
-def micro_run(tmp_path_factory):
+@pytest.fixture(scope="module", params=["fill", "discharge"])
+def micro_run(request, tmp_path_factory):
     require_yade()
     raw = load_config_file(DEFAULT_CONFIG)
     raw["silo_flat"] = {**raw["silo_flat"], **MICRO_SILO}
     config = validate_config(raw)
     case = build_silo_case(config)
     engine = engine_for(config, "silo_flat")
-    run_dir = (tmp_path_factory.mktemp("yade") / case.run_id).resolve()
+    stage = request.param
+    run_dir = (tmp_path_factory.mktemp(f"yade_killed_in_{stage}") / case.run_id).resolve()
     engine.write_inputs(case, run_dir)
     failure = []
     first = threading.Thread(target=lambda: failure.append(_expect_failure(engine, case, run_dir)))
     first.start()
     listening_while_running = None
     deadline = time.monotonic() + 900
-    while len(restart_files(run_dir)) < 2 and first.is_alive() and time.monotonic() < deadline:
+    # on until it can be killed in its stage and has been seen running (the sockets looked at)
+    while ((not killable(run_dir, stage, "log.yade", restart_files) or listening_while_running is None)
+           and first.is_alive() and time.monotonic() < deadline):
         pids = script_processes(run_dir)
         log = run_dir / "log.yade"
         # YADE is imported and the scene runs once the script reports progress
         if pids and listening_while_running is None and log.exists() and "SILOFLOW progress" in log.read_text():
             listening_while_running = {pid: socket_inodes(pid) & listening_inodes() for pid in pids}
-        time.sleep(0.5)
-    assert first.is_alive(), "the run finished before it could be killed; lengthen the discharge"
+        time.sleep(0.2)
+    assert first.is_alive(), f"the run went past its {stage} before it could be killed there"
+    assert killable(run_dir, stage, "log.yade", restart_files), f"no two snapshots in its {stage} within 15 minutes"
     for pid in script_processes(run_dir):
         os.kill(pid, signal.SIGKILL)
     first.join()
     record = engine.run(case, run_dir, EngineOptions())
-    return case, engine, run_dir, record, listening_while_running, failure
+    return case, engine, run_dir, record, listening_while_running, failure, stage
 
 
 def _expect_failure(engine, case, run_dir):
@@ -106,21 +111,25 @@ def _expect_failure(engine, case, run_dir):
 
 
 def test_no_socket_listens_while_yade_runs(micro_run):
-    _, _, _, _, listening, _ = micro_run
+    _, _, _, _, listening, _, _ = micro_run
     assert listening, "the script's process was not seen running"
     assert all(inodes == set() for inodes in listening.values()), listening
 
 
 def test_the_killed_run_failed_and_resumed_from_a_snapshot(micro_run):
-    _, _, run_dir, record, _, failure = micro_run
+    case, _, run_dir, record, _, failure, stage = micro_run
     assert failure and failure[0] is not None and "exit code -9" in failure[0]
     assert record.resumed_attempts == 1
-    assert "SILOFLOW resumed" in (run_dir / "resume1.log.yade").read_text()
+    resumed_log = (run_dir / "resume1.log.yade").read_text()
+    assert "SILOFLOW resumed" in resumed_log
+    # a pour resumed goes on inserting where it stopped, from the random state its snapshot kept
+    assert ("SILOFLOW filled" in resumed_log) == (stage == "fill")
+    assert record.stage("fill")["clumps"] == case.fill.n_clumps
     assert not (run_dir / "restart").exists()  # snapshots only serve resumption
 
 
 def test_the_silo_filled_settled_and_discharged(micro_run):
-    case, engine, run_dir, record, _, _ = micro_run
+    case, engine, run_dir, record, _, _, _ = micro_run
     assert record.engine == "yade" and record.n_clumps == case.fill.n_clumps
     assert record.stage("settle")["ke_per_clump"] < case.settle_threshold
     frames = engine.read_frames(run_dir, record)
@@ -135,7 +144,7 @@ def test_the_silo_filled_settled_and_discharged(micro_run):
 
 
 def test_wall_forces_span_the_run_and_the_settled_fill_balances(micro_run):
-    case, engine, run_dir, record, _, _ = micro_run
+    case, engine, run_dir, record, _, _, _ = micro_run
     history = engine.wall_forces(run_dir, record)
     assert set(history.walls) == {"wall_left", "wall_right", "wall_front", "wall_back", "floor_left", "floor_right",
                                   "outlet_gate"}
@@ -151,6 +160,6 @@ def test_wall_forces_span_the_run_and_the_settled_fill_balances(micro_run):
 
 
 def test_the_yade_run_opens_in_paraview_on_its_simulated_clock(micro_run, tmp_path):
-    case, engine, run_dir, record, _, _ = micro_run
+    case, engine, run_dir, record, _, _, _ = micro_run
     frames = write_engine_paraview_files("silo_flat", case, engine, run_dir, record)
     check_paraview_folder(run_dir, frames, fields=False, workdir=tmp_path)

@@ -130,7 +130,7 @@ def test_the_deck_stops_the_re_entry_then_discharges(golden_config):
     assert tail.index("SILOFLOW recirculated") < tail.index("change_box all boundary f f f")
     discharge = tail.split("change_box all boundary f f f")[1]
     assert "thermo_modify lost ignore" in discharge and f"run {case.final_discharge_steps}\n" in discharge
-    assert discharge.rstrip().endswith('print "SILOFLOW discharged step=$(step) time=$(time) clumps=${n_clumps} '
+    assert discharge.rstrip().endswith('print "SILOFLOW discharged step=$(step) time=$(step*dt) clumps=${n_clumps} '
                                        'ke_per_clump=${ke_per_clump}"')
 
 

@@ -22,7 +22,7 @@ from siloflow.engines.liggghts.forces import (
 from siloflow.engines.liggghts.run import WALL_FORCES_NAME
 from siloflow.engines.liggghts.jenike import FORCES_NAME
 from siloflow.engines.jenike_checks import FORCE_COLUMNS, JENIKE_WALLS
-from siloflow.engines.liggghts.run import RESUME_STEM, Resume
+from siloflow.engines.liggghts.run import RESUME_STEM, Resume, ResumePoint
 from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
 
 GOLDEN = Path(__file__).resolve().parent.parent / "golden"
@@ -259,7 +259,8 @@ def test_the_silo_deck_names_every_wall_as_the_reader_expects(tmp_path):
 def test_the_resume_deck_writes_the_same_columns_to_a_file_named_by_its_restart_step():
     case = _golden_case()
     context = silo_deck_context(case)
-    deck = Resume("liggghts/silo_flat.lmp.j2", context, case.discharge_steps).deck("restart/state_31200.restart", 77952)
+    deck = Resume("liggghts/silo_flat.lmp.j2", context, case.discharge_steps).deck("restart/state_31200.restart",
+                                                                             ResumePoint("discharge", final_step=77952))
     name, header = _fix_header(deck)
     assert name == f"{RESUMED_WALL_FORCES_PREFIX}_$(step).txt"
     assert header == _fix_header(render_silo_deck(case))[1]

@@ -28,7 +28,7 @@ from siloflow.engines.liggghts.dumps import list_dumps
 from siloflow.engines.layout import RUN_RECORD, write_text_atomic
 from siloflow.engines.liggghts.inputs import DECK_NAME
 from siloflow.engines.liggghts.markers import error_lines, log_excerpt
-from siloflow.engines.markers import Marker, parse_markers
+from siloflow.engines.markers import Marker, parse_markers, without_redone
 from siloflow.engines.liggghts.thermo import ThermoProgress
 from siloflow.engines.progress import run_with_progress
 from siloflow.engines.templating import render_deck
@@ -63,7 +63,8 @@ def settled_fill_context(contacts_prefix: str, contact_columns: int, timestep: f
 
 
 
-#: Restart files of the last stage: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per stage.
+#: Restart files of a silo-type run, from its pour on: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per
+#: stage.
 RESTART_DIR = "restart"
 RESTART_PREFIX = "state"
 RESTARTS_PER_STAGE = 20
@@ -175,26 +176,77 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     return log_text
 
 
+#: The stages a silo-type run resumes in: the pour, the settling and the last stage (after the outlet opened).
+RESUME_STAGES = ("fill", "settle", "discharge")
+
+
+@dataclass(frozen=True)
+class ResumePoint:
+    """Where a stopped silo-type run goes on from a restart file.
+
+    Attributes
+    ----------
+    stage : str
+        One of :data:`RESUME_STAGES`: the stage the restart file lies in.
+    final_step : int or None
+        In the last stage, the step the uninterrupted run ends at (its outlet's opening step plus the last stage's
+        steps); None before.
+    settle_checks : int or None
+        In the settling, the checks the stopped run had still to make (at least 1); None otherwise.
+    """
+
+    stage: str
+    final_step: int | None = None
+    settle_checks: int | None = None
+
+
+def resume_point(markers: list[Marker], restart_step: int, last_stage_steps: int,
+                 settle_max_checks: int) -> ResumePoint:
+    """The stage a restart file written at ``restart_step`` lies in, from the stage markers of the attempts so far.
+
+    The last stage when an ``opened`` marker is at or before it; the settling when a ``filled`` marker is (the checks
+    still to make: ``settle_max_checks`` less the ``settle`` markers at or before it, whatever attempt printed them);
+    else the pour. ``markers`` are those of the attempts so far without the ones a later attempt made again
+    (:func:`siloflow.engines.markers.without_redone`); those after the restart step were printed by an attempt
+    that went on past it, and are made again.
+    """
+    def steps(event: str) -> list[int]:
+        return [step for m in markers if m.event == event and (step := int(round(m.values["step"]))) <= restart_step]
+
+    opened = steps("opened")
+    if opened:
+        return ResumePoint("discharge", final_step=max(opened) + last_stage_steps)
+    if steps("filled"):
+        return ResumePoint("settle", settle_checks=max(settle_max_checks - len(steps("settle")), 1))
+    return ResumePoint("fill")
+
+
 @dataclass(frozen=True)
 class Resume:
     """How a silo-type run resumes: the deck template of its case, its rendering context and the steps of its
-    last stage (the one that writes restart files)."""
+    last stage."""
 
     template: str
     context: dict
     last_stage_steps: int
 
-    def deck(self, restart_file: str, final_step: int) -> str:
-        """The resume deck: the case deck from ``restart_file`` up to ``final_step``."""
+    def deck(self, restart_file: str, point: ResumePoint) -> str:
+        """The resume deck: the case deck from ``restart_file``, in the stage of ``point`` (:func:`resume_point`)."""
         context = dict(self.context)
-        context.update(
-            case_template=self.template,
-            resume={"restart_file": restart_file},
-            discharge={**self.context["discharge"], "steps": int(final_step), "upto": True},
-            # the dumps go on on the steps of the first attempt (multiples of the interval), none at the restart
-            dump={**self.context["dump"], "first": False},
-        )
+        context.update(case_template=self.template, resume={"restart_file": restart_file, "stage": point.stage})
+        if point.stage == "discharge":
+            context.update(
+                discharge={**self.context["discharge"], "steps": int(point.final_step), "upto": True},
+                # the dumps go on on the steps of the first attempt (multiples of the interval), none at the restart
+                dump={**self.context["dump"], "first": False},
+            )
+        elif point.stage == "settle":
+            context["settle"] = {**self.context["settle"], "max_checks": int(point.settle_checks)}
         return render_deck("liggghts/resume.lmp.j2", context)
+
+    def point(self, markers: list[Marker], restart_step: int) -> ResumePoint:
+        """:func:`resume_point` of this run's case."""
+        return resume_point(markers, restart_step, self.last_stage_steps, self.context["settle"]["max_checks"])
 
 
 RESUME_STEM = "resume"
@@ -223,19 +275,41 @@ def _logs_text(run_dir: Path) -> str:
     return "\n".join(path.read_text(encoding="utf-8", errors="replace") for path in attempt_logs(run_dir))
 
 
-def _resume_run(run_dir: Path, resume: Resume, opened: Marker, engine: dict) -> None:
-    """Resume from the newest restart file (the one before it if the newest was cut off by the kill)."""
+#: What a run writes once its fill has settled (snapshot, contacts, walls' forces, the assembly): a run resumed in
+#: its fill or settling writes them again, so those of the attempt it resumes are removed first.
+SETTLED_OUTPUTS = (f"dumps/{SETTLED_FILL_PREFIX}_*.txt", f"dumps/{CONTACT_PREFIX}_*.txt", SETTLED_WALLS_PATH,
+                   ASSEMBLY_RESTART)
+
+
+def discard_settled_outputs(run_dir: Path) -> list[str]:
+    """Remove what a stopped attempt wrote once its fill had settled (:data:`SETTLED_OUTPUTS`), before an attempt that
+    resumes in the pour or the settling writes them again; returns the names removed."""
+    removed = []
+    for pattern in SETTLED_OUTPUTS:
+        for stale in sorted(run_dir.glob(pattern)):
+            stale.unlink()
+            removed.append(stale.relative_to(run_dir).as_posix())
+    return removed
+
+
+def _resume_run(run_dir: Path, resume: Resume, markers: list[Marker], engine: dict) -> None:
+    """Resume from the newest restart file (the one before it if the newest was cut off by the kill), in the stage
+    that file lies in."""
     log = logging.getLogger("siloflow")
-    final_step = int(round(opened.values["step"])) + resume.last_stage_steps
 
     def run_from(restart: Path) -> None:
         relative = f"{RESTART_DIR}/{restart.name}"
-        write_text_atomic(run_dir / "deck" / RESUME_DECK, resume.deck(relative, final_step))
-        log.info("resuming %s from restart file %s (the last stage ends at step %d)", run_dir.name, relative, final_step)
+        restart_step = int(_RESTART_STEP.match(restart.name).group(1))
+        point = resume.point(markers, restart_step)
+        if point.stage != "discharge":
+            discard_settled_outputs(run_dir)
+        write_text_atomic(run_dir / "deck" / RESUME_DECK, resume.deck(relative, point))
+        log.info("resuming %s from restart file %s in its %s%s", run_dir.name, relative, point.stage,
+                 f" (the last stage ends at step {point.final_step})" if point.final_step is not None else "")
         options = dict(engine)
         if options.get("target_time"):
             # LIGGGHTS restarts the clock at zero: progress counts the simulated time still to go
-            restart_step = int(_RESTART_STEP.match(restart.name).group(1))
+            final_step = point.final_step or max(int(round(options["target_time"] / resume.context["timestep"])), 1)
             options["target_time"] *= max(final_step - restart_step, 1) / final_step
         attempt = len(attempt_logs(run_dir))
         run_engine(run_dir, **options, deck_name=RESUME_DECK, log_name=f"{RESUME_STEM}{attempt}.{LOG_NAME}",
@@ -255,8 +329,8 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, to_recor
                 resume: Resume | None = None) -> RunRecord:
     """Run the rendered deck of ``run_dir``, check the run and write ``run.json``; returns the record.
 
-    A run that was killed after its last stage began (it left restart files and its log has the ``opened``
-    marker) resumes from its newest restart file when ``resume`` is given; its logs are then the first attempt's
+    A run that was stopped after its pour began (it left a log and restart files) resumes from its newest restart
+    file when ``resume`` is given, in the stage that file lies in; its logs are then the first attempt's
     plus one per resumption, checked together. Otherwise the output of an earlier unfinished attempt is moved to
     ``failed_attempts/`` first, so the dumps of this run are never mixed with older ones. ``check(markers,
     dump_files)`` raises :class:`EngineRunError` or returns what it checked (a dict); ``engine`` holds the
@@ -270,15 +344,13 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, to_recor
     if not deck.exists():
         raise FileNotFoundError(f"no deck at {deck}; render it first")
     (run_dir / RUN_RECORD).unlink(missing_ok=True)
-    earlier = parse_markers(_logs_text(run_dir)) if resume is not None else []
-    opened = [m for m in earlier if m.event == "opened"]
-    resumed = resume is not None and bool(opened) and bool(restart_files(run_dir))
+    resumed = resume is not None and bool(attempt_logs(run_dir)) and bool(restart_files(run_dir))
     if resumed:
-        _resume_run(run_dir, resume, opened[-1], engine)
+        _resume_run(run_dir, resume, without_redone(parse_markers(_logs_text(run_dir))), engine)
     else:
         set_aside_previous_attempt(run_dir)
         run_engine(run_dir, **engine)
-    checked = check(parse_markers(_logs_text(run_dir)), list_dumps(run_dir / "dumps", DUMP_PREFIX))
+    checked = check(without_redone(parse_markers(_logs_text(run_dir))), list_dumps(run_dir / "dumps", DUMP_PREFIX))
     checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "resumed_attempts": len(attempt_logs(run_dir)) - 1})
     shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
     checked["output_bytes"] = output_bytes(run_dir)

@@ -94,6 +94,11 @@ def silo_deck_context(case: SiloCase) -> dict:
             "settled_fill": settled_fill_context(CONTACT_PREFIX, N_CONTACT_COLUMNS, case.timestep),
             "discharge": {"steps": case.discharge_steps, "upto": False},
             "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
+            # the fill and the settling write restart files too, at 1/20 of the pour: a run stopped there resumes
+            "fill_restart": {"every": restart_every(case.fill.fill_steps),
+                             "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
+            # the first attempt's deck; a resumed attempt's names its restart file and stage (Resume)
+            "resume": None,
             "thermo_every": dump_every,
             # the settled fill, kept for the runs that start from it (the recirculating silo's; the others set None)
             "assembly_restart": ASSEMBLY_RESTART,

@@ -34,7 +34,7 @@ from typing import Callable
 
 from siloflow.model.record import RunRecord
 from siloflow.engines.interface import EngineNotFound, EngineRunError
-from siloflow.engines.markers import Marker, parse_markers
+from siloflow.engines.markers import Marker, parse_markers, without_redone
 from siloflow.engines.progress import run_with_progress
 from siloflow.engines.run_files import output_bytes, set_aside_previous_attempt, write_run_record
 from siloflow.engines.yade.inputs import DECK_NAME
@@ -136,18 +136,32 @@ def run_script(run_dir: str | Path, options: YadeOptions, target_time: float | N
     return text
 
 
-def _resume(run_dir: Path, options: YadeOptions, target_time: float, final_step: int) -> None:
-    """Resume from the newest snapshot (the one before it if the newest cannot be read)."""
+def _resume(run_dir: Path, options: YadeOptions, target_time: float, markers: list[Marker]) -> None:
+    """Resume from the newest snapshot (the one before it if the newest cannot be read), in the stage the snapshot
+    keeps in its tags: the pour, the settling, or the last stage, which ends at the step the ``opened`` marker names
+    (``markers``: those of the attempts so far)."""
     log = logging.getLogger("siloflow")
     newest, *older = restart_files(run_dir)[-2:][::-1]
     for attempt_from in (newest, *older):
         step = int(_RESTART.match(attempt_from.name).group(1))
+        opened = [m for m in markers if m.event == "opened" and m.values["step"] <= step]
         attempt = len(attempt_logs(run_dir))
-        log.info("resuming %s from snapshot %s (the last stage ends at step %d)", run_dir.name, attempt_from.name,
-                 final_step)
+        arguments = (f"{RESTART_DIR}/{attempt_from.name}",)
+        remaining = target_time
+        if opened:
+            final_step = int(round(opened[-1].values["final_step"]))
+            arguments += (str(final_step),)
+            remaining = target_time * max(final_step - step, 1) / final_step
+            log.info("resuming %s from snapshot %s in its discharge (the last stage ends at step %d)", run_dir.name,
+                     attempt_from.name, final_step)
+        else:
+            # what the stopped attempt wrote once its fill had settled is written again
+            for stale in [*(run_dir / "dumps").glob(f"{SETTLED_FILL_PREFIX}_*.npz"), run_dir / ASSEMBLY_STATE]:
+                stale.unlink(missing_ok=True)
+            # YADE keeps its clock in the snapshot: the progress goes on from the simulated time it holds
+            log.info("resuming %s from snapshot %s before its outlet opened", run_dir.name, attempt_from.name)
         try:
-            run_script(run_dir, options, target_time * max(final_step - step, 1) / final_step,
-                       (f"{RESTART_DIR}/{attempt_from.name}", str(final_step)), f"{RESUME_STEM}{attempt}.{LOG_NAME}")
+            run_script(run_dir, options, remaining, arguments, f"{RESUME_STEM}{attempt}.{LOG_NAME}")
             return
         except EngineRunError as error:
             if attempt_from is not newest or not older:
@@ -169,15 +183,13 @@ def run_script_checked(run_dir: str | Path, options: YadeOptions, target_time: f
     if not (run_dir / "deck" / DECK_NAME).exists():
         raise FileNotFoundError(f"no script at {run_dir / 'deck' / DECK_NAME}; render it first")
     (run_dir / "run.json").unlink(missing_ok=True)
-    opened = [m for m in parse_markers(_logs_text(run_dir)) if m.event == "opened"]
-    if opened and restart_files(run_dir):
-        final_step = int(round(opened[-1].values["final_step"]))
-        _resume(run_dir, options, target_time, final_step)
+    if attempt_logs(run_dir) and restart_files(run_dir):
+        _resume(run_dir, options, target_time, without_redone(parse_markers(_logs_text(run_dir))))
     else:
         set_aside_previous_attempt(run_dir, RUN_OUTPUTS + tuple(extra_outputs), (f"{RESUME_STEM}*",))
         (run_dir / "dumps").mkdir(parents=True, exist_ok=True)
         run_script(run_dir, options, target_time)
-    checked = check(parse_markers(_logs_text(run_dir)), frame_files(run_dir, DUMP_PREFIX))
+    checked = check(without_redone(parse_markers(_logs_text(run_dir))), frame_files(run_dir, DUMP_PREFIX))
     checked.update({"mpi_ranks": 1, "resumed_attempts": len(attempt_logs(run_dir)) - 1})
     shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
     checked["output_bytes"] = output_bytes(run_dir)

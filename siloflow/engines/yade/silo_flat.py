@@ -86,6 +86,7 @@ def silo_script_context(case: SiloCase, gravity: float = GRAVITY) -> dict:
         "discharge": {"steps": case.discharge_steps, "stage": "discharge", "marker": "discharged"},
         "sample_every": case.dump_every,
         "restart_every": max(1, -(-case.discharge_steps // RESTARTS_PER_STAGE)),
+        "fill_restart_every": max(1, -(-case.fill.fill_steps // RESTARTS_PER_STAGE)),
         "wall_forces_path": WALL_FORCES_NAME,
         # the settled fill, kept for the runs that start from it (the recirculating silo's; the others set None), and
         # the assembly a run starts from (None: it pours its own)
