@@ -10,7 +10,7 @@ from siloflow.model.cases.blender import build_blender_case
 from siloflow.model.cases.silo_recirculation import build_recirculation_case
 from siloflow.engines.config import load_config, validate_config
 from siloflow.engines.liggghts.run import (Resume, ResumePoint, attempt_logs, discard_settled_outputs, restart_every,
-                                           restart_files, resume_point)
+                                           restart_files, resume_point, set_aside_previous_attempt)
 from siloflow.engines.markers import Marker, without_redone
 from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
 from siloflow.engines.liggghts.blender import blender_deck_context
@@ -188,3 +188,13 @@ def test_a_resumption_before_the_opening_removes_what_the_stopped_attempt_wrote_
                                                  "assembly.restart"]
     assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["particles_1400.vtk", "wall_forces.txt"]
     assert discard_settled_outputs(tmp_path) == []
+
+
+def test_an_attempt_set_aside_takes_the_restart_file_liggghts_wrote_when_a_signal_stopped_it(tmp_path):
+    for name in ("log.liggghts", "restart_forced_liggghts_91946.data", "resume1.log.liggghts"):
+        (tmp_path / name).write_text("x")
+    (tmp_path / "deck").mkdir()
+    target = set_aside_previous_attempt(tmp_path)
+    assert sorted(p.name for p in target.iterdir()) == ["log.liggghts", "restart_forced_liggghts_91946.data",
+                                                        "resume1.log.liggghts"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deck", "failed_attempts"]

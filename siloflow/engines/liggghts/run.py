@@ -130,12 +130,15 @@ WALL_FORCES_NAME = "wall_forces.txt"
 #: run's folder); a run that starts from it reads its copy in ``deck/``.
 ASSEMBLY_RESTART = "assembly.restart"
 RUN_OUTPUTS = ("dumps", LOG_NAME, SCREEN_NAME, "restart", WALL_FORCES_NAME, ASSEMBLY_RESTART)
+#: The restart file LIGGGHTS writes of its own when a signal stops it (SIGTERM at a part's deadline): a resumed run
+#: goes on from its periodic restart files instead, so these only serve an inspection of the stopped attempt.
+FORCED_RESTARTS = "restart_forced_*.data"
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...] = RUN_OUTPUTS) -> Path | None:
     """Move the output of an unfinished earlier attempt (``outputs``, and the resumptions' files) into
     ``failed_attempts/<UTC time>/`` (:func:`siloflow.engines.run_files.set_aside_previous_attempt`)."""
-    return set_aside(run_dir, outputs, (f"{RESUME_STEM}*",))
+    return set_aside(run_dir, outputs, (f"{RESUME_STEM}*", FORCED_RESTARTS))
 
 
 #: Wall time between progress lines in a run's log (s) and between polls of the engine's output (s).
@@ -353,6 +356,8 @@ def run_checked(run_dir: str | Path, check, engine: dict | None = None, to_recor
     checked = check(without_redone(parse_markers(_logs_text(run_dir))), list_dumps(run_dir / "dumps", DUMP_PREFIX))
     checked.update({"mpi_ranks": engine.get("mpi_ranks", 1), "resumed_attempts": len(attempt_logs(run_dir)) - 1})
     shutil.rmtree(run_dir / RESTART_DIR, ignore_errors=True)
+    for forced in run_dir.glob(FORCED_RESTARTS):
+        forced.unlink()
     checked["output_bytes"] = output_bytes(run_dir)
     record = to_record(checked)
     write_run_record(run_dir, record)
