@@ -13,10 +13,32 @@ from siloflow.model.record import RunRecord
 from siloflow.engines.estimates import format_bytes
 from siloflow.engines.layout import RUN_RECORD, write_text_atomic
 
-__all__ = ["FAILED_ATTEMPTS", "earlier_attempt_logs", "output_bytes", "set_aside_attempts", "set_aside_previous_attempt", "write_run_record"]
+__all__ = ["FAILED_ATTEMPTS", "RESTARTS_PER_STAGE", "earlier_attempt_logs", "output_bytes", "remove_matching",
+           "restart_every", "set_aside_attempts", "set_aside_previous_attempt", "write_run_record"]
 
 #: The folder of a run directory that holds its unfinished earlier attempts, one ``<UTC time>/`` folder each.
 FAILED_ATTEMPTS = "failed_attempts"
+#: Restart files (LIGGGHTS) or snapshots (YADE) a silo-type run writes per stage, from its pour on.
+RESTARTS_PER_STAGE = 20
+
+
+def restart_every(stage_steps: int) -> int:
+    """Steps between restart files of a stage of ``stage_steps`` steps: a stopped run loses at most 1/20 of it."""
+    if stage_steps < 1:
+        raise ValueError(f"stage_steps must be >= 1, got {stage_steps!r}")
+    return max(1, -(-stage_steps // RESTARTS_PER_STAGE))
+
+
+def remove_matching(run_dir: Path, patterns: tuple[str, ...]) -> list[str]:
+    """Remove the files of ``run_dir`` that match ``patterns`` (globs relative to it); returns their relative names, in
+    the patterns' order. What a stopped attempt wrote after the restart file a resumed attempt goes on from, which
+    that attempt writes again."""
+    removed = []
+    for pattern in patterns:
+        for stale in sorted(Path(run_dir).glob(pattern)):
+            stale.unlink()
+            removed.append(stale.relative_to(run_dir).as_posix())
+    return removed
 
 
 def set_aside_previous_attempt(run_dir: Path, outputs: tuple[str, ...], patterns: tuple[str, ...] = ()) -> Path | None:

@@ -9,8 +9,9 @@ import pytest
 from siloflow.model.cases.blender import build_blender_case
 from siloflow.model.cases.silo_recirculation import build_recirculation_case
 from siloflow.engines.config import load_config, validate_config
-from siloflow.engines.liggghts.run import (Resume, ResumePoint, attempt_logs, discard_settled_outputs, restart_every,
-                                           restart_files, resume_point, set_aside_previous_attempt)
+from siloflow.engines.liggghts.run import (Resume, ResumePoint, attempt_logs, discard_settled_outputs, restart_files,
+                                           resume_point, set_aside_previous_attempt)
+from siloflow.engines.run_files import restart_every
 from siloflow.engines.markers import Marker, without_redone
 from siloflow.engines.liggghts.silo_flat import render_silo_deck, silo_deck_context
 from siloflow.engines.liggghts.blender import blender_deck_context

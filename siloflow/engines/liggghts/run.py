@@ -22,7 +22,7 @@ from pathlib import Path
 
 from siloflow.model.record import RunRecord
 from siloflow.engines.interface import EngineNotFound, EngineRunError
-from siloflow.engines.run_files import output_bytes, write_run_record
+from siloflow.engines.run_files import output_bytes, remove_matching, write_run_record
 from siloflow.engines.run_files import set_aside_previous_attempt as set_aside
 from siloflow.engines.liggghts.dumps import list_dumps
 from siloflow.engines.layout import RUN_RECORD, write_text_atomic
@@ -63,18 +63,11 @@ def settled_fill_context(contacts_prefix: str, contact_columns: int, timestep: f
 
 
 
-#: Restart files of a silo-type run, from its pour on: ``restart/state_<step>.restart``, about RESTARTS_PER_STAGE per
-#: stage.
+#: Restart files of a silo-type run, from its pour on: ``restart/state_<step>.restart``, about
+#: :data:`~siloflow.engines.run_files.RESTARTS_PER_STAGE` per stage (:func:`~siloflow.engines.run_files.restart_every`).
 RESTART_DIR = "restart"
 RESTART_PREFIX = "state"
-RESTARTS_PER_STAGE = 20
-
-
-def restart_every(stage_steps: int) -> int:
-    """Steps between restart files of a stage of ``stage_steps`` steps: a killed run loses at most 1/20 of it."""
-    if stage_steps < 1:
-        raise ValueError(f"stage_steps must be >= 1, got {stage_steps!r}")
-    return max(1, -(-stage_steps // RESTARTS_PER_STAGE))
+RESTART_PATH = f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"
 
 
 
@@ -179,10 +172,6 @@ def run_engine(run_dir: str | Path, executable: str = "liggghts", mpi_ranks: int
     return log_text
 
 
-#: The stages a silo-type run resumes in: the pour, the settling and the last stage (after the outlet opened).
-RESUME_STAGES = ("fill", "settle", "discharge")
-
-
 @dataclass(frozen=True)
 class ResumePoint:
     """Where a stopped silo-type run goes on from a restart file.
@@ -190,7 +179,8 @@ class ResumePoint:
     Attributes
     ----------
     stage : str
-        One of :data:`RESUME_STAGES`: the stage the restart file lies in.
+        The stage the restart file lies in: ``fill`` (the pour), ``settle`` or ``discharge`` (the last stage, after
+        the outlet opened).
     final_step : int or None
         In the last stage, the step the uninterrupted run ends at (its outlet's opening step plus the last stage's
         steps); None before.
@@ -287,12 +277,7 @@ SETTLED_OUTPUTS = (f"dumps/{SETTLED_FILL_PREFIX}_*.txt", f"dumps/{CONTACT_PREFIX
 def discard_settled_outputs(run_dir: Path) -> list[str]:
     """Remove what a stopped attempt wrote once its fill had settled (:data:`SETTLED_OUTPUTS`), before an attempt that
     resumes in the pour or the settling writes them again; returns the names removed."""
-    removed = []
-    for pattern in SETTLED_OUTPUTS:
-        for stale in sorted(run_dir.glob(pattern)):
-            stale.unlink()
-            removed.append(stale.relative_to(run_dir).as_posix())
-    return removed
+    return remove_matching(run_dir, SETTLED_OUTPUTS)
 
 
 def _resume_run(run_dir: Path, resume: Resume, markers: list[Marker], engine: dict) -> None:

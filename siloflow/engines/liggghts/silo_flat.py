@@ -17,14 +17,13 @@ from siloflow.engines.liggghts.run import (
     ASSEMBLY_RESTART,
     CONTACT_PREFIX,
     DUMP_PREFIX,
-    RESTART_DIR,
-    RESTART_PREFIX,
+    RESTART_PATH,
     Resume,
     WALL_FORCES_NAME,
-    restart_every,
     run_checked,
     settled_fill_context,
 )
+from siloflow.engines.run_files import restart_every
 from siloflow.engines.silo_checks import check_silo_run, expected_simulated_time, silo_run_record
 from siloflow.engines.templating import render_deck
 
@@ -93,10 +92,9 @@ def silo_deck_context(case: SiloCase) -> dict:
                      "fields": list(SILO_DUMP_FIELDS)},
             "settled_fill": settled_fill_context(CONTACT_PREFIX, N_CONTACT_COLUMNS, case.timestep),
             "discharge": {"steps": case.discharge_steps, "upto": False},
-            "restart": {"every": restart_every(case.discharge_steps), "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
+            "restart": {"every": restart_every(case.discharge_steps), "path": RESTART_PATH},
             # the fill and the settling write restart files too, at 1/20 of the pour: a run stopped there resumes
-            "fill_restart": {"every": restart_every(case.fill.fill_steps),
-                             "path": f"{RESTART_DIR}/{RESTART_PREFIX}_*.restart"},
+            "fill_restart": {"every": restart_every(case.fill.fill_steps), "path": RESTART_PATH},
             # the first attempt's deck; a resumed attempt's names its restart file and stage (Resume)
             "resume": None,
             "thermo_every": dump_every,

@@ -36,7 +36,7 @@ from siloflow.model.record import RunRecord
 from siloflow.engines.interface import EngineNotFound, EngineRunError
 from siloflow.engines.markers import Marker, parse_markers, without_redone
 from siloflow.engines.progress import run_with_progress
-from siloflow.engines.run_files import output_bytes, set_aside_previous_attempt, write_run_record
+from siloflow.engines.run_files import output_bytes, remove_matching, set_aside_previous_attempt, write_run_record
 from siloflow.engines.yade.inputs import DECK_NAME
 from siloflow.engines.yade.progress import ScriptProgress
 
@@ -156,8 +156,7 @@ def _resume(run_dir: Path, options: YadeOptions, target_time: float, markers: li
                      attempt_from.name, final_step)
         else:
             # what the stopped attempt wrote once its fill had settled is written again
-            for stale in [*(run_dir / "dumps").glob(f"{SETTLED_FILL_PREFIX}_*.npz"), run_dir / ASSEMBLY_STATE]:
-                stale.unlink(missing_ok=True)
+            remove_matching(run_dir, (f"dumps/{SETTLED_FILL_PREFIX}_*.npz", ASSEMBLY_STATE))
             # YADE keeps its clock in the snapshot: the progress goes on from the simulated time it holds
             log.info("resuming %s from snapshot %s before its outlet opened", run_dir.name, attempt_from.name)
         try:

@@ -17,13 +17,10 @@ from siloflow.engines.templating import render_deck
 from siloflow.engines.yade.inputs import (
     ENGINE_NAME, GEOMETRY_PATH, common_context, exploded_speed, materials_context, rolling_friction, write_script_inputs,
 )
+from siloflow.engines.run_files import restart_every
 from siloflow.engines.yade.run import (
     ASSEMBLY_STATE, DUMP_PREFIX, RESTART_DIR, RESUME_STEM, SETTLED_FILL_PREFIX, WALL_FORCES_NAME, YadeOptions, run_script_checked,
 )
-
-#: Restart snapshots per discharge: a killed run loses at most 1/20 of it.
-RESTARTS_PER_STAGE = 20
-
 
 def check_silo_case(case: SiloCase) -> None:
     """Refuse what the YADE silo scripts (flat-bottom, recirculating, blender) do not build.
@@ -85,8 +82,8 @@ def silo_script_context(case: SiloCase, gravity: float = GRAVITY) -> dict:
         "settled_fill": {"steps": 200},
         "discharge": {"steps": case.discharge_steps, "stage": "discharge", "marker": "discharged"},
         "sample_every": case.dump_every,
-        "restart_every": max(1, -(-case.discharge_steps // RESTARTS_PER_STAGE)),
-        "fill_restart_every": max(1, -(-case.fill.fill_steps // RESTARTS_PER_STAGE)),
+        "restart_every": restart_every(case.discharge_steps),
+        "fill_restart_every": restart_every(case.fill.fill_steps),
         "wall_forces_path": WALL_FORCES_NAME,
         # the settled fill, kept for the runs that start from it (the recirculating silo's; the others set None), and
         # the assembly a run starts from (None: it pours its own)
