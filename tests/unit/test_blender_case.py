@@ -81,6 +81,21 @@ def test_gravity_factor_scales_gravity_stiffness_and_times_at_the_same_steps(gol
     assert "youngs_modulus_factor" not in base.defining_parameters
 
 
+def test_at_fixed_moduli_a_faster_run_keeps_the_material_and_its_own_id(golden_config):
+    fixed = changed(golden_config, lambda b: b.update(gravity_moduli="fixed"))
+    base, fast = build_blender_case(fixed, "straight", 1.0), build_blender_case(fixed, "straight", 4.0)
+    scaled_fast = build_blender_case(golden_config, "straight", 4.0)
+    # the study's series: the same moduli at every factor, gravity and the flow times as under the other rule
+    assert fast.silo.materials.youngs_modulus == base.silo.materials.youngs_modulus
+    assert fast.gravity == pytest.approx(4 * 9.81) and fast.steady_window == scaled_fast.steady_window
+    assert "youngs_modulus_factor" not in fast.defining_parameters
+    # the stiffer rule's run is another run; at 1 g both rules make the same run
+    assert fast.run_id != scaled_fast.run_id
+    assert base.run_id == build_blender_case(golden_config, "straight", 1.0).run_id
+    # the time step follows the Hertz limit of the faster pour, not a stiffer contact: longer than the scaled run's
+    assert scaled_fast.silo.timestep < fast.silo.timestep <= base.silo.timestep
+
+
 def test_fill_area_of_an_empty_hopper_is_the_trapezoid_plus_the_rectangle():
     geometry = blender_geometry(0.2, 0.01, 0.2, 30.0, 0.02, 0.002, tube_width=0, insert="none")
     tan30 = math.tan(math.radians(30.0))

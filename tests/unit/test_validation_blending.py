@@ -37,10 +37,8 @@ def test_every_part_of_chapters_6_and_7_is_made_or_unmade_with_a_reason():
     assert set(MADE) | set(UNMADE) == parts and not set(MADE) & set(UNMADE)
     assert not any(part.startswith("B") for part in UNMADE)  # every part of ch. 6 can be made
     assert all(UNMADE[part] for part in UNMADE)
-    assert "blender.gravity_factors" in UNMADE["M4.mass_flow"] and "fixed" in UNMADE["M4.mass_flow"]
-    assert set(UNMADE) == {"M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates", "M4.interior_deviates",
-                           "M4.inlet_differential_decreases"}
-    assert "M2.vertical_uniform" in MADE
+    assert UNMADE == {}  # M4 is made from a gravity series at fixed moduli
+    assert {"M2.vertical_uniform", "M4.mass_flow", "M4.inlet_differential_decreases"} <= set(MADE)
 
 
 def test_no_row_reads_a_mass_flow_ratio_threshold():
@@ -263,8 +261,11 @@ def _wall(outlet=(-2.0, -1.6, -0.4), inlet=(-1.0, -1.02), vertical=None):
             "vertical_section": vertical or {}}
 
 
-def _brun(summary, note="one seed: within-run error only", dof=None):
-    return {"case": {}, "summary": summary, "note": note, "dof": dof}
+def _brun(summary, note="one seed: within-run error only", dof=None, scaled=True):
+    """A run of the blender rows; beyond 1 g its moduli were scaled with gravity or, ``scaled=False``, fixed."""
+    factor = summary["gravity_factor"]
+    parameters = {"youngs_modulus_factor": factor} if scaled and factor != 1.0 else {}
+    return {"case": {"parameters": parameters}, "summary": summary, "note": note, "dof": dof}
 
 
 def test_m1_is_each_passage_of_the_diverging_insert_over_the_mean_of_the_bins_at_the_insert_outlet():
@@ -427,3 +428,60 @@ def test_gravity_rows_are_a_similarity_check_with_each_run_s_own_note():
         assert "mean of 3 seeds" not in other
         assert ("one seed; error includes" if factor == "5 g" else "one seed at 50 g") in other
     assert gravity_rows([runs[1], runs[2]], TOLERANCES) == []  # no 1 g run to scale from
+
+
+def _fixed_series(configuration="diverging", exterior_exponent=0.2, inlet_errors=(0.01, 0.01)):
+    """A 1 g and a 5 g run at fixed moduli: the flow, the tube and the interior annulus scale with sqrt(5), the
+    exterior annulus with 5 ** exterior_exponent; at the inlet the annuli differ by 0.1 m/s at 1 g and by
+    0.05 sqrt(5) at 5 g."""
+    root = math.sqrt(5.0)
+    one = _blender(configuration, -3.0, -2.0, -1.0, mode="batch", inlet=(-1.0, -1.1))
+    five = _blender(configuration, -3.0 * root, -2.0 * root, -(5.0 ** exterior_exponent), factor=5.0,
+                    flow=0.01 * root, mode="batch", inlet=(-1.0 * root, -1.05 * root))
+    for summary in (one, five):
+        summary["passages_at_insert_inlet"]["mean_v_z_m_s_error"] = dict(zip(("interior", "exterior"), inlet_errors))
+    return [_brun(one, note="reference", scaled=False), _brun(five, note="one seed at 5 g", scaled=False)]
+
+
+def test_m4_at_fixed_moduli_fits_each_figure_s_exponent_and_judges_the_study_s_insert():
+    rows = gravity_rows(_fixed_series(), TOLERANCES)
+    assert {entry["group"] for entry in rows} == {"Blender gravity series at fixed moduli"}
+    ln5 = math.log(5.0)
+    flow = _one(rows, "M4.mass_flow")
+    # two factors: the exponent is the slope of the logarithms, its error the relative errors combined over ln 5
+    assert flow["value"] == pytest.approx(0.5)
+    assert flow["value_error"] == pytest.approx(math.hypot(0.0001 / 0.01, 0.0001 / (0.01 * math.sqrt(5.0))) / ln5)
+    assert flow["agreement"] == REPRODUCED and flow["unit"] == "-"
+    exterior, interior = _one(rows, "M4.exterior_deviates"), _one(rows, "M4.interior_deviates")
+    assert exterior["value"] == pytest.approx(0.2) and exterior["agreement"] == REPRODUCED  # deviates from 0.5
+    assert interior["value"] == pytest.approx(0.5) and interior["agreement"] == NOT_REPRODUCED  # scales
+    # the cross-section means: at the outlet over the bins (2, 4, 4) of tube, interior and exterior, at the inlet
+    # over the 5 and 5 of the annuli
+    outlet = _one(rows, "M4.mean_velocity", "insert outlet")
+    speeds_1g, speeds_5g = (2 * 3.0 + 4 * 2.0 + 4 * 1.0) / 10, (2 * 3.0 + 4 * 2.0) * math.sqrt(5.0) / 10 + 4 * 5 ** 0.2 / 10
+    assert outlet["value"] == pytest.approx(math.log(speeds_5g / speeds_1g) / ln5)
+    inlet = _one(rows, "M4.mean_velocity", "insert inlet")
+    assert inlet["value"] == pytest.approx(0.5 + math.log(1.025 / 1.05) / ln5)  # the means 1.05 and 1.025 sqrt(5)
+    # the differential: 0.05 sqrt(5) / sqrt(5) - 0.1 = -0.05 m/s, each end's error the annuli's combined
+    change = _one(rows, "M4.inlet_differential_decreases")
+    assert change["value"] == pytest.approx(-0.05) and change["unit"] == "m/s"
+    assert change["value_error"] == pytest.approx(math.hypot(math.hypot(0.01, 0.01) / math.sqrt(5.0),
+                                                             math.hypot(0.01, 0.01)))
+    assert change["agreement"] == REPRODUCED
+    # the series is the study's batch discharge but not its factors; each row quotes both runs' notes
+    assert all(entry["differs"] == "gravity factors 1, 5 (the study's 1, 5, 50)" for entry in rows)
+    assert all("1 g: reference; 5 g: one seed at 5 g" in entry["evidence"] for entry in rows)
+
+
+def test_m4_unresolved_and_other_inserts_state_no_finding():
+    # the inlet differential's change within its error: not resolved
+    rows = gravity_rows(_fixed_series(inlet_errors=(0.05, 0.05)), TOLERANCES)
+    assert _one(rows, "M4.inlet_differential_decreases")["agreement"] == NOT_RESOLVED
+    # the study ran the diverging insert: another's rows are measurements with no finding
+    rows = gravity_rows(_fixed_series("converging"), TOLERANCES)
+    assert len(rows) == 6 and {entry["finding"] for entry in rows} == {NO_FINDING}
+    # a series mixing fixed and scaled moduli is refused
+    series = _fixed_series()
+    scaled = _brun(_blender("diverging", -3.0, -2.0, -1.0, factor=50.0), scaled=True)
+    with pytest.raises(ValueError, match="mixes runs at fixed and at scaled moduli"):
+        gravity_rows([*series, scaled], TOLERANCES)

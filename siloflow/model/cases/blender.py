@@ -12,14 +12,18 @@ of the silo with its id: the head stays constant and the silo is fed centrally w
 ch. 7).
 
 Gravity scaling: at gravity factor f, gravity is f g and every time of the flow (discharge time, steady window,
-dump interval, settling checks) is divided by sqrt(f). Every Young's modulus is multiplied by f, so that the
-dimensionless stiffness E / (rho g d) is the same at every factor: the overlaps under the pile's weight and at the
-pour's impacts (whose speed squared grows as f) stay the fraction of a radius they are at 1 g, and a difference
-between the factors is the flow's, not the contacts' softening. (At fixed moduli, the reduced stiffness of the
-smaller scales lets the pour's clumps, falling at 18 m/s at 50 g, pass through the walls: LIGGGHTS stops with
-"Lost atoms".) The time step, which scales as 1 / sqrt(E) at the same impact overlap, so falls by sqrt(f) too: a
-run makes about the same number of steps at every factor. The settling threshold is a fraction of m g d, so as a
-kinetic energy it scales by f; the pour keeps its insertion velocity.
+dump interval, settling checks) is divided by sqrt(f). The moduli follow ``blender.gravity_moduli``:
+
+- ``fixed``, the study's series (§7.9, the same material at every factor): the dimensionless stiffness
+  E / (rho g d) falls as 1/f, so the overlaps under the pile's weight and at the pour's impacts grow, and the flow may
+  depart from sqrt(g) scaling: the study's finding M4. The time step follows the Hertz limit of the faster impacts.
+- ``scaled``: every Young's modulus is multiplied by f, so that E / (rho g d) is the same at every factor: the
+  overlaps stay the fraction of a radius they are at 1 g, the flow scales with sqrt(g) by construction (a similarity
+  check of the code), and the time step, which scales as 1 / sqrt(E) at the same impact overlap, falls by sqrt(f):
+  a run makes about the same number of steps at every factor.
+
+The settling threshold is a fraction of m g d, so as a kinetic energy it scales by f; the pour keeps its insertion
+velocity.
 """
 
 from __future__ import annotations
@@ -245,8 +249,9 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
                 "widen the silo (blender.width), the outlet or the tube"
             )
     walls = blender["wall_materials"]
-    table = gravity_scaled_stiffness(material_table(config, material_name, [walls["side"], walls["front_back"]]),
-                                     gravity_factor)
+    table = material_table(config, material_name, [walls["side"], walls["front_back"]])
+    moduli_factor = gravity_factor if blender["gravity_moduli"] == "scaled" else 1.0
+    table = gravity_scaled_stiffness(table, moduli_factor)
     scale = 1.0 / math.sqrt(gravity_factor)
     gravity = GRAVITY * gravity_factor
 
@@ -308,13 +313,13 @@ def build_blender_case(config: dict, configuration: str, gravity_factor: float =
         # the inserts enter through "insert"; the steady and profile windows only steer the analysis
         "blender": without_fill_checks({k: copy.deepcopy(v) for k, v in blender.items()
                                         if k not in (*ANALYSIS_ONLY_KEYS, "inserts", "discharge", "engine",
-                                                     "settle_kinetic_energy_ratio")}),
+                                                     "settle_kinetic_energy_ratio", "gravity_moduli")}),
         "discharge": {"mode": discharge["mode"], "time": discharge["time"]},
     }
-    if gravity_factor != 1.0:
-        # the moduli the engine is given; only where they differ from the configuration's, so that the runs at 1 g
-        # keep the ids they had before the moduli followed gravity
-        defining["youngs_modulus_factor"] = float(gravity_factor)
+    if moduli_factor != 1.0:
+        # the moduli the engine is given, only where they differ from the configuration's: blender.gravity_moduli
+        # enters a run's id through it, so that a run at 1 g is the same run under either rule
+        defining["youngs_modulus_factor"] = float(moduli_factor)
     # The threshold in joules defines the run; settle's own criterion keys (inherited, unused here) do not.
     defining["blender"]["settle"] = defining_settle(settle, criterion.threshold)
     silo = SiloCase(

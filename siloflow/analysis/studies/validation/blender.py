@@ -1,5 +1,6 @@
 """Validation rows of the multi-flow blender (thesis ch. 7): each judged against a finding part M1-M3 where the study
-states one, else a measurement with no finding; and the gravity series, a similarity check of the code.
+states one, else a measurement with no finding; and the gravity series: M4 at fixed moduli, a similarity check of the
+code at scaled ones.
 
 Rows, from the runs at 1 g (see :mod:`siloflow.analysis.studies.validation.rows`):
 
@@ -23,10 +24,19 @@ diameter of the front and back walls, :func:`siloflow.analysis.studies.blender.w
 their rows judge its figures and quote the depth average's beside them; a summary without it gives the depth
 average's, and ``differs`` says that it is not the PIV's plane (:data:`DEPTH_AVERAGED`).
 
-Gravity series (:func:`gravity_rows`): a run at ``f g`` scales every Young's modulus by ``f`` and every time by
-``1 / sqrt(f)`` (:mod:`siloflow.model.cases.blender`), so its flow is similar to the 1 g run's and every rate scales
-with ``sqrt(g)`` by construction. Its rows check the code's similarity; they are not the study's M4, whose series
-is at fixed material (§7.9): M4 is unmade (:data:`UNMADE`).
+Gravity series (:func:`gravity_rows`), by the rule ``blender.gravity_moduli`` the runs were made with:
+
+- at fixed moduli, the study's series (§7.9, the same material at every factor): M4, each figure's exponent
+  against the gravity factor (a weighted fit of its logarithm, :func:`~siloflow.analysis.studies.validation.agreement.
+  power_law`), the mass flow rate and the cross-section mean velocity judged as scaling with ``sqrt(g)``, the
+  annuli's velocities at the insert outlet as deviating from it, and the change of the annuli's velocity
+  differential at the insert inlet over ``sqrt(g / g0)``, from 1 g to the largest factor, as decreasing. The study
+  ran the diverging insert (its "Inward", inferred): another insert's rows state no finding.
+- at scaled moduli, every Young's modulus times ``f`` and every time over ``sqrt(f)``
+  (:mod:`siloflow.model.cases.blender`): the flow is similar to the 1 g run's and every rate scales with ``sqrt(g)``
+  by construction, so the rows check the code's similarity and state no finding.
+
+A run's moduli are scaled when its ``case.json`` parameters hold ``youngs_modulus_factor``.
 
 Inputs are per-run mappings ``{"case": case.json, "summary": blender.json, "note": str, "dof": float | None}``:
 ``note`` is the evidence about the run's seeds, appended to the evidence of every row that draws on the run;
@@ -48,11 +58,16 @@ from siloflow.analysis.studies.validation.findings import PARTS
 from siloflow.analysis.studies.validation.rows import (joined, plus_minus, precise, resolution, resolved, row,
                                                       smallest_dof)
 
-__all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "MADE", "UNMADE", "DEPTH_AVERAGED", "smallest_dof", "capped",
-           "section_mean", "blender_rows", "gravity_rows"]
+__all__ = ["BLENDER_GROUP", "GRAVITY_GROUP", "FIXED_GRAVITY_GROUP", "MADE", "UNMADE", "DEPTH_AVERAGED", "smallest_dof",
+           "capped",           "section_mean", "blender_rows", "gravity_rows"]
 
 BLENDER_GROUP = "Multi-flow blender"
 GRAVITY_GROUP = "Blender gravity series: similarity check of the code (scaled moduli)"
+FIXED_GRAVITY_GROUP = "Blender gravity series at fixed moduli"
+#: The insert of the study's gravity series (§7.9: its table's "Inward", the text's diverging insert).
+STUDY_GRAVITY_INSERT = "diverging"
+#: The study's gravity factors (§7.9).
+STUDY_GRAVITY_FACTORS = (1.0, 5.0, 50.0)
 #: The passages at the insert outlet (metric key: name), innermost first, and their names in the geometry's clear
 #: widths.
 PASSAGES = {"tube": "tube", "interior": "interior annulus", "exterior": "exterior annulus"}
@@ -66,21 +81,13 @@ GRAVITY_STUDY = ("identity: with every modulus scaled by g and every time by 1/s
                  "material, §7.9)")
 #: The finding parts of ch. 7 these rows make (given the runs each needs).
 MADE = ("M1.exterior", "M1.interior", "M1.tube", "M2.outlet_order", "M2.inlet_uniform", "M2.vertical_uniform",
-        "M3.over_straight", "M3.over_diverging")
+        "M3.over_straight", "M3.over_diverging", "M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates",
+        "M4.interior_deviates", "M4.inlet_differential_decreases")
 #: The ``differs`` clause of a PIV figure (M1, M2) taken from the depth average: the summary has no wall layer.
 DEPTH_AVERAGED = ("averaged over the depth, not in the layer at the front wall the study's PIV sees (§7.2, §7.5; "
                   "its DEM gave both, §7.8.2.1)")
-_M4 = ("the study's series (§7.9) is at fixed material; this tier's (blender.gravity_factors, "
-       "blender.gravity_configurations) multiplies every Young's modulus by the gravity factor "
-       "(siloflow.model.cases.blender.gravity_scaled_stiffness): a similarity check of the code whose sqrt(g) scaling "
-       "holds by construction (the gravity series group), and at fixed moduli the 50 g pour pushed clumps through "
-       "the walls (LIGGGHTS: lost atoms). It would be made by blender.gravity_factors [1, 5, 50] with "
-       "blender.gravity_configurations [diverging] at fixed moduli, which no configuration key gives yet")
-#: The parts of ch. 7 these rows cannot make, and what would make them.
-UNMADE = MappingProxyType({
-    **{part: _M4 for part in ("M4.mass_flow", "M4.mean_velocity", "M4.exterior_deviates", "M4.interior_deviates",
-                              "M4.inlet_differential_decreases")},
-})
+#: The parts of ch. 7 these rows cannot make: none (M4 needs blender.gravity_moduli fixed).
+UNMADE: Mapping[str, str] = MappingProxyType({})
 
 
 def _metric(metrics: Mapping, key: str) -> tuple[float, float]:
@@ -383,21 +390,33 @@ def blender_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> li
     return rows + _m3_rows(at_1g)
 
 
+def moduli_scaled(case: Mapping) -> bool:
+    """Whether a run's Young's moduli were scaled with its gravity factor (its ``case.json`` parameters hold
+    ``youngs_modulus_factor``, :func:`siloflow.model.cases.blender.build_blender_case`)."""
+    return "youngs_modulus_factor" in (case.get("parameters") or {})
+
+
 def gravity_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> list[dict]:
-    """The gravity series as a similarity check of the code: per configuration run at 1 g and at other factors f,
-    ``(q_f / q_1g) / sqrt(f)`` of the mass flow rate and the tube's and exterior annulus's velocities (1 where q
-    scales with sqrt(g)); no finding (see the module docstring).
+    """The gravity series of every configuration run at 1 g and at other factors: M4 where its runs are at fixed
+    moduli (:func:`_fixed_moduli_rows`), a similarity check of the code where they are scaled
+    (:func:`_similarity_rows`); see the module docstring.
 
     Parameters
     ----------
     runs : sequence of mapping
-        ``{"case", "summary", "note", "dof"}`` per run; each row's evidence quotes the notes of its two runs.
+        ``{"case", "summary", "note", "dof"}`` per run; each row's evidence quotes the notes of its runs.
     tolerances : AgreementTolerances
 
     Returns
     -------
     list of dict
-        One row per configuration, factor and figure known at both factors, in the group :data:`GRAVITY_GROUP`.
+        Configuration by configuration (alphabetical), the rows of its series; none for a configuration without a
+        1 g run or another factor.
+
+    Raises
+    ------
+    ValueError
+        Two runs of one configuration and factor, or a series whose runs beyond 1 g mix fixed and scaled moduli.
     """
     series: dict[str, dict[float, Mapping]] = {}
     for run in runs:
@@ -410,27 +429,141 @@ def gravity_rows(runs: Sequence[Mapping], tolerances: AgreementTolerances) -> li
     rows = []
     for name in sorted(series):
         by_factor = series[name]
-        if 1.0 not in by_factor:
+        if 1.0 not in by_factor or len(by_factor) < 2:
             continue
-        base = by_factor[1.0]
-        for factor in sorted(f for f in by_factor if f != 1.0):
-            run = by_factor[factor]
-            dof = smallest_dof(base.get("dof"), run.get("dof"))
-            for key, label, unit in GRAVITY_FIGURES:
-                q1, qf = _metric(base["summary"]["metrics"], key), _metric(run["summary"]["metrics"], key)
-                if not (math.isfinite(q1[0]) and math.isfinite(qf[0])):
-                    continue
-                value, error = ratio(*qf, *q1)
-                root = math.sqrt(factor)
-                scaled, scaled_error = value / root, error / root
-                off = resolved(scaled - 1.0, scaled_error, dof)
-                verdict = "unknown whether it scales" if off is None else "does not scale" if off else "scales"
-                rows.append(row(
-                    GRAVITY_GROUP, f"{label.capitalize()} at {factor:g} g / (1 g value × sqrt({factor:g}))", name,
-                    scaled, scaled_error, "-",
-                    f"{verdict} with sqrt(g): its departure from 1 is {resolution(scaled - 1.0, scaled_error, dof)}; "
-                    f"1 g: {plus_minus(*q1)} {unit} ({base.get('note') or 'no note'}); {factor:g} g: "
-                    f"{plus_minus(*qf)} {unit} ({run.get('note') or 'no note'}); "
-                    f"{precise(scaled, scaled_error, tolerances)[1]}",
-                    dof=dof, study=GRAVITY_STUDY))
+        rules_used = {moduli_scaled(run.get("case") or {}) for factor, run in by_factor.items() if factor != 1.0}
+        if len(rules_used) > 1:
+            raise ValueError(f"the gravity series of {name} mixes runs at fixed and at scaled moduli "
+                             "(blender.gravity_moduli): record one rule at a time")
+        rows += (_similarity_rows if rules_used == {True} else _fixed_moduli_rows)(name, by_factor, tolerances)
+    return rows
+
+
+def _similarity_rows(name: str, by_factor: Mapping[float, Mapping], tolerances: AgreementTolerances) -> list[dict]:
+    """At scaled moduli: per factor f other than 1, ``(q_f / q_1g) / sqrt(f)`` of the mass flow rate and the tube's
+    and exterior annulus's velocities (1 where q scales with sqrt(g)), with no finding."""
+    rows = []
+    base = by_factor[1.0]
+    for factor in sorted(f for f in by_factor if f != 1.0):
+        run = by_factor[factor]
+        dof = smallest_dof(base.get("dof"), run.get("dof"))
+        for key, label, unit in GRAVITY_FIGURES:
+            q1, qf = _metric(base["summary"]["metrics"], key), _metric(run["summary"]["metrics"], key)
+            if not (math.isfinite(q1[0]) and math.isfinite(qf[0])):
+                continue
+            value, error = ratio(*qf, *q1)
+            root = math.sqrt(factor)
+            scaled, scaled_error = value / root, error / root
+            off = resolved(scaled - 1.0, scaled_error, dof)
+            verdict = "unknown whether it scales" if off is None else "does not scale" if off else "scales"
+            rows.append(row(
+                GRAVITY_GROUP, f"{label.capitalize()} at {factor:g} g / (1 g value × sqrt({factor:g}))", name,
+                scaled, scaled_error, "-",
+                f"{verdict} with sqrt(g): its departure from 1 is {resolution(scaled - 1.0, scaled_error, dof)}; "
+                f"1 g: {plus_minus(*q1)} {unit} ({base.get('note') or 'no note'}); {factor:g} g: "
+                f"{plus_minus(*qf)} {unit} ({run.get('note') or 'no note'}); "
+                f"{precise(scaled, scaled_error, tolerances)[1]}",
+                dof=dof, study=GRAVITY_STUDY))
+    return rows
+
+
+def _downward(pair: tuple[float, float]) -> tuple[float, float]:
+    """A v_z and its error (m/s) as a downward speed and its error."""
+    return -pair[0], pair[1]
+
+
+def _inlet_passages(summary: Mapping) -> tuple[dict, dict]:
+    """The depth-averaged passages at the insert inlet: name -> (v_z, error) (m/s; the error NaN where the summary
+    writes none) and name -> bins; empty when the summary has no inlet."""
+    inlet = summary.get("passages_at_insert_inlet") or {}
+    means, bins, errors = inlet.get("mean_v_z_m_s") or {}, inlet.get("n_bins") or {}, inlet.get(
+        "mean_v_z_m_s_error") or {}
+    if not all(bins.get(key) for key in means):
+        return {}, {}
+    return ({key: (float(v), number_or_nan(errors.get(key))) for key, v in means.items()},
+            {key: float(bins[key]) for key in means})
+
+
+def _series_figures(summary: Mapping) -> dict[str, tuple[float, float]]:
+    """The figures of one run that M4 scales (downward speeds, m/s; the mass flow rate, kg/s), each with its error;
+    those the summary lacks are left out."""
+    metrics = summary["metrics"]
+    figures = {"mass_flow": _metric(metrics, "mass_flow_rate_kg_s")}
+    for key in ("exterior", "interior"):
+        figures[key] = _downward(_metric(metrics, f"{key}_v_z_m_s"))
+    velocities, (mean, mean_error), _, _ = _outlet(summary)
+    if velocities:
+        figures["mean_outlet"] = _downward((mean, mean_error))
+    passages, bins = _inlet_passages(summary)
+    if passages:
+        figures["mean_inlet"] = _downward(section_mean(passages, bins))
+        if {"interior", "exterior"} <= passages.keys():
+            (interior, e_i), (exterior, e_e) = passages["interior"], passages["exterior"]
+            figures["inlet_differential"] = (abs(interior - exterior), combine_independent([e_i, e_e]))
+    return {key: value for key, value in figures.items() if math.isfinite(value[0])}
+
+
+#: M4's power-law figures: key of :func:`_series_figures`, the figure's name, its part.
+_M4_POWER = (("mass_flow", "mass flow rate", "M4.mass_flow"),
+             ("mean_outlet", "cross-section mean downward speed at the insert outlet", "M4.mean_velocity"),
+             ("mean_inlet", "cross-section mean downward speed at the insert inlet", "M4.mean_velocity"),
+             ("exterior", "exterior annulus downward speed at the insert outlet", "M4.exterior_deviates"),
+             ("interior", "interior annulus downward speed at the insert outlet", "M4.interior_deviates"))
+
+
+def _batch(summary: Mapping) -> str:
+    """The ``differs`` clause of a gravity run not in the study's batch discharge (its DEM, §7.7)."""
+    mode = summary.get("mode", "continuous")
+    return "" if mode == "batch" else f"{mode} discharge: the study's gravity series discharged in batch (§7.7)"
+
+
+def _fixed_moduli_rows(name: str, by_factor: Mapping[float, Mapping], tolerances: AgreementTolerances) -> list[dict]:
+    """At fixed moduli: M4 for the study's insert (:data:`STUDY_GRAVITY_INSERT`), the same figures with no finding
+    for another. Each power law is the exponent of a figure against the gravity factor over every factor run (the
+    errors as known sigmas); the inlet differential's change is ``d_max / sqrt(f_max) - d_1g`` (m/s), ``d`` the
+    absolute difference of the annuli's downward speeds at the insert inlet."""
+    factors = sorted(by_factor)
+    runs = [by_factor[f] for f in factors]
+    figures = [_series_figures(run["summary"]) for run in runs]
+    dof = smallest_dof(*(run.get("dof") for run in runs))
+    notes = "; ".join(f"{f:g} g: {run.get('note') or 'no note'}" for f, run in zip(factors, runs))
+    factors_text = ", ".join(f"{f:g}" for f in factors)
+    differs = joined((
+        "" if tuple(factors) == STUDY_GRAVITY_FACTORS else
+        f"gravity factors {factors_text} (the study's {', '.join(f'{f:g}' for f in STUDY_GRAVITY_FACTORS)})",
+        *(_batch(run["summary"]) for run in runs)))
+    study = name == STUDY_GRAVITY_INSERT
+    rows = []
+    for key, label, part_id in _M4_POWER:
+        if not all(key in entry for entry in figures) or not all(entry[key][0] > 0 for entry in figures):
+            continue
+        values, errors = [entry[key][0] for entry in figures], [entry[key][1] for entry in figures]
+        exponent, error = rules.power_law_exponent(factors, values, errors)
+        unit = "kg/s" if key == "mass_flow" else "m/s"
+        evidence = (f"{label} at {factors_text} g: "
+                    + ", ".join(f"{plus_minus(v, e)}" for v, e in zip(values, errors)) + f" {unit}; {notes}")
+        figure = f"Exponent of the {label} against the gravity factor"
+        if study:
+            agreement = rules.power_law(factors, values, errors, dof, PARTS[part_id], tolerances)
+            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, exponent, error, "-", evidence, dof=dof,
+                            finding=part_id, agreement=agreement, differs=differs))
+        else:
+            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, exponent, error, "-", evidence, dof=dof, study="-",
+                            differs=differs))
+    if all("inlet_differential" in entry for entry in figures):
+        (first, first_error), (last, last_error) = figures[0]["inlet_differential"], figures[-1]["inlet_differential"]
+        root = math.sqrt(factors[-1])
+        change, change_error = last / root - first, combine_independent([last_error / root, first_error])
+        evidence = (f"|interior - exterior| downward speed at the insert inlet, 1 g: {plus_minus(first, first_error)} "
+                    f"m/s; {factors[-1]:g} g: {plus_minus(last, last_error)} m/s, over sqrt({factors[-1]:g}); {notes}")
+        figure = (f"Change of the annuli's velocity differential at the insert inlet over sqrt(g / g0), 1 to "
+                  f"{factors[-1]:g} g")
+        if study:
+            part = PARTS["M4.inlet_differential_decreases"]
+            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, change, change_error, "m/s", evidence, dof=dof,
+                            finding=part.id, agreement=rules.sign_of_change(change, change_error, dof, part),
+                            differs=differs))
+        else:
+            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, change, change_error, "m/s", evidence, dof=dof,
+                            study="-", differs=differs))
     return rows

@@ -99,7 +99,8 @@ STUDY: Mapping[str, Mapping[str, StudyDimension]] = MappingProxyType({
         "bed_above_insert": StudyDimension(_study_bed("diverging"), "§7.2",
                                            note="fill height above the tube inlet, rebuilt from §7.2"),
         "particle_diameter": StudyDimension(STUDY_PARTICLE_DIAMETER, "§4.6, §7.7"),
-        "particle_count": StudyDimension(606652, "§7.7", "clumps", "at the end of filling")}),
+        "particle_count": StudyDimension(606652, "§7.7", "clumps", "at the end of filling"),
+        "youngs_modulus": _STIFFNESS}),
 })
 
 #: Why a dimension bears on the findings that list it.
@@ -202,8 +203,9 @@ FINDING_SCALES: Mapping[str, FindingScale] = MappingProxyType({
                        "the vertical section (§7.5.3)", inserts=("converging",)),
     "M3": FindingScale("blender", _BLENDER, "RTD from path lines through the steady velocity field and the LTI "
                        "convolution, the three inserts compared (§7.6)", inserts=_BLENDER_INSERTS),
-    "M4": FindingScale("blender", ("width", "depth", "outlet") + _BLENDER[2:], "diverging insert at 1, 5 and 50 g: "
-                       "mass flow rate and velocities over sqrt(g ratio) (§7.9)", inserts=("diverging",)),
+    "M4": FindingScale("blender", ("width", "depth", "outlet") + _BLENDER[2:] + ("youngs_modulus",),
+                       "diverging insert at 1, 5 and 50 g, the same material at every factor: mass flow rate and "
+                       "velocities against sqrt(g ratio) (§7.9)", inserts=("diverging",)),
 })
 
 
