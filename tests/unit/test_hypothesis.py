@@ -230,8 +230,21 @@ def test_the_bed_variant_raises_the_blender_s_fill_and_walls_only():
     assert (base["blender"]["fill_height"], variant["blender"]["fill_height"]) == (0.225, 0.325)
 
 
+def test_the_gravity_variant_stiffens_every_material_fivefold_only():
+    chosen = HYPOTHESES["stiffness_gravity"]
+    base = validate_config(layered_config(chosen.base_files(REPO_ROOT)))
+    variant = validate_config(layered_config(chosen.variant_files(REPO_ROOT)))
+    assert {key for key in base if base[key] != variant[key]} == {"materials"}
+    assert {material: variant["materials"][material]["youngs_modulus"] / base["materials"][material]["youngs_modulus"]
+            for material in ("hdpe", "aluminium", "perspex", "lid")} == dict.fromkeys(
+        ("hdpe", "aluminium", "perspex", "lid"), 5.0)
+    # the base is the study's series at fixed material, beyond 1 g
+    assert base["blender"]["gravity_moduli"] == "fixed" and base["blender"]["gravity_factors"] == [1.0, 5.0]
+
+
 def test_an_unknown_hypothesis_or_group_is_refused_naming_what_there_is(capsys):
-    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo, stiffness_blending, bed_blender"):
+    with pytest.raises(ValueError, match="the hypotheses are stiffness_calibration, stiffness_silo, stiffness_blending, "
+                                         "bed_blender, stiffness_gravity"):
         hypothesis_named("nonsense")
     with pytest.raises(ValueError, match="no validation group 'silos'"):
         Hypothesis("h", "silos", ("S2",), "s", "c", "base.yaml", "variant.yaml")
