@@ -94,10 +94,10 @@ HYPOTHESES: dict[str, Hypothesis] = {hypothesis.name: hypothesis for hypothesis 
         "Young's modulus of the pellets and every wall 5e6 -> 2.8e8 Pa (the study's)",
         "blending_reduced.yaml", "stiffness_study.yaml"),
     Hypothesis(
-        "bed_blender", "blender", ("M1",),
-        "The flow through the insert's passages moves with the bed above them: the tier's bed stands 14 mm above the "
-        "insert (the study's about 700 mm), so the head that feeds the passages and the tube inlet is a small share of "
-        "the study's.",
+        "bed_blender", "blender", ("M1", "M2", "M3"),
+        "The flow through the insert's passages, and so how the inserts blend, moves with the bed above them: the "
+        "tier's bed stands 14 mm above the insert (the study's about 700 mm), so the head that feeds the passages and "
+        "the tube inlet is a small share of the study's.",
         "fill height 0.225 -> 0.325 m (the bed above the insert 14 -> 114 mm), the vertical walls 0.21 -> 0.32 m to "
         "hold it",
         "blender_reduced.yaml", "bed_taller.yaml"),
