@@ -34,9 +34,9 @@ from siloflow.engines.config import load_config
 from siloflow.engines.hypotheses import HYPOTHESES
 from siloflow.engines.layout import RESULTS, RUN_RECORD, VALIDATION_RECORD
 from siloflow.engines.planning import config_estimates, group_runs, run_directory
-from siloflow.engines.validation_groups import (GROUPS, MISSING, STALE, check_group, check_reads, find_part, finished_groups,
-                                       group_costs, group_of_part, group_status, planned_runs, runs_wall_time,
-                                       split_groups, status_lines)
+from siloflow.engines.validation_groups import (GROUP_BUDGET_S, GROUPS, MISSING, STALE, TIER_BUDGET_CORE_S, check_group,
+                                       check_reads, find_part, finished_groups, group_costs, group_of_part,
+                                       group_status, planned_runs, runs_wall_time, split_groups, status_lines)
 
 #: The record's page, in its folder.
 RECORD_PAGE = "README.md"
@@ -231,7 +231,8 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
                        measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
                        verdicts, UNMADE, {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)},
-                       read_hypothesis_records(record_dir), {name: h.findings for name, h in HYPOTHESES.items()})
+                       read_hypothesis_records(record_dir), {name: h.findings for name, h in HYPOTHESES.items()},
+                       (TIER_BUDGET_CORE_S, GROUP_BUDGET_S))
 
 
 #: The configurations and the record the commands take by default, relative to the working directory.

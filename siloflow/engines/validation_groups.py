@@ -61,6 +61,8 @@ GROUPS: dict[str, Group] = {
 
 #: The longest a group (or a part of one) may take on :data:`PART_CORES` cores (s): a working session.
 GROUP_BUDGET_S = 2.5 * 3600.0
+#: The core time the whole validation tier may take, recorded on :data:`PART_CORES` cores (CPU s).
+TIER_BUDGET_CORE_S = 60.0 * 3600.0
 
 #: The share of the budget a part is filled to by its estimated wall time: with the validation configuration's rates per
 #: case kind, a group's estimate is within about a tenth of its recorded time (the record's page sets them side by

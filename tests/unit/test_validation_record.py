@@ -21,8 +21,8 @@ from siloflow.analysis.io.validation_record import (DERIVATION, LEGACY_MARK, PRO
 from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, Agreement
 from siloflow.analysis.studies.validation.findings_summary import finding_statuses
 from siloflow.analysis.studies.validation.rows import AT_SCALE
-from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, findings_section, provenance_row,
-                                                         record_page, run_wall_time, simulated_time)
+from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, budget_lines, findings_section,
+                                                         provenance_row, record_page, run_wall_time, simulated_time)
 from siloflow.analysis.studies.validation.rows import COLUMNS, row
 from siloflow.engines.config import load_config_file
 from tests.repo import REPO_ROOT
@@ -247,6 +247,27 @@ def test_the_page_renders_status_runs_rows_and_both_verdicts():
     assert ("Not complete against `config/validation.yaml` and today's row code: calibration, silo (see [The "
             "groups](#the-groups))") in summary
 
+
+
+def test_the_budget_paragraph_adds_the_complete_groups_records_to_the_others_estimates():
+    runs = [provenance_row(_record(), "silo_1", "3.8", [1], "c0ffee", 5400.0, [600.0], "2026-11-28", 1),
+            provenance_row(_record("sphere2-def", ranks=2), "silo_2", "3.8", [2], "c0ffee", 1800.0, [], "2026-11-29")]
+    groups = {"silo": GroupRecord(rows=_rows(), runs=runs)}
+    status = {"calibration": "missing", "silo": "complete"}
+    wall = {"silo": {"silo_1": 6000.0, "silo_2": 1800.0}}
+    hypothesis = {"hypothesis": "stiffness_silo", "core_hours": 1.5}  # two rows of one pair
+    lines = budget_lines(groups, status, wall, {"calibration": 7200.0, "silo": 1.0}, [hypothesis, hypothesis], 2,
+                         3 * 3600.0, 1.5 * 3600.0)
+    # silo: (5400 + 600) s on one core and 1800 s on two, 9600 s; the calibration's estimate 7200 s: 16800 s of 10800
+    assert lines == ["**Budget**: the complete groups recorded 2.67 h of core time and the runs the other groups plan "
+                     "are estimated at 2.00 h: 4.67 h against the tier's 3.00 h on 2 cores, over it by 1.67 h. The "
+                     "longest part of a complete group, silo_1, took 1.67 h of wall time, over a part's 1.50 h. The "
+                     "measured hypotheses are counted apart: 1 recorded, 1.50 h of core time."]
+    # all complete and within: no estimate, and each part within its budget
+    within = budget_lines(groups, {"silo": "complete"}, wall, {}, [], 2, 3 * 3600.0, 2 * 3600.0)
+    assert within == ["**Budget**: the complete groups recorded 2.67 h of core time: 2.67 h against the tier's 3.00 h "
+                      "on 2 cores, within it. The longest part of a complete group, silo_1, took 1.67 h of wall time, "
+                      "within a part's 2.00 h."]
 
 def test_publish_copies_what_the_pipeline_recorded_and_leaves_other_groups(tmp_path):
     workdir, record_dir = tmp_path / "work", tmp_path / "docs"

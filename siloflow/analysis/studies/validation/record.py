@@ -360,13 +360,53 @@ def _figure_width(count: int) -> str:
     return "100%" if count == 1 else "49%"
 
 
+def _group_core_s(record: GroupRecord, part_walls: Mapping[str, float]) -> float:
+    """CPU time of the runs a group's record holds that its parts make, over all their attempts (s)."""
+    return math.fsum(run_wall_time(run) * int(run["cores"]) for run in record.runs if run["group"] in part_walls)
+
+
+def budget_lines(groups: Mapping[str, GroupRecord], status: Mapping[str, str], wall_s: Mapping[str, Mapping[str, float]],
+                 planned_core_s: Mapping[str, float], hypotheses: Sequence[Mapping], cores: int,
+                 tier_budget_core_s: float, part_budget_s: float) -> list[str]:
+    """The tier against its budgets: the core time the complete groups recorded plus the estimate of what the others
+    plan, against ``tier_budget_core_s`` (CPU s); the longest part of a complete group against ``part_budget_s`` (s of
+    wall time on ``cores`` cores); the measured hypotheses' recorded core time, counted apart.
+
+    Returns
+    -------
+    list of str
+        Markdown lines (one paragraph).
+    """
+    complete = [name for name, state in status.items() if state == "complete"]
+    recorded = math.fsum(_group_core_s(groups.get(name, GroupRecord()), wall_s.get(name, {})) for name in complete)
+    rest = [name for name in status if name not in complete]
+    estimated = math.fsum(planned_core_s.get(name, 0.0) for name in rest)
+    total = recorded + estimated
+    verdict = "within it" if total <= tier_budget_core_s else f"over it by {_hours(total - tier_budget_core_s)}"
+    text = (f"**Budget**: the complete groups recorded {_hours(recorded)} of core time"
+            + (f" and the runs the other groups plan are estimated at {_hours(estimated)}" if rest else "")
+            + f": {_hours(total)} against the tier's {_hours(tier_budget_core_s)} on {cores} cores, {verdict}.")
+    parts = [(part, seconds) for name in complete for part, seconds in wall_s.get(name, {}).items()]
+    if parts:
+        part, longest = max(parts, key=lambda item: item[1])
+        text += (f" The longest part of a complete group, {part}, took {_hours(longest)} of wall time, "
+                 + ("within" if longest <= part_budget_s else "over") + f" a part's {_hours(part_budget_s)}.")
+    by_name = _by_hypothesis(hypotheses)
+    if by_name:
+        spent = math.fsum(float(rows[0]["core_hours"]) for rows in by_name.values()) * 3600.0
+        text += (f" The measured hypotheses are counted apart: {len(by_name)} recorded, {_hours(spent)} of core "
+                 "time.")
+    return [text]
+
+
 def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], full_scale_core_s: Mapping[str, float],
                 wall_s: Mapping[str, Mapping[str, float]], cores: int, config_name: str, full_scale_config: str,
                 parts: Mapping[str, Sequence[str]] | None = None,
                 estimated_core_s: Mapping[str, float] | None = None,
                 verdicts: Mapping[str, ScaleVerdict] | None = None, unmade: Mapping[str, str] | None = None,
                 planned_core_s: Mapping[str, float] | None = None, hypotheses: Sequence[Mapping] = (),
-                planned_hypotheses: Mapping[str, Sequence[str]] | None = None) -> str:
+                planned_hypotheses: Mapping[str, Sequence[str]] | None = None,
+                budgets: tuple[float, float] | None = None) -> str:
     """The record's page (Markdown): the study it compares with (:data:`STUDY_PARAGRAPH`), then per group its
     freshness, runs and rows with their two verdicts, and for the rows not at the study's scale, what the study's scale
     costs.
@@ -405,6 +445,9 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     hypotheses, planned_hypotheses
         The measured hypotheses' rows and ``{name: finding ids}`` of those siloflow defines, for the summary
         (:func:`hypotheses_section`).
+    budgets : (float, float), optional
+        The tier's budget of core time (CPU s) and a part's of wall time (s): with them, a paragraph under the groups'
+        table weighs the tier against both (:func:`budget_lines`).
 
     Returns
     -------
@@ -440,13 +483,15 @@ def record_page(groups: Mapping[str, GroupRecord], status: Mapping[str, str], fu
     for name, state in status.items():
         record, part_walls = groups.get(name, GroupRecord()), wall_s.get(name, {})
         made = [run for run in record.runs if run["group"] in part_walls]
-        core = math.fsum(run_wall_time(run) * int(run["cores"]) for run in made)
+        core = _group_core_s(record, part_walls)
         judged = sum(row["finding"] != NO_FINDING for row in record.rows)
         shown = sum(row["scale"] == AT_SCALE for row in record.rows)
         wall = ", ".join(_hours(s) if part == name else f"{part} {_hours(s)}" for part, s in part_walls.items())
         estimated = _estimated(made, estimated_core_s or {}, (planned_core_s or {}).get(name, math.nan))
         lines.append(f"| {name} | {state} | {len(made)} | {_hours(core) if made else '-'} | {estimated} | "
                      f"{wall if made else '-'} | {len(record.rows)} | {judged} | {shown} |")
+    if budgets is not None:
+        lines += ["", *budget_lines(groups, status, wall_s, planned_core_s or {}, hypotheses, cores, *budgets)]
     for name, state in status.items():
         record = groups.get(name)
         command = ", then ".join(f"`make validate GROUP={part}`" for part in (parts or {}).get(name, [name]))
