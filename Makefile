@@ -191,8 +191,9 @@ bench: install-test
 	$(PYTHON) -m tests.bench.bench_engines results/bench/engines.csv
 	$(PYTHON) -m tests.bench.bench_piv results/bench/piv.csv
 
-# 1 against 2 MPI ranks on the validation tier's 270 mm assembly (a flat-bottom silo run of the tier that has settled
-# its fill): make bench-assembly ASSEMBLY=results/validation/results/silo_flat/<run>
+# 1 against 2 MPI ranks on the validation tier's 270 mm assembly (a flat-bottom silo run of the tier: from its settled
+# fill, or for a run a part stopped before that, its own continuation): make bench-assembly
+# ASSEMBLY=results/validation/results/silo_flat/<run>
 ASSEMBLY ?=
 bench-assembly: install-test
 	$(if $(ASSEMBLY),,$(error name the flat-bottom silo run whose fill the benchmark starts from: ASSEMBLY=<run folder>))
