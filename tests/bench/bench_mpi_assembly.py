@@ -35,6 +35,7 @@ from siloflow.engines.deadline import PartDeadline, until
 from siloflow.engines.interface import EngineOptions, engine_for
 from siloflow.engines.layout import RUN_RECORD
 from siloflow.engines.liggghts.run import attempt_logs
+from siloflow.engines.liggghts.thermo import ThermoProgress
 from siloflow.engines.run_files import FAILED_ATTEMPTS
 from siloflow.model.cases import case_for_run
 from siloflow.model.cases.silo_recirculation import build_recirculation_case
@@ -68,21 +69,15 @@ CONTINUATIONS = (("1 rank", (1,)), ("2 ranks", (2,)), ("2 runs x 1 rank", (1, 1)
 
 
 def thermo_rate(log_text: str) -> float:
-    """Steps per second of the engine's clock over the last run of a LIGGGHTS log: the first and last thermo lines
-    (``step atoms time ... cpu``: the first and last columns) after the last header that starts with ``Step``."""
-    rows = []
-    for line in log_text.splitlines():
-        fields = line.split()
-        if fields and fields[0] == "Step":
-            rows = []
-        elif len(fields) >= 5 and fields[0].isdigit():
-            try:
-                rows.append((int(fields[0]), float(fields[-1])))
-            except ValueError:
-                continue
-    if len(rows) < 2 or rows[-1][1] <= rows[0][1]:
-        raise ValueError("the log has fewer than two thermo lines with time between them")
-    return (rows[-1][0] - rows[0][0]) / (rows[-1][1] - rows[0][1])
+    """Steps per second of the engine's clock over the last ``run`` of a LIGGGHTS log: between its first and last
+    thermo rows (:class:`siloflow.engines.liggghts.thermo.ThermoProgress`), whose ``cpu`` restarts with each run."""
+    parser = ThermoProgress()
+    rows = [row for row in (*parser.feed(log_text), *parser.flush()) if row.cpu is not None]
+    starts = [i for i in range(1, len(rows)) if rows[i].cpu < rows[i - 1].cpu]
+    rows = rows[starts[-1] if starts else 0:]
+    if len(rows) < 2 or rows[-1].cpu <= rows[0].cpu:
+        raise ValueError("the log's last run has fewer than two thermo rows with time between them")
+    return (rows[-1].step - rows[0].step) / (rows[-1].cpu - rows[0].cpu)
 
 
 def _continue(run_dir: Path, ranks: int, wall_s: float) -> None:

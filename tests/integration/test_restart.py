@@ -1,5 +1,5 @@
 """A run killed with SIGKILL resumes from its newest restart file on the next workflow call, in the stage it was
-killed in.
+killed in; a validation part's deadline stops a resumed run where it is, and the next call resumes it again.
 
 The tiny silo (about 1,400 clumps) runs killed (the whole process group: Snakemake, the script and LIGGGHTS) once
 during its pour, after it has written two restart files, and once during its discharge, after two restart files past
@@ -24,7 +24,8 @@ from siloflow.model.record import read_run_record
 from siloflow.engines.config import load_config_file, validate_config
 from tests.repo import REPO_ROOT
 from siloflow.engines.layout import run_dir as layout_run_dir, run_path
-from siloflow.engines.liggghts.run import restart_files
+from siloflow.engines.deadline import DEADLINE_VARIABLE
+from siloflow.engines.liggghts.run import attempt_logs, restart_files
 from siloflow.model.cases.silo_flat import build_silo_case
 from tests.stopped_runs import killable
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
@@ -76,10 +77,25 @@ def killed_and_resumed(request, tmp_path_factory):
     assert not (run_dir / "run.json").exists()
     unlock = run_snakemake(workdir, "--unlock", "--configfile", str(workdir / "tiny.yaml"))
     assert unlock.returncode == 0, unlock.stdout[-2000:] + unlock.stderr[-2000:]
+    if stage == "fill":
+        # a validation part's deadline falls while the resumed run pours: the run stops there, and it neither goes
+        # back to an older restart file nor runs on past the deadline
+        part = subprocess.run(_snakemake_command(workdir, workdir / "tiny.yaml", target) + ["--rerun-incomplete"],
+                              capture_output=True, text=True, env={**os.environ, DEADLINE_VARIABLE: str(time.time() + 20)})
+        assert part.returncode != 0
+        first_resumption = (run_dir / "logs" / "run.log").read_text()
+        assert "the validation part's time is up" in first_resumption
+        assert [path.name for path in attempt_logs(run_dir)] == ["log.liggghts", "resume1.log.liggghts"]
+        assert "SILOFLOW discharged" not in (run_dir / "resume1.log.liggghts").read_text()
+        assert not (run_dir / "run.json").exists()
+        unlock = run_snakemake(workdir, "--unlock", "--configfile", str(workdir / "tiny.yaml"))
+        assert unlock.returncode == 0, unlock.stdout[-2000:] + unlock.stderr[-2000:]
     resumed = run_snakemake(workdir, "--cores", "1", "--rerun-incomplete", "--configfile",
                             str(workdir / "tiny.yaml"), targets=[target])
     assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
-    yield stage, run_dir
+    if stage != "fill":
+        first_resumption = (run_dir / "logs" / "run.log").read_text()
+    yield stage, run_dir, first_resumption
 
 
 @pytest.fixture(scope="module")
@@ -95,16 +111,16 @@ def uninterrupted(tmp_path_factory):
 
 
 def test_the_killed_run_resumes_from_its_restart_file_in_the_stage_it_was_killed_in(killed_and_resumed):
-    stage, run_dir = killed_and_resumed
-    log = (run_dir / "logs" / "run.log").read_text()
+    stage, run_dir, log = killed_and_resumed
     assert "from restart file restart/state_" in log and f" in its {stage}" in log, log[-2000:]
     record = read_run_record(run_dir / "run.json")
-    assert record.resumed_attempts == 1
-    resumed_log = (run_dir / "resume1.log.liggghts").read_text()
-    assert "SILOFLOW resumed" in resumed_log
+    # a run killed in its pour was stopped once more by a part's deadline (the fixture)
+    assert record.resumed_attempts == (2 if stage == "fill" else 1)
+    resumed_logs = [path.read_text() for path in attempt_logs(run_dir)[1:]]
+    assert all("SILOFLOW resumed" in text for text in resumed_logs)
     # a pour resumed goes on inserting where it stopped: the fill holds the case's clumps, no more
     assert record.stage("fill")["clumps"] == record.n_clumps
-    assert ("SILOFLOW filled" in resumed_log) == (stage == "fill")
+    assert ("SILOFLOW filled" in resumed_logs[0]) == (stage == "fill")
     # the markers' times are the steps' (LIGGGHTS starts its clock again at zero in a resumed attempt)
     assert record.open_time_s == pytest.approx(record.open_step * record.timestep_s, rel=1e-12)
     # restart files only serve resumption; a finished run has none left
@@ -113,7 +129,7 @@ def test_the_killed_run_resumes_from_its_restart_file_in_the_stage_it_was_killed
 
 @pytest.mark.physics  # a second run of the tiny silo, uninterrupted
 def test_resumed_and_uninterrupted_runs_agree(killed_and_resumed, uninterrupted):
-    (_, resumed_dir), uninterrupted_dir = killed_and_resumed, uninterrupted
+    (_, resumed_dir, _), uninterrupted_dir = killed_and_resumed, uninterrupted
     resumed = read_run_record(resumed_dir / "run.json")
     uninterrupted = read_run_record(uninterrupted_dir / "run.json")
     assert resumed.stage("fill")["clumps"] == uninterrupted.stage("fill")["clumps"] == resumed.n_clumps

@@ -20,7 +20,8 @@ from siloflow.analysis.numerics.force_balance import settled_fill_balance
 from siloflow.model.cases.silo_flat import build_silo_case
 from siloflow.engines.config import load_config_file, validate_config
 from siloflow.engines.interface import EngineOptions, EngineRunError, engine_for
-from siloflow.engines.yade.run import restart_files
+from siloflow.engines.deadline import PartDeadline, until
+from siloflow.engines.yade.run import attempt_logs, restart_files
 from tests.stopped_runs import killable
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
 from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
@@ -98,6 +99,13 @@ def micro_run(request, tmp_path_factory):
     for pid in script_processes(run_dir):
         os.kill(pid, signal.SIGKILL)
     first.join()
+    if stage == "fill":
+        # a validation part's deadline falls while the resumed run goes on: it stops there, and neither goes back
+        # to an older snapshot nor runs on past the deadline
+        with pytest.raises(PartDeadline), until(time.time() + 15.0, case.run_id):
+            engine.run(case, run_dir, EngineOptions())
+        assert [path.name for path in attempt_logs(run_dir)] == ["log.yade", "resume1.log.yade"]
+        assert "SILOFLOW discharged" not in (run_dir / "resume1.log.yade").read_text()
     record = engine.run(case, run_dir, EngineOptions())
     return case, engine, run_dir, record, listening_while_running, failure, stage
 
@@ -119,7 +127,8 @@ def test_no_socket_listens_while_yade_runs(micro_run):
 def test_the_killed_run_failed_and_resumed_from_a_snapshot(micro_run):
     case, _, run_dir, record, _, failure, stage = micro_run
     assert failure and failure[0] is not None and "exit code -9" in failure[0]
-    assert record.resumed_attempts == 1
+    # a run killed in its pour was stopped once more by a part's deadline (the fixture)
+    assert record.resumed_attempts == (2 if stage == "fill" else 1)
     resumed_log = (run_dir / "resume1.log.yade").read_text()
     assert "SILOFLOW resumed" in resumed_log
     # a pour resumed goes on inserting where it stopped, from the random state its snapshot kept

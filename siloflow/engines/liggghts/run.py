@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from siloflow.model.record import RunRecord
+from siloflow.engines.deadline import PartDeadline
 from siloflow.engines.interface import EngineNotFound, EngineRunError
 from siloflow.engines.run_files import output_bytes, remove_matching, write_run_record
 from siloflow.engines.run_files import set_aside_previous_attempt as set_aside
@@ -306,6 +307,10 @@ def _resume_run(run_dir: Path, resume: Resume, markers: list[Marker], engine: di
     newest, *older = restart_files(run_dir)[-2:][::-1]
     try:
         run_from(newest)
+    except PartDeadline:
+        # the part's time ran out while the run went on from its newest file, which was read: the next part
+        # resumes from the newest file then; going back one file now would run on past the deadline
+        raise
     except EngineRunError as error:
         if not older or "restart" not in str(error).lower():
             raise

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Callable
 
 from siloflow.model.record import RunRecord
+from siloflow.engines.deadline import PartDeadline
 from siloflow.engines.interface import EngineNotFound, EngineRunError
 from siloflow.engines.markers import Marker, parse_markers, without_redone
 from siloflow.engines.progress import run_with_progress
@@ -162,6 +163,10 @@ def _resume(run_dir: Path, options: YadeOptions, target_time: float, markers: li
         try:
             run_script(run_dir, options, remaining, arguments, f"{RESUME_STEM}{attempt}.{LOG_NAME}")
             return
+        except PartDeadline:
+            # the part's time ran out while the run went on: the next part resumes it; an older snapshot now would
+            # run on past the deadline
+            raise
         except EngineRunError as error:
             if attempt_from is not newest or not older:
                 raise
