@@ -120,7 +120,8 @@ def test_the_killed_run_resumes_from_its_restart_file_in_the_stage_it_was_killed
     assert all("SILOFLOW resumed" in text for text in resumed_logs)
     # a pour resumed goes on inserting where it stopped: the fill holds the case's clumps, no more
     assert record.stage("fill")["clumps"] == record.n_clumps
-    assert ("SILOFLOW filled" in resumed_logs[0]) == (stage == "fill")
+    # (the fill ends in the first resumption or, where the part's deadline came first, in the next)
+    assert any("SILOFLOW filled" in text for text in resumed_logs) == (stage == "fill")
     # the markers' times are the steps' (LIGGGHTS starts its clock again at zero in a resumed attempt)
     assert record.open_time_s == pytest.approx(record.open_step * record.timestep_s, rel=1e-12)
     # restart files only serve resumption; a finished run has none left
