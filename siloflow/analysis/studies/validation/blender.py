@@ -238,15 +238,13 @@ def _inlet_rows(summary: Mapping, note: str, dof, tolerances: AgreementTolerance
         passages, bins, plane = wall
         measured, differs = "", _continuous(summary)
     else:
-        inlet = summary.get("passages_at_insert_inlet") or {}
-        means, bins = inlet.get("mean_v_z_m_s") or {}, inlet.get("n_bins") or {}
-        if not ({"interior", "exterior"} <= means.keys() and all(bins.get(key) for key in means)):
+        passages, bins = _inlet_passages(summary)
+        if not {"interior", "exterior"} <= passages.keys():
             return []
         # The depth average's inlet means have no batch means behind them: an error only where one is written.
-        errors = inlet.get("mean_v_z_m_s_error") or {}
-        passages = {key: (float(v), number_or_nan(errors.get(key))) for key, v in means.items()}
+        written = (summary.get("passages_at_insert_inlet") or {}).get("mean_v_z_m_s_error")
         plane = "depth-averaged"
-        measured = "" if errors else "; its error is not measured (blender.json has no error of the inlet's passages)"
+        measured = "" if written else "; its error is not measured (blender.json has no error of the inlet's passages)"
         differs = joined((DEPTH_AVERAGED, _continuous(summary)))
     if not {"interior", "exterior"} <= passages.keys():
         return []
@@ -542,14 +540,10 @@ def _fixed_moduli_rows(name: str, by_factor: Mapping[float, Mapping], tolerances
         unit = "kg/s" if key == "mass_flow" else "m/s"
         evidence = (f"{label} at {factors_text} g: "
                     + ", ".join(f"{plus_minus(v, e)}" for v, e in zip(values, errors)) + f" {unit}; {notes}")
-        figure = f"Exponent of the {label} against the gravity factor"
-        if study:
-            agreement = rules.power_law(factors, values, errors, dof, PARTS[part_id], tolerances)
-            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, exponent, error, "-", evidence, dof=dof,
-                            finding=part_id, agreement=agreement, differs=differs))
-        else:
-            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, exponent, error, "-", evidence, dof=dof, study="-",
-                            differs=differs))
+        judged = (dict(finding=part_id, agreement=rules.power_law(factors, values, errors, dof, PARTS[part_id],
+                                                                   tolerances)) if study else dict(study="-"))
+        rows.append(row(FIXED_GRAVITY_GROUP, f"Exponent of the {label} against the gravity factor", name, exponent,
+                        error, "-", evidence, dof=dof, differs=differs, **judged))
     if all("inlet_differential" in entry for entry in figures):
         (first, first_error), (last, last_error) = figures[0]["inlet_differential"], figures[-1]["inlet_differential"]
         root = math.sqrt(factors[-1])
@@ -558,12 +552,9 @@ def _fixed_moduli_rows(name: str, by_factor: Mapping[float, Mapping], tolerances
                     f"m/s; {factors[-1]:g} g: {plus_minus(last, last_error)} m/s, over sqrt({factors[-1]:g}); {notes}")
         figure = (f"Change of the annuli's velocity differential at the insert inlet over sqrt(g / g0), 1 to "
                   f"{factors[-1]:g} g")
-        if study:
-            part = PARTS["M4.inlet_differential_decreases"]
-            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, change, change_error, "m/s", evidence, dof=dof,
-                            finding=part.id, agreement=rules.sign_of_change(change, change_error, dof, part),
-                            differs=differs))
-        else:
-            rows.append(row(FIXED_GRAVITY_GROUP, figure, name, change, change_error, "m/s", evidence, dof=dof,
-                            study="-", differs=differs))
+        part = PARTS["M4.inlet_differential_decreases"]
+        judged = (dict(finding=part.id, agreement=rules.sign_of_change(change, change_error, dof, part)) if study
+                  else dict(study="-"))
+        rows.append(row(FIXED_GRAVITY_GROUP, figure, name, change, change_error, "m/s", evidence, dof=dof,
+                        differs=differs, **judged))
     return rows
