@@ -24,11 +24,11 @@ from siloflow.model.record import read_run_record
 from siloflow.engines.config import load_config_file, validate_config
 from tests.repo import REPO_ROOT
 from siloflow.engines.layout import run_dir as layout_run_dir, run_path
-from siloflow.engines.deadline import PartDeadline, until
+from siloflow.engines.deadline import PartDeadline
 from siloflow.engines.interface import EngineOptions, engine_for
 from siloflow.engines.liggghts.run import attempt_logs, restart_files
 from siloflow.model.cases.silo_flat import build_silo_case
-from tests.stopped_runs import killable
+from tests.stopped_runs import deadline_once, killable, started_log
 from tests.conftest import NO_BLENDER, NO_BLENDING, TINY_SILO, require_liggghts, run_snakemake
 
 pytestmark = [pytest.mark.integration, pytest.mark.core_seconds(160)]
@@ -87,17 +87,17 @@ def killed_and_resumed(request, tmp_path_factory):
         # back to an older restart file nor runs on past the deadline (the engine called directly, so that the
         # deadline counts from the resumption, not from the workflow's start)
         case = build_silo_case(_config())
-        with pytest.raises(PartDeadline), until(time.time() + 10.0, run_id):
+        with pytest.raises(PartDeadline), deadline_once(started_log(run_dir / "resume1.log.liggghts"), run_id):
             engine_for(_config(), "silo_flat").run(case, run_dir, EngineOptions())
         assert [path.name for path in attempt_logs(run_dir)] == ["log.liggghts", "resume1.log.liggghts"]
-        first_resumption = (run_dir / "resume1.log.liggghts").read_text()
-        assert "SILOFLOW discharged" not in first_resumption and not (run_dir / "run.json").exists()
+        stopped = (run_dir / "resume1.log.liggghts").read_text()
+        assert "SILOFLOW discharged" not in stopped and not (run_dir / "run.json").exists()
     resumed = run_snakemake(workdir, "--cores", "1", "--rerun-incomplete", "--configfile",
                             str(workdir / "tiny.yaml"), targets=[target])
     assert resumed.returncode == 0, resumed.stdout[-3000:] + resumed.stderr[-3000:]
-    if stage != "fill":
-        first_resumption = (run_dir / "logs" / "run.log").read_text()
-    yield stage, run_dir, first_resumption
+    # the resumption that completed the run: the engine's own log where the deadline stopped the first one early
+    completed = attempt_logs(run_dir)[-1] if stage == "fill" else run_dir / "logs" / "run.log"
+    yield stage, run_dir, completed.read_text()
 
 
 @pytest.fixture(scope="module")

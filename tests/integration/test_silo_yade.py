@@ -20,9 +20,9 @@ from siloflow.analysis.numerics.force_balance import settled_fill_balance
 from siloflow.model.cases.silo_flat import build_silo_case
 from siloflow.engines.config import load_config_file, validate_config
 from siloflow.engines.interface import EngineOptions, EngineRunError, engine_for
-from siloflow.engines.deadline import PartDeadline, until
+from siloflow.engines.deadline import PartDeadline
 from siloflow.engines.yade.run import attempt_logs, restart_files
-from tests.stopped_runs import killable
+from tests.stopped_runs import deadline_once, killable, started_log
 from tests.conftest import DEFAULT_CONFIG, MICRO_SILO, require_yade
 from tests.paraview_checks import check_paraview_folder, write_engine_paraview_files
 
@@ -102,7 +102,7 @@ def micro_run(request, tmp_path_factory):
     if stage == "fill":
         # a validation part's deadline falls while the resumed run goes on: it stops there, and neither goes back
         # to an older snapshot nor runs on past the deadline
-        with pytest.raises(PartDeadline), until(time.time() + 15.0, case.run_id):
+        with pytest.raises(PartDeadline), deadline_once(started_log(run_dir / "resume1.log.yade"), case.run_id):
             engine.run(case, run_dir, EngineOptions())
         assert [path.name for path in attempt_logs(run_dir)] == ["log.yade", "resume1.log.yade"]
         assert "SILOFLOW discharged" not in (run_dir / "resume1.log.yade").read_text()
