@@ -16,9 +16,11 @@ from pathlib import Path
 
 from siloflow.model.record import RunRecordError, read_run_record
 from siloflow.model.cases import cases_of, run_roles
+from siloflow.model.cases.common import engine_kind
 from siloflow.model.cases.kinds import configured_kinds
+from siloflow.engines.config import ENGINE_ONLY_KEYS
 from siloflow.engines.interface import engine_for
-from siloflow.model.cost import CostModel, MeasuredWork, RunEstimate
+from siloflow.model.cost import CostModel, MeasuredWork, RunEstimate, on_ranks
 from siloflow.engines.estimates import (
     check_disk_space,
     estimate_case,
@@ -28,7 +30,8 @@ from siloflow.engines.estimates import (
     total_dump_bytes,
 )
 from siloflow.engines.layout import RUN_RECORD, run_dir
-from siloflow.engines.validation_groups import assign, cost_lines, group_costs, part_costs, split_groups
+from siloflow.engines.validation_groups import (PART_CORES, assign, cost_lines, group_costs, lone_runs, part_costs,
+                                               split_groups)
 
 
 def cost_model(config: dict) -> CostModel:
@@ -36,6 +39,7 @@ def cost_model(config: dict) -> CostModel:
     section = config["estimates"]
     return CostModel(seconds_per_sphere_step=section["seconds_per_sphere_step"],
                      settle_fraction=section["settle_fraction"],
+                     parallel_efficiency=section["parallel_efficiency"],
                      kind_seconds_per_sphere_step=dict(section["seconds_per_sphere_step_by_case"]))
 
 
@@ -275,8 +279,27 @@ def comparison_report(measured: list[tuple[RunEstimate, MeasuredWork]], steps: l
 
 
 def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[RunEstimate]]:
-    """The runs each validation group makes, of a configuration's ``estimates`` (:func:`siloflow.engines.validation_groups.assign`)."""
-    return assign(estimates, {run: role for kind in configured_kinds() for run, role in run_roles(config, kind).items()})
+    """The runs each validation group makes, of a configuration's ``estimates``
+    (:func:`siloflow.engines.validation_groups.assign`); a run that would leave a part's cores idle through all its
+    parts is estimated on the ranks that use them (:func:`siloflow.engines.validation_groups.lone_runs`) where its
+    engine takes MPI ranks, and the workflow runs it so (:func:`run_ranks`)."""
+    roles = {run: role for kind in configured_kinds() for run, role in run_roles(config, kind).items()}
+    made = assign(estimates, roles)
+    wider = lone_runs({name: [e for e in runs if _takes_ranks(config, e.kind)] for name, runs in made.items()})
+    model = cost_model(config)
+    return {name: [on_ranks(e, wider[e.run_id], model) if e.run_id in wider else e for e in runs]
+            for name, runs in made.items()}
+
+
+def _takes_ranks(config: dict, kind: str) -> bool:
+    """Whether the engine that runs case kind ``kind`` runs on MPI ranks (``engine.mpi_ranks`` is its own)."""
+    return ("engine", "mpi_ranks") in ENGINE_ONLY_KEYS[engine_kind(config, kind)]
+
+
+def run_ranks(made: dict[str, list[RunEstimate]]) -> dict[str, int]:
+    """``{run id: MPI ranks}`` of the validation groups' runs (:func:`group_runs`): what the workflow gives each run
+    step (its threads) and so its engine."""
+    return {e.run_id: e.mpi_ranks for runs in made.values() for e in runs}
 
 
 def estimate_report(config: dict, label: str, results: str | Path, cores: int) -> str:
@@ -293,11 +316,13 @@ def estimate_report(config: dict, label: str, results: str | Path, cores: int) -
         model = calibrated_model(apriori, measured)
         source = (f"measured on this machine, the median of {len(measured)} finished run(s) under {results}/; the "
                   f"config says {apriori.seconds_per_sphere_step:.3g}")
+    table = config_estimates(config, model) if measured else estimates
+    made = group_runs(config, table)
+    ranks = run_ranks(made)
     lines = [f"Estimates for {label} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere-step on one "
-             f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run; settling at "
-             f"{model.settle_fraction:.0%} of its longest time)",
-             estimate_table(config_estimates(config, model) if measured else estimates), ""]
-    made = group_runs(config, config_estimates(config, model) if measured else estimates)
+             f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run, a validation run alone through "
+             f"its parts on {PART_CORES}; settling at {model.settle_fraction:.0%} of its longest time)",
+             estimate_table([on_ranks(e, ranks.get(e.run_id, e.mpi_ranks), model) for e in table]), ""]
     # the parts come from the config's own cost model, so that measuring a run never moves a run to another part
     parts = split_groups(group_runs(config, estimates))
     lines += cost_lines(group_costs(made, cores), cores, part_costs(parts, made, cores))

@@ -7,6 +7,7 @@ run, check the disk and log what it will cost (:mod:`siloflow.engines.planning`)
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from pathlib import Path
 
@@ -37,11 +38,14 @@ def render_run(config: dict, case_kind: str, case, run_dir: str | Path, assembly
     return summary
 
 
-def run_case(config: dict, case_kind: str, case, run_dir: str | Path) -> RunRecord:
+def run_case(config: dict, case_kind: str, case, run_dir: str | Path, mpi_ranks: int | None = None) -> RunRecord:
     """Run the rendered inputs of ``case`` (a run of ``case_kind`` of the validated ``config``) on its engine, after
-    checking the disk and logging the estimate; returns the run record (also written as ``<run_dir>/run.json``)."""
+    checking the disk and logging the estimate; returns the run record (also written as ``<run_dir>/run.json``).
+    ``mpi_ranks``: the ranks the workflow gives the run (its step's threads), instead of ``engine.mpi_ranks``."""
     _check_kind(case_kind, case)
     kind = engine_kind(config, case_kind)
     options = EngineOptions.from_config(config, kind)
+    if mpi_ranks is not None:
+        options = dataclasses.replace(options, mpi_ranks=mpi_ranks)
     logging.getLogger("siloflow").info(preflight(config, estimate_case(case, options.mpi_ranks, cost_model(config)), run_dir))
     return engine_for(config, case_kind).run(case, run_dir, options)

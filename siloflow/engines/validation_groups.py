@@ -183,6 +183,47 @@ class Part:
         return [members[i] for i in self.positions]
 
 
+def _longest_first(members: Sequence[RunEstimate]) -> list[int]:
+    """Positions of ``members``, the most core time first (ties by run id)."""
+    return sorted(range(len(members)),
+                  key=lambda i: (-members[i].wall_time_s * members[i].mpi_ranks, members[i].run_id))
+
+
+def _side_by_side(members: Sequence[RunEstimate], order: Sequence[int], cores: int,
+                  budget_s: float) -> list[list[int]]:
+    """The runs longer than ``budget_s`` on their own (positions in ``order``), gathered side by side while the
+    ``cores`` hold their ranks: each list runs through the same consecutive time-sliced parts."""
+    long = [i for i in order if members[i].wall_time_s > budget_s]
+    gathered: list[list[int]] = []
+    while long:
+        chosen, used = [], 0
+        for i in list(long):
+            ranks = min(members[i].mpi_ranks, cores)
+            if not chosen or used + ranks <= cores:
+                chosen.append(i)
+                used += ranks
+                long.remove(i)
+        gathered.append(chosen)
+    return gathered
+
+
+def lone_runs(made: Mapping[str, Sequence[RunEstimate]], cores: int = PART_CORES,
+              budget_s: float = PART_FILL * GROUP_BUDGET_S) -> dict[str, int]:
+    """The runs that would leave cores idle through the time-sliced parts of their group, with the MPI ranks that
+    use them: ``{run id: ranks}``, the cores shared out among the runs side by side (:func:`split`).
+
+    A run longer than a part, with no other such run of its group beside it, holds one core of the part's two for
+    all its parts; on two ranks it finishes sooner (`make bench-assembly` measures 1 rank against 2 on the tier's
+    largest assembly). A run already on as many ranks as its share is left out.
+    """
+    wider: dict[str, int] = {}
+    for members in made.values():
+        for chosen in _side_by_side(members, _longest_first(members), cores, budget_s):
+            share = cores // len(chosen)
+            wider.update({members[i].run_id: share for i in chosen if members[i].mpi_ranks < share})
+    return wider
+
+
 def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
           budget_s: float = PART_FILL * GROUP_BUDGET_S) -> list[Part]:
     """A group's runs in parts that each take at most ``budget_s`` on ``cores`` cores (by default
@@ -210,21 +251,9 @@ def split(group: str, members: Sequence[RunEstimate], cores: int = PART_CORES,
     list of Part
         In order of their longest run; none for a group without runs.
     """
-    order = sorted(range(len(members)), key=lambda i: (-members[i].wall_time_s * members[i].mpi_ranks,
-                                                       members[i].run_id))
-    long = [i for i in order if members[i].wall_time_s > budget_s]
-    sliced: list[tuple[list[int], int]] = []
-    while long:
-        # side by side while the cores hold their ranks
-        chosen, used = [], 0
-        for i in list(long):
-            ranks = min(members[i].mpi_ranks, cores)
-            if not chosen or used + ranks <= cores:
-                chosen.append(i)
-                used += ranks
-                long.remove(i)
-        slices = math.ceil(max(members[i].wall_time_s for i in chosen) / budget_s)
-        sliced.append((chosen, slices))
+    order = _longest_first(members)
+    sliced = [(chosen, math.ceil(max(members[i].wall_time_s for i in chosen) / budget_s))
+              for chosen in _side_by_side(members, order, cores, budget_s)]
     bins: list[list[int]] = []
     for i in (i for i in order if members[i].wall_time_s <= budget_s):
         fits = (b for b in bins

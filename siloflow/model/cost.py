@@ -25,6 +25,7 @@ parsed frames.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
@@ -257,6 +258,15 @@ class RunEstimate:
     def core_seconds(self) -> float:
         """CPU time over all ranks, ``wall_time_s * mpi_ranks`` (CPU s): what the engine's own timing adds up to."""
         return self.wall_time_s * self.mpi_ranks
+
+
+def on_ranks(estimate: RunEstimate, mpi_ranks: int, model: CostModel) -> RunEstimate:
+    """``estimate`` of the same run on ``mpi_ranks`` ranks: the same work at the model's speed-up
+    (:func:`parallel_speedup`), so ``wall = serial / speedup(mpi_ranks)`` with ``serial`` the estimate's."""
+    efficiency = model.parallel_efficiency
+    serial = estimate.wall_time_s * parallel_speedup(estimate.mpi_ranks, efficiency)
+    return dataclasses.replace(estimate, wall_time_s=serial / parallel_speedup(mpi_ranks, efficiency),
+                               mpi_ranks=mpi_ranks)
 
 
 def _count(name: str, value, minimum: int) -> int:

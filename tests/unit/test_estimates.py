@@ -23,6 +23,7 @@ from siloflow.model.cost import (
     drain_sphere_steps,
     dump_frames,
     estimate_run,
+    on_ranks,
     parallel_speedup,
     pour_sphere_steps,
     wall_time,
@@ -125,6 +126,19 @@ def test_parallel_speedup_loses_the_efficiency_per_doubling(ranks, speedup):
 
 def test_perfect_efficiency_divides_by_the_ranks():
     assert wall_time(90.0, 3, CostModel(parallel_efficiency=1.0)) == pytest.approx(30.0, rel=1e-12)
+
+
+def test_a_run_on_more_ranks_does_the_same_work_faster():
+    one = RunEstimate(run_id="r", kind="silo_flat", clumps=10, spheres=20, steps=100, sphere_steps=2000.0,
+                      simulated_time_s=0.1, wall_time_s=3600.0, dump_frames=3, dump_bytes=7, mpi_ranks=1)
+    model = CostModel(parallel_efficiency=0.9)
+    two = on_ranks(one, 2, model)
+    # 2 * 0.9: 1.8 times as fast; 4 ranks: 4 * 0.81 = 3.24
+    assert (two.mpi_ranks, two.wall_time_s) == (2, pytest.approx(2000.0, rel=1e-12))
+    assert two.core_seconds == pytest.approx(4000.0, rel=1e-12)
+    assert on_ranks(two, 4, model).wall_time_s == pytest.approx(3600.0 / 3.24, rel=1e-12)
+    assert on_ranks(two, 1, model).wall_time_s == pytest.approx(3600.0, rel=1e-12)
+    assert (two.sphere_steps, two.dump_bytes, two.run_id) == (2000.0, 7, "r")
 
 
 @pytest.mark.parametrize("ranks", [0, -2, 1.5, True])

@@ -11,7 +11,7 @@ from tests.repo import REPO_ROOT
 from siloflow.model.cost import RunEstimate
 from siloflow.model.cases import REFERENCE, VARIANT
 from siloflow.model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, ROLES, SHAPE_CHART
-from siloflow.engines.planning import config_estimates, group_runs
+from siloflow.engines.planning import config_estimates, group_runs, run_ranks
 from siloflow.engines.validation_groups import (
     COMPLETE,
     GROUP_BUDGET_S,
@@ -31,6 +31,7 @@ from siloflow.engines.validation_groups import (
     group_of,
     group_of_part,
     group_status,
+    lone_runs,
     makespan,
     part_costs,
     part_of_runs,
@@ -80,6 +81,34 @@ def test_the_validation_config_s_runs_fall_into_their_groups():
     # three inserts, the converging one's second seed and the diverging one at 5 g
     assert counts == {"calibration": 18, "calibration_shapes": 20, "calibration_checks": 14, "silo": 2,
                       "silo_series": 1, "blending": 3, "blender": 5}
+
+
+def test_the_validation_config_s_lone_fill_runs_on_both_cores():
+    config = load_config(REPO_ROOT / "config" / "validation.yaml")
+    estimates = config_estimates(config)
+    made = group_runs(config, estimates)
+    (lone,) = made["silo_series"]
+    alone = next(e for e in estimates if e.run_id == lone.run_id)
+    # 2 ranks at 0.9 per doubling: 1.8 times as fast, the same work
+    assert (alone.mpi_ranks, lone.mpi_ranks) == (1, 2)
+    assert lone.wall_time_s == pytest.approx(alone.wall_time_s / 1.8, rel=1e-12)
+    assert lone.sphere_steps == alone.sphere_steps
+    # the silo's two fills run side by side, one core each: they keep one rank
+    assert {e.mpi_ranks for e in made["silo"]} == {1}
+    assert run_ranks(made)[lone.run_id] == 2
+
+
+def test_a_run_alone_through_its_parts_gets_the_cores_the_others_leave():
+    hour = 3600.0
+    made = {"silo": [_estimate("a", "silo_flat", 5.0 * hour), _estimate("b", "silo_flat", 4.0 * hour)],
+            "silo_series": [_estimate("c", "silo_flat", 5.0 * hour), _estimate("d", "silo_flat", 1.0 * hour)],
+            "blending": [_estimate("e", "silo_recirculation", 5.0 * hour, mpi_ranks=2)],
+            "blender": [_estimate("f", "blender", 1.0 * hour)]}
+    # a and b share their parts; c runs alone through its parts (d is short, a part of its own); e has both cores
+    # already; f is short
+    assert lone_runs(made) == {"c": 2}
+    assert lone_runs(made, cores=4) == {"a": 2, "b": 2, "c": 4, "e": 4}
+    assert lone_runs({"silo": [_estimate("a", "silo_flat", 2.0 * hour)]}) == {}
 
 
 def test_an_unknown_group_is_refused_with_the_groups_named():
@@ -328,7 +357,7 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
     assert record_main(["restore", "--group", "calibration_1", "--config", config, "--record", str(tmp_path),
                         "--directory", str(workdir)]) == 0
     assert capsys.readouterr().out == "" and not workdir.exists()
-    assert record_main(["check", "--group", "silo_series_1", "--config", config, "--record", str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "silo_series", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
             "validate GROUP=silo_2 first" in
             capsys.readouterr().err)

@@ -58,8 +58,8 @@ rule blender_run:
         case=typed_case("blender"),
         engine=config["engine"],
     resources:
-        tasks=config["engine"]["mpi_ranks"],
-    threads: config["engine"]["mpi_ranks"]
+        tasks=mpi_ranks,
+    threads: mpi_ranks
     priority: RUN_PRIORITY.get("blender", 0)
     log:
         run_path("blender", "logs/run.log"),

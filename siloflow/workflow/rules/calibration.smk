@@ -105,8 +105,8 @@ rule jenike_run:
         case=typed_case("jenike"),
         engine=config["engine"],
     resources:
-        tasks=config["engine"]["mpi_ranks"],
-    threads: config["engine"]["mpi_ranks"]
+        tasks=mpi_ranks,
+    threads: mpi_ranks
     log:
         run_path("jenike", "logs/run.log"),
     benchmark:

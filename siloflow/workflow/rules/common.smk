@@ -20,7 +20,7 @@ from siloflow.model.cases.verification import verification_cases
 from siloflow.engines.interface import ENGINE_KINDS, CaseNotSupported, engine_for, engine_named
 from siloflow.engines.layout import (CALIBRATED_PARAMETERS, CALIBRATION_DIR, CASE_SUMMARY, CROSS_ENGINE_DIR, RESULTS, RUN_BENCHMARK,
                             RUN_RECORD, SUMMARY_DIR, VERIFICATION_DIR, case_root, run_dir, run_path)
-from siloflow.engines.planning import ensure_disk_space, run_priorities
+from siloflow.engines.planning import ensure_disk_space, group_runs as planned_group_runs, run_priorities, run_ranks
 
 # Snakemake has read the config files already, through YTE when a file asks for it (Snakemake has no switch to refuse
 # that); siloflow.engines.preflight reads them again as plain data, so that such a file, a repeated key or a YAML 1.1 boolean
@@ -54,6 +54,16 @@ CASES = PREFLIGHT.cases
 #: The estimate of every run, made once: the priorities below and the disk check at the start read it.
 ESTIMATES = PREFLIGHT.estimates
 RUN_PRIORITY = run_priorities(ESTIMATES)
+#: The runs each validation group makes, as its parts run them (validation.smk splits them into parts).
+PLANNED_GROUP_RUNS = planned_group_runs(config, ESTIMATES)
+#: MPI ranks of each run: the configuration's (engine.mpi_ranks), or both of a part's cores for a run alone through
+#: its parts (siloflow.engines.planning.group_runs).
+RUN_RANKS = run_ranks(PLANNED_GROUP_RUNS)
+
+
+def mpi_ranks(wildcards):
+    """MPI ranks of an engine run step (its threads; the run script starts its engine on them)."""
+    return RUN_RANKS.get(wildcards.run, config["engine"]["mpi_ranks"])
 
 
 #: Each case kind's products, ``{kind: targets(wildcards=None, runs=None)}``: its rule file adds its own. With ``runs``

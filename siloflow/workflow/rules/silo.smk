@@ -90,8 +90,8 @@ rule silo_run:
         case=typed_case("silo_flat"),
         engine=config["engine"],
     resources:
-        tasks=config["engine"]["mpi_ranks"],
-    threads: config["engine"]["mpi_ranks"]
+        tasks=mpi_ranks,
+    threads: mpi_ranks
     priority: RUN_PRIORITY.get("silo_flat", 0)
     log:
         run_path("silo_flat", "logs/run.log"),

@@ -81,8 +81,8 @@ rule silo_recirculation_run:
         case=typed_case(RECIRCULATION),
         engine=config["engine"],
     resources:
-        tasks=config["engine"]["mpi_ranks"],
-    threads: config["engine"]["mpi_ranks"]
+        tasks=mpi_ranks,
+    threads: mpi_ranks
     priority: RUN_PRIORITY.get("silo_recirculation", 0)
     log:
         run_path(RECIRCULATION, "logs/run.log"),

@@ -6,7 +6,6 @@ from siloflow.analysis.io.validation_record import RECORD_PLOT_FORMAT, check_plo
 from siloflow.model.cases import REFERENCE, VARIANT, run_roles
 from siloflow.model.cases.jenike_sweep import CALIBRATION_CHART, CHECK, SHAPE_CHART
 from siloflow.engines.layout import READ_PRODUCTS, SILO_ROW_PRODUCTS, SUMMARY_DIR, VALIDATION_RECORD
-from siloflow.engines.planning import group_runs as planned_group_runs
 from siloflow.engines.validation_groups import GROUPS, part_of_runs, split_groups
 
 
@@ -158,7 +157,7 @@ def group_targets(group):
     return CASE_TARGETS[spec.kind]()
 
 #: Each group's parts, from the configuration's own cost estimates (siloflow.engines.validation_groups.split).
-PARTS = split_groups(planned_group_runs(config, ESTIMATES))
+PARTS = split_groups(PLANNED_GROUP_RUNS)
 
 
 def part_runs(part):

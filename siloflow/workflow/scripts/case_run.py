@@ -17,4 +17,5 @@ with logged_to(snakemake.log[0]):
     engine = engine_kind(snakemake.config, snakemake.params.kind)
     note_attempt(run_dir, engine, engine_named(engine).installed_version(), code_commit(snakemake.scriptdir))
     with until(deadline_from(os.environ), f"{snakemake.params.kind} run {run_dir.name}"):
-        run_case(snakemake.config, snakemake.params.kind, snakemake.params.case, run_dir)
+        # the step's threads are its MPI ranks (the workflow's mpi_ranks: a run alone in its parts takes both cores)
+        run_case(snakemake.config, snakemake.params.kind, snakemake.params.case, run_dir, snakemake.threads)
