@@ -234,13 +234,13 @@ def test_validate_checks_the_group_before_anything_runs(tmp_path, capsys):
         capsys.readouterr().err)
     # a group longer than a session is run by its parts
     assert record_main(["check", "--group", "blending", "--config", config, "--record", str(tmp_path)]) == 2
-    # both flow patterns side by side over five time slices, the thin silo
-    assert ("runs in 6 parts: " + " then ".join(f"make validate GROUP=blending_{k}" for k in range(1, 7))
+    # both flow patterns side by side over eight time slices, the thin silo
+    assert ("runs in 9 parts: " + " then ".join(f"make validate GROUP=blending_{k}" for k in range(1, 10))
             in capsys.readouterr().err)
     # the blending study starts from the flat-bottom silo's settled fills: it waits for that silo's record
     assert record_main(["check", "--group", "blending_1", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
-            "validate GROUP=silo_2 first") in (
+            "validate GROUP=silo_2 then make validate GROUP=silo_3 first") in (
         capsys.readouterr().err)
     assert record_main(["status", "--config", "no-such-config.yaml"]) == 2
 
@@ -357,9 +357,9 @@ def test_a_group_that_compares_against_another_waits_for_its_record(tmp_path, ca
     assert record_main(["restore", "--group", "calibration_1", "--config", config, "--record", str(tmp_path),
                         "--directory", str(workdir)]) == 0
     assert capsys.readouterr().out == "" and not workdir.exists()
-    assert record_main(["check", "--group", "silo_series", "--config", config, "--record", str(tmp_path)]) == 2
+    assert record_main(["check", "--group", "silo_series_1", "--config", config, "--record", str(tmp_path)]) == 2
     assert ("compares against the runs of silo, whose record is missing: run make validate GROUP=silo_1 then make "
-            "validate GROUP=silo_2 first" in
+            "validate GROUP=silo_2 then make validate GROUP=silo_3 first" in
             capsys.readouterr().err)
 
 
