@@ -316,15 +316,16 @@ def estimate_report(config: dict, label: str, results: str | Path, cores: int) -
         model = calibrated_model(apriori, measured)
         source = (f"measured on this machine, the median of {len(measured)} finished run(s) under {results}/; the "
                   f"config says {apriori.seconds_per_sphere_step:.3g}")
-    table = config_estimates(config, model) if measured else estimates
-    made = group_runs(config, table)
-    ranks = run_ranks(made)
+    # the parts and each run's ranks come from the config's own cost model, as the workflow's, so that measuring a
+    # run never moves a run to another part
+    planned = group_runs(config, estimates)
+    parts, ranks = split_groups(planned), run_ranks(planned)
+    made = {name: [on_ranks(e, ranks[e.run_id], model) for e in runs]
+            for name, runs in group_runs(config, config_estimates(config, model) if measured else estimates).items()}
     lines = [f"Estimates for {label} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere-step on one "
              f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run, a validation run alone through "
              f"its parts on {PART_CORES}; settling at {model.settle_fraction:.0%} of its longest time)",
-             estimate_table([on_ranks(e, ranks.get(e.run_id, e.mpi_ranks), model) for e in table]), ""]
-    # the parts come from the config's own cost model, so that measuring a run never moves a run to another part
-    parts = split_groups(group_runs(config, estimates))
+             estimate_table([e for runs in made.values() for e in runs]), ""]
     lines += cost_lines(group_costs(made, cores), cores, part_costs(parts, made, cores))
     waiting = pending(estimates, results)
     lines.append(f"\n{len(waiting)} of {len(estimates)} runs still to do; they need about "
