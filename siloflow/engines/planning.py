@@ -285,9 +285,12 @@ def group_runs(config: dict, estimates: list[RunEstimate]) -> dict[str, list[Run
     engine takes MPI ranks, and the workflow runs it so (:func:`run_ranks`)."""
     roles = {run: role for kind in configured_kinds() for run, role in run_roles(config, kind).items()}
     made = assign(estimates, roles)
-    wider = lone_runs({name: [e for e in runs if _takes_ranks(config, e.kind)] for name, runs in made.items()})
+    # the runs beside each other as the parts run them, whatever their engine; only those an engine runs on MPI
+    # ranks take the idle cores
+    wider = lone_runs(made)
     model = cost_model(config)
-    return {name: [on_ranks(e, wider[e.run_id], model) if e.run_id in wider else e for e in runs]
+    return {name: [on_ranks(e, wider[e.run_id], model) if e.run_id in wider and _takes_ranks(config, e.kind) else e
+                   for e in runs]
             for name, runs in made.items()}
 
 
@@ -320,8 +323,8 @@ def estimate_report(config: dict, label: str, results: str | Path, cores: int) -
     # run never moves a run to another part
     planned = group_runs(config, estimates)
     parts, ranks = split_groups(planned), run_ranks(planned)
-    made = {name: [on_ranks(e, ranks[e.run_id], model) for e in runs]
-            for name, runs in group_runs(config, config_estimates(config, model) if measured else estimates).items()}
+    made = planned if not measured else {name: [on_ranks(e, ranks[e.run_id], model) for e in runs]
+                                         for name, runs in group_runs(config, config_estimates(config, model)).items()}
     lines = [f"Estimates for {label} (cost model: {model.seconds_per_sphere_step:.3g} s per sphere-step on one "
              f"core, {source}; {config['engine']['mpi_ranks']} MPI rank(s) per run, a validation run alone through "
              f"its parts on {PART_CORES}; settling at {model.settle_fraction:.0%} of its longest time)",

@@ -86,9 +86,9 @@ def killed_and_resumed(request, tmp_path_factory):
         # a validation part's deadline falls while the resumed run pours: the run stops there, and it neither goes
         # back to an older restart file nor runs on past the deadline (the engine called directly, so that the
         # deadline counts from the resumption, not from the workflow's start)
-        case = build_silo_case(_config())
+        config = _config()
         with pytest.raises(PartDeadline), deadline_once(started_log(run_dir / "resume1.log.liggghts"), run_id):
-            engine_for(_config(), "silo_flat").run(case, run_dir, EngineOptions())
+            engine_for(config, "silo_flat").run(build_silo_case(config), run_dir, EngineOptions())
         assert [path.name for path in attempt_logs(run_dir)] == ["log.liggghts", "resume1.log.liggghts"]
         stopped = (run_dir / "resume1.log.liggghts").read_text()
         assert "SILOFLOW discharged" not in stopped and not (run_dir / "run.json").exists()
