@@ -25,6 +25,8 @@ from siloflow.analysis.studies.silo_flat.field_comparisons import (
     comparison_plane,
     measured_comparison_rows,
     parametric_profiles,
+    seed_kinematic,
+    seed_profiles,
     parametric_rows,
 )
 from siloflow.analysis.studies.silo_flat.field_clock import WINDOW_CONFIGURED, WINDOW_STEADY, averaging_window
@@ -581,3 +583,45 @@ def test_parametric_profiles_at_the_highest_height_every_run_covers():
         parametric_profiles([], 0.05)
     with pytest.raises(ValueError, match=r"one node layer in y .* got \[3\]"):
         parametric_profiles([_linear_fields(tall, -1.0, -0.1)], 0.05)
+
+
+def test_seed_profiles_are_the_seeds_mean_with_the_standard_error_of_that_mean():
+    grid = silo_grid(0.06, 0.012, 0.06, (0.006, 0.004, 0.006))
+    other = silo_grid(0.06, 0.012, 0.06, (0.004, 0.004, 0.006))  # another x spacing: put on the first seed's nodes
+    seeds = [depth_average(_linear_fields(grid, -1.0, -0.1)), depth_average(_linear_fields(other, -1.0, -0.3))]
+    profiles = seed_profiles(seeds, [0.02, 0.04])
+    assert profiles.seeds == 2 and profiles.v_z.shape == (2, grid.shape[0])
+    np.testing.assert_allclose(profiles.x, grid.x, rtol=1e-12)
+    # v_z = offset - x: the mean offset -0.2; two seeds 0.2 apart have a standard deviation 0.2 / sqrt(2) and a
+    # standard error of their mean 0.1
+    np.testing.assert_allclose(profiles.v_z, np.tile(-0.2 - grid.x, (2, 1)), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(profiles.v_z_error, 0.1, rtol=1e-12)
+    alone = seed_profiles(seeds[:1], [0.02])
+    np.testing.assert_allclose(alone.v_z[0], -0.1 - grid.x, rtol=1e-12, atol=1e-15)
+    assert alone.seeds == 1 and np.all(np.isnan(alone.v_z_error))
+    with pytest.raises(ValueError, match=r"profile heights \[0.08\] m lie outside"):
+        seed_profiles(seeds, [0.02, 0.08])
+    with pytest.raises(ValueError, match="at least one profile height"):
+        seed_profiles(seeds, [])
+    with pytest.raises(ValueError, match="at least one"):
+        seed_profiles([], [0.02])
+
+
+def test_seed_kinematic_is_the_mean_of_the_seeds_that_fitted_a_b_with_its_replicate_error():
+    first = [{"z_m": 0.02, "B_m": 0.004, "B_m_error": 0.0001}, {"z_m": 0.04, "B_m": 0.006, "B_m_error": 0.003},
+             {"z_m": 0.08, "B_m": None, "B_m_error": None}]
+    second = [{"z_m": 0.02, "B_m": 0.006, "B_m_error": 0.0001}, {"z_m": 0.04, "B_m": 0.008, "B_m_error": 0.003},
+              {"z_m": 0.08, "B_m": 0.01, "B_m_error": 0.002}]
+    kinematic = seed_kinematic([first, second])
+    np.testing.assert_allclose(kinematic.heights, [0.02, 0.04, 0.08])
+    np.testing.assert_allclose(kinematic.B, [0.005, 0.007, 0.01], rtol=1e-12)
+    # 20 mm: the seeds' standard error 0.001 exceeds the within-run sqrt(2) 1e-4 / 2; 40 mm: the within-run
+    # sqrt(2) * 0.003 / 2 exceeds the seeds' 0.001; 80 mm: one seed, its own error
+    np.testing.assert_allclose(kinematic.B_error, [0.001, math.sqrt(2) * 0.0015, 0.002], rtol=1e-12)
+    assert kinematic.seeds.tolist() == [2, 2, 1]
+    none = seed_kinematic([[{"z_m": 0.02, "B_m": None, "B_m_error": None}]])
+    assert math.isnan(none.B[0]) and math.isnan(none.B_error[0]) and none.seeds.tolist() == [0]
+    with pytest.raises(ValueError, match="different heights"):
+        seed_kinematic([first, second[:2]])
+    with pytest.raises(ValueError, match="at least one"):
+        seed_kinematic([])

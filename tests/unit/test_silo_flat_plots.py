@@ -14,6 +14,7 @@ from matplotlib.colors import to_hex
 from siloflow.analysis.io.plot_style import PALETTE, StudyNote, StudyValue
 from siloflow.analysis.numerics.force_chains import ForceChainSegments
 from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
+from siloflow.analysis.studies.silo_flat.field_comparisons import SeedKinematic, SeedProfiles
 from siloflow.analysis.studies.silo_flat.fields import JanssenComparison, ProfileAnalysis, ProfileUncertainty
 from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile, compare_with_measurement
 from siloflow.analysis.studies.silo_flat.plots import (
@@ -27,6 +28,7 @@ from siloflow.analysis.studies.silo_flat.plots import (
     plot_parametric_study,
     plot_posterior_draws,
     plot_profiles_over_silo,
+    plot_seed_profiles,
     plot_velocity_contour,
 )
 from tests.plot_data import assert_legend_outside, legend_texts, lines_with_gid
@@ -359,3 +361,53 @@ def test_plot_posterior_draws_marks_each_run_with_its_error_and_the_calibration_
     band = flow.patches[0]
     assert band.get_y() == pytest.approx(0.09) and band.get_y() + band.get_height() == pytest.approx(0.13)
     assert not stress.patches  # no calibration band without a spread
+
+
+def _seeds(seeds=3):
+    v_z = np.array([[-0.02, -0.06, -0.1, -0.06, -0.02], [-0.01, -0.03, -0.05, -0.03, -0.01]])
+    error = np.full(v_z.shape, 0.004 if seeds > 1 else np.nan)
+    profiles = SeedProfiles(heights=HEIGHTS, x=X, v_z=v_z, v_z_error=error, seeds=seeds)
+    kinematic = SeedKinematic(heights=HEIGHTS, B=np.array([0.002, 0.0031]), B_error=np.array([0.0002, np.nan]),
+                              seeds=np.array([seeds, seeds]))
+    return profiles, kinematic
+
+
+def test_plot_seed_profiles_draws_the_seeds_mean_per_height_with_its_band_and_b_with_the_study(tmp_path, written):
+    path = tmp_path / "profiles.png"
+    figure = written(plot_seed_profiles(*_seeds(), path, "silo", findings=[S5]), path)
+    left, right = figure.axes
+    for z, row in zip(("10", "30"), _seeds()[0].v_z):
+        (line,) = lines_with_gid(left, f"v_z z={z}")
+        np.testing.assert_allclose(line.get_xydata(), np.column_stack([1e3 * X, row]), rtol=1e-14)
+        (band,) = [c for c in left.collections if c.get_gid() == f"v_z band z={z}"]
+        edges = band.get_paths()[0].vertices
+        np.testing.assert_allclose([edges[:, 1].min(), edges[:, 1].max()], [row.min() - 0.004, row.max() + 0.004])
+    colours = {to_hex(line.get_color()) for line in left.get_lines()}
+    assert len(colours) == 2  # one colour per height
+    (b_line,) = lines_with_gid(right, "kinematic_B")
+    np.testing.assert_allclose(b_line.get_xydata(), [[2.0, 10.0], [3.1, 30.0]], rtol=1e-14)
+    assert (left.get_xlabel(), left.get_ylabel(), right.get_xlabel(), right.get_ylabel()) == (
+        "x [mm]", "v_z [m/s]", "B [mm]", "z [mm]")
+    assert right.get_xscale() == "linear"  # B within a factor 10
+    assert legend_texts(right) == ["z = 10 mm", "z = 30 mm", "± standard error of 3 seeds' mean",
+                                   "B, seeds' mean ± error", "study (S5): B decreases with height"]
+    assert left.get_legend() is None
+    assert_legend_outside(figure, right)
+    figure.canvas.draw()
+    assert not right.get_legend().get_window_extent().overlaps(left.get_window_extent())
+
+
+def test_plot_seed_profiles_of_one_seed_draws_no_band_and_spans_of_b_go_on_a_log_axis(tmp_path, written):
+    profiles, kinematic = _seeds(seeds=1)
+    kinematic = SeedKinematic(heights=HEIGHTS, B=np.array([0.002, 0.09]), B_error=np.array([0.0002, 0.2]),
+                              seeds=np.array([1, 1]))
+    path = tmp_path / "profiles.png"
+    figure = written(plot_seed_profiles(profiles, kinematic, path, "silo"), path)
+    left, right = figure.axes
+    assert [c for c in left.collections if str(c.get_gid()).startswith("v_z band")] == []
+    assert legend_texts(right) == ["z = 10 mm", "z = 30 mm", "B, seeds' mean ± error"]
+    assert right.get_xscale() == "log"
+    (container,) = right.containers
+    # the lower bar of an error larger than B stops short of zero, the upper one is the error
+    lower, upper = container.lines[2][0].get_segments()[1][:, 0]
+    assert lower == pytest.approx(0.09e3 - 0.999 * 0.09e3) and upper == pytest.approx(0.29e3)

@@ -23,11 +23,11 @@ from siloflow.analysis.studies.validation.findings_summary import finding_status
 from siloflow.analysis.studies.validation.rows import AT_SCALE
 from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, budget_lines, findings_section,
                                                          provenance_row, record_page, run_wall_time, simulated_time)
-from siloflow.analysis.studies.validation.rows import COLUMNS, row
+from siloflow.analysis.studies.validation.rows import row
 from siloflow.engines.config import load_config_file
 from tests.repo import REPO_ROOT
 from siloflow.engines.layout import REPOSITORY_RECORD
-from siloflow.analysis.studies.validation.findings import FINDINGS, finding
+from siloflow.analysis.studies.validation.findings import FINDINGS
 from siloflow.analysis.studies.validation.scale import DimensionDifference, ScaleVerdict
 from siloflow.cli import record as CLI
 from tests.conftest import record_main
@@ -388,12 +388,14 @@ def test_rederive_writes_a_group_s_rows_again_from_the_products_its_record_keeps
     (tmp_path / "silo" / TABLE).write_text("group,figure,case,value,value_error,unit,study_value,scale_shows,evidence\n"
                                            "Silo,Density,r,1.0,0.1,kg/m3,667,yes,old\n")
     # runs the configuration no longer plans: their dimensions are not its own, so their rows are not judged on them
+    runs = (tmp_path / "silo" / RUNS).read_text().splitlines()
+    (tmp_path / "silo" / RUNS).write_text("\n".join([runs[0], *(re.sub(r"^[^,]+", f"sphere2-{k:010d}", line)
+                                                               for k, line in enumerate(runs[1:]))]) + "\n")
     assert record_main(["rederive", "--record", str(tmp_path), "--config", config]) == 2
     assert ("silo: its recorded runs are not those " + config + " plans, so their rows cannot be judged on its "
             "dimensions: `make validate GROUP=silo` records it again") in capsys.readouterr().err
     # the same record as if its runs were those the configuration plans: derived again with today's row code
     planned = sorted(CLI._planned(config)["silo"])
-    runs = (tmp_path / "silo" / RUNS).read_text().splitlines()
     (tmp_path / "silo" / RUNS).write_text("\n".join([runs[0], *(re.sub(r"^[^,]+", run_id, line)
                                                                for run_id, line in zip(planned, runs[1:]))]) + "\n")
     assert record_main(["rederive", "--record", str(tmp_path), "--config", config]) == 0

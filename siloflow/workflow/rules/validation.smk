@@ -93,6 +93,21 @@ def group_rows_params(group):
     return params
 
 
+rule validation_silo_profiles:
+    input:
+        fields=lambda wildcards: [run_path("silo_flat", "fields/depth_averaged.npz", run) for run in references("silo_flat")],
+        kinematic=lambda wildcards: [run_path("silo_flat", "metrics/kinematic.csv", run) for run in references("silo_flat")],
+        summaries=lambda wildcards: [run_path("silo_flat", "metrics/fields.json", run) for run in references("silo_flat")],
+    output:
+        plot=plot_file(f"{SUMMARY_DIR}/figures/silo_profiles"),
+    params:
+        heights=config["silo_flat"]["fields"]["profile_heights"],
+    log:
+        f"{SUMMARY_DIR}/figures/logs/silo_profiles.log",
+    script:
+        "../scripts/silo_seed_profiles.py"
+
+
 def makes_runs(spec):
     """Whether a group makes any run of this configuration."""
     role = run_roles(config, spec.kind)
@@ -194,7 +209,7 @@ for _part in (part for group_parts in PARTS.values() if len(group_parts) > 1 for
 
 def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
-    profiles and Janssen comparison with the front-wall series, VRR against Nr, the blender's passage velocities
+    seeds' profiles and B, its Janssen comparison and the front-wall series, VRR against Nr, the blender's passage velocities
     and gravity series. The record keeps PNG plots (siloflow.analysis.io.validation_record): with another plots.format a
     group's record is refused here, before anything runs."""
     try:
@@ -216,7 +231,9 @@ def record_plot_sources(group):
         plots = {}
         if GROUPS[group].makes(kind, REFERENCE):
             base = run_ids("silo_flat")[0]
-            plots.update({name: run_path("silo_flat", plot_file(f"plots/{name}"), base) for name in ("profiles", "janssen")})
+            # the seeds' profiles as their mean and band; Janssen's stresses from the first seed's fill
+            plots.update(profiles=plot_file(f"{SUMMARY_DIR}/figures/silo_profiles"),
+                         janssen=run_path("silo_flat", plot_file("plots/janssen"), base))
         if GROUPS[group].makes(kind, VARIANT):
             plots.update({study: plot_file(f"{case_root('silo_flat')}/parametric/{study}") for study in parametric_studies()})
         return plots

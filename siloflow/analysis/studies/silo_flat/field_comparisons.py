@@ -7,6 +7,7 @@ functions and write their rows and plots.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -16,6 +17,7 @@ from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.field_ops import depth_average, front_wall_slice
 from siloflow.analysis.numerics.grid import Fields
 from siloflow.analysis.numerics.profiles import velocity_profile
+from siloflow.analysis.numerics.replicates import replicate_error
 from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile, ProfileComparison, compare_with_measurement
 
 __all__ = [
@@ -26,6 +28,10 @@ __all__ = [
     "ParametricProfiles",
     "parametric_profiles",
     "parametric_rows",
+    "SeedProfiles",
+    "seed_profiles",
+    "SeedKinematic",
+    "seed_kinematic",
 ]
 
 MEASURED_PLANES = ("front_wall", "depth_average")
@@ -95,15 +101,131 @@ def parametric_profiles(depth_averaged: Sequence[Fields], height: float) -> Para
     workflow writes per run as ``fields/depth_averaged.npz``). The height is lowered, if need be, to the
     second-highest node row of the run with the lowest grid, so that every run's fields cover it with a row above.
     """
+    _one_layer(depth_averaged)
+    height = min([height] + [float(f.grid.z[-2]) for f in depth_averaged])
+    profiles = [velocity_profile(f, height) for f in depth_averaged]
+    x = profiles[0].x
+    return ParametricProfiles(height, x, [np.interp(x, p.x, p.v_z) for p in profiles])
+
+
+def _one_layer(depth_averaged: Sequence[Fields]) -> None:
     if not depth_averaged:
         raise ValueError("depth_averaged must hold at least one run's fields")
     layers = sorted({f.grid.shape[1] for f in depth_averaged} - {1})
     if layers:
         raise ValueError(f"depth_averaged fields must have one node layer in y (use depth_average), got {layers}")
-    height = min([height] + [float(f.grid.z[-2]) for f in depth_averaged])
-    profiles = [velocity_profile(f, height) for f in depth_averaged]
-    x = profiles[0].x
-    return ParametricProfiles(height, x, [np.interp(x, p.x, p.v_z) for p in profiles])
+
+
+# --------------------------------------------------------------------------- seeds of one configuration
+
+
+@dataclass(frozen=True)
+class SeedProfiles:
+    """The v_z profiles of one configuration's seeds at several heights: their mean and its standard error.
+
+    Attributes
+    ----------
+    heights : numpy.ndarray
+        (heights,) profile heights above the outlet (m).
+    x : numpy.ndarray
+        (nx,) node x positions of the first seed (m).
+    v_z, v_z_error : numpy.ndarray
+        (heights, nx) the seeds' mean v_z and its standard error between the seeds (m/s); the error is NaN for one
+        seed.
+    seeds : int
+        Seeds averaged.
+    """
+
+    heights: np.ndarray
+    x: np.ndarray
+    v_z: np.ndarray
+    v_z_error: np.ndarray
+    seeds: int
+
+
+def seed_profiles(depth_averaged: Sequence[Fields], heights: Sequence[float]) -> SeedProfiles:
+    """v_z(x) at each of ``heights`` (m) of one configuration's seeds, as their mean and its standard error.
+
+    Each seed's depth-averaged, time-averaged fields (one node layer in y, as the workflow writes them per run in
+    ``fields/depth_averaged.npz``) give its profile at a height (:func:`velocity_profile`, linear in z), put on the
+    first seed's nodes; the mean and error at each node are :func:`replicate_error`'s with no within-run error: the
+    standard error of the seeds' mean.
+
+    Raises
+    ------
+    ValueError
+        Without fields, for fields of more than one node layer, no heights, or a height outside a seed's grid.
+    """
+    _one_layer(depth_averaged)
+    heights = np.asarray(heights, dtype=float)
+    if heights.size == 0:
+        raise ValueError("heights must hold at least one profile height")
+    for fields in depth_averaged:
+        low, high = float(fields.grid.z[0]), float(fields.grid.z[-1])
+        outside = [float(z) for z in heights if not low <= z <= high]
+        if outside:
+            raise ValueError(f"profile heights {outside} m lie outside a seed's fields ({low:g} to {high:g} m)")
+    x = velocity_profile(depth_averaged[0], float(heights[0])).x
+    by_seed = np.array([[np.interp(x, profile.x, profile.v_z)
+                         for profile in (velocity_profile(fields, float(z)) for z in heights)]
+                        for fields in depth_averaged])
+    unknown = [math.nan] * len(depth_averaged)
+    mean = np.empty(by_seed.shape[1:])
+    error = np.empty(by_seed.shape[1:])
+    for index in np.ndindex(*mean.shape):
+        mean[index], error[index], _ = replicate_error(list(by_seed[(slice(None), *index)]), unknown)
+    if len(depth_averaged) == 1:
+        error[:] = math.nan
+    return SeedProfiles(heights, x, mean, error, len(depth_averaged))
+
+
+@dataclass(frozen=True)
+class SeedKinematic:
+    """The kinematic constant B of one configuration's seeds at each height: their mean and its error.
+
+    Attributes
+    ----------
+    heights : numpy.ndarray
+        (heights,) heights above the outlet (m), those of the first seed's table.
+    B, B_error : numpy.ndarray
+        (heights,) the mean B over the seeds that fitted one at that height and its error (m)
+        (:func:`replicate_error`: the larger of the seeds' standard error and the within-run errors); NaN where no
+        seed fitted one.
+    seeds : numpy.ndarray
+        (heights,) seeds that fitted a B at each height.
+    """
+
+    heights: np.ndarray
+    B: np.ndarray
+    B_error: np.ndarray
+    seeds: np.ndarray
+
+
+def seed_kinematic(tables: Sequence[Sequence[Mapping]]) -> SeedKinematic:
+    """B(z) of one configuration's seeds from each seed's ``metrics/kinematic.csv`` rows (``z_m``, ``B_m``,
+    ``B_m_error`` in m, as :func:`siloflow.analysis.io.tables.read_table` gives them; a B that is None or NaN is a
+    height where the fit failed).
+
+    Raises
+    ------
+    ValueError
+        Without tables, or when the seeds' tables do not list the same heights.
+    """
+    if not tables:
+        raise ValueError("tables must hold at least one seed's kinematic table")
+    heights = [[float(row["z_m"]) for row in table] for table in tables]
+    if any(h != heights[0] for h in heights[1:]):
+        raise ValueError(f"the seeds' kinematic tables list different heights: {heights}")
+    mean = np.full(len(heights[0]), math.nan)
+    error = np.full_like(mean, math.nan)
+    seeds = np.zeros(mean.size, dtype=int)
+    for i in range(mean.size):
+        pairs = [(number_or_nan(table[i]["B_m"]), number_or_nan(table[i]["B_m_error"])) for table in tables]
+        pairs = [(value, err) for value, err in pairs if math.isfinite(value)]
+        seeds[i] = len(pairs)
+        if pairs:
+            mean[i], error[i], _ = replicate_error([value for value, _ in pairs], [err for _, err in pairs])
+    return SeedKinematic(np.array(heights[0]), mean, error, seeds)
 
 
 def parametric_rows(study: str, labels: Sequence[str], runs: Sequence[str], flows: Sequence[Mapping],

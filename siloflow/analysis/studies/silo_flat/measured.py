@@ -19,7 +19,6 @@ Parsing is pure (text in, records out); comparison works on arrays.
 from __future__ import annotations
 
 import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path

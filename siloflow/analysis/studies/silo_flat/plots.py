@@ -14,12 +14,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 
 from siloflow.analysis.io.plot_style import (
+    BAND_ALPHA,
     PAGE_WIDTH,
     PALETTE,
     REFERENCE_COLOUR,
     StudyNote,
+    colour_of,
     journal_style,
     legend_outside,
     note_study,
@@ -27,6 +30,7 @@ from siloflow.analysis.io.plot_style import (
 )
 from siloflow.analysis.io.plots import save_figure, silo_outline
 from siloflow.analysis.numerics.flow import DischargeHistory, FlowRateFit
+from siloflow.analysis.studies.silo_flat.field_comparisons import SeedKinematic, SeedProfiles
 
 #: Colour of a velocity profile or fitted kinematic constant: the palette's blue.
 _PROFILE_COLOUR = PALETTE[5]
@@ -233,6 +237,87 @@ def plot_kinematic_constant(heights, B, path, title: str, B_error=None,
             axes.set_title(title)
             axes.grid(alpha=0.3)
             legend_outside(axes, handles=handles)
+            save_figure(figure, path, tight=True)
+        finally:
+            plt.close(figure)
+    return figure
+
+
+def plot_seed_profiles(profiles: SeedProfiles, kinematic: SeedKinematic, path, title: str,
+                       findings: Sequence[StudyNote] | None = None) -> Figure:
+    """The steady v_z profiles and the kinematic constant B of one configuration's seeds, in the project's style
+    (:func:`siloflow.analysis.io.plot_style.journal_style`): the figure the record shows beside the silo's rows.
+
+    Left, v_z [m/s] against x [mm]: one line per height (one colour each, ``gid="v_z z=<mm>"``), the seeds' mean,
+    with a band of one standard error of that mean (``gid="v_z band z=<mm>"``) where two or more seeds give one.
+    Right, B [mm] against z [mm] (on a log axis when B spans more than a factor 10): the seeds' mean with horizontal
+    error bars of its error (``gid="kinematic_B"``; an error bar reaching below zero is cut at the axis), and each
+    finding as an entry of the one legend, which stands right of the right axes.
+
+    Parameters
+    ----------
+    profiles : siloflow.analysis.studies.silo_flat.field_comparisons.SeedProfiles
+        The seeds' profiles (m, m/s).
+    kinematic : siloflow.analysis.studies.silo_flat.field_comparisons.SeedKinematic
+        The seeds' B at each height (m).
+    path : str or os.PathLike
+        Destination plot file, written atomically in the format of its suffix
+        (:func:`siloflow.analysis.io.plots.save_figure`).
+    title : str
+        Figure title.
+    findings : sequence of StudyNote, optional
+        The study's trend of B (S5), a legend entry labelled with its id. None (the default): none.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn, already closed (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        For a finding that is not a StudyNote.
+    """
+    notes = study_findings(findings, StudyNote)
+    labels = [f"z = {1e3 * z:g} mm" for z in profiles.heights]
+    colours = colour_of(labels)
+    x_mm = 1e3 * np.asarray(profiles.x)
+    with journal_style():
+        figure, (left, right) = plt.subplots(1, 2, figsize=(PAGE_WIDTH, 3.4), gridspec_kw={"width_ratios": [3, 2]})
+        try:
+            figure.subplots_adjust(left=0.09, right=0.66, bottom=0.14, top=0.88, wspace=0.38)
+            handles = []
+            for label, z, v_z, error in zip(labels, profiles.heights, profiles.v_z, profiles.v_z_error):
+                gid = f"{1e3 * z:g}"
+                handles += left.plot(x_mm, v_z, color=colours[label], label=label, gid=f"v_z z={gid}")
+                if np.any(np.isfinite(error)):
+                    left.fill_between(x_mm, v_z - error, v_z + error, color=colours[label], alpha=2 * BAND_ALPHA,
+                                      linewidth=0.0, label="_nolegend_", gid=f"v_z band z={gid}")
+            if profiles.seeds > 1:
+                handles.append(Patch(color=REFERENCE_COLOUR, alpha=2 * BAND_ALPHA,
+                                     label=f"± standard error of {profiles.seeds} seeds' mean"))
+            left.set_xlabel("x [mm]")
+            left.set_ylabel("v_z [m/s]")
+            left.grid(alpha=0.3)
+            B_mm, error_mm, z_mm = 1e3 * kinematic.B, 1e3 * kinematic.B_error, 1e3 * kinematic.heights
+            error_mm = np.where(np.isfinite(error_mm), error_mm, 0.0)
+            # a log axis cannot show a bar that reaches zero: the lower bar stops just short of it
+            lower = np.where(np.isfinite(B_mm), np.minimum(error_mm, 0.999 * np.abs(B_mm)), 0.0)
+            bars = right.errorbar(B_mm, z_mm, xerr=[lower, error_mm], fmt="o-",
+                                  color=_PROFILE_COLOUR, capsize=3, label="B, seeds' mean ± error")
+            bars.lines[0].set_gid("kinematic_B")
+            handles.append(bars)
+            handles += [note_study(right, note) for note in notes]
+            finite = B_mm[np.isfinite(B_mm)]
+            # B grows by orders of magnitude where the flow turns to plug flow: a log axis keeps the low heights
+            # apart
+            if finite.size and np.all(finite > 0.0) and finite.max() > 10.0 * finite.min():
+                right.set_xscale("log")
+            right.set_xlabel("B [mm]")
+            right.set_ylabel("z [mm]")
+            right.grid(alpha=0.3)
+            figure.suptitle(title)
+            legend_outside(right, handles=handles)
             save_figure(figure, path, tight=True)
         finally:
             plt.close(figure)

@@ -304,8 +304,9 @@ def findings_section(statuses: Sequence[FindingStatus], verdicts: Mapping[str, S
         "## Does siloflow reproduce the study?",
         "",
         f"Each row below judges one part of a finding of the study, by two verdicts fixed before the runs. "
-        f"*Agreement*: whether the row's 95 % interval (Student t for a spread between few seeds) lies within the "
-        "study's band, or a trend has the study's sign or order, by the rule of the finding's kind (the band where "
+        f"*Agreement*: whether the row's 95 % interval (Student t for a spread between few seeds) overlaps the "
+        "study's band (not reproduced when it lies entirely outside), or a trend has the study's sign or order, by "
+        "the rule of the finding's kind (the band where "
         "the study gives none: `validation.agreement` of the configuration reference); precision and steadiness only "
         "ever make a verdict \"not resolved\". *Scale*: whether the runs of "
         f"`{config_name}` are at the study's scale for the finding, from the configuration alone (every dimension it "
