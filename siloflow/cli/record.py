@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from itertools import zip_longest
 from pathlib import Path
 from typing import Sequence
 
@@ -27,7 +28,7 @@ from siloflow.analysis.io.validation_record import (PRODUCTS, check_plot_format,
                                            read_record, restore_products, write_group_record)
 from siloflow.analysis.studies.validation.group_rows import UNMADE, judged_rows
 from siloflow.analysis.studies.validation.findings import FINDINGS
-from siloflow.analysis.studies.validation.record import record_page, run_wall_time
+from siloflow.analysis.studies.validation.record import earlier_attempt_times, record_page, run_wall_time
 from siloflow.analysis.studies.validation.scale import FINDING_SCALES, scale_verdict
 from siloflow.calibration.table import point_table
 from siloflow.engines.config import load_config
@@ -121,18 +122,40 @@ def publish(workdir: str | Path, record_dir: str | Path, groups: Sequence[str]) 
     return copied
 
 
-def measured_wall_times(record: dict, cores: int) -> dict[str, dict[str, float]]:
-    """``{group: {part: s}}``: the wall time of the runs each part of each recorded group makes (the ``group`` column
-    of its runs names the part), from their measured times, on ``cores`` cores
-    (:func:`siloflow.engines.validation_groups.runs_wall_time`); the runs a group reads from another group are not its own."""
+def measured_wall_times(record: dict, cores: int, sliced: frozenset[str] = frozenset()) -> dict[str, dict[str, float]]:
+    """``{group: {part: s}}``: the wall time of each `make validate GROUP=` call of each recorded group, on ``cores``
+    cores (:func:`siloflow.engines.validation_groups.runs_wall_time`); the runs a group reads from another group are
+    not its own.
+
+    A run's ``group`` column names the part that finished it, which counts the run over all its attempts (one
+    interrupted and run again inside its part took the part that long). A run of ``sliced``, longer than a part and
+    carried on over several (:attr:`siloflow.engines.validation_groups.Part.time_slice`), counts only its last
+    attempt there: its earlier attempts ran in earlier calls, each listed as ``<group> earlier attempt <k>``, the
+    longest k-th earlier attempt of the group's sliced runs (they run side by side from their first part, so their
+    k-th attempts share a call).
+    """
     walls = {}
     for name, group in record.items():
         made: dict[str, list] = {}
+        earlier = []
         for run in group.runs:
-            if group_of_part(run["group"]) == name:
+            if group_of_part(run["group"]) != name:
+                continue
+            if run["run_id"] in sliced:
+                made.setdefault(run["group"], []).append((float(run["wall_time_s"]), int(run["cores"])))
+                earlier.append(earlier_attempt_times(run))
+            else:
                 made.setdefault(run["group"], []).append((run_wall_time(run), int(run["cores"])))
         walls[name] = {part: runs_wall_time(runs, cores) for part, runs in sorted(made.items())}
+        calls = [max(times) for times in zip_longest(*earlier, fillvalue=0.0)]
+        walls[name].update({f"{name} earlier attempt {k}": seconds for k, seconds in enumerate(calls, 1)})
     return walls
+
+
+def sliced_runs(made: dict[str, list]) -> frozenset[str]:
+    """Run ids that a configuration's plan carries over several parts (each longer than a part on its own)."""
+    return frozenset(made[part.group][position].run_id for group_parts in split_groups(made).values()
+                     for part in group_parts if part.time_slice is not None for position in part.positions)
 
 
 def _plan(config_path: str, record: bool = False) -> tuple[list, dict[str, list]]:
@@ -229,7 +252,8 @@ def page(config_path: str, full_scale_path: str, record_dir: str | Path, cores: 
     parts = {name: [part.name for part in group_parts] for name, group_parts in split_groups(made).items()}
     full_scale = {cost.name: cost.core_seconds for cost in group_costs(_plan(full_scale_path)[1], cores=1)}
     return record_page(record, status, {name: full_scale.get(name, math.nan) for name in GROUPS},
-                       measured_wall_times(record, cores), cores, config_path, full_scale_path, parts, estimated,
+                       measured_wall_times(record, cores, sliced_runs(made)), cores, config_path, full_scale_path,
+                       parts, estimated,
                        verdicts, UNMADE, {cost.name: cost.core_seconds for cost in group_costs(made, cores=1)},
                        read_hypothesis_records(record_dir), {name: h.findings for name, h in HYPOTHESES.items()},
                        (TIER_BUDGET_CORE_S, GROUP_BUDGET_S))

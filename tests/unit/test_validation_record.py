@@ -22,7 +22,8 @@ from siloflow.analysis.studies.validation.agreement import NOT_REPRODUCED, Agree
 from siloflow.analysis.studies.validation.findings_summary import finding_statuses
 from siloflow.analysis.studies.validation.rows import AT_SCALE
 from siloflow.analysis.studies.validation.record import (RUN_COLUMNS, GroupRecord, budget_lines, findings_section,
-                                                         provenance_row, record_page, run_wall_time, simulated_time)
+                                                         provenance_row, record_page, run_wall_time, simulated_time,
+                                                         earlier_attempt_times)
 from siloflow.analysis.studies.validation.rows import row
 from siloflow.engines.config import load_config_file
 from tests.repo import REPO_ROOT
@@ -411,3 +412,27 @@ def test_rederive_writes_a_group_s_rows_again_from_the_products_its_record_keeps
     (tmp_path / "blender" / DERIVATION).unlink(missing_ok=True)
     assert record_main(["rederive", "--group", "blender", "--record", str(tmp_path), "--config", config]) == 2
     assert "blender: its record keeps no derivation" in capsys.readouterr().err
+
+
+def test_a_run_carried_over_several_parts_counts_its_last_attempt_in_its_part_and_each_earlier_one_as_a_call():
+    # two fills of 2.25 + 2.25 + 1 h side by side over three parts, the second a little slower in its last part
+    runs = [provenance_row(_record(), "silo_3", "3.8", [1], "c0ffee", 3600.0, [8100.0, 8000.0], "2026-12-07", 1),
+            provenance_row(_record("sphere2-def"), "silo_3", "3.8", [2], "c0ffee", 3900.0, [8050.0, 8100.0],
+                           "2026-12-07", 1)]
+    assert earlier_attempt_times(runs[0]) == [8100.0, 8000.0]
+    # a record without attempt times: its earlier attempts' total as one; none when zero
+    assert earlier_attempt_times({"earlier_attempts_s": 50.0}) == [50.0]
+    assert earlier_attempt_times({"earlier_attempts_s": 0.0, "attempt_times_s": ""}) == []
+    groups = {"silo": GroupRecord(rows=_rows(), runs=runs)}
+    wall = CLI.measured_wall_times(groups, cores=2, sliced=frozenset({"sphere2-abc", "sphere2-def"}))
+    assert wall == {"silo": {"silo_3": 3900.0, "silo earlier attempt 1": 8100.0, "silo earlier attempt 2": 8100.0}}
+    # not carried over parts: interrupted and run again inside its part, which took it all its attempts
+    assert CLI.measured_wall_times(groups, cores=2) == {"silo": {"silo_3": 3900.0 + 16150.0}}
+
+
+def test_the_runs_the_validation_plan_carries_over_several_parts_are_its_long_silo_runs():
+    made = CLI._plan(str(REPO_ROOT / "config" / "validation.yaml"))[1]
+    sliced = CLI.sliced_runs(made)
+    kinds = {e.run_id: e.kind for runs in made.values() for e in runs}
+    # the two 270 mm fills, the front-wall series' fill and the two 12 s recirculations; no Jenike or blender run
+    assert sorted(kinds[run] for run in sliced) == ["silo_flat"] * 3 + ["silo_recirculation"] * 2

@@ -130,6 +130,17 @@ def run_wall_time(run: Mapping) -> float:
     return float(run["wall_time_s"]) + (earlier if math.isfinite(earlier) else 0.0)
 
 
+def earlier_attempt_times(run: Mapping) -> list[float]:
+    """Wall time of each of a recorded run's attempts before its last (s), oldest first: those of
+    ``attempt_times_s`` but the last; a record that lists no attempt times gives its ``earlier_attempts_s`` as one
+    attempt (none when it is zero or unknown)."""
+    listed = str(run.get("attempt_times_s") or "").split()
+    if listed:
+        return [float(value) for value in listed[:-1]]
+    earlier = number_or_nan(run.get("earlier_attempts_s"))
+    return [earlier] if math.isfinite(earlier) and earlier > 0 else []
+
+
 def _attempts_sentence(runs: Sequence[Mapping]) -> str:
     """What the runs' attempts before their last took, when some run was interrupted or its record does not say."""
     earlier = [number_or_nan(run.get("earlier_attempts_s")) for run in runs]
