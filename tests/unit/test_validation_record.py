@@ -217,8 +217,9 @@ def test_the_page_renders_status_runs_rows_and_both_verdicts():
             "rows changed since they were recorded; `make validate GROUP=silo_1`, then `make validate GROUP=silo_2` "
             "brings the record up to date (`make validate-status` says which).") in lines
     assert ("3 runs on liggghts 3.8, 1 core(s) each, code c0ffee, 2026-11-28 to 2026-11-29; run ids and seeds in "
-            "[`silo/runs.csv`](silo/runs.csv). 1 run(s) were interrupted and run again; their attempts before the "
-            "last took 0.25 h, counted in the group's times above.") in lines
+            "[`silo/runs.csv`](silo/runs.csv). 1 run(s) ran in more than one attempt (carried over parts, or "
+            "interrupted and run again); their attempts before the last took 0.25 h, counted in the group's times "
+            "above.") in lines
     assert "For 1 run(s) the record gives the time of the last attempt only." in text
     # a run that did not note its own commit: the page says whose commit the record holds
     assert "2 runs on liggghts 3.8, 1 core(s) each, code c0ffee, unknown (the record was written by c0ffee)" in text

@@ -148,8 +148,9 @@ def _attempts_sentence(runs: Sequence[Mapping]) -> str:
     interrupted = [value for value in earlier if math.isfinite(value) and value > 0]
     sentences = []
     if interrupted:
-        sentences.append(f"{len(interrupted)} run(s) were interrupted and run again; their attempts before the last "
-                         f"took {_hours(math.fsum(interrupted))}, counted in the group's times above.")
+        sentences.append(f"{len(interrupted)} run(s) ran in more than one attempt (carried over parts, or interrupted "
+                         f"and run again); their attempts before the last took {_hours(math.fsum(interrupted))}, "
+                         "counted in the group's times above.")
     if unknown:
         sentences.append(f"For {unknown} run(s) the record gives the time of the last attempt only.")
     return " ".join(sentences)
