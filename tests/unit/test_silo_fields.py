@@ -25,6 +25,7 @@ from siloflow.analysis.studies.silo_flat.field_comparisons import (
     comparison_plane,
     measured_comparison_rows,
     parametric_profiles,
+    seed_janssen,
     seed_kinematic,
     seed_profiles,
     parametric_rows,
@@ -625,3 +626,26 @@ def test_seed_kinematic_is_the_mean_of_the_seeds_that_fitted_a_b_with_its_replic
         seed_kinematic([first, second[:2]])
     with pytest.raises(ValueError, match="at least one"):
         seed_kinematic([])
+
+
+def test_seed_janssen_combines_the_seeds_stresses_row_by_row_as_the_rows_do():
+    def table(depth_top, dem, dem_error):
+        return [{"depth_below_surface_m": depth_top + 0.006 * k, "z_m": 0.021 - 0.006 * k, "sigma_v_dem_Pa": value,
+                 "sigma_v_dem_Pa_error": dem_error, "sigma_v_janssen_Pa": 100.0 + k, "hydrostatic_pa": 120.0 + k,
+                 "hydrostatic_pa_error": 1.0} for k, value in enumerate(dem)]
+    first, second = table(0.27, [800.0, 820.0], 2.0), table(0.29, [840.0, 830.0], 2.0)
+    comparison = seed_janssen([first, second])
+    np.testing.assert_allclose(comparison.height, [0.021, 0.015])
+    np.testing.assert_allclose(comparison.depth_below_surface, [0.28, 0.286], rtol=1e-12)
+    assert comparison.surface_height == pytest.approx(0.301, rel=1e-12)
+    np.testing.assert_allclose(comparison.simulated, [820.0, 825.0], rtol=1e-12)
+    # the seeds' standard errors, 20 and 5 Pa, are larger than the within-run sqrt(2) * 2 / 2 Pa: they are the errors
+    np.testing.assert_allclose(comparison.simulated_error, [20.0, 5.0], rtol=1e-12)
+    np.testing.assert_allclose(comparison.janssen, [100.0, 101.0])
+    np.testing.assert_allclose(comparison.hydrostatic, [120.0, 121.0])
+    np.testing.assert_allclose(comparison.hydrostatic_error, math.sqrt(2.0) / 2.0, rtol=1e-12)
+    assert comparison.bin_pairs == 0
+    with pytest.raises(ValueError, match="different heights"):
+        seed_janssen([first, second[:1]])
+    with pytest.raises(ValueError, match="at least one"):
+        seed_janssen([])

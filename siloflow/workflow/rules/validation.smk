@@ -108,6 +108,17 @@ rule validation_silo_profiles:
         "../scripts/silo_seed_profiles.py"
 
 
+rule validation_silo_janssen:
+    input:
+        janssen=lambda wildcards: [run_path("silo_flat", "metrics/janssen.csv", run) for run in references("silo_flat")],
+    output:
+        plot=plot_file(f"{SUMMARY_DIR}/figures/silo_janssen"),
+    log:
+        f"{SUMMARY_DIR}/figures/logs/silo_janssen.log",
+    script:
+        "../scripts/silo_seed_janssen.py"
+
+
 def makes_runs(spec):
     """Whether a group makes any run of this configuration."""
     role = run_roles(config, spec.kind)
@@ -209,7 +220,7 @@ for _part in (part for group_parts in PARTS.values() if len(group_parts) > 1 for
 
 def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
-    seeds' profiles and B, its Janssen comparison and the front-wall series, VRR against Nr, the blender's passage velocities
+    seeds' profiles and B and their stresses beside Janssen's, and the front-wall series, VRR against Nr, the blender's passage velocities
     and gravity series. The record keeps PNG plots (siloflow.analysis.io.validation_record): with another plots.format a
     group's record is refused here, before anything runs."""
     try:
@@ -230,10 +241,9 @@ def record_plot_sources(group):
     if kind == "silo_flat":
         plots = {}
         if GROUPS[group].makes(kind, REFERENCE):
-            base = run_ids("silo_flat")[0]
-            # the seeds' profiles as their mean and band; Janssen's stresses from the first seed's fill
+            # the reference seeds' profiles and stresses, combined as the rows combine them
             plots.update(profiles=plot_file(f"{SUMMARY_DIR}/figures/silo_profiles"),
-                         janssen=run_path("silo_flat", plot_file("plots/janssen"), base))
+                         janssen=plot_file(f"{SUMMARY_DIR}/figures/silo_janssen"))
         if GROUPS[group].makes(kind, VARIANT):
             plots.update({study: plot_file(f"{case_root('silo_flat')}/parametric/{study}") for study in parametric_studies()})
         return plots

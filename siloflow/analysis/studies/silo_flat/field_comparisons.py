@@ -17,7 +17,9 @@ from siloflow.model.checks import number_or_nan
 from siloflow.analysis.numerics.field_ops import depth_average, front_wall_slice
 from siloflow.analysis.numerics.grid import Fields
 from siloflow.analysis.numerics.profiles import velocity_profile
+from siloflow.analysis.numerics.reference_spread import combine_seeds
 from siloflow.analysis.numerics.replicates import replicate_error
+from siloflow.analysis.studies.silo_flat.fields import JanssenComparison
 from siloflow.analysis.studies.silo_flat.measured import MeasuredProfile, ProfileComparison, compare_with_measurement
 
 __all__ = [
@@ -32,6 +34,7 @@ __all__ = [
     "seed_profiles",
     "SeedKinematic",
     "seed_kinematic",
+    "seed_janssen",
 ]
 
 MEASURED_PLANES = ("front_wall", "depth_average")
@@ -226,6 +229,41 @@ def seed_kinematic(tables: Sequence[Sequence[Mapping]]) -> SeedKinematic:
         if pairs:
             mean[i], error[i], _ = replicate_error([value for value, _ in pairs], [err for _, err in pairs])
     return SeedKinematic(np.array(heights[0]), mean, error, seeds)
+
+
+def seed_janssen(tables: Sequence[Sequence[Mapping]]) -> JanssenComparison:
+    """The vertical stress at the end of filling of one configuration's seeds, as the validation rows judge it: each
+    seed's ``metrics/janssen.csv`` rows combined by :func:`~siloflow.analysis.numerics.reference_spread.combine_seeds`
+    (row by row: the DEM and hydrostatic stresses as the seeds' mean with the larger of their standard error and the
+    within-run errors, depth, height and Janssen's stress as the seeds' mean).
+
+    Returns
+    -------
+    JanssenComparison
+        In Pa and m; its surface height the mean of ``z + h`` over the rows, ``bin_pairs`` 0 (the error is the
+        seeds', not one fill's mirror bins).
+
+    Raises
+    ------
+    ValueError
+        Without tables, or when the seeds' tables do not list the same heights.
+    """
+    if not tables:
+        raise ValueError("tables must hold at least one seed's Janssen table")
+    heights = [[float(row["z_m"]) for row in table] for table in tables]
+    if any(h != heights[0] for h in heights[1:]):
+        raise ValueError(f"the seeds' Janssen tables list different heights: {heights}")
+    combined, _ = combine_seeds([[dict(row) for row in table] for table in tables])
+
+    def column(key: str) -> np.ndarray:
+        return np.array([number_or_nan(row.get(key)) for row in combined])
+
+    depth, height = column("depth_below_surface_m"), column("z_m")
+    return JanssenComparison(depth_below_surface=depth, simulated=column("sigma_v_dem_Pa"),
+                             janssen=column("sigma_v_janssen_Pa"), surface_height=float(np.mean(depth + height)),
+                             height=height, simulated_error=column("sigma_v_dem_Pa_error"),
+                             hydrostatic=column("hydrostatic_pa"), hydrostatic_error=column("hydrostatic_pa_error"),
+                             bin_pairs=0)
 
 
 def parametric_rows(study: str, labels: Sequence[str], runs: Sequence[str], flows: Sequence[Mapping],
