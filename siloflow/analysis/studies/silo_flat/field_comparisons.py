@@ -182,6 +182,17 @@ def seed_profiles(depth_averaged: Sequence[Fields], heights: Sequence[float]) ->
     return SeedProfiles(heights, x, mean, error, len(depth_averaged))
 
 
+def _same_heights(tables: Sequence[Sequence[Mapping]], what: str) -> list[float]:
+    """The heights ``z_m`` (m) every seed's table lists, in its order; ValueError without tables or when they
+    differ."""
+    if not tables:
+        raise ValueError(f"tables must hold at least one seed's {what} table")
+    heights = [[float(row["z_m"]) for row in table] for table in tables]
+    if any(h != heights[0] for h in heights[1:]):
+        raise ValueError(f"the seeds' {what} tables list different heights: {heights}")
+    return heights[0]
+
+
 @dataclass(frozen=True)
 class SeedKinematic:
     """The kinematic constant B of one configuration's seeds at each height: their mean and its error.
@@ -214,12 +225,8 @@ def seed_kinematic(tables: Sequence[Sequence[Mapping]]) -> SeedKinematic:
     ValueError
         Without tables, or when the seeds' tables do not list the same heights.
     """
-    if not tables:
-        raise ValueError("tables must hold at least one seed's kinematic table")
-    heights = [[float(row["z_m"]) for row in table] for table in tables]
-    if any(h != heights[0] for h in heights[1:]):
-        raise ValueError(f"the seeds' kinematic tables list different heights: {heights}")
-    mean = np.full(len(heights[0]), math.nan)
+    heights = _same_heights(tables, "kinematic")
+    mean = np.full(len(heights), math.nan)
     error = np.full_like(mean, math.nan)
     seeds = np.zeros(mean.size, dtype=int)
     for i in range(mean.size):
@@ -228,7 +235,7 @@ def seed_kinematic(tables: Sequence[Sequence[Mapping]]) -> SeedKinematic:
         seeds[i] = len(pairs)
         if pairs:
             mean[i], error[i], _ = replicate_error([value for value, _ in pairs], [err for _, err in pairs])
-    return SeedKinematic(np.array(heights[0]), mean, error, seeds)
+    return SeedKinematic(np.array(heights), mean, error, seeds)
 
 
 def seed_janssen(tables: Sequence[Sequence[Mapping]]) -> JanssenComparison:
@@ -248,11 +255,7 @@ def seed_janssen(tables: Sequence[Sequence[Mapping]]) -> JanssenComparison:
     ValueError
         Without tables, or when the seeds' tables do not list the same heights.
     """
-    if not tables:
-        raise ValueError("tables must hold at least one seed's Janssen table")
-    heights = [[float(row["z_m"]) for row in table] for table in tables]
-    if any(h != heights[0] for h in heights[1:]):
-        raise ValueError(f"the seeds' Janssen tables list different heights: {heights}")
+    _same_heights(tables, "Janssen")
     combined, _ = combine_seeds([[dict(row) for row in table] for table in tables])
 
     def column(key: str) -> np.ndarray:
