@@ -176,9 +176,8 @@ def seed_profiles(depth_averaged: Sequence[Fields], heights: Sequence[float]) ->
     mean = np.empty(by_seed.shape[1:])
     error = np.empty(by_seed.shape[1:])
     for index in np.ndindex(*mean.shape):
+        # one seed: replicate_error's error is its unknown within-run one, NaN
         mean[index], error[index], _ = replicate_error(list(by_seed[(slice(None), *index)]), unknown)
-    if len(depth_averaged) == 1:
-        error[:] = math.nan
     return SeedProfiles(heights, x, mean, error, len(depth_averaged))
 
 
