@@ -45,7 +45,10 @@ FAKE_SNAKEMAKE = textwrap.dedent("""
             lock.unlink()
         sys.exit(int(os.environ.get("FAKE_UNLOCK_EXIT", "0")))
     if os.environ.get("FAKE_PID_FILE"):
-        pathlib.Path(os.environ["FAKE_PID_FILE"]).write_text(str(os.getpid()))
+        # written whole and then renamed, so that a reader never sees the file empty
+        pid_file = pathlib.Path(os.environ["FAKE_PID_FILE"])
+        pid_file.with_suffix(".partial").write_text(str(os.getpid()))
+        pid_file.with_suffix(".partial").replace(pid_file)
     time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
     if os.environ.get("FAKE_SIGNAL"):
         os.kill(os.getpid(), int(os.environ["FAKE_SIGNAL"]))
@@ -284,6 +287,7 @@ def test_snakemake_keeps_the_directory_locked_when_the_launcher_alone_is_killed(
     deadline = time.monotonic() + 20
     while not pid_file.exists() and time.monotonic() < deadline:
         time.sleep(0.05)
+    assert pid_file.exists(), "the fake Snakemake did not start within 20 s"
     snakemake_pid = int(pid_file.read_text())
     try:
         launcher.kill()
