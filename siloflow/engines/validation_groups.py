@@ -410,6 +410,18 @@ def group_status(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
     return status
 
 
+STATUS_IDS_SHOWN = 4
+"""How many run ids a status line names of the runs that differ from the plan, before it counts the rest."""
+
+
+def _first_ids(run_ids: Sequence[str]) -> str:
+    """The first :data:`STATUS_IDS_SHOWN` of ``run_ids`` and how many more, so that a group whose every run changed
+    (a changed parameter renames them all) keeps a line a reader takes in."""
+    shown = ", ".join(run_ids[:STATUS_IDS_SHOWN]) or "none"
+    more = len(run_ids) - STATUS_IDS_SHOWN
+    return f"{shown} and {more} more" if more > 0 else shown
+
+
 def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str]],
                  other_code: Mapping[str, bool] | None = None) -> list[str]:
     """`make validate-status`'s lines: per group, its status, the runs that differ from the plan and whether its rows
@@ -421,8 +433,8 @@ def status_lines(planned: Mapping[str, set[str]], recorded: Mapping[str, set[str
         line = f"{name:18s} {status:9s} {len(held & runs)} of {len(runs)} planned runs recorded"
         if status == STALE and held != runs:
             gone, new = sorted(held - runs), sorted(runs - held)
-            line += (f"; recorded but no longer planned: {', '.join(gone) or 'none'}; planned but not recorded: "
-                     f"{', '.join(new) or 'none'}")
+            line += (f"; recorded but no longer planned: {_first_ids(gone)}; planned but not recorded: "
+                     f"{_first_ids(new)}")
         if name in other_code and held:
             line += ("; its rows were written by other row code: `siloflow record rederive --group "
                      f"{name}` derives them again from the products its record keeps" if other_code[name] else

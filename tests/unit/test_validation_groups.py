@@ -189,6 +189,11 @@ def test_status_is_complete_stale_or_missing_against_the_plan():
     assert lines[1].endswith("recorded but no longer planned: s0; planned but not recorded: s1")
     assert lines[2].endswith("recorded but no longer planned: r2; planned but not recorded: s1")
     assert lines[3].split()[:2] == ["blender", "missing"]
+    # a group whose every run changed names the first four of each kind and counts the rest
+    many = status_lines({"silo": {f"n{k}" for k in range(6)}}, {"silo": {f"o{k}" for k in range(5)}})[0]
+    assert many.endswith("recorded but no longer planned: o0, o1, o2, o3 and 1 more; planned but not recorded: "
+                         "n0, n1, n2, n3 and 2 more")
+    assert status_lines({"silo": {"a", "b", "c", "d"}}, {"silo": {"e"}})[0].endswith("not recorded: a, b, c, d")
 
 
 def _write_runs(directory, run_ids):
