@@ -110,7 +110,8 @@ def _silo(density=650.0, problems=(), index=(0.5, 0.02), run_id="base", b=(0.008
     # rho g = 6000 Pa/m; the DEM follows it near the surface (slope 6000) and saturates below (slope 1500)
     stress = [6000.0 * d if d <= 0.02 else 120.0 + 3000.0 * (d - 0.02) if d <= 0.04 else 180.0 + 1500.0 * (d - 0.04)
               for d in depths]
-    janssen = stress[:-1] + [stress[-1] / 1.05]
+    # Janssen: 0.8 of the DEM at the two shallowest depths, the DEM between, 1/1.05 of it at the deepest
+    janssen = [0.8 * value for value in stress[:2]] + stress[2:-1] + [stress[-1] / 1.05]
     return SiloRun(case, flow, fields, balance, janssen=_janssen(depths, stress, [6000.0 * d for d in depths], janssen),
                    kinematic=[{"z_m": 0.02, "B_m": b[0], "B_m_error": 0.0004, "batches": 8},
                               {"z_m": 0.06, "B_m": b[1], "B_m_error": 0.0003, "batches": 4}],
@@ -136,6 +137,9 @@ def test_silo_rows_judge_density_stress_and_b_against_the_study():
     near = table["Stress gradient near the surface / unit weight"]
     assert near["finding"] == "S1.linear_near_surface" and near["value"] == pytest.approx(1.0)
     assert near["agreement"] == REPRODUCED
+    # Janssen's own slope over the same two shallowest depths: 0.8 x 6000 Pa/m
+    assert "Janssen's curve over the same depths: 4800 Pa/m (0.800 of rho g; the DEM's gradient 1.250 of it)" in (
+        near["evidence"])
     saturates = table["Change of the stress gradient, bottom - top of the fill"]
     assert saturates["value"] == pytest.approx(1500.0 - 6000.0) and saturates["agreement"] == REPRODUCED
     janssen = table["Vertical stress / Janssen, 60 mm below the surface"]

@@ -244,11 +244,17 @@ def _janssen_rows(run: SiloRun, case_name: str, settled: bool, settled_text: str
     hydrostatic = float(deepest["hydrostatic_pa"]), number_or_nan(deepest.get("hydrostatic_pa_error"))
     where = f"{float(deepest['depth_below_surface_m']) * 1000:.0f} mm below the surface"
     gradient_note = "the shallowest and deepest thirds of the profile: the study names no depths"
+    # Janssen's curve is not straight over the window either: its own slope there shows how far "linear, at rho g"
+    # can hold for a fill in good agreement with Janssen (the row's verdict stays the comparison with rho g)
+    janssen_top = stress_gradient(_column(top, "depth_below_surface_m"), _column(top, "sigma_v_janssen_Pa"),
+                                  [math.nan] * len(top))[0]
     return [
         row(GROUP, "Stress gradient near the surface / unit weight", case_name,
             *ratio(*dem_top, *unit_weight), "-",
             f"{settled_text}; fitted over {_span(top)}: DEM {plus_minus(*dem_top)} Pa/m, rho g "
-            f"{plus_minus(*unit_weight)} Pa/m ({gradient_note}){tail}", dof=dof, finding="S1.linear_near_surface",
+            f"{plus_minus(*unit_weight)} Pa/m ({gradient_note}); Janssen's curve over the same depths: "
+            f"{janssen_top:.4g} Pa/m ({janssen_top / unit_weight[0]:.3f} of rho g; the DEM's gradient "
+            f"{dem_top[0] / janssen_top:.3f} of it){tail}", dof=dof, finding="S1.linear_near_surface",
             agreement=rules.ratio_in_band(*dem_top, *unit_weight, dof, PARTS["S1.linear_near_surface"], tolerances,
                                           steady=settled)),
         row(GROUP, "Change of the stress gradient, bottom - top of the fill", case_name, *change, "Pa/m",
