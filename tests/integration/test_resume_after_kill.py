@@ -3,8 +3,8 @@ manual `snakemake --unlock`; a second call while a run is live is refused and le
 
 A small pipeline `make run` runs whole: the small silo (about 650 clumps) on LIGGGHTS without PIV, one tiny Jenike
 shear test, and no blending study, blender or verification. The README's run command starts it in its own session;
-once an engine job runs, a second `make run` is refused, then the whole session is killed with SIGKILL and the same
-`make run` is called again.
+once an engine job runs, the session is frozen where it is (SIGSTOP), a second `make run` is refused, then the whole
+session is killed with SIGKILL and the same `make run` is called again.
 """
 
 from __future__ import annotations
@@ -63,6 +63,15 @@ def _session_processes(session: int) -> list[int]:
     return found
 
 
+def _signal_session(session: int, number: int) -> None:
+    """Send signal ``number`` to every live process of a session."""
+    for pid in _session_processes(session):
+        try:
+            os.kill(pid, number)
+        except ProcessLookupError:
+            pass  # ended between the listing and the signal
+
+
 def _lock_files(workdir: Path) -> dict[str, str]:
     locks = workdir / ".snakemake" / "locks"
     return {path.name: path.read_text() for path in sorted(locks.iterdir())} if locks.is_dir() else {}
@@ -85,6 +94,9 @@ def killed_and_resumed(tmp_path_factory):
         while killed.poll() is None and time.monotonic() < deadline and not (
                 list((workdir / "results").glob("**/logs/run.log")) and _lock_files(workdir)):
             time.sleep(0.5)
+        # Frozen where it is, the run stays live, holding its locks, however long the second call takes to reach
+        # its launcher: on a loaded machine the small pipeline could otherwise finish before that.
+        _signal_session(killed.pid, signal.SIGSTOP)
         assert killed.poll() is None, (workdir / "killed_make.log").read_text()[-3000:]
         seen["locks_while_live"] = _lock_files(workdir)
         assert seen["locks_while_live"], "no engine job within 10 minutes"
@@ -94,6 +106,9 @@ def killed_and_resumed(tmp_path_factory):
         seen["alive_after_refusal"] = killed.poll() is None
     finally:
         os.killpg(killed.pid, signal.SIGKILL)
+        # a process of the session outside its group (none is expected) carries on as it would have unfrozen, so
+        # that the check for left-over processes below sees it
+        _signal_session(killed.pid, signal.SIGCONT)
         killed.wait()
     # the engine dies with its group; wait until nothing of the session is left before looking at the directory
     deadline = time.monotonic() + 30
