@@ -110,7 +110,8 @@ rule validation_silo_profiles:
 
 rule validation_silo_janssen:
     input:
-        janssen=lambda wildcards: [run_path("silo_flat", "metrics/janssen.csv", run) for run in references("silo_flat")],
+        janssen=lambda wildcards: [run_path("silo_flat", "metrics/janssen.csv", run)
+                                   for run in references("silo_flat")],
     output:
         plot=plot_file(f"{SUMMARY_DIR}/figures/silo_janssen"),
     log:
@@ -220,9 +221,10 @@ for _part in (part for group_parts in PARTS.values() if len(group_parts) > 1 for
 
 def record_plots(group):
     """``{name in the record: plot}`` a reader needs to judge a group's rows: calibration charts, the base silo's
-    seeds' profiles and B and their stresses beside Janssen's, and the front-wall series, VRR against Nr, the blender's passage velocities
-    and gravity series. The record keeps PNG plots (siloflow.analysis.io.validation_record): with another plots.format a
-    group's record is refused here, before anything runs."""
+    seeds' profiles and B and their stresses beside Janssen's, and the front-wall series, VRR against Nr, the
+    blender's passage velocities and gravity series. The record keeps PNG plots
+    (siloflow.analysis.io.validation_record): with another plots.format a group's record is refused here, before
+    anything runs."""
     try:
         check_plot_format(PLOT_FORMAT)
     except ValueError as error:
